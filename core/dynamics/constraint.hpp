@@ -1,0 +1,30 @@
+#pragma once
+// Bilateral constraints on reduced or maximal coordinates, enforced through the KKT systems of
+// [D Sec. 4.6.4-4.6.5]. A constraint states, at the acceleration level,
+//     G(q) qddot = rhs(q, qdot, t)      (rhs already contains -Gdot qdot and prescribed terms)
+// and reports its position and velocity errors for stabilisation and projection.
+// Maximal-coordinate constraints (G_m) multiply by J_mr themselves, so every G here is in q_r.
+#include <string>
+
+#include "core/skeleton/state.hpp"
+#include "core/skeleton/workspace.hpp"
+
+namespace redmax {
+
+class Constraint {
+ public:
+  virtual ~Constraint() = default;
+  virtual std::string name() const = 0;
+  virtual int rows() const = 0;
+  /// G (rows x ndof) and the acceleration-level right-hand side (rows); needs Stage::Velocity
+  virtual void calcAcceleration(const Model&, const State&, const SkeletonWorkspace&,
+                                Eigen::Ref<MatX> G, Eigen::Ref<VecX> rhs) const = 0;
+  /// position error C(q, t) and velocity error (rows each); zero when satisfied
+  virtual void calcErrors(const Model&, const State&, const SkeletonWorkspace&,
+                          Eigen::Ref<VecX> pos_err, Eigen::Ref<VecX> vel_err) const = 0;
+  /// true if the constraint prescribes motion (hybrid dynamics [D Eq. 4.109]): its multipliers
+  /// are the torques needed to realise the prescribed motion
+  virtual bool isPrescribed() const { return false; }
+};
+
+}  // namespace redmax

@@ -1,0 +1,146 @@
+#include "core/dynamics/skeleton_dynamics.hpp"
+
+namespace redmax {
+
+void calcSkeletonMass(const Model& model, const SkeletonWorkspace& ws, MatX& M_r) {
+  const int nr = model.nr();
+  M_r.setZero(nr, nr);
+  // sum over bodies of J_i^T M_i J_i, restricted to the columns of i's ancestors
+  Eigen::Matrix<double, 6, Eigen::Dynamic> MJ(6, nr);
+  for (int i = 0; i < model.nb(); ++i) {
+    const auto Ji = ws.J_mr.middleRows<6>(6 * i);
+    MJ.noalias() = model.bodies[i].M * Ji;
+    const auto& an = model.ancestors(i);
+    for (int a : an) {
+      const JointSlot& sa = model.joints[a];
+      if (sa.nq == 0) continue;
+      for (int b : an) {
+        const JointSlot& sb = model.joints[b];
+        if (sb.nq == 0) continue;
+        M_r.block(sa.q_index, sb.q_index, sa.nq, sb.nq).noalias() +=
+            Ji.middleCols(sa.q_index, sa.nq).transpose() * MJ.middleCols(sb.q_index, sb.nq);
+      }
+    }
+  }
+}
+
+void calcMaximalForce(const Model& model, const SkeletonWorkspace& ws, VecX& f_m) {
+  f_m.resize(model.nm());
+  for (int i = 0; i < model.nb(); ++i) {
+    const Body& b = model.bodies[i];
+    const Vec6& phi = ws.phi[i];
+    // Coriolis [D Eq. 3.21]
+    Vec6 f = ad(phi).transpose() * (b.M * phi);
+    // gravity at the COM, in body coordinates [D Eq. 3.22] with the general inertia
+    const Vec3 g_i = ws.E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity);
+    f += Gamma(b.com).transpose() * g_i;
+    f_m.segment<6>(6 * i) = f;
+  }
+}
+
+void calcSkeletonForce(const Model& model, const State& state, const SkeletonWorkspace& ws, VecX& f_r) {
+  const int nr = model.nr();
+  f_r.setZero(nr);
+  for (int i = 0; i < model.nb(); ++i) {
+    const Body& b = model.bodies[i];
+    const auto Ji = ws.J_mr.middleRows<6>(6 * i);
+    const auto Jdi = ws.Jdot_mr.middleRows<6>(6 * i);
+    const Vec6& phi = ws.phi[i];
+    Vec6 f = ad(phi).transpose() * (b.M * phi);
+    const Vec3 g_i = ws.E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity);
+    f += Gamma(b.com).transpose() * g_i;
+    // quadratic velocity vector -M_m Jdot_mr qdot [D Eq. 4.18]
+    f.noalias() -= b.M * (Jdi * state.qdot.head(nr));
+    for (int a : model.ancestors(i)) {
+      const JointSlot& sa = model.joints[a];
+      if (sa.nq == 0) continue;
+      f_r.segment(sa.q_index, sa.nq).noalias() += Ji.middleCols(sa.q_index, sa.nq).transpose() * f;
+    }
+  }
+  // joint springs and dampers [D Eq. 4.75, 4.77]
+  for (int k = 0; k < nr; ++k) {
+    const Coordinate& c = model.coordinates[k];
+    f_r[k] += -c.stiffness * (state.q[k] - c.rest_value) - c.damping * state.qdot[k];
+  }
+}
+
+void addJointStiffnessDamping(const Model& model, MatX& K_r, MatX& D_r) {
+  for (int k = 0; k < model.nr(); ++k) {
+    K_r(k, k) += model.coordinates[k].stiffness;
+    D_r(k, k) += model.coordinates[k].damping;
+  }
+}
+
+VecX inverseDynamicsRecursive(const Model& model, const State& state, const VecX& qddot) {
+  // forward pass: body twists and accelerations from joint kinematics; backward pass: wrenches.
+  // Body acceleration (body coordinates): phidot_i = Ad_ip phidot_p + ad(phi_i)... derived from
+  // phi_i = Ad_ip phi_p + psi_i with dAd_ip/dt = -ad(psi_i) Ad_ip:
+  //   phidot_i = Ad_ip phidot_p - ad(psi_i) Ad_ip phi_p + Ad_ij (S qddot + Sdot qdot)
+  const int nb = model.nb();
+  std::vector<Vec6> phi(nb), phidot(nb), w(nb);
+  std::vector<Mat6> Ad_ip(nb);
+  std::vector<Mat4> E_wi(nb);
+  std::vector<Mat6X> S_i(nb);
+  JointKinematics jk;
+  for (int i = 0; i < nb; ++i) {
+    const JointSlot& s = model.joints[i];
+    s.joint.calc(state.q.segment(s.q_index, s.nq), state.qdot.segment(s.q_index, s.nq), jk);
+    const Mat4 E_pi = s.E_pf * jk.Q * s.E_mi;
+    const Mat6 Ad_ij = AdInv(s.E_mi);
+    Ad_ip[i] = AdInv(E_pi);
+    S_i[i] = Ad_ij * jk.S;
+    const auto qd = state.qdot.segment(s.q_index, s.nq);
+    const auto qdd = qddot.segment(s.q_index, s.nq);
+    const Vec6 psi = S_i[i] * qd;
+    Vec6 acc = S_i[i] * qdd + Ad_ij * (jk.Sdot * qd);
+    if (s.parent >= 0) {
+      const int p = s.parent;
+      E_wi[i] = E_wi[p] * E_pi;
+      const Vec6 phi_pi = Ad_ip[i] * phi[p];
+      phi[i] = phi_pi + psi;
+      phidot[i] = Ad_ip[i] * phidot[p] - ad(psi) * phi_pi + acc;
+    } else {
+      E_wi[i] = E_pi;
+      phi[i] = psi;
+      phidot[i] = acc;
+    }
+    // net wrench the body needs minus what gravity and Coriolis give [D Eq. 3.21]
+    const Body& b = model.bodies[i];
+    const Vec3 g_i = E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity);
+    w[i] = b.M * phidot[i] - ad(phi[i]).transpose() * (b.M * phi[i]) - Gamma(b.com).transpose() * g_i;
+  }
+  VecX tau(model.nr());
+  for (int i = nb - 1; i >= 0; --i) {
+    const JointSlot& s = model.joints[i];
+    if (s.nq > 0) tau.segment(s.q_index, s.nq) = S_i[i].transpose() * w[i];
+    // transmit to the parent: wrenches map with Ad^T
+    if (s.parent >= 0) w[s.parent] += Ad_ip[i].transpose() * w[i];
+  }
+  for (int k = 0; k < model.nr(); ++k) {
+    const Coordinate& c = model.coordinates[k];
+    tau[k] -= -c.stiffness * (state.q[k] - c.rest_value) - c.damping * state.qdot[k];
+  }
+  return tau;
+}
+
+double skeletonKineticEnergy(const Model& model, const SkeletonWorkspace& ws) {
+  double T = 0.0;
+  for (int i = 0; i < model.nb(); ++i) T += 0.5 * ws.phi[i].dot(model.bodies[i].M * ws.phi[i]);
+  return T;
+}
+
+double skeletonPotentialEnergy(const Model& model, const State& state, const SkeletonWorkspace& ws) {
+  double V = 0.0;
+  for (int i = 0; i < model.nb(); ++i) {
+    const Body& b = model.bodies[i];
+    V -= b.mass * model.gravity.dot(transformPoint(ws.E_wi[i], b.com));
+  }
+  for (int k = 0; k < model.nr(); ++k) {
+    const Coordinate& c = model.coordinates[k];
+    const double d = state.q[k] - c.rest_value;
+    V += 0.5 * c.stiffness * d * d;
+  }
+  return V;
+}
+
+}  // namespace redmax

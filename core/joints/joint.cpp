@@ -1,0 +1,43 @@
+#include "core/joints/joint.hpp"
+
+namespace redmax {
+
+namespace {
+template <class T>
+concept HasReparameterize = requires(const T& j, VecJ& q, VecJ& qd) {
+  { j.reparameterize(q, qd) } -> std::convertible_to<bool>;
+};
+template <class... Ts>
+struct Overloaded : Ts... {
+  using Ts::operator()...;
+};
+}  // namespace
+
+int Joint::nq() const {
+  return std::visit([](const auto& j) { return j.nq(); }, v);
+}
+
+void Joint::calc(const VecJ& q, const VecJ& qdot, JointKinematics& out) const {
+  std::visit([&](const auto& j) { j.calc(q, qdot, out); }, v);
+}
+
+bool Joint::reparameterize(VecJ& q, VecJ& qdot) const {
+  return std::visit(
+      [&](const auto& j) -> bool {
+        if constexpr (HasReparameterize<std::decay_t<decltype(j)>>) {
+          return j.reparameterize(q, qdot);
+        } else {
+          return false;
+        }
+      },
+      v);
+}
+
+std::string Joint::typeName() const {
+  return std::visit(Overloaded{[](const Fixed&) { return std::string("fixed"); },
+                               [](const Revolute&) { return std::string("revolute"); },
+                               [](const Prismatic&) { return std::string("prismatic"); }},
+                    v);
+}
+
+}  // namespace redmax
