@@ -1,0 +1,116 @@
+// Dependencies point down only (STYLE.md): this test fails on any upward or forbidden #include.
+//   core/spatial <- core/joints <- core/skeleton <- core/muscles <- core/dynamics <- core/integrators
+//   converter/, plugin/ -> core/ (plugin may also read the converter's description)
+//   validation/ -> core, converter, plugin;  cli/ -> anything
+// External libraries: tinyxml2 only in converter/; Simbody only in plugin/, validation/ and
+// tests; SUNDIALS only in core/integrators/*.cpp (never a header).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Include {
+  std::string file;
+  int line;
+  std::string target;
+};
+
+std::vector<Include> scan(const fs::path& root, const std::string& dir) {
+  std::vector<Include> out;
+  const fs::path base = root / dir;
+  if (!fs::exists(base)) return out;
+  const std::regex re(R"(^\s*#\s*include\s*[<"]([^>"]+)[>"])");
+  for (const auto& e : fs::recursive_directory_iterator(base)) {
+    if (!e.is_regular_file()) continue;
+    const auto ext = e.path().extension();
+    if (ext != ".hpp" && ext != ".cpp" && ext != ".h") continue;
+    std::ifstream in(e.path());
+    std::string s;
+    int n = 0;
+    while (std::getline(in, s)) {
+      ++n;
+      std::smatch m;
+      if (std::regex_search(s, m, re)) out.push_back({fs::relative(e.path(), root).string(), n, m[1]});
+    }
+  }
+  return out;
+}
+
+// the project folder an include names ("core/joints/joint.hpp" -> "core/joints"), or "" if external
+std::string layerOf(const std::string& inc) {
+  static const std::vector<std::string> layers = {
+      "core/spatial", "core/joints", "core/skeleton", "core/muscles", "core/dynamics",
+      "core/integrators", "converter", "plugin", "validation", "cli"};
+  for (const auto& l : layers)
+    if (inc.rfind(l + "/", 0) == 0) return l;
+  return "";
+}
+
+bool isSimbody(const std::string& inc) {
+  return inc.rfind("Simbody", 0) == 0 || inc.rfind("SimTK", 0) == 0 || inc.rfind("simbody/", 0) == 0 ||
+         inc.rfind("simmath/", 0) == 0 || inc.rfind("OpenSim", 0) == 0;
+}
+bool isSundials(const std::string& inc) {
+  return inc.rfind("sundials/", 0) == 0 || inc.rfind("arkode/", 0) == 0 || inc.rfind("cvode/", 0) == 0 ||
+         inc.rfind("nvector/", 0) == 0 || inc.rfind("sunmatrix/", 0) == 0 || inc.rfind("sunlinsol/", 0) == 0;
+}
+
+TEST(Layering, IncludesPointDownOnly) {
+  const fs::path root = REDMAX_SOURCE_DIR;
+  const std::map<std::string, std::set<std::string>> allowed = {
+      {"core/spatial", {"core/spatial"}},
+      {"core/joints", {"core/spatial", "core/joints"}},
+      {"core/skeleton", {"core/spatial", "core/joints", "core/skeleton"}},
+      {"core/muscles", {"core/spatial", "core/joints", "core/skeleton", "core/muscles"}},
+      {"core/dynamics", {"core/spatial", "core/joints", "core/skeleton", "core/muscles", "core/dynamics"}},
+      {"core/integrators",
+       {"core/spatial", "core/joints", "core/skeleton", "core/muscles", "core/dynamics", "core/integrators"}},
+  };
+  const std::set<std::string> core_all = allowed.at("core/integrators");
+  std::set<std::string> converter = core_all, plugin = core_all, validation = core_all;
+  converter.insert("converter");
+  plugin.insert({"converter", "plugin"});
+  validation.insert({"converter", "plugin", "validation"});
+  std::map<std::string, std::set<std::string>> rules = allowed;
+  rules["converter"] = converter;
+  rules["plugin"] = plugin;
+  rules["validation"] = validation;
+
+  int checked = 0;
+  for (const auto& [dir, ok] : rules) {
+    for (const auto& inc : scan(root, dir)) {
+      ++checked;
+      const std::string where = inc.file + ":" + std::to_string(inc.line) + " includes " + inc.target;
+      const std::string l = layerOf(inc.target);
+      if (!l.empty()) EXPECT_TRUE(ok.count(l)) << where << " (upward or sideways dependency)";
+      if (inc.target.rfind("tinyxml2", 0) == 0)
+        EXPECT_EQ(dir, "converter") << where << " (tinyxml2 belongs to converter/ only)";
+      if (isSimbody(inc.target))
+        EXPECT_TRUE(dir == "plugin" || dir == "validation") << where << " (Simbody outside plugin/validation)";
+      if (isSundials(inc.target))
+        EXPECT_TRUE(dir == "core/integrators" && inc.file.size() > 4 &&
+                    inc.file.substr(inc.file.size() - 4) == ".cpp")
+            << where << " (SUNDIALS only in core/integrators/*.cpp)";
+    }
+  }
+  EXPECT_GT(checked, 20) << "the scan found almost no includes: wrong source root?";
+}
+
+TEST(Layering, DetectsAViolation) {
+  // the classifier itself must flag an upward include, or the test above could never fail
+  EXPECT_EQ(layerOf("core/dynamics/system.hpp"), "core/dynamics");
+  EXPECT_EQ(layerOf("Eigen/Core"), "");
+  EXPECT_TRUE(isSimbody("Simbody.h"));
+  EXPECT_TRUE(isSundials("arkode/arkode_erkstep.h"));
+}
+
+}  // namespace
