@@ -86,6 +86,17 @@ Vec3 pointVelocity(const SkeletonWorkspace& ws, int body, const Vec3& x_i) {
   return ws.E_wi[body].topLeftCorner<3, 3>() * (Gamma(x_i) * ws.phi[body]);
 }
 
+void pointJacobian(const Model& model, const SkeletonWorkspace& ws, int body, const Vec3& x_i,
+                   Eigen::Ref<MatX> J) {
+  J.setZero();
+  const Mat3x6 RG = ws.E_wi[body].topLeftCorner<3, 3>() * Gamma(x_i);
+  for (int a : model.ancestors(body)) {
+    const JointSlot& sa = model.joints[a];
+    if (sa.nq == 0) continue;
+    J.middleCols(sa.q_index, sa.nq).noalias() = RG * ws.J_mr.block(6 * body, sa.q_index, 6, sa.nq);
+  }
+}
+
 int reparameterizeJoints(const Model& model, State& state) {
   int count = 0;
   for (const JointSlot& s : model.joints) {

@@ -18,6 +18,11 @@ void calcBodyPoses(const Model& model, const VecX& q, std::vector<Mat4>& E_wi);
 Vec3 pointPosition(const SkeletonWorkspace& ws, int body, const Vec3& x_i);
 Vec3 pointVelocity(const SkeletonWorkspace& ws, int body, const Vec3& x_i);
 
+/// Jacobian of a body-fixed point's world velocity with respect to qdot (3 x nr):
+/// J = R_i Gamma(x_i) J_mr(i,:)  [D Eq. 3.13, 4.1]; needs Stage::Position.
+void pointJacobian(const Model& model, const SkeletonWorkspace& ws, int body, const Vec3& x_i,
+                   Eigen::Ref<MatX> J);
+
 /// Apply every joint's chart switch (exponential coordinates near |q| = 2 pi [D Sec. 4.5.8]).
 /// Returns the number of joints reparameterized.
 int reparameterizeJoints(const Model& model, State& state);

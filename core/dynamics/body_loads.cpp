@@ -1,0 +1,38 @@
+#include "core/dynamics/body_loads.hpp"
+
+namespace redmax {
+
+namespace {
+void addBodyWrench(const Model& model, const SkeletonWorkspace& ws, int body, const Vec6& w_i, VecX& f) {
+  for (int a : model.ancestors(body)) {
+    const JointSlot& sa = model.joints[a];
+    if (sa.nq == 0) continue;
+    f.segment(sa.q_index, sa.nq).noalias() += ws.J_mr.block(6 * body, sa.q_index, 6, sa.nq).transpose() * w_i;
+  }
+}
+}  // namespace
+
+void BodyLoads::addForce(const Model& model, const State&, const SkeletonWorkspace& ws, VecX& f) const {
+  for (const PointForce& p : point_forces) {
+    if (p.body < 0) continue;  // force on the world does nothing
+    const Mat3 R = ws.E_wi[p.body].topLeftCorner<3, 3>();
+    const Vec6 w = Gamma(p.point_i).transpose() * (R.transpose() * p.force_w);
+    addBodyWrench(model, ws, p.body, w, f);
+  }
+  for (const BodyWrench& b : wrenches) {
+    if (b.body < 0) continue;
+    const Mat3 R = ws.E_wi[b.body].topLeftCorner<3, 3>();
+    Vec6 w;
+    w << R.transpose() * b.torque_w, R.transpose() * b.force_w;
+    addBodyWrench(model, ws, b.body, w, f);
+  }
+}
+
+double BodyLoads::potentialEnergy(const Model&, const State&, const SkeletonWorkspace& ws) const {
+  double V = 0.0;
+  for (const PointForce& p : point_forces)
+    if (p.body >= 0) V -= p.force_w.dot(transformPoint(ws.E_wi[p.body], p.point_i));
+  return V;
+}
+
+}  // namespace redmax
