@@ -36,7 +36,18 @@ bool Joint::reparameterize(VecJ& q, VecJ& qdot) const {
 std::string Joint::typeName() const {
   return std::visit(Overloaded{[](const Fixed&) { return std::string("fixed"); },
                                [](const Revolute&) { return std::string("revolute"); },
-                               [](const Prismatic&) { return std::string("prismatic"); }},
+                               [](const Prismatic&) { return std::string("prismatic"); },
+                               [](const Planar&) { return std::string("planar"); },
+                               [](const Translational&) { return std::string("translational"); },
+                               [](const SphericalEuler&) { return std::string("spherical_euler"); },
+                               [](const Universal&) { return std::string("universal"); },
+                               [](const SphericalExp&) { return std::string("spherical_exp"); },
+                               [](const Composite&) { return std::string("composite"); },
+                               [](const Free2D&) { return std::string("free2d"); },
+                               [](const Free3D&) { return std::string("free3d"); },
+                               [](const SplineCurve&) { return std::string("spline_curve"); },
+                               [](const SplineSurface&) { return std::string("spline_surface"); },
+                               [](const FunctionBased&) { return std::string("function_based"); }},
                     v);
 }
 

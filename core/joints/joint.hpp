@@ -6,14 +6,29 @@
 // and optionally
 //   bool reparameterize(VecJ& q, VecJ& qdot) const;        chart switch (exponential coordinates)
 // Every joint here uses qdot = dq/dt, so q integrates as q += h qdot.
+//
+// Types [D Sec. 4.5]: Fixed, Revolute, Prismatic (basic_joints.hpp); Planar, Translational
+// (translational_joints.hpp); SphericalEuler (any of 12 sequences), Universal (euler_joints.hpp);
+// SphericalExp (spherical_exp.hpp); Composite (composite.hpp); Free2D, Free3D (free_joints.hpp);
+// SplineCurve, SplineSurface (spline_joints.hpp); FunctionBased = OpenSim CustomJoint
+// (function_based.hpp, functions in functions.hpp).
 #include <string>
 #include <variant>
 
 #include "core/joints/basic_joints.hpp"
+#include "core/joints/composite.hpp"
+#include "core/joints/euler_joints.hpp"
+#include "core/joints/free_joints.hpp"
+#include "core/joints/function_based.hpp"
+#include "core/joints/spherical_exp.hpp"
+#include "core/joints/spline_joints.hpp"
+#include "core/joints/translational_joints.hpp"
 
 namespace redmax {
 
-using JointVariant = std::variant<Fixed, Revolute, Prismatic>;
+using JointVariant =
+    std::variant<Fixed, Revolute, Prismatic, Planar, Translational, SphericalEuler, Universal,
+                 SphericalExp, Composite, Free2D, Free3D, SplineCurve, SplineSurface, FunctionBased>;
 
 /// A joint of any type. Value semantics: copying a Model copies its joints.
 struct Joint {

@@ -1,6 +1,10 @@
 #include "validation/scenes/scenes.hpp"
 
-#include <random>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
 #include <string>
 
 namespace redmax::scenes {
@@ -13,7 +17,156 @@ void rodInertia(double m, double L, Vec3& com, Mat3& I) {
   I(0, 0) = I(2, 2) = m * L * L / 12.0;
   I(1, 1) = 1e-6 * m * L * L;  // a rod with a tiny radius, keeps the inertia positive definite
 }
+
+double uniform(std::mt19937& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+Vec3 randomVec(std::mt19937& rng, double scale = 1.0) {
+  return Vec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)) * scale;
+}
+Vec3 randomUnit(std::mt19937& rng) {
+  Vec3 v;
+  do v = randomVec(rng);
+  while (v.norm() < 0.2);
+  return v.normalized();
+}
+Mat3 randomRotation(std::mt19937& rng) { return expSO3(randomVec(rng, 2.0)); }
+int pick(std::mt19937& rng, int n) { return static_cast<int>(rng() % static_cast<unsigned>(n)); }
+
+// smooth one-coordinate coupling of amplitude <= amp (knee-like SimmSpline, etc.)
+AxisFunctionPtr randomCoupling(std::mt19937& rng, double amp) {
+  const double A = uniform(rng, -amp, amp), w = uniform(rng, 0.5, 1.5), ph = uniform(rng, -1, 1);
+  switch (pick(rng, 4)) {
+    case 0: {
+      const int n = 4 + pick(rng, 4);
+      std::vector<double> x(n), y(n);
+      for (int i = 0; i < n; ++i) {
+        x[i] = -1.6 + 3.2 * i / (n - 1) + (i > 0 && i < n - 1 ? uniform(rng, -0.1, 0.1) : 0.0);
+        y[i] = A * std::sin(w * x[i] + ph);
+      }
+      return std::make_shared<const SimmSpline>(x, y);
+    }
+    case 1: {
+      std::vector<double> x{-1.5, -0.4, 0.3, 1.5}, y(4);
+      for (int i = 0; i < 4; ++i) y[i] = A * std::cos(w * x[i] + ph);
+      return std::make_shared<const NaturalCubicSpline>(x, y);
+    }
+    case 2:
+      return std::make_shared<const PolynomialFunction>(
+          std::vector<double>{0.3 * A, -0.5 * A, A, uniform(rng, -0.2, 0.2)});
+    default: {
+      std::vector<double> x{-1.5, 0.0, 1.5}, y{A, -A * 0.5, A * ph};
+      return std::make_shared<const MultiplierFunction>(std::make_shared<const SimmSpline>(x, y),
+                                                        uniform(rng, 0.5, 1.5));
+    }
+  }
+}
+
+Joint randomFunctionBased(std::mt19937& rng) {
+  const int nq = 1 + pick(rng, 3);
+  std::array<TransformAxis, 6> ax;
+  // orthonormal rotation axes (no gimbal lock in range), translation axes only non-parallel
+  const Mat3 Rr = randomRotation(rng);
+  for (int k = 0; k < 3; ++k) ax[k].axis = Rr.col(k);
+  const Mat3 Rt = randomRotation(rng);
+  for (int k = 0; k < 3; ++k) ax[3 + k].axis = (Rt.col(k) + randomVec(rng, 0.3)).normalized();
+  // every coordinate drives its own axis linearly (S keeps full rank)...
+  std::vector<int> slots{0, 1, 2, 3, 4, 5};
+  std::shuffle(slots.begin(), slots.end(), rng);
+  for (int j = 0; j < nq; ++j) {
+    TransformAxis& a = ax[slots[j]];
+    a.coordinates = {j};
+    const double s = uniform(rng, 0.6, 1.0) * (rng() % 2 ? 1.0 : -1.0);
+    a.function = std::make_shared<const LinearFunction>(s, uniform(rng, -0.2, 0.2));
+  }
+  // ...and the other axes get couplings, multi-argument linears or constants
+  for (int j = nq; j < 6; ++j) {
+    TransformAxis& a = ax[slots[j]];
+    const double amp = slots[j] < 3 ? 0.3 : 0.1;
+    switch (pick(rng, 3)) {
+      case 0:
+        a.coordinates = {pick(rng, nq)};
+        a.function = randomCoupling(rng, amp);
+        break;
+      case 1:
+        if (nq >= 2) {
+          a.coordinates = {0, nq - 1};
+          a.function = std::make_shared<const LinearFunction>(
+              std::vector<double>{uniform(rng, -amp, amp), uniform(rng, -amp, amp), uniform(rng, -0.1, 0.1)});
+          break;
+        }
+        [[fallthrough]];
+      default:
+        a.function = std::make_shared<const ConstantFunction>(uniform(rng, -0.2, 0.2));
+    }
+  }
+  return FunctionBased(nq, ax);
+}
+
+// a small joint for composites
+Joint randomPart(std::mt19937& rng, int max_nq) {
+  for (;;) {
+    Joint j;
+    switch (pick(rng, 6)) {
+      case 0: j = Revolute{randomUnit(rng)}; break;
+      case 1: j = Prismatic{randomUnit(rng)}; break;
+      case 2: j = Universal{}; break;
+      case 3: j = SphericalEuler{static_cast<EulerSequence>(pick(rng, 6))}; break;
+      case 4: j = Planar{}; break;
+      default: j = SphericalExp{}; break;
+    }
+    if (j.nq() <= max_nq) return j;
+  }
+}
 }  // namespace
+
+Joint randomJoint(std::size_t index, std::mt19937& rng) {
+  switch (index) {
+    case 0: return Fixed{};
+    case 1: return Revolute{randomUnit(rng)};
+    case 2: return Prismatic{randomUnit(rng)};
+    case 3: return Planar{};
+    case 4: return Translational{};
+    case 5: return SphericalEuler{static_cast<EulerSequence>(pick(rng, 12))};
+    case 6: return Universal{};
+    case 7: return SphericalExp{};
+    case 8: {
+      // two or three parts, sometimes nested: Q1 (Q2 Q3)
+      Joint a = randomPart(rng, 4);
+      Joint b = randomPart(rng, 5 - a.nq());
+      if (a.nq() + b.nq() < 6 && rng() % 2) {
+        Joint c = randomPart(rng, 6 - a.nq() - b.nq());
+        return Composite({a, Composite({b, c})});
+      }
+      return Composite({a, b});
+    }
+    case 9: return Free2D{};
+    case 10:
+      return Free3D{static_cast<FreeRotation>(pick(rng, 2)), static_cast<EulerSequence>(pick(rng, 6)),
+                    static_cast<FreeOrder>(pick(rng, 2)), static_cast<FreeLayout>(pick(rng, 2))};
+    case 11: {
+      const int n = 4 + pick(rng, 4);
+      std::vector<Mat4> frames{makeE(randomRotation(rng), randomVec(rng, 0.2))};
+      for (int i = 1; i < n; ++i)
+        frames.push_back(frames.back() * makeE(expSO3(randomVec(rng, 0.6)), randomVec(rng, 0.3)));
+      return SplineCurve(frames);
+    }
+    case 12: {
+      std::array<Mat4, 6> C;
+      for (int k = 0; k < 6; ++k) {
+        const double amp = k < 3 ? 0.3 : 0.5;
+        // a tilted plane plus noise, so both coordinates move every spatial coordinate
+        const double gx = uniform(rng, -amp, amp), gy = uniform(rng, -amp, amp);
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j < 4; ++j) C[k](i, j) = gx * i + gy * j + uniform(rng, -0.3, 0.3) * amp - 1.5 * (gx + gy);
+      }
+      return SplineSurface(C);
+    }
+    case 13: return randomFunctionBased(rng);
+    default:
+      throw std::out_of_range("randomJoint: no generator for joint alternative " + std::to_string(index));
+  }
+}
 
 Model doublePendulum(double L, double m) {
   ModelBuilder b("double_pendulum");
@@ -62,11 +215,18 @@ Model randomTree(int n, std::uint32_t seed, TreeJoints kinds) {
     const Mat3 R = expSO3(rvec() * 2.0);
     const Mat3 Ic = R * Vec3(d.y() + d.z(), d.x() + d.z(), d.x() + d.y()).asDiagonal() * R.transpose() * m;
     Joint j;
-    const int kind = static_cast<int>(rng() % 3);
-    if (kind == 0) j = Revolute{rvec().normalized()};
-    else if (kind == 1) j = Prismatic{rvec().normalized()};
-    else j = Fixed{};
-    (void)kinds;
+    if (kinds == TreeJoints::All) {
+      j = randomJoint(rng() % std::variant_size_v<JointVariant>, rng);
+    } else {
+      switch (rng() % 6) {
+        case 0: j = Revolute{rvec().normalized()}; break;
+        case 1: j = Prismatic{rvec().normalized()}; break;
+        case 2: j = Fixed{}; break;
+        case 3: j = SphericalEuler{EulerSequence::XYZ}; break;
+        case 4: j = Universal{}; break;
+        default: j = Free3D::opensim(); break;
+      }
+    }
     b.addBody("body" + std::to_string(i), m, rvec() * 0.3, Ic, p, "joint" + std::to_string(i), j,
               rpose(0.5), rpose(0.3));
   }
