@@ -1,0 +1,86 @@
+#include "core/dynamics/muscle_term.hpp"
+
+namespace redmax {
+
+MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options)
+    : muscles_(std::move(muscles)), options_(options), nr_(model.nr()) {
+  for (const Muscle& m : muscles_) {
+    validateMuscle(model, m);
+    if (m.mass_points.size() > 0) massive_.push_back(m);
+  }
+  ws_ = MuscleWorkspace(model, massive_);
+}
+
+double MuscleTerm::totalMass() const {
+  double m = 0.0;
+  for (const Muscle& mu : massive_) m += mu.mass_points.totalMass();
+  return m;
+}
+
+void MuscleTerm::update(const Model& model, const State& s, const SkeletonWorkspace& sk) const {
+  if (model.nr() != nr_)
+    throw std::logic_error("MuscleTerm: built for a model with " + std::to_string(nr_) +
+                           " coordinates, used with one with " + std::to_string(model.nr()));
+  // one evaluation serves addMass, addForce and the energies of the same state
+  if (cache_valid_ && q_cache_.size() == s.q.size() && qdot_cache_.size() == s.qdot.size() &&
+      q_cache_ == s.q && qdot_cache_ == s.qdot)
+    return;
+  cache_valid_ = false;
+  calcMuscleKinematics(model, s, sk, massive_, ws_, true);
+  q_cache_ = s.q;
+  qdot_cache_ = s.qdot;
+  cache_valid_ = true;
+}
+
+void MuscleTerm::addMass(const Model& model, const State& s, const SkeletonWorkspace& sk, MatX& M) const {
+  if (massive_.empty()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  update(model, s, sk);
+  // J_ar^T M_a J_ar, M_a diagonal [D Eq. 5.7b]
+  for (size_t m = 0; m < massive_.size(); ++m) {
+    const MassPoints& mp = massive_[m].mass_points;
+    const MatX& J = ws_.muscles[m].J_ar;
+    for (int a = 0; a < mp.size(); ++a) {
+      const auto Ja = J.middleRows<3>(3 * a);
+      M.noalias() += mp.mass[a] * (Ja.transpose() * Ja);
+    }
+  }
+}
+
+void MuscleTerm::addForce(const Model& model, const State& s, const SkeletonWorkspace& sk, VecX& f) const {
+  if (massive_.empty()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  update(model, s, sk);
+  // J_ar^T (f_a - M_a Jdot_ar qdot), f_a = m_a g [D Eq. 5.6, 5.7c]
+  for (size_t m = 0; m < massive_.size(); ++m) {
+    const MassPoints& mp = massive_[m].mass_points;
+    const MuscleKinematics& mk = ws_.muscles[m];
+    for (int a = 0; a < mp.size(); ++a) {
+      Vec3 fa = mp.mass[a] * model.gravity;
+      if (options_.quadratic_velocity) fa.noalias() -= mp.mass[a] * (mk.Jdot_ar.middleRows<3>(3 * a) * s.qdot);
+      f.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * fa;
+    }
+  }
+}
+
+double MuscleTerm::kineticEnergy(const Model& model, const State& s, const SkeletonWorkspace& sk) const {
+  if (massive_.empty()) return 0.0;
+  std::lock_guard<std::mutex> lock(mutex_);
+  update(model, s, sk);
+  double T = 0.0;
+  for (size_t m = 0; m < massive_.size(); ++m)
+    T += muscleKineticEnergy(massive_[m].mass_points, ws_.muscles[m], s.qdot);
+  return T;
+}
+
+double MuscleTerm::potentialEnergy(const Model& model, const State& s, const SkeletonWorkspace& sk) const {
+  if (massive_.empty()) return 0.0;
+  std::lock_guard<std::mutex> lock(mutex_);
+  update(model, s, sk);
+  double V = 0.0;
+  for (size_t m = 0; m < massive_.size(); ++m)
+    V += musclePotentialEnergy(massive_[m].mass_points, ws_.muscles[m], model.gravity);
+  return V;
+}
+
+}  // namespace redmax

@@ -1,0 +1,65 @@
+#pragma once
+// Muscle mass points [D Sec. 5.3]: N point masses per musculotendon, each fixed at a material
+// coordinate alpha in [0, 1] (fraction of the path's arc length, the "texture coordinate"), and a
+// muscle (path + fibre/tendon lengths + mass points) as plain data.
+//
+// Placement convention (DESIGN.md: mass only in the fibre portion, tendons massless by default):
+//   - fibre share   phi = l_opt / (l_opt + l_ts)  (optimal fibre length, tendon slack length),
+//     taken as a constant fraction of the path;
+//   - the tendon share 1 - phi is split equally between the two ends, so the fibre occupies
+//     alpha in [(1 - phi) / 2, (1 + phi) / 2]. OpenSim's Hill models have a single lumped tendon in
+//     series and do not say where it sits; most limb muscles have both a proximal and a distal
+//     tendon/aponeurosis, and the symmetric split keeps the mass centred (a choice at one end would
+//     move the muscle's centre of mass by up to (1 - phi) / 2 of the path for no stated reason);
+//   - N points at the centres of N equal sub-intervals of that range,
+//       alpha_k = a0 + (a1 - a0) (k + 1/2) / N,   k = 0..N-1,
+//     each carrying mass m / N (uniform distribution). This is the midpoint rule for the kinetic and
+//     potential energy of a uniform line density; no point sits on an attachment, where its mass
+//     would only add to a bone.
+//   - Region::WholePath spreads the points over alpha in [0, 1] in the same way.
+#include <string>
+#include <vector>
+
+#include "core/muscles/path.hpp"
+
+namespace redmax {
+
+/// Where the points of a muscle sit along the path.
+struct MassPointOptions {
+  enum class Region { Fibre, WholePath };
+  int count = 20;                     // points per muscle (>= 1)
+  Region region = Region::Fibre;
+};
+
+/// Material coordinates and masses of one muscle's points (alpha.size() == mass.size()).
+struct MassPoints {
+  std::vector<double> alpha;          // arc-length fractions in [0, 1]                   (N)
+  std::vector<double> mass;           // kg                                              (N)
+  int size() const { return static_cast<int>(alpha.size()); }
+  double totalMass() const;
+};
+
+/// Uniform distribution of `total_mass` (kg) by the convention above. Throws ModelError on a
+/// negative or non-finite mass, count < 1, optimal_fiber_length <= 0 or tendon_slack_length < 0
+/// (only checked for Region::Fibre).
+MassPoints makeMassPoints(double total_mass, double optimal_fiber_length, double tendon_slack_length,
+                          const MassPointOptions& options = {});
+
+/// Explicit points; throws ModelError unless sizes match, alpha in [0, 1] and masses >= 0 finite.
+MassPoints makeMassPoints(std::vector<double> alpha, std::vector<double> mass);
+
+/// A musculotendon: its path and, when it carries inertia, its mass points. A muscle with no mass
+/// points is lumped (massless), as OpenSim sees it; Type III paths must stay lumped for now.
+struct Muscle {
+  std::string name;
+  MusclePath path;
+  double optimal_fiber_length = 0.0;  // m (informative here; used by makeMassPoints)
+  double tendon_slack_length = 0.0;   // m
+  MassPoints mass_points;             // empty = massless
+};
+
+/// validatePath plus: Type III paths with mass points are rejected (wrapping surfaces are not yet
+/// supported for inertial muscles), alpha and masses checked. Throws ModelError naming the muscle.
+void validateMuscle(const Model& model, const Muscle& muscle);
+
+}  // namespace redmax

@@ -1,0 +1,43 @@
+#include "core/muscles/muscle_kinematics.hpp"
+
+namespace redmax {
+
+void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
+                          const Muscle& muscle, MuscleKinematics& mk, bool velocity) {
+  calcPathPoints(model, state, sk, muscle.path, mk, velocity);
+  const MassPoints& mp = muscle.mass_points;
+  if (mp.size() == 0) return;
+  if (pathType(muscle.path) == PathType::III)
+    throw std::logic_error("muscle '" + muscle.name + "': Type III paths cannot carry mass points yet");
+  // two active points: Type I [D Sec. 5.3.1]; more: EOL [D Sec. 5.3.2]
+  if (mk.x_w.size() == 2) {
+    if (!(mk.length > 0.0))
+      throw MuscleError("muscle '" + muscle.name + "': origin and insertion coincide here; mass points need a path of positive length");
+    calcStraightMassPoints(mp, mk);
+    return;
+  }
+  calcEulerianCoordinates(mk, muscle.name);
+  calcViaPointMassPoints(mp, mk);
+}
+
+void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
+                          const std::vector<Muscle>& muscles, MuscleWorkspace& ws, bool velocity) {
+  if (ws.muscles.size() != muscles.size()) ws = MuscleWorkspace(model, muscles);
+  for (size_t m = 0; m < muscles.size(); ++m)
+    calcMuscleKinematics(model, state, sk, muscles[m], ws.muscles[m], velocity);
+}
+
+double muscleKineticEnergy(const MassPoints& mp, const MuscleKinematics& mk, const VecX& qdot) {
+  double T = 0.0;
+  for (int a = 0; a < mp.size(); ++a)
+    T += 0.5 * mp.mass[a] * (mk.J_ar.middleRows<3>(3 * a) * qdot).squaredNorm();
+  return T;
+}
+
+double musclePotentialEnergy(const MassPoints& mp, const MuscleKinematics& mk, const Vec3& gravity) {
+  double V = 0.0;
+  for (int a = 0; a < mp.size(); ++a) V -= mp.mass[a] * gravity.dot(mk.x_a[a]);
+  return V;
+}
+
+}  // namespace redmax

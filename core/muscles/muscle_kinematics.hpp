@@ -1,0 +1,28 @@
+#pragma once
+// The whole muscle pipeline for one musculotendon or a list of them, in stage order:
+//   calcPathPoints -> (Type II) calcEulerianCoordinates -> mass points (straight / via_point),
+// giving x_a, J_ar = J_am J_mr and Jdot_ar = Jdot_am J_mr + J_am Jdot_mr [D Eq. 5.4-5.5].
+// Muscles without mass points stop after the path stage (length and lengthening speed only).
+#include "core/muscles/path_kinematics.hpp"
+#include "core/muscles/straight.hpp"
+#include "core/muscles/via_point.hpp"
+
+namespace redmax {
+
+/// One muscle: path stage, then Eulerian and mass-point stages when it has mass points. With
+/// `velocity` also every d/dt quantity (needs the skeleton workspace at Stage::Velocity).
+/// Throws MuscleError for a degenerate path under mass points, std::logic_error for a Type III path
+/// with mass points (validateMuscle rejects those up front).
+void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
+                          const Muscle& muscle, MuscleKinematics& mk, bool velocity = true);
+
+/// Every muscle of `muscles` into ws.muscles (built as MuscleWorkspace(model, muscles)).
+void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
+                          const std::vector<Muscle>& muscles, MuscleWorkspace& ws, bool velocity = true);
+
+/// Mass-point kinetic energy 1/2 sum m_a |J_ar qdot|^2 and gravitational potential
+/// -sum m_a g . x_a (world origin reference, as the skeleton's), after calcMuscleKinematics.
+double muscleKineticEnergy(const MassPoints& mp, const MuscleKinematics& mk, const VecX& qdot);
+double musclePotentialEnergy(const MassPoints& mp, const MuscleKinematics& mk, const Vec3& gravity);
+
+}  // namespace redmax

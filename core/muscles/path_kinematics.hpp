@@ -1,0 +1,35 @@
+#pragma once
+// Path points of a musculotendon: active set, world positions and velocities [D Eq. 5.8], their
+// Jacobians J_xr = J_xm J_mr and d/dt [D Eq. 5.9, 5.11, 5.37], plus the moving-point terms, and
+// the path length and lengthening speed.
+//
+// For a point at x_b(q) in body b with pose (R, p):
+//   x_w    = R x_b + p
+//   xdot_w = R Gamma(x_b) phi_b + R x_b'(q_k) qdot_k                          [D Eq. 5.8]
+//   J_xr   = R Gamma(x_b) J_mr(b) + R x_b' e_k^T
+//   Jdot_xr = R ([omega] Gamma(x_b) + Gamma(xdot_b)) J_mr(b) + R Gamma(x_b) Jdot_mr(b)
+//             + R ([omega] x_b' + x_b'' qdot_k) e_k^T                          [D Eq. 5.11]
+// with Gamma(xdot_b) = ([xdot_b]^T 0) and xdot_b = x_b' qdot_k (moving points only).
+#include "core/muscles/muscle_workspace.hpp"
+#include "core/skeleton/state.hpp"
+#include "core/skeleton/workspace.hpp"
+
+namespace redmax {
+
+/// Active points, x_b, x_w, J_xm blocks, J_xr, segment lengths and directions, path length; with
+/// `velocity` also xdot_w, Jdot_xm, Jdot_xr, ldot and the lengthening speed. Needs the skeleton
+/// workspace at Stage::Position (Stage::Velocity with `velocity`) for the same state.
+void calcPathPoints(const Model& model, const State& state, const SkeletonWorkspace& sk,
+                    const MusclePath& path, MuscleKinematics& mk, bool velocity = true);
+
+/// Path length (m) at configuration q from body poses only (no Jacobians), e.g. for length
+/// reports: polyline through the active points; wrap objects are ignored (Type III paths need the
+/// wrap code). E_wi from calcBodyPoses(model, q, E_wi).
+double calcPathLength(const Model& model, const MusclePath& path, const VecX& q,
+                      const std::vector<Mat4>& E_wi);
+
+/// Location of point p in its body frame at q, with d/dq and d2/dq2 along its coordinate (zero
+/// unless it is a moving point with a coordinate, inside its clamp range).
+void calcPointLocation(const PathPoint& p, const VecX& q, Vec3& x_b, Vec3& dx_b, Vec3& ddx_b);
+
+}  // namespace redmax
