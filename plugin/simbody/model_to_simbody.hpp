@@ -1,0 +1,116 @@
+#pragma once
+// A core redmax::Model rebuilt as a Simbody system, for cross-checks and speed comparisons.
+//
+// Notation (Simbody's, see MobilizedBody.h): P parent body, F joint frame on the parent, M joint
+// frame on the child, B child body. X_PF = JointSlot::E_pf and X_BM = inverse of JointSlot::E_mi.
+// One MobilizedBody per JointSlot, in core body order (parents first):
+//   Fixed -> Weld, Revolute(axis) -> Pin, Prismatic(axis) -> Slider (F and M are rotated by the
+//   same rotation so that Simbody's z (Pin) or x (Slider) axis lies along the core axis),
+//   SphericalEuler XYZ -> Gimbal or Ball, Universal -> Universal, Free3D (OpenSim layout) -> Free.
+// Ball and Free always run with Euler angles (SimbodyMatterSubsystem::setUseEulerAngles), so
+// Simbody's q equals the core q for every joint. Simbody's generalized speeds u equal qdot except
+// for Ball (u = w_FM expressed in F) and Free (u = [w_FM; v_FM], both in F). The velocity map
+//   u = T(q) qdot,   udot = T qddot + Tdot qdot        (T block diagonal, nu x nr)
+// converts between the two spaces: M_core = T^T M_u T, tau_core = T^T f_u.
+//
+// Only TUs that need Simbody include this header (BUILD_NOTES: ~15 s and 700 MB per TU; every such
+// TU must be compiled with -UNDEBUG, which the SimTKcommon target propagates).
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "plugin/simbody/simbody_include.hpp"
+
+#include "core/skeleton/model.hpp"
+#include "core/skeleton/state.hpp"
+
+namespace redmax::simbody {
+
+/// How a core SphericalEuler (XYZ) joint becomes a Simbody mobilizer.
+enum class SphericalAs {
+  Gimbal,  // q = body-fixed XYZ angles, u = qdot
+  Ball     // Euler-angle Ball: same q, u = angular velocity w_FM expressed in F
+};
+
+struct SimbodyBuildOptions {
+  SphericalAs spherical = SphericalAs::Gimbal;
+  /// Force::UniformGravity with the model's gravity
+  bool gravity = true;
+  /// Force::MobilityLinearSpring / MobilityLinearDamper for coordinates with nonzero stiffness or
+  /// damping. Only exact where u = qdot (the spring acts on q, the damper on u): a spring or damper
+  /// on a rotational coordinate of a Ball or Free mobilizer is rejected with SimbodyBuildError.
+  bool joint_springs = true;
+};
+
+enum class MobilizerKind { Weld, Pin, Slider, Gimbal, Ball, Universal, Free };
+
+/// Where one core joint lives in Simbody's q and u vectors.
+struct MobilizerMap {
+  MobilizerKind kind = MobilizerKind::Weld;
+  int q_index = 0;    // first core coordinate
+  int nq = 0;         // core coordinates (== Simbody nq == nu with Euler angles)
+  int simbody_q = 0;  // first Simbody q (matter subsystem indexing)
+  int simbody_u = 0;  // first Simbody u
+  bool u_is_qdot = true;  // false for Ball and Free: u = T qdot with T from calcVelocityMap
+};
+
+/// The Simbody system built from a core model. Not copyable (Simbody handles point into it).
+struct SimbodyModel {
+  SimbodyModel() : matter(system), forces(system) {}
+  SimbodyModel(const SimbodyModel&) = delete;
+  SimbodyModel& operator=(const SimbodyModel&) = delete;
+
+  SimTK::MultibodySystem system;
+  SimTK::SimbodyMatterSubsystem matter;
+  SimTK::GeneralForceSubsystem forces;
+  std::vector<SimTK::MobilizedBody> mobods;  // per core body                       (nb)
+  std::vector<MobilizerMap> map;             // per core joint slot                  (nb)
+  int nq = 0;                                // Simbody q count (>= core nr: see map)
+  int nu = 0;                                // Simbody u count (== core nr)
+  /// default state: Euler angles on, realized to Stage::Model, q = core defaults, u = 0
+  SimTK::State default_state;
+};
+
+/// Construction failed: a joint type without a Simbody counterpart, an invalid inertia, a spring on
+/// a mobilizer where q and u differ.
+class SimbodyBuildError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Build the Simbody system. Throws SimbodyBuildError naming the offending body or joint.
+std::unique_ptr<SimbodyModel> makeSimbodyModel(const Model& model, const SimbodyBuildOptions& opt = {});
+
+/// T (nu x nr) and, if Tdot is given, its time derivative, with u = T qdot; core state needed
+/// (q and qdot). Identity blocks for mobilizers with u = qdot; rows in Simbody u order.
+void calcVelocityMap(const SimbodyModel& sm, const Model& model, const State& s, MatX& T,
+                     MatX* Tdot = nullptr);
+
+/// Write the core state (t, q, qdot) into a Simbody state made from sm.default_state: q copied,
+/// u = T qdot. Invalidates Stage::Position and above.
+void setSimbodyState(const SimbodyModel& sm, const Model& model, const State& s, SimTK::State& sb);
+
+/// Read a Simbody state back: q copied, qdot = T^-1 u.
+void getCoreState(const SimbodyModel& sm, const Model& model, const SimTK::State& sb, State& s);
+
+/// Simbody's mass matrix (calcM, u space) mapped to core velocities: T^T M_u T (nr x nr).
+MatX calcSimbodyMassCore(const SimbodyModel& sm, const Model& model, const State& s);
+
+/// Simbody inverse dynamics (calcResidualForceIgnoringConstraints with the force subsystem's body
+/// and mobility forces at Stage::Dynamics as the applied forces) mapped to core generalized forces:
+/// tau with M qddot = f + tau in core terms.
+VecX calcSimbodyInverseDynamicsCore(const SimbodyModel& sm, const Model& model, const State& s,
+                                    const VecX& qddot);
+
+/// Simbody forward dynamics (realize(Acceleration)) mapped to core accelerations:
+/// qddot = T^-1 (udot - Tdot qdot).
+VecX calcSimbodyForwardDynamicsCore(const SimbodyModel& sm, const Model& model, const State& s);
+
+/// conversions between Eigen and SimTK containers
+SimTK::Vector toSimTK(const VecX& v);
+VecX fromSimTK(const SimTK::Vector& v);
+MatX fromSimTK(const SimTK::Matrix& m);
+SimTK::Transform toTransform(const Mat4& E);
+
+}  // namespace redmax::simbody
