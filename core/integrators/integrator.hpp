@@ -1,6 +1,17 @@
 #pragma once
 // Forward-dynamics integrators behind one interface [D Eq. 4.20, 4.21, 4.82].
 // SUNDIALS appears only in core/integrators/*.cpp, never in a header (STYLE.md).
+//
+//   name    method                                            step      constraints
+//   euler   symplectic (semi-implicit) Euler [D Eq. 4.20]     fixed     velocity-level KKT [D Eq. 4.102, 4.110]
+//   bdf1    linearly implicit backward Euler [D Eq. 4.80-4.82] fixed    velocity-level KKT
+//   sdirk2  2-stage L-stable SDIRK, order 2, Newton           fixed     KKT accelerations + Baumgarte
+//   rk45    Dormand-Prince 5(4), SUNDIALS ARKODE ERKStep      adaptive  KKT accelerations + Baumgarte
+//   cvode   variable-order BDF, SUNDIALS CVODE, dense Newton  adaptive  KKT accelerations + Baumgarte
+//
+// Every method treats q and qdot as independent coordinates with dq/dt = qdot (true for every
+// joint type, see core/joints/joint.hpp). After each internal step the joints get a chance to
+// switch chart (reparameterizeJoints, exponential coordinates [D Sec. 4.5.8]).
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -10,19 +21,24 @@
 namespace redmax {
 
 struct IntegratorOptions {
-  double dt = 1e-3;        // fixed step (euler, bdf1, sdirk2); initial step hint for adaptive ones
+  double dt = 1e-3;        // fixed step (euler, bdf1, sdirk2); the last step of a span is not shortened:
+                           // a span is cut into ceil(span / dt) equal steps
   double rtol = 1e-6;      // adaptive methods (rk45, cvode)
-  double atol = 1e-8;
-  double max_step = 0.0;   // 0: unlimited
+  double atol = 1e-8;      // absolute tolerance on every q and qdot entry (rk45, cvode)
+  double max_step = 0.0;   // adaptive methods: largest internal step; 0 = unlimited
+  double initial_step = 0.0;    // adaptive methods: first step; 0 = estimated by SUNDIALS
   long max_steps = 10'000'000;  // per advance() call
+  double newton_tol = 1e-10;    // sdirk2: converged when |dV| <= newton_tol (1 + |V|)
+  int newton_max_iter = 12;     // sdirk2: iterations per Newton phase (approximate, then FD Jacobian)
 };
 
+/// Counters accumulated over the lifetime of one Integrator (all advance() calls).
 struct IntegratorStats {
-  long steps = 0;
-  long rhs_evals = 0;          // evaluations of M and f
-  long jacobian_evals = 0;     // implicit methods
-  long reparameterizations = 0;
-  long failed_steps = 0;
+  long steps = 0;              // accepted internal steps
+  long rhs_evals = 0;          // evaluations of M and f (for cvode including its difference-quotient Jacobians)
+  long jacobian_evals = 0;     // implicit methods: Newton/implicit matrix assemblies (K, D or FD Jacobians)
+  long reparameterizations = 0;  // joint chart switches applied to the integrated state
+  long failed_steps = 0;       // rejected steps (error test or Newton failures)
 };
 
 /// A simulation produced NaN/Inf or diverged: says when, what, and with which step.
@@ -38,8 +54,13 @@ class Integrator {
  public:
   virtual ~Integrator() = default;
   virtual std::string name() const = 0;
-  /// advance `state` from state.t to t_out. Fixed-step methods shorten the last step to land on
-  /// t_out exactly, so output sampling needs no events.
+  /// Advance `state` from state.t to t_out; afterwards state.t == t_out exactly. Fixed-step
+  /// methods cut the span into ceil(span / dt) equal steps; adaptive methods step past t_out and
+  /// interpolate (their dense output), continuing from their internal state on the next call when
+  /// `state` is still the one they returned. t_out == state.t does nothing.
+  /// Throws std::invalid_argument if t_out < state.t or q/qdot do not have sys.ndof() entries,
+  /// SimulationError on NaN/Inf, divergence or a solver failure; `state` then holds the last
+  /// finite step reached (fixed-step methods) or is left as it was passed (adaptive methods).
   virtual void advance(const System& sys, State& state, double t_out) = 0;
   const IntegratorStats& stats() const { return stats_; }
 
@@ -48,10 +69,33 @@ class Integrator {
 };
 
 /// names: euler (symplectic/semi-implicit), bdf1 (linearly implicit), sdirk2, rk45 (ARKODE
-/// Dormand-Prince 5(4)), cvode (adaptive BDF). Throws std::invalid_argument on an unknown name.
+/// Dormand-Prince 5(4)), cvode (adaptive BDF). Throws std::invalid_argument on an unknown name or
+/// on invalid options (non-positive dt or tolerances).
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const IntegratorOptions& opt);
 
-/// throws SimulationError naming the first non-finite entry of q or qdot
+/// Throws SimulationError naming the first non-finite entry of q or qdot, or the first entry whose
+/// magnitude exceeds kDivergenceLimit (a diverging simulation, reported before it overflows).
 void checkFinite(const State& s, double h, const char* where);
+
+/// |q| or |qdot| beyond this is reported as divergence by checkFinite.
+inline constexpr double kDivergenceLimit = 1e100;
+
+/// Throws std::invalid_argument if the state does not fit the system or t_out < state.t.
+void checkAdvanceArguments(const System& sys, const State& s, double t_out, const char* where);
+
+/// Shared driver of the fixed-step methods: cuts [state.t, t_out] into ceil(span / dt) equal
+/// steps, calls step() for each, lets the joints switch chart after each step, checks for
+/// NaN/Inf, and sets state.t = t_out exactly at the end.
+class FixedStepIntegrator : public Integrator {
+ public:
+  explicit FixedStepIntegrator(const IntegratorOptions& opt) : opt_(opt) {}
+  void advance(const System& sys, State& state, double t_out) override;
+  /// one step of size h from state (state.t advanced by h); no chart switch, no NaN check
+  virtual void step(const System& sys, State& state, double h, DynamicsWorkspace& ws) = 0;
+  const IntegratorOptions& options() const { return opt_; }
+
+ protected:
+  IntegratorOptions opt_;
+};
 
 }  // namespace redmax

@@ -3,19 +3,20 @@
 
 namespace redmax {
 
-/// Semi-implicit (symplectic) Euler [D Eq. 4.20]: M qdot+ = M qdot + h f, q+ = q + h qdot+.
-/// Constraints are applied at the velocity level [D Eq. 4.102, 4.110]:
-///   G qdot+ = G qdot + h rhs - vel_err (drift correction), solved as one KKT system.
-class SymplecticEuler final : public Integrator {
+/// Semi-implicit (symplectic) Euler [D Eq. 4.19-4.20]:
+///   M qdot+ = M qdot + h f(q, qdot),   q+ = q + h qdot+.
+/// First order, explicit in the forces (stable only while h is below ~2/omega_max), but with
+/// bounded energy error on conservative systems. Constraints are applied at the velocity level
+/// [D Eq. 4.102, 4.104, 4.110] as one KKT system
+///   [M G^T; G 0] [qdot+; lambda] = [M qdot + h f; G qdot + h rhs - vel_err],
+/// where rhs = -Gdot qdot (+ prescribed accelerations) and subtracting vel_err removes velocity
+/// drift: for a closed loop vel_err = G qdot, so G qdot+ = -h Gdot qdot, i.e. G(q+) qdot+ ~ 0.
+class SymplecticEuler final : public FixedStepIntegrator {
  public:
-  explicit SymplecticEuler(const IntegratorOptions& opt) : opt_(opt) {}
+  explicit SymplecticEuler(const IntegratorOptions& opt) : FixedStepIntegrator(opt) {}
   std::string name() const override { return "euler"; }
-  void advance(const System& sys, State& state, double t_out) override;
-  /// one step of size h
-  void step(const System& sys, State& state, double h, DynamicsWorkspace& ws);
-
- private:
-  IntegratorOptions opt_;
+  /// one step of size h (state.t += h); M, f and constraint rows at the start of the step
+  void step(const System& sys, State& state, double h, DynamicsWorkspace& ws) override;
 };
 
 }  // namespace redmax

@@ -1,0 +1,24 @@
+#pragma once
+#include "core/integrators/integrator.hpp"
+
+namespace redmax {
+
+/// Linearly implicit backward Euler ("bdf1") [D Eq. 4.78-4.82]: the forces at the end of the
+/// step are linearised about the start, f(q+, qdot+) ~ f - K (q+ - q) - D (qdot+ - qdot) with
+/// K = -df/dq, D = -df/dqdot from System::calcStiffnessDamping (joint springs and dampers and
+/// every ForceTerm's implicit part), and q+ = q + h qdot+, giving
+///   (M + h D + h^2 K) qdot+ = M qdot + h (f + D qdot),   q+ = q + h qdot+.
+/// Our f already contains the damping force -D qdot at the old velocity; adding h D qdot back
+/// leaves the damping entirely implicit, which is [D Eq. 4.79-4.80] (there f excludes it).
+/// Gravity and velocity-product terms stay explicit (they are not in K, D). First order;
+/// unconditionally stable for linear springs and dampers. Constraints as in SymplecticEuler:
+/// velocity-level KKT rows with the implicit matrix in place of M.
+class LinearlyImplicitEuler final : public FixedStepIntegrator {
+ public:
+  explicit LinearlyImplicitEuler(const IntegratorOptions& opt) : FixedStepIntegrator(opt) {}
+  std::string name() const override { return "bdf1"; }
+  /// one step of size h (state.t += h)
+  void step(const System& sys, State& state, double h, DynamicsWorkspace& ws) override;
+};
+
+}  // namespace redmax

@@ -1,0 +1,397 @@
+// SUNDIALS 6.4 back ends of rk45 (ARKODE ERKStep, Dormand-Prince 5(4)) and cvode (CVODE BDF,
+// dense Newton). The only translation unit that includes SUNDIALS headers; the static SUNDIALS
+// archives are linked into libredmax_integrators with their symbols hidden (BUILD_NOTES trap 2).
+#include "core/integrators/sundials_integrators.hpp"
+
+#include <arkode/arkode_erkstep.h>
+#include <cvode/cvode.h>
+#include <cvode/cvode_ls.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <exception>
+#include <sstream>
+
+#include "core/skeleton/kinematics.hpp"
+
+namespace redmax {
+namespace detail {
+
+enum class SundialsKind { Erk, Cvode };
+
+/// Everything SUNDIALS: context, state vectors, solver memory, plus the binding to the System
+/// for the duration of one advance() call.
+struct SundialsSolver {
+  SundialsSolver(SundialsKind k, const IntegratorOptions& o) : kind(k), opt(o) {}
+  ~SundialsSolver() { release(); }
+
+  SundialsKind kind;
+  IntegratorOptions opt;
+  const char* label() const { return kind == SundialsKind::Erk ? "rk45" : "cvode"; }
+
+  // SUNDIALS objects, created once per system size
+  SUNContext ctx = nullptr;
+  N_Vector y = nullptr;     // internal state (2 ndof) at t_cur
+  N_Vector yout = nullptr;  // interpolated output
+  void* mem = nullptr;
+  SUNMatrix A = nullptr;
+  SUNLinearSolver LS = nullptr;
+  sunindextype N = 0;
+
+  // binding while advance() runs
+  const System* sys = nullptr;
+  DynamicsWorkspace* ws = nullptr;
+  State scratch;
+  std::exception_ptr rhs_exception;  // thrown inside the RHS (never propagated through C frames)
+  std::string rhs_error;             // why the RHS refused (non-finite input or output)
+  double rhs_error_t = 0.0;          // at which time
+  std::string sun_message;           // last error reported by SUNDIALS
+
+  // where the internal solution is, and what the last advance() returned
+  bool valid = false;
+  double t_cur = 0.0;
+  bool pending_chart_check = false;
+  const System* last_sys = nullptr;
+  State last_out;
+
+  // counters already folded into the stats
+  long seen_steps = 0, seen_rhs = 0, seen_jac = 0, seen_fail = 0;
+
+  void release() {
+    if (mem) {
+      if (kind == SundialsKind::Erk) ERKStepFree(&mem);
+      else CVodeFree(&mem);
+    }
+    if (LS) SUNLinSolFree(LS);
+    if (A) SUNMatDestroy(A);
+    if (y) N_VDestroy(y);
+    if (yout) N_VDestroy(yout);
+    if (ctx) SUNContext_Free(&ctx);
+    mem = nullptr;
+    LS = nullptr;
+    A = nullptr;
+    y = yout = nullptr;
+    ctx = nullptr;
+    N = 0;
+    valid = false;
+  }
+
+  [[noreturn]] void fail(const std::string& what, int flag) {
+    valid = false;
+    // an exception from the dynamics is rethrown as it was
+    if (rhs_exception) {
+      std::exception_ptr e = rhs_exception;
+      rhs_exception = nullptr;
+      std::rethrow_exception(e);
+    }
+    double t = t_cur, h = 0.0;
+    if (mem) {
+      if (kind == SundialsKind::Erk) {
+        ERKStepGetCurrentTime(mem, &t);
+        ERKStepGetCurrentStep(mem, &h);
+      } else {
+        CVodeGetCurrentTime(mem, &t);
+        CVodeGetCurrentStep(mem, &h);
+      }
+    }
+    // a refused RHS evaluation pins the time down better than the step start
+    if (!rhs_error.empty()) t = rhs_error_t;
+    std::ostringstream os;
+    os << label() << ": " << what;
+    if (flag != 0) {
+      char* name = kind == SundialsKind::Erk ? ERKStepGetReturnFlagName(flag)
+                                             : CVodeGetReturnFlagName(flag);
+      os << " (" << (name ? name : "?") << ")";
+      std::free(name);
+    }
+    os << " at t = " << t << " with step h = " << h;
+    if (!rhs_error.empty()) os << ": " << rhs_error;
+    else if (!sun_message.empty()) os << ": " << sun_message;
+    throw SimulationError(os.str(), t, h);
+  }
+
+  void check(int flag, const char* call) {
+    if (flag < 0) fail(std::string(call) + " failed", flag);
+  }
+
+  static int rhs(sunrealtype t, N_Vector yv, N_Vector ydot, void* user) {
+    auto* self = static_cast<SundialsSolver*>(user);
+    try {
+      const int n = self->sys->ndof();
+      const Eigen::Map<const VecX> Y(N_VGetArrayPointer(yv), 2 * n);
+      Eigen::Map<VecX> Yd(N_VGetArrayPointer(ydot), 2 * n);
+      if (!Y.allFinite()) {
+        std::ostringstream os;
+        os << "non-finite state passed to the dynamics at t = " << t;
+        self->rhs_error = os.str();
+        self->rhs_error_t = t;
+        return -1;
+      }
+      State& s = self->scratch;
+      s.t = t;
+      s.q = Y.head(n);
+      s.qdot = Y.tail(n);
+      const VecX qddot = self->sys->forwardDynamics(s, *self->ws);
+      for (int k = 0; k < n; ++k) {
+        if (!std::isfinite(qddot[k])) {
+          std::ostringstream os;
+          os << "non-finite qddot[" << k << "] = " << qddot[k] << " at t = " << t;
+          self->rhs_error = os.str();
+          self->rhs_error_t = t;
+          return -1;  // unrecoverable: no smaller step fixes a singular mass matrix
+        }
+      }
+      Yd.head(n) = s.qdot;
+      Yd.tail(n) = qddot;
+      return 0;
+    } catch (...) {
+      self->rhs_exception = std::current_exception();
+      return -1;
+    }
+  }
+
+  static void errHandler(int code, const char* module, const char* function, char* msg, void* user) {
+    if (code > 0) return;  // warnings (e.g. t + h == t) are not failures
+    auto* self = static_cast<SundialsSolver*>(user);
+    self->sun_message = std::string(module ? module : "") + "::" + (function ? function : "") + ": " +
+                        (msg ? msg : "");
+  }
+
+  /// make sure the vectors fit 2 ndof; a new size frees and recreates everything
+  void ensureSize(int n2) {
+    if (ctx && N == n2) return;
+    release();
+    if (SUNContext_Create(nullptr, &ctx) != 0 || !ctx) fail("SUNContext_Create failed", 0);
+    N = n2;
+    y = N_VNew_Serial(N, ctx);
+    yout = N_VNew_Serial(N, ctx);
+    if (!y || !yout) fail("N_VNew_Serial failed", 0);
+  }
+
+  /// (re)initialise the solver at (t0, y); keeps all options
+  void init(double t0) {
+    if (kind == SundialsKind::Erk) {
+      if (!mem) {
+        mem = ERKStepCreate(&SundialsSolver::rhs, t0, y, ctx);
+        if (!mem) fail("ERKStepCreate failed", 0);
+        check(ERKStepSetTableNum(mem, ARKODE_DORMAND_PRINCE_7_4_5), "ERKStepSetTableNum");
+        check(ERKStepSStolerances(mem, opt.rtol, opt.atol), "ERKStepSStolerances");
+        check(ERKStepSetUserData(mem, this), "ERKStepSetUserData");
+        check(ERKStepSetErrHandlerFn(mem, &SundialsSolver::errHandler, this), "ERKStepSetErrHandlerFn");
+        if (opt.max_step > 0.0) check(ERKStepSetMaxStep(mem, opt.max_step), "ERKStepSetMaxStep");
+        if (opt.initial_step > 0.0) check(ERKStepSetInitStep(mem, opt.initial_step), "ERKStepSetInitStep");
+      } else {
+        check(ERKStepReInit(mem, &SundialsSolver::rhs, t0, y), "ERKStepReInit");
+      }
+    } else {
+      if (!mem) {
+        mem = CVodeCreate(CV_BDF, ctx);
+        if (!mem) fail("CVodeCreate failed", 0);
+        check(CVodeSetErrHandlerFn(mem, &SundialsSolver::errHandler, this), "CVodeSetErrHandlerFn");
+        check(CVodeInit(mem, &SundialsSolver::rhs, t0, y), "CVodeInit");
+        check(CVodeSStolerances(mem, opt.rtol, opt.atol), "CVodeSStolerances");
+        check(CVodeSetUserData(mem, this), "CVodeSetUserData");
+        A = SUNDenseMatrix(N, N, ctx);
+        LS = A ? SUNLinSol_Dense(y, A, ctx) : nullptr;
+        if (!A || !LS) fail("SUNDenseMatrix/SUNLinSol_Dense failed", 0);
+        // no Jacobian function: CVODE's difference quotients (2 ndof RHS evaluations each)
+        check(CVodeSetLinearSolver(mem, LS, A), "CVodeSetLinearSolver");
+        if (opt.max_step > 0.0) check(CVodeSetMaxStep(mem, opt.max_step), "CVodeSetMaxStep");
+        if (opt.initial_step > 0.0) check(CVodeSetInitStep(mem, opt.initial_step), "CVodeSetInitStep");
+      } else {
+        check(CVodeReInit(mem, t0, y), "CVodeReInit");
+      }
+    }
+    t_cur = t0;
+    resetCounterBaseline();
+  }
+
+  /// restart after a chart switch of the state in y at t_cur
+  void restartAfterChartSwitch() {
+    if (kind == SundialsKind::Erk) {
+      // keeps counters and the step size history
+      check(ERKStepReset(mem, t_cur, y), "ERKStepReset");
+      resetCounterBaseline();
+    } else {
+      init(t_cur);
+    }
+  }
+
+  void readCounters(long& nst, long& nfe, long& nje, long& nfail) {
+    nst = nfe = nje = nfail = 0;
+    if (!mem) return;
+    if (kind == SundialsKind::Erk) {
+      long netf = 0;
+      ERKStepGetNumSteps(mem, &nst);
+      ERKStepGetNumRhsEvals(mem, &nfe);
+      ERKStepGetNumErrTestFails(mem, &netf);
+      nfail = netf;
+    } else {
+      long nfe_ls = 0, netf = 0, ncfn = 0;
+      CVodeGetNumSteps(mem, &nst);
+      CVodeGetNumRhsEvals(mem, &nfe);
+      CVodeGetNumLinRhsEvals(mem, &nfe_ls);
+      CVodeGetNumJacEvals(mem, &nje);
+      CVodeGetNumErrTestFails(mem, &netf);
+      CVodeGetNumNonlinSolvConvFails(mem, &ncfn);
+      nfe += nfe_ls;
+      nfail = netf + ncfn;
+    }
+  }
+
+  void resetCounterBaseline() { readCounters(seen_steps, seen_rhs, seen_jac, seen_fail); }
+
+  /// fold counter increments since the last call into the stats (works whether a re-init
+  /// resets SUNDIALS' counters or not, since the baseline is re-read after each)
+  void syncStats(IntegratorStats& st) {
+    long nst, nfe, nje, nfail;
+    readCounters(nst, nfe, nje, nfail);
+    auto add = [](long& stat, long& seen, long now) {
+      stat += now >= seen ? now - seen : now;
+      seen = now;
+    };
+    add(st.steps, seen_steps, nst);
+    add(st.rhs_evals, seen_rhs, nfe);
+    add(st.jacobian_evals, seen_jac, nje);
+    add(st.failed_steps, seen_fail, nfail);
+  }
+
+  /// one internal step towards t_out; returns the new internal time
+  double step(double t_out) {
+    sunrealtype tret = t_cur;
+    rhs_error.clear();
+    sun_message.clear();
+    const int flag = kind == SundialsKind::Erk ? ERKStepEvolve(mem, t_out, y, &tret, ARK_ONE_STEP)
+                                               : CVode(mem, t_out, y, &tret, CV_ONE_STEP);
+    if (flag < 0 || rhs_exception) fail("step failed", flag);
+    t_cur = tret;
+    return tret;
+  }
+
+  void interpolate(double t, N_Vector out) {
+    const int flag = kind == SundialsKind::Erk ? ERKStepGetDky(mem, t, 0, out) : CVodeGetDky(mem, t, 0, out);
+    if (flag < 0) fail("dense output failed", flag);
+  }
+
+  double lastStep() {
+    sunrealtype h = 0.0;
+    if (mem) {
+      if (kind == SundialsKind::Erk) ERKStepGetLastStep(mem, &h);
+      else CVodeGetLastStep(mem, &h);
+    }
+    return h;
+  }
+};
+
+}  // namespace detail
+
+namespace {
+using detail::SundialsSolver;
+
+void toState(N_Vector v, int n, double t, State& s) {
+  const Eigen::Map<const VecX> Y(N_VGetArrayPointer(v), 2 * n);
+  s.t = t;
+  s.q = Y.head(n);
+  s.qdot = Y.tail(n);
+}
+
+void fromState(const State& s, N_Vector v) {
+  const int n = static_cast<int>(s.q.size());
+  Eigen::Map<VecX> Y(N_VGetArrayPointer(v), 2 * n);
+  Y.head(n) = s.q;
+  Y.tail(n) = s.qdot;
+}
+
+/// binds the System and workspace to the solver for one advance() call
+struct Binding {
+  Binding(SundialsSolver& s, const System& sys, DynamicsWorkspace& ws) : solver(s) {
+    solver.sys = &sys;
+    solver.ws = &ws;
+    solver.rhs_exception = nullptr;
+  }
+  ~Binding() {
+    solver.sys = nullptr;
+    solver.ws = nullptr;
+  }
+  SundialsSolver& solver;
+};
+}  // namespace
+
+SundialsIntegrator::SundialsIntegrator(const IntegratorOptions& opt) : opt_(opt) {}
+SundialsIntegrator::~SundialsIntegrator() = default;
+
+ArkodeRk45::ArkodeRk45(const IntegratorOptions& opt) : SundialsIntegrator(opt) {
+  solver_ = std::make_unique<detail::SundialsSolver>(detail::SundialsKind::Erk, opt);
+}
+
+CvodeBdf::CvodeBdf(const IntegratorOptions& opt) : SundialsIntegrator(opt) {
+  solver_ = std::make_unique<detail::SundialsSolver>(detail::SundialsKind::Cvode, opt);
+}
+
+void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
+  const std::string who = name();
+  checkAdvanceArguments(sys, s, t_out, who.c_str());
+  if (t_out == s.t) return;
+  SundialsSolver& S = *solver_;
+  const int n = sys.ndof();
+  DynamicsWorkspace ws(sys.model());
+  Binding bind(S, sys, ws);
+  try {
+    // resume from the internal solution only if the caller did not touch the returned state
+    const bool resume = S.valid && S.last_sys == &sys && S.N == 2 * n && s.t == S.last_out.t &&
+                        s.q == S.last_out.q && s.qdot == S.last_out.qdot;
+    if (!resume) {
+      checkFinite(s, 0.0, who.c_str());
+      S.valid = false;
+      S.ensureSize(2 * n);
+      fromState(s, S.y);
+      S.init(s.t);
+      S.valid = true;
+      S.pending_chart_check = true;
+    }
+    State internal;
+    long steps_here = 0;
+    while (S.t_cur < t_out) {
+      // chart switch of the last accepted step, deferred until its interpolant is no longer
+      // needed for output (a restart discards it)
+      if (S.pending_chart_check) {
+        S.pending_chart_check = false;
+        toState(S.y, n, S.t_cur, internal);
+        const int switched = reparameterizeJoints(sys.model(), internal);
+        if (switched > 0) {
+          stats_.reparameterizations += switched;
+          fromState(internal, S.y);
+          S.restartAfterChartSwitch();
+        }
+      }
+      if (++steps_here > opt_.max_steps) {
+        S.valid = false;
+        throw SimulationError(who + ": more than max_steps = " + std::to_string(opt_.max_steps) +
+                                  " internal steps in one advance() call",
+                              S.t_cur, S.lastStep());
+      }
+      const double t = S.step(t_out);
+      S.syncStats(stats_);
+      toState(S.y, n, t, internal);
+      checkFinite(internal, S.lastStep(), who.c_str());
+      S.pending_chart_check = true;
+    }
+    // dense output at t_out; the returned state may switch chart on its own copy
+    S.interpolate(t_out, S.yout);
+    toState(S.yout, n, t_out, s);
+    checkFinite(s, S.lastStep(), who.c_str());
+    reparameterizeJoints(sys.model(), s);
+    S.last_out = s;
+    S.last_sys = &sys;
+  } catch (...) {
+    S.valid = false;
+    S.syncStats(stats_);
+    throw;
+  }
+}
+
+}  // namespace redmax
