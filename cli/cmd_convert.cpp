@@ -1,0 +1,58 @@
+// `redmax convert`: read an OpenSim model, print a summary, optionally write the intermediate
+// description as JSON. Errors are `error: FILE:LINE: what` with exit code 2 (DESIGN.md §3).
+#include <iostream>
+
+#include "cli/args.hpp"
+#include "converter/atomic_file.hpp"
+#include "converter/json_writer.hpp"
+#include "converter/osim_reader.hpp"
+
+namespace redmax::cli {
+namespace {
+
+int runConvert(const std::vector<std::string>& argv) {
+  Args a(argv, {"json"}, {"strict", "quiet"});
+  if (a.positionals().size() != 1)
+    throw UsageError{a.positionals().empty() ? "convert needs a MODEL.osim"
+                                             : "convert takes one MODEL.osim"};
+  const std::string model_path = a.positionals()[0];
+  try {
+    const osim::ModelDescription d = osim::readOsimModel(model_path);
+    if (a.has("strict") && !d.unsupported.empty()) {
+      // --strict: anything read but not modelled is an error; name the first, count the rest
+      const auto& u = d.unsupported.front();
+      std::cerr << "error: " << osim::ConvertError(model_path, u.line, "unsupported: " + u.what).what()
+                << "\n";
+      if (d.unsupported.size() > 1)
+        std::cerr << "error: ... and " << d.unsupported.size() - 1
+                  << " more unsupported items (run without --strict to list them)\n";
+      return 2;
+    }
+    // write the JSON first: a failed write must not be preceded by a success summary
+    if (auto out = a.get("json")) osim::writeFileAtomic(*out, osim::describeAsJson(d));
+    if (!a.has("quiet")) std::cout << osim::formatSummary(d);
+    return 0;
+  } catch (const osim::ConvertError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+}
+
+CommandRegistration reg(
+    {"convert", "read an OpenSim .osim model; print a summary, optionally write JSON",
+     "usage: redmax convert MODEL.osim [--json OUT.json] [--strict] [--quiet]\n"
+     "Reads an OpenSim model (file versions 10901 to 40600; legacy files are upgraded as OpenSim\n"
+     "upgrades them) and prints a summary: bodies, degrees of freedom, joints by type, muscles by\n"
+     "path type (I straight, II via/conditional/moving points, III wrapping), constraints, and\n"
+     "the items that are read but not modelled.\n"
+     "  --json OUT.json  also write the intermediate description (written atomically): name,\n"
+     "                   osim_version, bodies, joints, coordinates (in OpenSim's multibody-tree\n"
+     "                   order), constraints, muscles, forces, wrap_objects, markers, tree,\n"
+     "                   unsupported, warnings\n"
+     "  --strict         treat any unsupported item as an error (exit 2)\n"
+     "  --quiet          do not print the summary\n"
+     "Errors are printed as `error: FILE:LINE: what` with exit code 2.\n",
+     runConvert});
+
+}  // namespace
+}  // namespace redmax::cli

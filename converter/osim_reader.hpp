@@ -1,0 +1,24 @@
+#pragma once
+// Reader for OpenSim model files (.osim): the 4.0 layout (Version 40000 and later) and the legacy
+// layouts 10901 ... 30000, upgraded as OpenSim upgrades them (OPENSIM_SEMANTICS.md §1).
+#include <string>
+
+#include "converter/error.hpp"
+#include "converter/model_description.hpp"
+
+namespace redmax::osim {
+
+/// Read and resolve a .osim file. Sockets, offset-frame chains and legacy upgrades are resolved;
+/// coordinates come out in OpenSim's multibody-tree order (§3.1). Items that are read but not
+/// modelled are listed in ModelDescription::unsupported. Throws ConvertError ("FILE:LINE: what")
+/// on unreadable, malformed or inconsistent input; never leaves a partial result.
+ModelDescription readOsimModel(const std::string& path);
+
+/// Build the multibody tree as Simbody's MultibodyGraphMaker does for OpenSim (§3.1): fills
+/// d.tree, appends FreeJoints for unconnected bodies and loop-closure constraints, and reorders
+/// d.coordinates (with the joints' indices) into mobilizer order. Expects d.joints with resolved
+/// parent_body/child_body and d.coordinates in any order. Throws ConvertError on bodies or joints
+/// that cannot form a tree (e.g. a joint naming an unknown body).
+void buildMultibodyTree(ModelDescription& d);
+
+}  // namespace redmax::osim
