@@ -1,5 +1,7 @@
 #include "core/dynamics/system.hpp"
 
+#include <cmath>
+
 #include <Eigen/Dense>
 
 #include "core/dynamics/skeleton_dynamics.hpp"
@@ -14,35 +16,128 @@ DynamicsWorkspace::DynamicsWorkspace(const Model& model) : sk(model) {
   D.setZero(n, n);
 }
 
-System::System(Model model) : model_(std::move(model)) {}
+System::System(Model model) : model_(std::move(model)), ndof_(model_.nr()) {}
 
 void System::addConstraint(std::shared_ptr<const Constraint> c) {
+  if (!c) throw ModelError("System::addConstraint: null constraint");
   nc_ += c->rows();
   constraints_.push_back(std::move(c));
 }
 
+void System::setCoordinateMap(std::shared_ptr<const CoordinateMap> map) {
+  if (map && map->nr() != model_.nr())
+    throw ModelError("System::setCoordinateMap: map built for " + std::to_string(map->nr()) +
+                     " coordinates, model has " + std::to_string(model_.nr()));
+  map_ = std::move(map);
+  ndof_ = map_ ? map_->nR() : model_.nr();
+}
+
 State System::defaultState() const {
   State s;
-  s.q = model_.defaultQ();
+  s.q = map_ ? map_->reduce(model_.defaultQ()) : model_.defaultQ();
   s.qdot = VecX::Zero(ndof());
   return s;
 }
 
-void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
-  calcKinematics(model_, s, ws.sk);
-  calcSkeletonMass(model_, ws.sk, ws.M);
-  calcSkeletonForce(model_, s, ws.sk, ws.f);
-  for (const auto& t : terms_) {
-    t->addMass(model_, s, ws.sk, ws.M);
-    t->addForce(model_, s, ws.sk, ws.f);
+void System::expandInto(const State& s, DynamicsWorkspace& ws) const {
+  ws.s_r.t = s.t;
+  map_->calc(s.q, s.qdot, ws.s_r.q, ws.s_r.qdot, ws.J_rR, ws.Jdot_rR);
+}
+
+State System::expandState(const State& s) const {
+  if (!map_) return s;
+  State r;
+  r.t = s.t;
+  MatX J, Jdot;
+  map_->calc(s.q, s.qdot, r.q, r.qdot, J, Jdot);
+  return r;
+}
+
+State System::reduceState(const State& s_r) const {
+  if (!map_) return s_r;
+  State s;
+  s.t = s_r.t;
+  s.q = map_->reduce(s_r.q);
+  s.qdot = map_->reduce(s_r.qdot);
+  return s;
+}
+
+int System::reparameterize(State& s) const {
+  if (!map_) return reparameterizeJoints(model_, s);
+  int count = 0;
+  VecJ q, qd;
+  for (const JointSlot& slot : model_.joints) {
+    if (slot.nq == 0) continue;
+    // only joints entirely made of independent coordinates that drive no dependent one
+    bool free = true;
+    for (int k = 0; k < slot.nq && free; ++k) {
+      const int r = slot.q_index + k;
+      free = map_->reducedIndex(r) >= 0 && !map_->isArgument(r);
+    }
+    if (!free) continue;
+    q.resize(slot.nq);
+    qd.resize(slot.nq);
+    for (int k = 0; k < slot.nq; ++k) {
+      const int j = map_->reducedIndex(slot.q_index + k);
+      q[k] = s.q[j];
+      qd[k] = s.qdot[j];
+    }
+    if (!slot.joint.reparameterize(q, qd)) continue;
+    for (int k = 0; k < slot.nq; ++k) {
+      const int j = map_->reducedIndex(slot.q_index + k);
+      s.q[j] = q[k];
+      s.qdot[j] = qd[k];
+    }
+    ++count;
   }
+  return count;
+}
+
+void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
+  if (!map_) {
+    calcKinematics(model_, s, ws.sk);
+    calcSkeletonMass(model_, ws.sk, ws.M);
+    calcSkeletonForce(model_, s, ws.sk, ws.f);
+    for (const auto& t : terms_) {
+      t->addMass(model_, s, ws.sk, ws.M);
+      t->addForce(model_, s, ws.sk, ws.f);
+    }
+    return;
+  }
+  // skeleton and terms in q_r at the expanded state, then chained through J_rR [D Eq. 4.86]
+  expandInto(s, ws);
+  calcKinematics(model_, ws.s_r, ws.sk);
+  calcSkeletonMass(model_, ws.sk, ws.M_r);
+  calcSkeletonForce(model_, ws.s_r, ws.sk, ws.f_r);
+  for (const auto& t : terms_) {
+    t->addMass(model_, ws.s_r, ws.sk, ws.M_r);
+    t->addForce(model_, ws.s_r, ws.sk, ws.f_r);
+  }
+  const MatX MJ = ws.M_r * ws.J_rR;
+  ws.M.noalias() = ws.J_rR.transpose() * MJ;
+  const VecX fr = ws.f_r - ws.M_r * (ws.Jdot_rR * s.qdot);
+  ws.f.noalias() = ws.J_rR.transpose() * fr;
 }
 
 void System::calcStiffnessDamping(const State& s, DynamicsWorkspace& ws) const {
-  ws.K.setZero(ndof(), ndof());
-  ws.D.setZero(ndof(), ndof());
-  addJointStiffnessDamping(model_, ws.K, ws.D);
-  for (const auto& t : terms_) t->addStiffnessDamping(model_, s, ws.sk, ws.K, ws.D);
+  if (!map_) {
+    ws.K.setZero(ndof(), ndof());
+    ws.D.setZero(ndof(), ndof());
+    addJointStiffnessDamping(model_, ws.K, ws.D);
+    for (const auto& t : terms_) t->addStiffnessDamping(model_, s, ws.sk, ws.K, ws.D);
+    return;
+  }
+  // K_R = J^T K_r J, D_R = J^T D_r J. The derivatives of J_rR and Jdot_rR themselves are left
+  // out, as the skeleton leaves out dM/dq and its velocity products: the implicit part covers
+  // springs and dampers, the rest stays explicit.
+  expandInto(s, ws);
+  const int nr = model_.nr();
+  ws.K_r.setZero(nr, nr);
+  ws.D_r.setZero(nr, nr);
+  addJointStiffnessDamping(model_, ws.K_r, ws.D_r);
+  for (const auto& t : terms_) t->addStiffnessDamping(model_, ws.s_r, ws.sk, ws.K_r, ws.D_r);
+  ws.K.noalias() = ws.J_rR.transpose() * (ws.K_r * ws.J_rR);
+  ws.D.noalias() = ws.J_rR.transpose() * (ws.D_r * ws.J_rR);
 }
 
 void System::calcConstraints(const State& s, DynamicsWorkspace& ws) const {
@@ -50,12 +145,28 @@ void System::calcConstraints(const State& s, DynamicsWorkspace& ws) const {
   ws.rhs.setZero(nc_);
   ws.pos_err.setZero(nc_);
   ws.vel_err.setZero(nc_);
-  int row = 0;
-  for (const auto& c : constraints_) {
-    const int m = c->rows();
-    c->calcAcceleration(model_, s, ws.sk, ws.G.middleRows(row, m), ws.rhs.segment(row, m));
-    c->calcErrors(model_, s, ws.sk, ws.pos_err.segment(row, m), ws.vel_err.segment(row, m));
-    row += m;
+  if (!map_) {
+    int row = 0;
+    for (const auto& c : constraints_) {
+      const int m = c->rows();
+      c->calcAcceleration(model_, s, ws.sk, ws.G.middleRows(row, m), ws.rhs.segment(row, m));
+      c->calcErrors(model_, s, ws.sk, ws.pos_err.segment(row, m), ws.vel_err.segment(row, m));
+      row += m;
+    }
+  } else {
+    // constraints on q_r (reduced or maximal, [D Eq. 4.105]) chained through q_r = g(q_R):
+    // G_r qddot_r = G_r J_rR qddot_R + G_r Jdot_rR qdot_R
+    ws.G_r.setZero(nc_, model_.nr());
+    ws.rhs_r.setZero(nc_);
+    int row = 0;
+    for (const auto& c : constraints_) {
+      const int m = c->rows();
+      c->calcAcceleration(model_, ws.s_r, ws.sk, ws.G_r.middleRows(row, m), ws.rhs_r.segment(row, m));
+      c->calcErrors(model_, ws.s_r, ws.sk, ws.pos_err.segment(row, m), ws.vel_err.segment(row, m));
+      row += m;
+    }
+    ws.G.noalias() = ws.G_r * ws.J_rR;
+    ws.rhs = ws.rhs_r - ws.G_r * (ws.Jdot_rR * s.qdot);
   }
   const auto& st = stabilization;
   if (st.alpha != 0.0 || st.beta != 0.0)
@@ -106,17 +217,61 @@ VecX System::inverseDynamics(const State& s, const VecX& qddot, DynamicsWorkspac
   return ws.M * qddot - ws.f;
 }
 
+VecX System::prescribedForces(const DynamicsWorkspace& ws) const {
+  VecX tau = VecX::Zero(ndof());
+  if (ws.lambda.size() != nc_ || ws.G.rows() != nc_) return tau;
+  int row = 0;
+  for (const auto& c : constraints_) {
+    const int m = c->rows();
+    if (c->isPrescribed()) tau.noalias() -= ws.G.middleRows(row, m).transpose() * ws.lambda.segment(row, m);
+    row += m;
+  }
+  return tau;
+}
+
+double System::projectPositions(State& s, DynamicsWorkspace& ws, double tol, int max_iter) const {
+  if (nc_ == 0) return 0.0;
+  const VecX zero = VecX::Zero(ndof());
+  for (int it = 0;; ++it) {
+    calcMassAndForce(s, ws);
+    calcConstraints(s, ws);
+    const double err = ws.pos_err.lpNorm<Eigen::Infinity>();
+    if (err <= tol || it >= max_iter || !std::isfinite(err)) return err;
+    // Newton step on C(q) = 0 of least kinetic metric |dq|_M (redundant rows: minimum norm)
+    s.q += solveKKT(ws.M, ws.G, zero, -ws.pos_err, nullptr);
+  }
+}
+
+double System::projectVelocities(State& s, DynamicsWorkspace& ws) const {
+  if (nc_ == 0) return 0.0;
+  calcMassAndForce(s, ws);
+  calcConstraints(s, ws);
+  const VecX dqdot = solveKKT(ws.M, ws.G, VecX::Zero(ndof()), -ws.vel_err, nullptr);
+  s.qdot += dqdot;
+  return (ws.vel_err + ws.G * dqdot).lpNorm<Eigen::Infinity>();
+}
+
 double System::kineticEnergy(const State& s, DynamicsWorkspace& ws) const {
-  calcKinematics(model_, s, ws.sk);
+  const State* sk_state = &s;
+  if (map_) {
+    expandInto(s, ws);
+    sk_state = &ws.s_r;
+  }
+  calcKinematics(model_, *sk_state, ws.sk);
   double T = skeletonKineticEnergy(model_, ws.sk);
-  for (const auto& t : terms_) T += t->kineticEnergy(model_, s, ws.sk);
+  for (const auto& t : terms_) T += t->kineticEnergy(model_, *sk_state, ws.sk);
   return T;
 }
 
 double System::potentialEnergy(const State& s, DynamicsWorkspace& ws) const {
-  calcKinematics(model_, s, ws.sk);
-  double V = skeletonPotentialEnergy(model_, s, ws.sk);
-  for (const auto& t : terms_) V += t->potentialEnergy(model_, s, ws.sk);
+  const State* sk_state = &s;
+  if (map_) {
+    expandInto(s, ws);
+    sk_state = &ws.s_r;
+  }
+  calcKinematics(model_, *sk_state, ws.sk);
+  double V = skeletonPotentialEnergy(model_, *sk_state, ws.sk);
+  for (const auto& t : terms_) V += t->potentialEnergy(model_, *sk_state, ws.sk);
   return V;
 }
 

@@ -5,10 +5,21 @@
 // and, with constraints, the KKT system of [D Eq. 4.101-4.109]
 //   [ M  G^T ] [qddot ]   [ f   ]
 //   [ G   0  ] [lambda] = [ rhs ]
+// i.e. M qddot = f - G^T lambda: -G^T lambda is the generalized constraint force. (Prescribed
+// coordinates choose the sign of their row so that their multiplier is the actuating force; see
+// core/dynamics/constraints/prescribed_coordinate.hpp.)
+//
+// Hyper-reduced coordinates [D Sec. 4.6.2]: with a CoordinateMap q_r = g(q_R) the system's
+// coordinates are q_R (ndof = map->nR()); the skeleton, the ForceTerms and the Constraints still
+// see the expanded q_r, and the System maps everything to q_R:
+//   M = J_rR^T M_r J_rR,  f = J_rR^T (f_r - M_r Jdot_rR qdot_R),  G = G_r J_rR,
+//   rhs = rhs_r - G_r Jdot_rR qdot_R                                 [D Eq. 4.84-4.86, 4.105]
+// Without a map (the default) nothing changes: q = q_r and ndof = nr.
 #include <memory>
 #include <vector>
 
 #include "core/dynamics/constraint.hpp"
+#include "core/dynamics/coordinate_map.hpp"
 #include "core/dynamics/force_term.hpp"
 #include "core/skeleton/kinematics.hpp"
 
@@ -25,6 +36,16 @@ struct DynamicsWorkspace {
   VecX rhs;        // acceleration-level rhs           (nc)
   VecX lambda;     // constraint multipliers           (nc)
   VecX pos_err, vel_err;                            // (nc)
+
+  // hyper-reduced coordinates only (System with a CoordinateMap); skeleton-side quantities,
+  // sized on first use
+  State s_r;                 // expanded state: q_r = g(q_R), qdot_r = J_rR qdot_R   (nr)
+  MatX J_rR, Jdot_rR;        // (nr x ndof)
+  MatX M_r;                  // skeleton + terms mass matrix in q_r              (nr x nr)
+  VecX f_r;                  // skeleton + terms force in q_r                    (nr)
+  MatX K_r, D_r;             // (nr x nr)
+  MatX G_r;                  // constraint Jacobian in q_r                       (nc x nr)
+  VecX rhs_r;                // (nc)
 };
 
 /// Baumgarte stabilisation for acceleration-level constraints: rhs -= 2 alpha verr + beta^2 perr.
@@ -38,7 +59,8 @@ class System {
   explicit System(Model model);
 
   const Model& model() const { return model_; }
-  int ndof() const { return model_.nr(); }
+  /// number of system coordinates: nr, or the map's nR with hyper-reduced coordinates
+  int ndof() const { return ndof_; }
   int numConstraintRows() const { return nc_; }
 
   void addTerm(std::shared_ptr<const ForceTerm> term) { terms_.push_back(std::move(term)); }
@@ -48,6 +70,31 @@ class System {
   StabilizationOptions stabilization;
 
   State defaultState() const;
+
+  /// Use hyper-reduced coordinates q_r = g(q_R) [D Sec. 4.6.2]; nullptr goes back to q_r.
+  /// States passed to the System afterwards have ndof() = map->nR() entries. Throws ModelError
+  /// if the map was built for a model with a different number of coordinates.
+  void setCoordinateMap(std::shared_ptr<const CoordinateMap> map);
+  const std::shared_ptr<const CoordinateMap>& coordinateMap() const { return map_; }
+  /// the skeleton state (q_r, qdot_r) of a system state, for output and for skeleton-level
+  /// algorithms (identity without a map)
+  State expandState(const State& s) const;
+  /// the system state of a skeleton state: the independent entries (identity without a map)
+  State reduceState(const State& s_r) const;
+  /// Joint chart switches [D Sec. 4.5.8] on a system state. Without a map this is
+  /// reparameterizeJoints(model(), s). With a map, only joints whose coordinates are all
+  /// independent and none of which drives a dependent coordinate may switch (a switch would
+  /// otherwise jump the dependents). Returns the number of joints switched.
+  int reparameterize(State& s) const;
+
+  /// Position projection onto the constraint manifold: mass-weighted Newton steps
+  ///   [M G^T; G 0] [dq; mu] = [0; -C]
+  /// until max |C| <= tol or max_iter steps; redundant rows are handled as in solveKKT.
+  /// Returns the final max |C| (0 without constraints). Uses s.t for prescribed motion.
+  double projectPositions(State& s, DynamicsWorkspace& ws, double tol = 1e-12, int max_iter = 20) const;
+  /// Velocity projection: qdot += dqdot with [M G^T; G 0] [dqdot; mu] = [0; -Cdot]; returns the
+  /// remaining max |Cdot| predicted by the linear step.
+  double projectVelocities(State& s, DynamicsWorkspace& ws) const;
 
   /// kinematics, M and f (skeleton + terms) [D Eq. 4.76]
   void calcMassAndForce(const State& s, DynamicsWorkspace& ws) const;
@@ -60,11 +107,17 @@ class System {
   VecX forwardDynamics(const State& s, DynamicsWorkspace& ws) const;
   /// generalized forces tau with M qddot = f + tau (REDMAX route, unconstrained) [D Eq. 4.18]
   VecX inverseDynamics(const State& s, const VecX& qddot, DynamicsWorkspace& ws) const;
+  /// generalized forces (ndof) of the prescribed constraints' rows, -G_p^T lambda_p, after
+  /// forwardDynamics: the actuation that realises the prescribed motion [D Eq. 4.109]
+  VecX prescribedForces(const DynamicsWorkspace& ws) const;
 
   double kineticEnergy(const State& s, DynamicsWorkspace& ws) const;
   double potentialEnergy(const State& s, DynamicsWorkspace& ws) const;
 
-  /// solve [M G^T; G 0] [x; lambda] = [a; b] (dense; G may be empty)
+  /// solve [M G^T; G 0] [x; lambda] = [a; b] (dense; G may be empty). Redundant rows of G
+  /// (rank-deficient G M^-1 G^T, e.g. a 3-row point constraint closing a planar loop) are
+  /// handled by a complete orthogonal decomposition: x is the consistent solution and lambda the
+  /// minimum-norm multiplier; an inconsistent b is met in the least-squares sense.
   static VecX solveKKT(const MatX& M, const MatX& G, const VecX& a, const VecX& b, VecX* lambda);
 
  private:
@@ -72,6 +125,10 @@ class System {
   std::vector<std::shared_ptr<const ForceTerm>> terms_;
   std::vector<std::shared_ptr<const Constraint>> constraints_;
   int nc_ = 0;
+  std::shared_ptr<const CoordinateMap> map_;
+  int ndof_ = 0;
+  /// with a map: ws.s_r, ws.J_rR, ws.Jdot_rR from a system state
+  void expandInto(const State& s, DynamicsWorkspace& ws) const;
 };
 
 }  // namespace redmax
