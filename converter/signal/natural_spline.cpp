@@ -52,12 +52,23 @@ struct HermiteBasis {
 // kl extra super-diagonals that partial pivoting fills in (as LAPACK's dgbtrf does).
 class BandMatrix {
  public:
-  BandMatrix(int n, int kl, int ku) : n_(n), kl_(kl), ku_(ku), w_(2 * kl + ku + 1), a_(static_cast<size_t>(n) * w_, 0.0) {}
+  BandMatrix(int n, int kl, int ku)
+      : n_(n), kl_(kl), ku_(ku), w_(2 * kl + ku + 1), a_(static_cast<size_t>(n) * w_, 0.0), piv_(n) {}
   // requires r - kl <= c <= r + kl + ku
   double& at(int r, int c) { return a_[static_cast<size_t>(r) * w_ + (c - r + kl_)]; }
+  double at(int r, int c) const { return a_[static_cast<size_t>(r) * w_ + (c - r + kl_)]; }
 
-  // solve A x = b in place by Gaussian elimination with partial pivoting
-  void solve(std::vector<double>& b) {
+  // A x, summed in long double (for the refinement residual); before factorize() only
+  void multiply(const std::vector<double>& x, std::vector<long double>& y) const {
+    for (int r = 0; r < n_; ++r) {
+      long double s = 0;
+      for (int c = std::max(r - kl_, 0); c <= std::min(r + ku_, n_ - 1); ++c) s += static_cast<long double>(at(r, c)) * x[c];
+      y[r] = s;
+    }
+  }
+
+  // in-place LU by Gaussian elimination with partial pivoting; multipliers kept below the diagonal
+  void factorize() {
     for (int k = 0; k < n_; ++k) {
       const int last_row = std::min(k + kl_, n_ - 1);
       const int last_col = std::min(k + kl_ + ku_, n_ - 1);
@@ -65,17 +76,24 @@ class BandMatrix {
       for (int r = k + 1; r <= last_row; ++r)
         if (std::abs(at(r, k)) > std::abs(at(p, k))) p = r;
       if (!(std::abs(at(p, k)) > 0.0)) throw SignalError("natural spline: singular system (knots too close?)");
-      if (p != k) {
+      piv_[k] = p;
+      if (p != k)
         for (int c = k; c <= last_col; ++c) std::swap(at(k, c), at(p, c));
-        std::swap(b[k], b[p]);
-      }
       for (int r = k + 1; r <= last_row; ++r) {
         const double f = at(r, k) / at(k, k);
+        at(r, k) = f;
         if (f == 0.0) continue;
         for (int c = k + 1; c <= last_col; ++c) at(r, c) -= f * at(k, c);
-        b[r] -= f * b[k];
-        at(r, k) = 0.0;
       }
+    }
+  }
+
+  // solve with the factors, in place
+  void solve(std::vector<double>& b) const {
+    for (int k = 0; k < n_; ++k) {
+      if (piv_[k] != k) std::swap(b[k], b[piv_[k]]);
+      const int last_row = std::min(k + kl_, n_ - 1);
+      for (int r = k + 1; r <= last_row; ++r) b[r] -= at(r, k) * b[k];
     }
     for (int k = n_ - 1; k >= 0; --k) {
       double s = b[k];
@@ -88,6 +106,7 @@ class BandMatrix {
  private:
   int n_, kl_, ku_, w_;
   std::vector<double> a_;
+  std::vector<int> piv_;
 };
 
 }  // namespace
@@ -164,7 +183,20 @@ NaturalSpline::NaturalSpline(int degree, std::span<const double> x, std::span<co
       if (i <= n - 2) add_interval(i, -std::pow(g[i] / h_[i], j) * basis.D0.row(j - m));
     }
   }
+  // solve, then one step of iterative refinement with the residual summed in long double: it
+  // recovers the digits the elimination loses for the higher degrees (septic mostly)
+  const BandMatrix A0 = A;
+  const std::vector<double> b0 = rhs;
+  A.factorize();
   A.solve(rhs);
+  if (N > 0) {
+    std::vector<long double> Ax(N);
+    A0.multiply(rhs, Ax);
+    std::vector<double> r(N);
+    for (int i = 0; i < N; ++i) r[i] = static_cast<double>(static_cast<long double>(b0[i]) - Ax[i]);
+    A.solve(r);
+    for (int i = 0; i < N; ++i) rhs[i] += r[i];
+  }
 
   // knot derivatives s^(k)(x_i) = z_{i,k} / g_i^k
   auto knot_derivative = [&](int i, int k) { return k == 0 ? y_[i] : rhs[i * nu + k - 1] / std::pow(g[i], k); };
@@ -194,6 +226,7 @@ NaturalSpline::NaturalSpline(int degree, std::span<const double> x, std::span<co
 double NaturalSpline::calcValue(double t) const { return calcDerivative(0, t); }
 
 double NaturalSpline::calcDerivative(int order, double t) const {
+  if (x_.empty()) throw SignalError("natural spline: evaluated before it was fitted");
   if (order < 0) throw SignalError("natural spline: negative derivative order");
   if (order > degree()) return 0.0;
   double out[8];
