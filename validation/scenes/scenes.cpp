@@ -103,19 +103,25 @@ Joint randomFunctionBased(std::mt19937& rng) {
   return FunctionBased(nq, ax);
 }
 
-// a small joint for composites
-Joint randomPart(std::mt19937& rng, int max_nq) {
+// a small joint for composites, within budgets of rotational and translational freedoms (a
+// composite with more than 3 of either would have a singular S everywhere)
+Joint randomPart(std::mt19937& rng, int& rot_left, int& trans_left) {
   for (;;) {
     Joint j;
+    int r = 0, t = 0;
     switch (pick(rng, 6)) {
-      case 0: j = Revolute{randomUnit(rng)}; break;
-      case 1: j = Prismatic{randomUnit(rng)}; break;
-      case 2: j = Universal{}; break;
-      case 3: j = SphericalEuler{static_cast<EulerSequence>(pick(rng, 6))}; break;
-      case 4: j = Planar{}; break;
-      default: j = SphericalExp{}; break;
+      case 0: j = Revolute{randomUnit(rng)}, r = 1; break;
+      case 1: j = Prismatic{randomUnit(rng)}, t = 1; break;
+      case 2: j = Universal{}, r = 2; break;
+      case 3: j = SphericalEuler{static_cast<EulerSequence>(pick(rng, 6))}, r = 3; break;
+      case 4: j = Planar{}, t = 2; break;
+      default: j = SphericalExp{}, r = 3; break;
     }
-    if (j.nq() <= max_nq) return j;
+    if (r <= rot_left && t <= trans_left) {
+      rot_left -= r;
+      trans_left -= t;
+      return j;
+    }
   }
 }
 }  // namespace
@@ -132,10 +138,11 @@ Joint randomJoint(std::size_t index, std::mt19937& rng) {
     case 7: return SphericalExp{};
     case 8: {
       // two or three parts, sometimes nested: Q1 (Q2 Q3)
-      Joint a = randomPart(rng, 4);
-      Joint b = randomPart(rng, 5 - a.nq());
-      if (a.nq() + b.nq() < 6 && rng() % 2) {
-        Joint c = randomPart(rng, 6 - a.nq() - b.nq());
+      int rot = 3, trans = 3;
+      Joint a = randomPart(rng, rot, trans);
+      Joint b = randomPart(rng, rot, trans);
+      if (rot + trans > 0 && rng() % 2) {
+        Joint c = randomPart(rng, rot, trans);
         return Composite({a, Composite({b, c})});
       }
       return Composite({a, b});
