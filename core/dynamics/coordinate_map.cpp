@@ -17,6 +17,7 @@ void CoordinateMap::addDependent(int dependent, std::vector<int> args, Constrain
   const std::string what = "coordinate map: dependent coordinate " + name(dependent);
   if (dependent < 0 || dependent >= nr_) throw ModelError(what + " out of range");
   if (args.empty()) throw ModelError(what + " has no argument");
+  if (args.size() > 6) throw ModelError(what + ": at most 6 arguments, got " + std::to_string(args.size()));
   for (size_t k = 0; k < args.size(); ++k) {
     if (args[k] < 0 || args[k] >= nr_) throw ModelError(what + ": argument " + name(args[k]) + " out of range");
     if (args[k] == dependent) throw ModelError(what + " depends on itself");
@@ -24,7 +25,7 @@ void CoordinateMap::addDependent(int dependent, std::vector<int> args, Constrain
       throw ModelError(what + ": argument " + name(args[k]) + " given twice");
   }
   if (!f) throw ModelError(what + ": no function");
-  if (f->numArgs() != static_cast<int>(args.size()))
+  if (!acceptsArguments(*f, static_cast<int>(args.size())))
     throw ModelError(what + ": function takes " + std::to_string(f->numArgs()) + " arguments, " +
                      std::to_string(args.size()) + " given");
   if (!std::isfinite(scale)) throw ModelError(what + ": non-finite scale");
@@ -88,11 +89,13 @@ void CoordinateMap::calcPosition(const VecX& q_R, VecX& q_r) const {
                      std::to_string(q_R.size()));
   q_r.resize(nr_);
   for (int j = 0; j < nR(); ++j) q_r[independent_[j]] = q_R[j];
-  VecX x;
+  VecJ x;
+  FunctionValue fv;
   for (const Dependent& d : deps_) {
     x.resize(static_cast<long>(d.args.size()));
     for (size_t k = 0; k < d.args.size(); ++k) x[static_cast<long>(k)] = q_r[d.args[k]];
-    q_r[d.index] = d.scale * d.f->value(x);
+    evaluateWithArguments(*d.f, x, 0, fv);
+    q_r[d.index] = d.scale * fv.value;
   }
 }
 
@@ -116,7 +119,8 @@ void CoordinateMap::calc(const VecX& q_R, const VecX& qdot_R, VecX& q_r, VecX& q
   // dependent rows in dependency order (chain rule through earlier rows):
   //   J_d    = s sum_k g_k J_ak
   //   Jdot_d = s sum_k (g_k Jdot_ak + sum_l H_kl qdot_al J_ak)
-  VecX x, xdot;
+  VecJ x, xdot;
+  FunctionValue fv;
   for (const Dependent& d : deps_) {
     const long n = static_cast<long>(d.args.size());
     x.resize(n);
@@ -125,9 +129,10 @@ void CoordinateMap::calc(const VecX& q_R, const VecX& qdot_R, VecX& q_r, VecX& q
       x[k] = q_r[d.args[k]];
       xdot[k] = qdot_r[d.args[k]];
     }
-    const VecX g = d.f->gradient(x);
-    const VecX Hxdot = d.f->hessian(x) * xdot;
-    q_r[d.index] = d.scale * d.f->value(x);
+    evaluateWithArguments(*d.f, x, 2, fv);
+    const VecJ& g = fv.gradient;
+    const VecJ Hxdot = fv.hessian * xdot;
+    q_r[d.index] = d.scale * fv.value;
     for (long k = 0; k < n; ++k) {
       const int a = d.args[k];
       J_rR.row(d.index) += (d.scale * g[k]) * J_rR.row(a);

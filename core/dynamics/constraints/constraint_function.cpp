@@ -5,15 +5,19 @@
 namespace redmax {
 namespace {
 
-class CallableFunction final : public ConstraintFunction {
+class CallableFunction final : public AxisFunction {
  public:
   CallableFunction(int n, std::function<double(const VecX&)> v, std::function<VecX(const VecX&)> g,
                    std::function<MatX(const VecX&)> h)
       : n_(n), v_(std::move(v)), g_(std::move(g)), h_(std::move(h)) {}
   int numArgs() const override { return n_; }
-  double value(const VecX& x) const override { return v_(x); }
-  VecX gradient(const VecX& x) const override { return g_(x); }
-  MatX hessian(const VecX& x) const override { return h_(x); }
+  void evaluate(const VecJ& x, int order, FunctionValue& out) const override {
+    const VecX xx = x;
+    out.value = v_(xx);
+    if (order >= 1) out.gradient = g_(xx);
+    if (order >= 2) out.hessian = h_(xx);
+  }
+  std::string typeName() const override { return "callable"; }
 
  private:
   int n_;
@@ -22,25 +26,26 @@ class CallableFunction final : public ConstraintFunction {
   std::function<MatX(const VecX&)> h_;
 };
 
-class LinearFunction final : public ConstraintFunction {
- public:
-  LinearFunction(VecX slopes, double intercept) : a_(std::move(slopes)), b_(intercept) {}
-  int numArgs() const override { return static_cast<int>(a_.size()); }
-  double value(const VecX& x) const override { return a_.dot(x) + b_; }
-  VecX gradient(const VecX&) const override { return a_; }
-  MatX hessian(const VecX&) const override { return MatX::Zero(a_.size(), a_.size()); }
-
- private:
-  VecX a_;
-  double b_;
-};
-
 }  // namespace
+
+bool acceptsArguments(const AxisFunction& f, int n) { return f.numArgs() == n || f.numArgs() == 0; }
+
+void evaluateWithArguments(const AxisFunction& f, const VecJ& x, int order, FunctionValue& out) {
+  if (f.numArgs() == x.size()) {
+    f.evaluate(x, order, out);
+    return;
+  }
+  // a constant of no arguments: value only, zero derivatives in the caller's arguments
+  f.evaluate(VecJ(0), 0, out);
+  if (order >= 1) out.gradient.setZero(x.size());
+  if (order >= 2) out.hessian.setZero(x.size(), x.size());
+}
 
 ConstraintFunctionPtr makeConstraintFunction(int num_args, std::function<double(const VecX&)> value,
                                              std::function<VecX(const VecX&)> gradient,
                                              std::function<MatX(const VecX&)> hessian) {
-  if (num_args < 1) throw std::invalid_argument("constraint function: needs at least one argument");
+  if (num_args < 1 || num_args > 6)
+    throw std::invalid_argument("constraint function: 1 to 6 arguments, got " + std::to_string(num_args));
   if (!value || !gradient || !hessian)
     throw std::invalid_argument("constraint function: value, gradient and Hessian are all required");
   return std::make_shared<CallableFunction>(num_args, std::move(value), std::move(gradient),
@@ -59,13 +64,13 @@ ConstraintFunctionPtr makeConstraintFunction1(std::function<double(double)> valu
 }
 
 ConstraintFunctionPtr makeConstantFunction(double c, int num_args) {
-  if (num_args < 1) throw std::invalid_argument("constant function: needs at least one argument");
-  return std::make_shared<LinearFunction>(VecX::Zero(num_args), c);
+  return std::make_shared<ConstantFunction>(c, num_args);
 }
 
 ConstraintFunctionPtr makeLinearFunction(const std::vector<double>& slopes, double intercept) {
-  if (slopes.empty()) throw std::invalid_argument("linear function: needs at least one slope");
-  return std::make_shared<LinearFunction>(Eigen::Map<const VecX>(slopes.data(), slopes.size()), intercept);
+  std::vector<double> coef = slopes;
+  coef.push_back(intercept);
+  return std::make_shared<LinearFunction>(std::move(coef));
 }
 
 }  // namespace redmax

@@ -16,8 +16,9 @@ namespace redmax {
 
 class CoordinateCoupler final : public Constraint {
  public:
-  /// dependent, independent: reduced-coordinate indices in [0, nr), all distinct;
-  /// f->numArgs() == independent.size(). Throws ModelError on bad input.
+  /// dependent, independent: reduced-coordinate indices in [0, nr), all distinct, 1 to 6
+  /// independent ones; f->numArgs() == independent.size() (or 0 for a constant). Throws
+  /// ModelError on bad input.
   CoordinateCoupler(const Model& model, int dependent, std::vector<int> independent,
                     ConstraintFunctionPtr f, double scale = 1.0, std::string name = "coupler");
   std::string name() const override { return name_; }
@@ -34,7 +35,7 @@ class CoordinateCoupler final : public Constraint {
   double scale() const { return scale_; }
 
  private:
-  VecX gather(const VecX& v) const;
+  VecJ gather(const VecX& v) const;
   std::string name_;
   int dep_;
   std::vector<int> indep_;

@@ -10,9 +10,9 @@ PrescribedCoordinate::PrescribedCoordinate(const Model& model, int coordinate, C
                      std::to_string(model.nr()) + " coordinates)");
   if (name_.empty()) name_ = "prescribed_" + model.coordinates[k_].name;
   if (!traj_) throw ModelError(name_ + ": no trajectory function");
-  if (traj_->numArgs() != 1)
+  if (!acceptsArguments(*traj_, 1))
     throw ModelError(name_ + ": the trajectory must be a function of time only (1 argument), got " +
-                     std::to_string(traj_->numArgs()));
+                     std::to_string(traj_->numArgs()) + " arguments");
 }
 
 std::shared_ptr<PrescribedCoordinate> PrescribedCoordinate::makeLocked(const Model& model, int coordinate,
@@ -23,10 +23,28 @@ std::shared_ptr<PrescribedCoordinate> PrescribedCoordinate::makeLocked(const Mod
                                                 "locked_" + coord_name);
 }
 
-double PrescribedCoordinate::position(double t) const { return traj_->value(VecX::Constant(1, t)); }
-double PrescribedCoordinate::velocity(double t) const { return traj_->gradient(VecX::Constant(1, t))[0]; }
+void PrescribedCoordinate::trajectory(double t, double& q, double& qdot, double& qddot) const {
+  FunctionValue fv;
+  evaluateWithArguments(*traj_, VecJ::Constant(1, t), 2, fv);
+  q = fv.value;
+  qdot = fv.gradient[0];
+  qddot = fv.hessian(0, 0);
+}
+
+double PrescribedCoordinate::position(double t) const {
+  double q, qd, qdd;
+  trajectory(t, q, qd, qdd);
+  return q;
+}
+double PrescribedCoordinate::velocity(double t) const {
+  double q, qd, qdd;
+  trajectory(t, q, qd, qdd);
+  return qd;
+}
 double PrescribedCoordinate::acceleration(double t) const {
-  return traj_->hessian(VecX::Constant(1, t))(0, 0);
+  double q, qd, qdd;
+  trajectory(t, q, qd, qdd);
+  return qdd;
 }
 
 void PrescribedCoordinate::calcAcceleration(const Model& model, const State& s, const SkeletonWorkspace&,
@@ -42,8 +60,10 @@ void PrescribedCoordinate::calcAcceleration(const Model& model, const State& s, 
 void PrescribedCoordinate::calcErrors(const Model& model, const State& s, const SkeletonWorkspace&,
                                       Eigen::Ref<VecX> pos_err, Eigen::Ref<VecX> vel_err) const {
   if (model.nr() != nr_) throw ModelError(name_ + ": used with a model of a different size");
-  pos_err[0] = position(s.t) - s.q[k_];
-  vel_err[0] = velocity(s.t) - s.qdot[k_];
+  double q, qd, qdd;
+  trajectory(s.t, q, qd, qdd);
+  pos_err[0] = q - s.q[k_];
+  vel_err[0] = qd - s.qdot[k_];
 }
 
 }  // namespace redmax

@@ -20,7 +20,8 @@ namespace redmax {
 
 class PrescribedCoordinate final : public Constraint {
  public:
-  /// coordinate in [0, nr); trajectory: a one-argument function of time t. Throws ModelError.
+  /// coordinate in [0, nr); trajectory: a function of time t (one argument, or none for a
+  /// constant). Throws ModelError.
   PrescribedCoordinate(const Model& model, int coordinate, ConstraintFunctionPtr trajectory,
                        std::string name = "");
   /// a locked coordinate: held at `value`
@@ -40,6 +41,8 @@ class PrescribedCoordinate final : public Constraint {
   double position(double t) const;
   double velocity(double t) const;
   double acceleration(double t) const;
+  /// q_p, qdot_p, qddot_p at t in one evaluation
+  void trajectory(double t, double& q, double& qdot, double& qddot) const;
 
  private:
   std::string name_;
