@@ -173,7 +173,9 @@ NaturalSpline::NaturalSpline(int degree, std::span<const double> x, std::span<co
       const int r = i * nu + (j - m);
       // add w . v_l for interval l, where v_l = [a; b] in u-units
       auto add_interval = [&](int l, const Eigen::RowVectorXd& w) {
-        rhs[r] -= w[0] * y_[l] + w[m] * y_[l + 1];
+        // a derivative of order >= 1 ignores the level, so w[0] = -w[m]: use the difference of
+        // the values, not the values (a column at 5.04 varying in its 8th digit loses nothing)
+        rhs[r] -= w[m] * (y_[l + 1] - y_[l]);
         for (int k = 1; k < m; ++k) {
           A.at(r, l * nu + k - 1) += w[k] * std::pow(h_[l] / g[l], k);
           A.at(r, (l + 1) * nu + k - 1) += w[m + k] * std::pow(h_[l] / g[l + 1], k);
@@ -201,16 +203,18 @@ NaturalSpline::NaturalSpline(int degree, std::span<const double> x, std::span<co
   // knot derivatives s^(k)(x_i) = z_{i,k} / g_i^k
   auto knot_derivative = [&](int i, int k) { return k == 0 ? y_[i] : rhs[i * nu + k - 1] / std::pow(g[i], k); };
 
-  // per-interval monomial coefficients c = C [a; b], a_k = h^k s^(k)(x_l), b_k = h^k s^(k)(x_{l+1})
+  // per-interval monomial coefficients c = C [a; b], a_k = h^k s^(k)(x_l), b_k = h^k s^(k)(x_{l+1});
+  // the level y_l is taken out first (C maps a constant to itself), so c_1.. carry no cancellation
   const int nc = 2 * m;
   coef_.resize(static_cast<size_t>(n - 1) * nc);
   Eigen::VectorXd v(nc);
   for (int l = 0; l + 1 < n; ++l) {
     for (int k = 0; k < m; ++k) {
-      v[k] = k == 0 ? y_[l] : rhs[l * nu + k - 1] * std::pow(h_[l] / g[l], k);
-      v[m + k] = k == 0 ? y_[l + 1] : rhs[(l + 1) * nu + k - 1] * std::pow(h_[l] / g[l + 1], k);
+      v[k] = k == 0 ? 0.0 : rhs[l * nu + k - 1] * std::pow(h_[l] / g[l], k);
+      v[m + k] = k == 0 ? y_[l + 1] - y_[l] : rhs[(l + 1) * nu + k - 1] * std::pow(h_[l] / g[l + 1], k);
     }
-    const Eigen::VectorXd c = basis.C * v;
+    Eigen::VectorXd c = basis.C * v;
+    c[0] = y_[l];
     std::copy(c.data(), c.data() + nc, coef_.begin() + static_cast<ptrdiff_t>(l) * nc);
   }
 
