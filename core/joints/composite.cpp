@@ -1,5 +1,6 @@
 #include "core/joints/composite.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "core/joints/joint.hpp"
@@ -46,6 +47,17 @@ void Composite::calc(const VecJ& q, const VecJ& qdot, JointKinematics& out) cons
     out.Q = out.Q * part.Q;
     off += n;
   }
+}
+
+double Composite::singularityDistance(const VecJ& q) const {
+  double d = 1.0;
+  int off = 0;
+  for (const Joint& j : parts) {
+    const int n = j.nq();
+    d = std::min(d, j.singularityDistance(q.segment(off, n)));
+    off += n;
+  }
+  return d;
 }
 
 bool Composite::reparameterize(VecJ& q, VecJ& qdot) const {

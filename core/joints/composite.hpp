@@ -25,6 +25,9 @@ struct Composite {
   void calc(const VecJ& q, const VecJ& qdot, JointKinematics& out) const;
   /// passes the chart switch to every part (e.g. an exponential-coordinate part)
   bool reparameterize(VecJ& q, VecJ& qdot) const;
+  /// smallest singularityDistance of the parts (their own coordinate singularities only, not
+  /// configurations where the parts' motions happen to align)
+  double singularityDistance(const VecJ& q) const;
 };
 
 }  // namespace redmax

@@ -46,6 +46,8 @@ struct SphericalEuler {
   /// Distance from gimbal lock, |det S_rot| in [0, 1]: |sin q2| (proper) or |cos q2|
   /// (Tait-Bryan). 0 means S has lost rank; integrators and solvers can report it.
   double gimbalDistance(const VecJ& q) const;
+  /// same as gimbalDistance (the name every joint with coordinate singularities provides)
+  double singularityDistance(const VecJ& q) const { return gimbalDistance(q); }
   /// rotation part only, 3 x 3 blocks (used by the free joints)
   void calcRotation(const Vec3& q, const Vec3& qdot, Mat3& R, Mat3& S, Mat3& Sdot) const;
 };

@@ -58,6 +58,12 @@ void Free3D::calc(const VecJ& q, const VecJ& qdot, JointKinematics& out) const {
   }
 }
 
+double Free3D::singularityDistance(const VecJ& q) const {
+  const Vec3 r = q.segment<3>(rotationOffset());
+  if (rotation == FreeRotation::Exponential) return SphericalExp::rotationSingularityDistance(r);
+  return SphericalEuler{sequence}.gimbalDistance(VecJ(r));
+}
+
 bool Free3D::reparameterize(VecJ& q, VecJ& qdot) const {
   if (rotation != FreeRotation::Exponential) return false;
   const int ir = rotationOffset();

@@ -57,6 +57,9 @@ struct Free3D {
   /// exponential rotation: the SphericalExp chart switch on r (p and its rate are unchanged:
   /// the rotation and the body twist stay the same); Euler: never
   bool reparameterize(VecJ& q, VecJ& qdot) const;
+  /// the rotation part's singularityDistance (SphericalEuler or SphericalExp); translation
+  /// never makes a free joint singular
+  double singularityDistance(const VecJ& q) const;
   /// offsets of the rotation and translation coordinates in q
   int rotationOffset() const { return layout == FreeLayout::RotationFirst ? 0 : 3; }
   int translationOffset() const { return layout == FreeLayout::RotationFirst ? 3 : 0; }

@@ -76,6 +76,16 @@ double FunctionBased::spatialCoordinate(int k, const VecJ& q) const {
   return v;
 }
 
+double FunctionBased::singularityDistance(const VecJ& q) const {
+  for (int k = 0; k < 3; ++k)
+    if (axes_[k].coordinates.empty()) return 1.0;
+  const Mat3 R1 = rotationAxisAngle(axes_[0].axis, spatialCoordinate(0, q));
+  const Mat3 R2 = rotationAxisAngle(axes_[1].axis, spatialCoordinate(1, q));
+  Mat3 W;
+  W << axes_[0].axis, R1 * axes_[1].axis, R1 * R2 * axes_[2].axis;
+  return std::abs(W.determinant());
+}
+
 void FunctionBased::calc(const VecJ& q, const VecJ& qdot, JointKinematics& out) const {
   if (simbody_compat) {
     calcSimbody(q, qdot, out);

@@ -54,6 +54,10 @@ class FunctionBased {
   const std::array<TransformAxis, 6>& axes() const { return axes_; }
   /// value of spatial coordinate k (theta_1..3, d_1..3) at q
   double spatialCoordinate(int k, const VecJ& q) const;
+  /// Gimbal-lock measure of the rotation sequence when all three rotations are driven by
+  /// coordinates: |det [a_1, R_1 a_2, R_1 R_2 a_3]| (1 for orthonormal axes away from lock);
+  /// otherwise 1. (S can also lose rank where function gradients vanish; that is not reported.)
+  double singularityDistance(const VecJ& q) const;
 
   /// Reproduce Simbody's approximate velocity terms (see the file comment). Default: exact.
   bool simbody_compat = false;

@@ -7,6 +7,10 @@ template <class T>
 concept HasReparameterize = requires(const T& j, VecJ& q, VecJ& qd) {
   { j.reparameterize(q, qd) } -> std::convertible_to<bool>;
 };
+template <class T>
+concept HasSingularityDistance = requires(const T& j, const VecJ& q) {
+  { j.singularityDistance(q) } -> std::convertible_to<double>;
+};
 template <class... Ts>
 struct Overloaded : Ts... {
   using Ts::operator()...;
@@ -28,6 +32,18 @@ bool Joint::reparameterize(VecJ& q, VecJ& qdot) const {
           return j.reparameterize(q, qdot);
         } else {
           return false;
+        }
+      },
+      v);
+}
+
+double Joint::singularityDistance(const VecJ& q) const {
+  return std::visit(
+      [&](const auto& j) -> double {
+        if constexpr (HasSingularityDistance<std::decay_t<decltype(j)>>) {
+          return j.singularityDistance(q);
+        } else {
+          return 1.0;
         }
       },
       v);

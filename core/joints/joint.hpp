@@ -44,6 +44,11 @@ struct Joint {
   /// coordinates [D Sec. 4.5.8]); updates q and qdot so the motion is unchanged. Returns true
   /// when it changed them.
   bool reparameterize(VecJ& q, VecJ& qdot) const;
+  /// Distance from a coordinate singularity in [0, 1] (0 = S has lost rank there): the Euler
+  /// gimbal-lock measure |sin q2| or |cos q2|, the exponential-map |sin(th/2)/(th/2)|, the minimum
+  /// over a composite's parts; 1 for joints whose coordinates have no singular configuration.
+  /// For integrators and solvers to report, e.g. a simulation that ran into gimbal lock.
+  double singularityDistance(const VecJ& q) const;
   /// short type name for summaries and errors
   std::string typeName() const;
 };

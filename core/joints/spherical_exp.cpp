@@ -73,6 +73,15 @@ bool SphericalExp::reparameterizeRotation(Vec3& q, Vec3& qdot) {
   return true;
 }
 
+double SphericalExp::rotationSingularityDistance(const Vec3& q) {
+  const double half = 0.5 * q.norm();
+  return half < 1e-8 ? 1.0 : std::abs(std::sin(half) / half);
+}
+
+double SphericalExp::singularityDistance(const VecJ& q) const {
+  return rotationSingularityDistance(Vec3(q[0], q[1], q[2]));
+}
+
 bool SphericalExp::reparameterize(VecJ& q, VecJ& qdot) const {
   Vec3 r(q[0], q[1], q[2]), rd(qdot[0], qdot[1], qdot[2]);
   if (!reparameterizeRotation(r, rd)) return false;

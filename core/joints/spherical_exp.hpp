@@ -31,11 +31,16 @@ struct SphericalExp {
   /// qdot -> S_new^-1 S_prev qdot (the same body angular velocity) [D Sec. 4.5.8]. Returns
   /// whether it changed q and qdot.
   bool reparameterize(VecJ& q, VecJ& qdot) const;
+  /// Distance from the singular shells |q| = 2 pi n: sigma_min(S)/sigma_max(S) =
+  /// |sin(th/2)/(th/2)| in [0, 1] (1 at q = 0, 0.64 at pi, 0.30 at the 1.5 pi switch, 0 at 2 pi).
+  double singularityDistance(const VecJ& q) const;
 
   /// rotation part only, 3 x 3 blocks (used by the free joints)
   static void calcRotation(const Vec3& q, const Vec3& qdot, Mat3& R, Mat3& S, Mat3& Sdot);
   /// the 3-vector version of reparameterize
   static bool reparameterizeRotation(Vec3& q, Vec3& qdot);
+  /// the 3-vector version of singularityDistance
+  static double rotationSingularityDistance(const Vec3& q);
 };
 
 }  // namespace redmax

@@ -43,8 +43,10 @@ SplineCurve::SplineCurve(std::vector<Mat4> control_frames) : frames_(std::move(c
 
 void SplineCurve::calc(const VecJ& q, const VecJ& qdot, JointKinematics& out) const {
   // segment and local parameter; end segments extrapolate (see the header)
+  // (compared as doubles first: a NaN or huge q must not reach the int conversion)
   const int last = numSegments() - 1;
-  const int s = std::clamp(static_cast<int>(std::floor(q[0])), 0, last);
+  const double fl = std::floor(q[0]);
+  const int s = fl >= last ? last : (fl > 0.0 ? static_cast<int>(fl) : 0);
   const double u = q[0] - s;
   const CumulativeBasis basis(u);
   // [D Alg. 3] as a product of exponentials with theta_i = B~_i(u), dtheta/dq = B~_i'(u)

@@ -145,6 +145,54 @@ TYPED_TEST(JointFd, ReparameterizeKeepsRotationAndTwist) {
     EXPECT_GT(fired, 0);
 }
 
+TEST(Joint, SingularityDistance) {
+  std::mt19937 rng(17);
+  const VecJ q3 = randomVecJ(3, rng);
+  EXPECT_EQ(Joint(Revolute{}).singularityDistance(VecJ::Constant(1, 0.3)), 1.0);
+  EXPECT_EQ(Joint(Universal{}).singularityDistance(VecJ(Vec2(0.3, 1.5))), 1.0);
+  const Joint zyz = SphericalEuler{EulerSequence::ZYZ};
+  EXPECT_DOUBLE_EQ(zyz.singularityDistance(q3), std::abs(std::sin(q3[1])));
+  // exponential coordinates: sigma_min(S)/sigma_max(S), 0 on the 2 pi shell
+  const Joint ex = SphericalExp{};
+  for (double len : {0.0, 1.0, M_PI, 1.5 * M_PI, 2 * M_PI}) {
+    const VecJ q = VecJ(Vec3(q3.normalized() * len));
+    const Eigen::JacobiSVD<Mat3> svd(Mat3(calcJoint(ex, q).S.topRows<3>()));
+    EXPECT_NEAR(ex.singularityDistance(q), svd.singularValues()[2] / svd.singularValues()[0], 1e-12) << len;
+  }
+  EXPECT_LT(ex.singularityDistance(VecJ(Vec3(0, 2 * M_PI, 0))), 1e-15);
+  // free joint: its rotation part; composite: the smallest part
+  VecJ qf(6);
+  qf << 0.2, M_PI / 2, -0.3, 1.0, 2.0, 3.0;
+  EXPECT_LT(Joint(Free3D::opensim()).singularityDistance(qf), 1e-15);
+  const Joint comp = Composite({Revolute{}, Composite({Prismatic{}, zyz})});
+  VecJ qc(5);
+  qc << 0.4, 0.1, q3;
+  EXPECT_DOUBLE_EQ(comp.singularityDistance(qc), std::abs(std::sin(q3[1])));
+  // function-based with three driven orthonormal rotations: the Euler measure
+  std::array<TransformAxis, 6> ax;
+  for (int k = 0; k < 3; ++k) ax[k] = {Vec3::Unit(k), {k}, nullptr};
+  for (int k = 0; k < 3; ++k) ax[3 + k] = {Vec3::Unit(k), {}, nullptr};
+  EXPECT_NEAR(Joint(FunctionBased(3, ax)).singularityDistance(q3),
+              Joint(SphericalEuler{EulerSequence::XYZ}).singularityDistance(q3), 1e-15);
+  ax[2].coordinates.clear();
+  EXPECT_EQ(Joint(FunctionBased(3, ax)).singularityDistance(q3), 1.0);
+}
+
+TEST(Joint, NonFiniteCoordinatesDoNotCrash) {
+  // a diverged state must come back as non-finite numbers for the caller to report, not a crash
+  std::mt19937 rng(18);
+  for (std::size_t i = 0; i < std::variant_size_v<JointVariant>; ++i) {
+    const Joint j = scenes::randomJoint(i, rng);
+    for (double bad : {std::nan(""), 1e300, -1e300}) {
+      JointKinematics k;
+      VecJ q = VecJ::Constant(j.nq(), bad), qd = VecJ::Zero(j.nq());
+      j.calc(q, qd, k);
+      j.reparameterize(q, qd);
+      EXPECT_EQ(k.S.cols(), j.nq());
+    }
+  }
+}
+
 TEST(Joint, TypeNamesAreDistinct) {
   std::mt19937 rng(15);
   std::set<std::string> names;
