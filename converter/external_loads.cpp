@@ -109,10 +109,10 @@ ExternalLoads readExternalLoads(const std::string& xml_path, const std::string& 
     match(f.force_identifier, "force", f.force_columns);
     match(f.point_identifier, "point", f.point_columns);
     match(f.torque_identifier, "torque", f.torque_columns);
-    if (!f.hasForce() && !f.hasTorque())
-      doc.fail(e, "ExternalForce '" + f.name + "' has neither a force nor a torque identifier");
     if (f.hasPoint() && !f.hasForce())
       doc.fail(e, "ExternalForce '" + f.name + "' has a point but no force");
+    if (!f.hasForce() && !f.hasTorque())
+      doc.fail(e, "ExternalForce '" + f.name + "' has neither a force nor a torque identifier");
     loads.forces.push_back(f);
   }
   return loads;

@@ -1,6 +1,7 @@
 // .osim reader: wrap objects on frames, the ForceSet, and the GeometryPath of every path force
 // (points, conditional and moving points, wraps), OPENSIM_SEMANTICS §6.
 #include <algorithm>
+#include <map>
 
 #include "converter/detail/osim_functions.hpp"
 #include "converter/detail/osim_reader_impl.hpp"
@@ -117,8 +118,16 @@ void OsimReader::readForces() {
   const XMLElement* set = firstChild(model_, "ForceSet");
   if (!set) set = firstChild(model_, "ActuatorSet");
   std::set<std::string> names;
+  // old class names OpenSim registers as aliases (RegisterTypes_osimActuators)
+  static const std::map<std::string, std::string> renamed = {
+      {"Schutte1993Muscle", "Schutte1993Muscle_Deprecated"},
+      {"Delp1990Muscle", "Delp1990Muscle_Deprecated"},
+      {"GeneralizedForce", "CoordinateActuator"},
+      {"Force", "PointActuator"},
+      {"Torque", "TorqueActuator"}};
   for (const XMLElement* e : childElements(firstChild(set, "objects"))) {
-    const std::string cls = e->Name();
+    std::string cls = e->Name();
+    if (auto it = renamed.find(cls); it != renamed.end()) cls = it->second;
     const std::string name = componentName(e, names);
     bool applies = true;
     if (const XMLElement* d = firstChild(e, "isDisabled"); d && version_ < 30509)
