@@ -108,7 +108,7 @@ void FixedStepIntegrator::advance(const System& sys, State& s, double t_out) {
       throw;
     }
     ++stats_.steps;
-    stats_.reparameterizations += reparameterizeJoints(sys.model(), s);
+    stats_.reparameterizations += sys.reparameterize(s);
     last_good.t = s.t;
     last_good.q = s.q;
     last_good.qdot = s.qdot;

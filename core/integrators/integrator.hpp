@@ -11,7 +11,7 @@
 //
 // Every method treats q and qdot as independent coordinates with dq/dt = qdot (true for every
 // joint type, see core/joints/joint.hpp). After each internal step the joints get a chance to
-// switch chart (reparameterizeJoints, exponential coordinates [D Sec. 4.5.8]).
+// switch chart (System::reparameterize, exponential coordinates [D Sec. 4.5.8]).
 #include <memory>
 #include <stdexcept>
 #include <string>

@@ -361,7 +361,7 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
       if (S.pending_chart_check) {
         S.pending_chart_check = false;
         toState(S.y, n, S.t_cur, internal);
-        const int switched = reparameterizeJoints(sys.model(), internal);
+        const int switched = sys.reparameterize(internal);
         if (switched > 0) {
           stats_.reparameterizations += switched;
           fromState(internal, S.y);
@@ -384,7 +384,7 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
     S.interpolate(t_out, S.yout);
     toState(S.yout, n, t_out, s);
     checkFinite(s, S.lastStep(), who.c_str());
-    reparameterizeJoints(sys.model(), s);
+    sys.reparameterize(s);
     S.last_out = s;
     S.last_sys = &sys;
   } catch (...) {

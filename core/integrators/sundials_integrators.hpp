@@ -16,7 +16,7 @@ struct SundialsSolver;  // SUNDIALS context, vectors, solver memory (sundials_in
 /// qddot from System::forwardDynamics (KKT accelerations with the System's Baumgarte
 /// stabilisation when there are constraints).
 ///  - one-step mode: after every internal step the state is checked for NaN/Inf and the joints
-///    may switch chart (reparameterizeJoints); a switch re-initialises the solver at that step.
+///    may switch chart (System::reparameterize); a switch re-initialises the solver at that step.
 ///  - output: the solver steps past t_out and interpolates (its dense output); the next call
 ///    resumes from the internal state if `state` is unchanged since this call returned it,
 ///    otherwise it re-initialises at `state`.
