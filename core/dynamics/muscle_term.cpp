@@ -1,5 +1,7 @@
 #include "core/dynamics/muscle_term.hpp"
 
+#include <cmath>
+
 namespace redmax {
 
 MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options)
@@ -37,13 +39,18 @@ void MuscleTerm::addMass(const Model& model, const State& s, const SkeletonWorks
   std::lock_guard<std::mutex> lock(mutex_);
   update(model, s, sk);
   // J_ar^T M_a J_ar, M_a diagonal [D Eq. 5.7b]
+  // one product per muscle on sqrt(m_a)-scaled rows, (W^1/2 J)^T (W^1/2 J) = J^T W J, in the
+  // muscle's compact columns, then scattered into M
   for (size_t m = 0; m < massive_.size(); ++m) {
     const MassPoints& mp = massive_[m].mass_points;
-    const MatX& J = ws_.muscles[m].J_ar;
-    for (int a = 0; a < mp.size(); ++a) {
-      const auto Ja = J.middleRows<3>(3 * a);
-      M.noalias() += mp.mass[a] * (Ja.transpose() * Ja);
-    }
+    const MuscleKinematics& mk = ws_.muscles[m];
+    const MatX& J = mk.J_ar;
+    scratch_.resize(J.rows(), J.cols());
+    for (int a = 0; a < mp.size(); ++a) scratch_.middleRows<3>(3 * a) = std::sqrt(mp.mass[a]) * J.middleRows<3>(3 * a);
+    Mc_.noalias() = scratch_.transpose() * scratch_;
+    const int k = static_cast<int>(mk.cols.size());
+    for (int j = 0; j < k; ++j)
+      for (int i = 0; i < k; ++i) M(mk.cols[i], mk.cols[j]) += Mc_(i, j);
   }
 }
 
@@ -51,15 +58,20 @@ void MuscleTerm::addForce(const Model& model, const State& s, const SkeletonWork
   if (massive_.empty()) return;
   std::lock_guard<std::mutex> lock(mutex_);
   update(model, s, sk);
-  // J_ar^T (f_a - M_a Jdot_ar qdot), f_a = m_a g [D Eq. 5.6, 5.7c]
+  // J_ar^T (f_a - M_a Jdot_ar qdot), f_a = m_a g [D Eq. 5.6, 5.7c], in compact columns
   for (size_t m = 0; m < massive_.size(); ++m) {
     const MassPoints& mp = massive_[m].mass_points;
     const MuscleKinematics& mk = ws_.muscles[m];
+    const int k = static_cast<int>(mk.cols.size());
+    qdot_c_.resize(k);
+    for (int j = 0; j < k; ++j) qdot_c_[j] = s.qdot[mk.cols[j]];
+    fc_.setZero(k);
     for (int a = 0; a < mp.size(); ++a) {
       Vec3 fa = mp.mass[a] * model.gravity;
-      if (options_.quadratic_velocity) fa.noalias() -= mp.mass[a] * (mk.Jdot_ar.middleRows<3>(3 * a) * s.qdot);
-      f.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * fa;
+      if (options_.quadratic_velocity) fa.noalias() -= mp.mass[a] * (mk.Jdot_ar.middleRows<3>(3 * a) * qdot_c_);
+      fc_.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * fa;
     }
+    for (int j = 0; j < k; ++j) f[mk.cols[j]] += fc_[j];
   }
 }
 

@@ -54,6 +54,9 @@ class MuscleTerm final : public ForceTerm {
   mutable MuscleWorkspace ws_;         // kinematics of massive_
   mutable VecX q_cache_, qdot_cache_;
   mutable bool cache_valid_ = false;
+  mutable MatX scratch_;               // sqrt(m_a)-scaled J_ar of one muscle (addMass)  (3N x k)
+  mutable MatX Mc_;                    // its J^T W J                                     (k x k)
+  mutable VecX qdot_c_, fc_;           // qdot and force in one muscle's columns          (k)
 };
 
 }  // namespace redmax

@@ -28,9 +28,10 @@ void calcMuscleKinematics(const Model& model, const State& state, const Skeleton
 }
 
 double muscleKineticEnergy(const MassPoints& mp, const MuscleKinematics& mk, const VecX& qdot) {
+  const VecX qdot_c = gatherColumns(qdot, mk);  // J_ar has the compact columns
   double T = 0.0;
   for (int a = 0; a < mp.size(); ++a)
-    T += 0.5 * mp.mass[a] * (mk.J_ar.middleRows<3>(3 * a) * qdot).squaredNorm();
+    T += 0.5 * mp.mass[a] * (mk.J_ar.middleRows<3>(3 * a) * qdot_c).squaredNorm();
   return T;
 }
 

@@ -20,7 +20,7 @@ void calcMuscleKinematics(const Model& model, const State& state, const Skeleton
 void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
                           const std::vector<Muscle>& muscles, MuscleWorkspace& ws, bool velocity = true);
 
-/// Mass-point kinetic energy 1/2 sum m_a |J_ar qdot|^2 and gravitational potential
+/// Mass-point kinetic energy 1/2 sum m_a |J_ar qdot|^2 (qdot with all nr entries) and gravitational potential
 /// -sum m_a g . x_a (world origin reference, as the skeleton's), after calcMuscleKinematics.
 double muscleKineticEnergy(const MassPoints& mp, const MuscleKinematics& mk, const VecX& qdot);
 double musclePotentialEnergy(const MassPoints& mp, const MuscleKinematics& mk, const Vec3& gravity);

@@ -9,6 +9,11 @@
 // point velocities [D Eq. 5.9, 5.37]) is stored as one 3 x 6 block per point (the only nonzero
 // block of its row) and is chained with the matching rows of J_mr at once, J_xr = J_xm J_mr
 // [D Eq. 5.4]; moving points add a column through their coordinate that has no J_xm counterpart.
+// Column compaction: a path can only be moved by the coordinates of the joints above its bodies
+// (and the coordinates driving its moving points). Those k coordinates, `cols`, are fixed by the
+// model and the path, so every Jacobian below has k columns, column j standing for coordinate
+// cols[j]; expandColumns() gives the nr-column matrix. (With a 6-dof root every path still skips
+// most limb coordinates, so this saves most of the work on full-body models.)
 // Buffers are resized only when P changes, so steady-state evaluation does not allocate.
 #include <stdexcept>
 #include <vector>
@@ -18,12 +23,16 @@
 namespace redmax {
 
 struct MuscleKinematics {
+  // columns (model- and path-dependent only): initMuscleKinematics
+  std::vector<int> cols;            // reduced coordinates that can move the path, ascending  (k)
+  std::vector<int> col_of;          // compact column of each coordinate, -1 if not in cols  (nr)
+
   // path stage, position: calcPathPoints
   std::vector<int> active;          // indices into path.points of the active points, in order (P)
   std::vector<Vec3> x_b;            // point locations in their body frames (moving ones evaluated) (P)
   std::vector<Vec3> x_w;            // point positions, world                                  (P)
   std::vector<Mat3x6> J_xm;         // R_b Gamma(x_b): the point's block of J_xm [D Eq. 5.8-5.9] (P)
-  MatX J_xr;                        // J_xm J_mr (+ moving-point column)                   (3P x nr)
+  MatX J_xr;                        // J_xm J_mr (+ moving-point column)                    (3P x k)
   VecX l;                           // segment lengths l_i = |x_{i+1} - x_i| [D Eq. 5.18]      (P-1)
   std::vector<Vec3> dxbar;          // unit segment directions [D Eq. 5.19] (0 if l_i = 0)    (P-1)
   double length = 0.0;              // path length, sum of l_i (m)
@@ -31,7 +40,7 @@ struct MuscleKinematics {
   // path stage, velocity
   std::vector<Vec3> xdot_w;         // point velocities, world                                 (P)
   std::vector<Mat3x6> Jdot_xm;      // R_b ([omega_b] Gamma(x_b) + Gamma(xdot_b)) [D Eq. 5.11]  (P)
-  MatX Jdot_xr;                     // d/dt J_xr                                           (3P x nr)
+  MatX Jdot_xr;                     // d/dt J_xr                                            (3P x k)
   VecX ldot;                        // segment lengthening speeds [D Eq. 5.27]                (P-1)
   double lengthening_speed = 0.0;   // d length / dt (m/s)
 
@@ -39,20 +48,30 @@ struct MuscleKinematics {
   VecX s;                           // Eulerian coordinates, equal strain: s_i = (arc length to i) / length,
                                     // so s_0 = 0, s_{P-1} = 1 and s is the arc fraction alpha (P)
   MatX J_sx;                        // internal s rate per stacked point velocity [D Eq. 5.23] (n x 3P)
-  MatX J_sr;                        // J_sx J_xr placed in rows 1..P-2, rows 0 and P-1 zero   (P x nr)
+  MatX J_sr;                        // J_sx J_xr placed in rows 1..P-2, rows 0 and P-1 zero    (P x k)
   VecX sdot;                        // (P), ends zero
   MatX Jdot_sx;                     // [D Eq. 5.24]                                          (n x 3P)
-  MatX Jdot_sr;                     // Jdot_sx J_xr + J_sx Jdot_xr in rows 1..P-2             (P x nr)
+  MatX Jdot_sr;                     // Jdot_sx J_xr + J_sx Jdot_xr in rows 1..P-2              (P x k)
 
   // mass-point stage: calcMassPointKinematics
   std::vector<Vec3> x_a;            // mass point positions, world                            (N)
   std::vector<int> segment;         // segment i (between active points i, i+1) of each point (N)
   std::vector<double> beta;         // fraction within that segment [D Eq. 5.29]             (N)
-  MatX J_ar;                        // J_am J_mr = J_az J_zm J_mr [D Eq. 5.4, 5.15]        (3N x nr)
-  MatX Jdot_ar;                     // Jdot_am J_mr + J_am Jdot_mr [D Eq. 5.5]             (3N x nr)
+  MatX J_ar;                        // J_am J_mr = J_az J_zm J_mr [D Eq. 5.4, 5.15]         (3N x k)
+  MatX Jdot_ar;                     // Jdot_am J_mr + J_am Jdot_mr [D Eq. 5.5]              (3N x k)
 
   bool velocity = false;            // true when the velocity-stage fields are valid
 };
+
+/// Columns of a path on `model` (cols, col_of) and buffers sized for all its points; the
+/// algorithms call it themselves when mk was not set up for this path.
+void initMuscleKinematics(const Model& model, const Muscle& muscle, MuscleKinematics& mk);
+void initMuscleKinematics(const Model& model, const MusclePath& path, MuscleKinematics& mk);
+
+/// The nr-column form of a compact Jacobian J (rows x k) of mk: column cols[j] = J.col(j).
+MatX expandColumns(const MatX& J, const MuscleKinematics& mk, int nr);
+/// v restricted to mk.cols (k), e.g. qdot for J_ar * qdot
+VecX gatherColumns(const VecX& v, const MuscleKinematics& mk);
 
 /// One MuscleKinematics per muscle, in the order of the muscle list it was built for.
 struct MuscleWorkspace {

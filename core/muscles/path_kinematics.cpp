@@ -4,29 +4,78 @@
 
 namespace redmax {
 
+void initMuscleKinematics(const Model& model, const MusclePath& path, MuscleKinematics& mk) {
+  const int nr = model.nr();
+  // coordinates of every joint above any path body, and those driving moving points
+  std::vector<char> used(nr, 0);
+  for (const PathPoint& pt : path.points) {
+    if (pt.body >= 0)
+      for (int j : model.ancestors(pt.body))
+        for (int c = 0; c < model.joints[j].nq; ++c) used[model.joints[j].q_index + c] = 1;
+    if (pt.kind == PathPointKind::Moving && pt.coordinate >= 0) used[pt.coordinate] = 1;
+  }
+  mk.cols.clear();
+  mk.col_of.assign(nr, -1);
+  for (int c = 0; c < nr; ++c)
+    if (used[c]) {
+      mk.col_of[c] = static_cast<int>(mk.cols.size());
+      mk.cols.push_back(c);
+    }
+  // buffers for every point active; conditional switches only change the used part
+  const int P = static_cast<int>(path.points.size());
+  const int k = static_cast<int>(mk.cols.size());
+  mk.active.reserve(P);
+  mk.x_b.reserve(P);
+  mk.x_w.reserve(P);
+  mk.J_xm.reserve(P);
+  mk.xdot_w.reserve(P);
+  mk.Jdot_xm.reserve(P);
+  mk.dxbar.reserve(P);
+  mk.J_xr.setZero(3 * P, k);
+  mk.Jdot_xr.setZero(3 * P, k);
+}
+
+void initMuscleKinematics(const Model& model, const Muscle& muscle, MuscleKinematics& mk) {
+  initMuscleKinematics(model, muscle.path, mk);
+  const int N = muscle.mass_points.size();
+  const int k = static_cast<int>(mk.cols.size());
+  mk.x_a.assign(N, Vec3::Zero());
+  mk.segment.assign(N, 0);
+  mk.beta.assign(N, 0.0);
+  mk.J_ar.setZero(3 * N, k);
+  mk.Jdot_ar.setZero(3 * N, k);
+}
+
 MuscleWorkspace::MuscleWorkspace(const Model& model, const std::vector<Muscle>& list) {
   muscles.resize(list.size());
-  for (size_t m = 0; m < list.size(); ++m) {
-    // size for every point active; conditional switches only shrink the used part
-    MuscleKinematics& mk = muscles[m];
-    const int P = static_cast<int>(list[m].path.points.size());
-    const int N = list[m].mass_points.size();
-    mk.active.reserve(P);
-    mk.x_b.reserve(P);
-    mk.x_w.reserve(P);
-    mk.J_xm.reserve(P);
-    mk.xdot_w.reserve(P);
-    mk.Jdot_xm.reserve(P);
-    mk.dxbar.reserve(P);
-    mk.J_xr.setZero(3 * P, model.nr());
-    mk.Jdot_xr.setZero(3 * P, model.nr());
-    mk.x_a.assign(N, Vec3::Zero());
-    mk.segment.assign(N, 0);
-    mk.beta.assign(N, 0.0);
-    mk.J_ar.setZero(3 * N, model.nr());
-    mk.Jdot_ar.setZero(3 * N, model.nr());
-  }
+  for (size_t m = 0; m < list.size(); ++m) initMuscleKinematics(model, list[m], muscles[m]);
 }
+
+MatX expandColumns(const MatX& J, const MuscleKinematics& mk, int nr) {
+  MatX full = MatX::Zero(J.rows(), nr);
+  for (int j = 0; j < static_cast<int>(mk.cols.size()); ++j) full.col(mk.cols[j]) = J.col(j);
+  return full;
+}
+
+VecX gatherColumns(const VecX& v, const MuscleKinematics& mk) {
+  VecX g(mk.cols.size());
+  for (int j = 0; j < static_cast<int>(mk.cols.size()); ++j) g[j] = v[mk.cols[j]];
+  return g;
+}
+
+namespace {
+// true if mk's columns cover every coordinate that can move `path`
+bool columnsCover(const Model& model, const MusclePath& path, const MuscleKinematics& mk) {
+  if (static_cast<int>(mk.col_of.size()) != model.nr()) return false;
+  for (const PathPoint& pt : path.points) {
+    if (pt.body >= 0)
+      for (int j : model.ancestors(pt.body))
+        if (model.joints[j].nq > 0 && mk.col_of[model.joints[j].q_index] < 0) return false;
+    if (pt.kind == PathPointKind::Moving && pt.coordinate >= 0 && mk.col_of[pt.coordinate] < 0) return false;
+  }
+  return true;
+}
+}  // namespace
 
 void calcPointLocation(const PathPoint& p, const VecX& q, Vec3& x_b, Vec3& dx_b, Vec3& ddx_b) {
   x_b = p.location;
@@ -60,7 +109,8 @@ void calcPointLocation(const PathPoint& p, const VecX& q, Vec3& x_b, Vec3& dx_b,
 
 void calcPathPoints(const Model& model, const State& state, const SkeletonWorkspace& sk,
                     const MusclePath& path, MuscleKinematics& mk, bool velocity) {
-  const int nr = model.nr();
+  if (!columnsCover(model, path, mk)) initMuscleKinematics(model, path, mk);
+  const int k = static_cast<int>(mk.cols.size());
   const int need = velocity ? static_cast<int>(Stage::Velocity) : static_cast<int>(Stage::Position);
   if (static_cast<int>(sk.stage) < need)
     throw std::logic_error("calcPathPoints: skeleton workspace is not at the required stage (call calcKinematics)");
@@ -74,12 +124,12 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
   mk.x_b.resize(P);
   mk.x_w.resize(P);
   mk.J_xm.resize(P);
-  if (mk.J_xr.rows() != 3 * P || mk.J_xr.cols() != nr) mk.J_xr.resize(3 * P, nr);
+  if (mk.J_xr.rows() != 3 * P || mk.J_xr.cols() != k) mk.J_xr.resize(3 * P, k);
   mk.J_xr.setZero();
   if (velocity) {
     mk.xdot_w.resize(P);
     mk.Jdot_xm.resize(P);
-    if (mk.Jdot_xr.rows() != 3 * P || mk.Jdot_xr.cols() != nr) mk.Jdot_xr.resize(3 * P, nr);
+    if (mk.Jdot_xr.rows() != 3 * P || mk.Jdot_xr.cols() != k) mk.Jdot_xr.resize(3 * P, k);
     mk.Jdot_xr.setZero();
   }
 
@@ -91,17 +141,18 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
     const int b = pt.body;
     const int c = pt.kind == PathPointKind::Moving ? pt.coordinate : -1;
     const double qdot_c = c >= 0 ? state.qdot[c] : 0.0;
+    const int cc = c >= 0 ? mk.col_of[c] : -1;  // its compact column
     auto J = mk.J_xr.middleRows<3>(3 * a);
 
     if (b < 0) {
       // world point: only a moving point's own coordinate moves it
       mk.x_w[a] = x_b;
       mk.J_xm[a].setZero();
-      if (c >= 0) J.col(c) += dx_b;
+      if (c >= 0) J.col(cc) += dx_b;
       if (velocity) {
         mk.xdot_w[a] = dx_b * qdot_c;
         mk.Jdot_xm[a].setZero();
-        if (c >= 0) mk.Jdot_xr.middleRows<3>(3 * a).col(c) += ddx_b * qdot_c;
+        if (c >= 0) mk.Jdot_xr.middleRows<3>(3 * a).col(cc) += ddx_b * qdot_c;
       }
       continue;
     }
@@ -110,14 +161,16 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
     const Mat3 R = sk.E_wi[b].topLeftCorner<3, 3>();
     mk.x_w[a] = R * x_b + sk.E_wi[b].topRightCorner<3, 1>();
     mk.J_xm[a].noalias() = R * Gamma(x_b);
-    // J_xr = J_xm J_mr over the columns of b's ancestor joints (others are zero in J_mr)
+    // J_xr = J_xm J_mr over the columns of b's ancestor joints (others are zero in J_mr); a
+    // joint's coordinates are consecutive in q and hence in the compact columns
     for (int j : model.ancestors(b)) {
       const JointSlot& sj = model.joints[j];
       if (sj.nq == 0) continue;
-      J.middleCols(sj.q_index, sj.nq).noalias() = mk.J_xm[a] * sk.J_mr.block(6 * b, sj.q_index, 6, sj.nq);
+      J.middleCols(mk.col_of[sj.q_index], sj.nq).noalias() =
+          mk.J_xm[a] * sk.J_mr.block(6 * b, sj.q_index, 6, sj.nq);
     }
     // moving point: direct dependence on its coordinate, not through the body twist
-    if (c >= 0) J.col(c) += R * dx_b;
+    if (c >= 0) J.col(cc) += R * dx_b;
 
     if (!velocity) continue;
     const Vec6& phi = sk.phi[b];
@@ -133,12 +186,12 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
     for (int j : model.ancestors(b)) {
       const JointSlot& sj = model.joints[j];
       if (sj.nq == 0) continue;
-      Jd.middleCols(sj.q_index, sj.nq).noalias() =
+      Jd.middleCols(mk.col_of[sj.q_index], sj.nq).noalias() =
           mk.Jdot_xm[a] * sk.J_mr.block(6 * b, sj.q_index, 6, sj.nq) +
           mk.J_xm[a] * sk.Jdot_mr.block(6 * b, sj.q_index, 6, sj.nq);
     }
     // d/dt (R x_b') = R ([omega] x_b' + x_b'' qdot_c)
-    if (c >= 0) Jd.col(c) += R * (omega.cross(dx_b) + ddx_b * qdot_c);
+    if (c >= 0) Jd.col(cc) += R * (omega.cross(dx_b) + ddx_b * qdot_c);
   }
 
   // segments [D Eq. 5.17-5.19, 5.27]

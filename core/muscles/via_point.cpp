@@ -25,7 +25,7 @@ Eigen::Matrix<double, 3, 8> calcJdot_az(double beta, double betadot, const Vec3&
 void calcEulerianCoordinates(MuscleKinematics& mk, const std::string& muscle_name) {
   const int P = static_cast<int>(mk.x_w.size());
   const int n = P - 2;
-  const int nr = static_cast<int>(mk.J_xr.cols());
+  const int k = static_cast<int>(mk.J_xr.cols());  // compact columns
   if (n < 1) throw std::logic_error("calcEulerianCoordinates: needs at least one internal path point");
   for (int i = 0; i < P - 1; ++i) {
     if (mk.l[i] > 1e-12 * (1.0 + mk.length)) continue;
@@ -60,7 +60,7 @@ void calcEulerianCoordinates(MuscleKinematics& mk, const std::string& muscle_nam
   const Eigen::PartialPivLU<MatX> Llu(L);
   mk.J_sx = -Llu.solve(dS * dXbar);
   // J_sr = J_sx J_xr on the internal rows; the ends have sdot = 0
-  mk.J_sr.setZero(P, nr);
+  mk.J_sr.setZero(P, k);
   mk.J_sr.middleRows(1, n).noalias() = mk.J_sx * mk.J_xr;
 
   if (!mk.velocity) return;
@@ -89,19 +89,19 @@ void calcEulerianCoordinates(MuscleKinematics& mk, const std::string& muscle_nam
   }
   // Jdot_sx = -L^-1 (Ldot J_sx + DeltaSdot DeltaXbar + DeltaS DeltaXbardot) [D Eq. 5.24]
   mk.Jdot_sx = -Llu.solve(Ld * mk.J_sx + dSd * dXbar + dS * dXbard);
-  mk.Jdot_sr.setZero(P, nr);
+  mk.Jdot_sr.setZero(P, k);
   mk.Jdot_sr.middleRows(1, n).noalias() = mk.Jdot_sx * mk.J_xr + mk.J_sx * mk.Jdot_xr;
 }
 
 void calcViaPointMassPoints(const MassPoints& mp, MuscleKinematics& mk) {
   const int P = static_cast<int>(mk.x_w.size());
   const int N = mp.size();
-  const int nr = static_cast<int>(mk.J_xr.cols());
+  const int k = static_cast<int>(mk.J_xr.cols());  // compact columns
   mk.x_a.resize(N);
   mk.segment.resize(N);
   mk.beta.resize(N);
-  if (mk.J_ar.rows() != 3 * N || mk.J_ar.cols() != nr) mk.J_ar.resize(3 * N, nr);
-  if (mk.velocity && (mk.Jdot_ar.rows() != 3 * N || mk.Jdot_ar.cols() != nr)) mk.Jdot_ar.resize(3 * N, nr);
+  if (mk.J_ar.rows() != 3 * N || mk.J_ar.cols() != k) mk.J_ar.resize(3 * N, k);
+  if (mk.velocity && (mk.Jdot_ar.rows() != 3 * N || mk.Jdot_ar.cols() != k)) mk.Jdot_ar.resize(3 * N, k);
 
   for (int a = 0; a < N; ++a) {
     const double s_a = mp.alpha[a];
@@ -116,31 +116,28 @@ void calcViaPointMassPoints(const MassPoints& mp, MuscleKinematics& mk) {
     mk.beta[a] = beta;
     mk.x_a[a] = (1.0 - beta) * mk.x_w[i] + beta * mk.x_w[i + 1];    // [D Eq. 5.30]
 
-    // J_ar = J_az J_zr, J_zr rows (J_xr(i); J_xr(i+1); J_sr(i); J_sr(i+1)) [D Eq. 5.15, 5.36]
-    const Eigen::Matrix<double, 3, 8> Jaz = calcJ_az(beta, F);
+    // J_ar = J_az J_zr, J_zr rows (J_xr(i); J_xr(i+1); J_sr(i); J_sr(i+1)) [D Eq. 5.15, 5.34,
+    // 5.36]; J_az's blocks are multiples of I and of F (calcJ_az), applied here as such
     const auto Jx0 = mk.J_xr.middleRows<3>(3 * i);
     const auto Jx1 = mk.J_xr.middleRows<3>(3 * (i + 1));
+    const auto Js0 = mk.J_sr.row(i);
+    const auto Js1 = mk.J_sr.row(i + 1);
     auto Ja = mk.J_ar.middleRows<3>(3 * a);
-    Ja.noalias() = Jaz.leftCols<3>() * Jx0;
-    Ja.noalias() += Jaz.middleCols<3>(3) * Jx1;
-    Ja.noalias() += Jaz.col(6) * mk.J_sr.row(i);
-    Ja.noalias() += Jaz.col(7) * mk.J_sr.row(i + 1);
+    Ja = (1.0 - beta) * Jx0 + beta * Jx1;
+    Ja.noalias() -= F * ((1.0 - beta) * Js0 + beta * Js1);
     if (!mk.velocity) continue;
 
     // betadot [D Eq. 5.31] and Fdot (sign: see header)
     const double betadot = -((1.0 - beta) * mk.sdot[i] + beta * mk.sdot[i + 1]) / ds;
     const Vec3 Fdot = (mk.xdot_w[i + 1] - mk.xdot_w[i] - F * (mk.sdot[i + 1] - mk.sdot[i])) / ds;
-    const Eigen::Matrix<double, 3, 8> Jdaz = calcJdot_az(beta, betadot, F, Fdot);
-    // Jdot_ar = Jdot_az J_zr + J_az Jdot_zr [D Eq. 5.15]
+    // Jdot_ar = Jdot_az J_zr + J_az Jdot_zr [D Eq. 5.15], Jdot_az from calcJdot_az:
+    //   (-betadot I, betadot I, betadot F - (1 - beta) Fdot, -betadot F - beta Fdot)
     auto Jda = mk.Jdot_ar.middleRows<3>(3 * a);
-    Jda.noalias() = Jdaz.leftCols<3>() * Jx0;
-    Jda.noalias() += Jdaz.middleCols<3>(3) * Jx1;
-    Jda.noalias() += Jdaz.col(6) * mk.J_sr.row(i);
-    Jda.noalias() += Jdaz.col(7) * mk.J_sr.row(i + 1);
-    Jda.noalias() += Jaz.leftCols<3>() * mk.Jdot_xr.middleRows<3>(3 * i);
-    Jda.noalias() += Jaz.middleCols<3>(3) * mk.Jdot_xr.middleRows<3>(3 * (i + 1));
-    Jda.noalias() += Jaz.col(6) * mk.Jdot_sr.row(i);
-    Jda.noalias() += Jaz.col(7) * mk.Jdot_sr.row(i + 1);
+    Jda = betadot * (Jx1 - Jx0) + (1.0 - beta) * mk.Jdot_xr.middleRows<3>(3 * i) +
+          beta * mk.Jdot_xr.middleRows<3>(3 * (i + 1));
+    Jda.noalias() += (betadot * F - (1.0 - beta) * Fdot) * Js0;
+    Jda.noalias() -= (betadot * F + beta * Fdot) * Js1;
+    Jda.noalias() -= F * ((1.0 - beta) * mk.Jdot_sr.row(i) + beta * mk.Jdot_sr.row(i + 1));
   }
 }
 

@@ -22,14 +22,26 @@ inline Vec3 randomVec(std::mt19937& rng, double scale) {
   return Vec3(u(rng), u(rng), u(rng)) * scale;
 }
 
-/// skeleton kinematics + one muscle's kinematics at s
+/// the same kinematics with every Jacobian in nr columns (cols becomes 0..nr-1)
+inline void expandAll(MuscleKinematics& mk, int nr) {
+  const int k = static_cast<int>(mk.cols.size());
+  for (MatX* J : {&mk.J_xr, &mk.Jdot_xr, &mk.J_sr, &mk.Jdot_sr, &mk.J_ar, &mk.Jdot_ar})
+    if (J->cols() == k && J->size() > 0) *J = expandColumns(*J, mk, nr);
+  mk.cols.resize(nr);
+  mk.col_of.resize(nr);
+  for (int c = 0; c < nr; ++c) mk.cols[c] = mk.col_of[c] = c;
+}
+
+/// skeleton kinematics + one muscle's kinematics at s, Jacobians expanded to nr columns
 inline MuscleKinematics evalMuscle(const Model& model, const Muscle& muscle, const State& s,
                                    bool velocity = true) {
   SkeletonWorkspace sk(model);
   calcKinematics(model, s, sk);
   MuscleWorkspace ws(model, {muscle});
   calcMuscleKinematics(model, s, sk, muscle, ws.muscles[0], velocity);
-  return ws.muscles[0];
+  MuscleKinematics mk = ws.muscles[0];
+  expandAll(mk, model.nr());
+  return mk;
 }
 
 /// state moved by t along its own velocity (q + t qdot, same qdot): every joint uses qdot = dq/dt

@@ -142,6 +142,38 @@ TEST(EolSegment, J_azAndJdot_azMatchTheirDefinitions) {
   }
 }
 
+TEST(EolSegment, MassPointJacobianIsJ_azTimesJ_zr) {
+  // the library applies J_az's block structure directly; check it against the explicit product
+  // J_ar = J_az J_zr and Jdot_ar = Jdot_az J_zr + J_az Jdot_zr [D Eq. 5.15], with J_xr = I
+  std::mt19937 rng(12);
+  for (int n = 1; n <= 4; ++n) {
+    std::vector<Vec3> x(n + 2), v(n + 2);
+    for (int i = 0; i < n + 2; ++i) {
+      x[i] = Vec3(0.3 * i, 0, 0) + test::randomVec(rng, 0.1);
+      v[i] = test::randomVec(rng, 1.0);
+    }
+    MuscleKinematics mk = rawPath(x, v);
+    MassPointOptions opt;
+    opt.count = 7;
+    opt.region = MassPointOptions::Region::WholePath;
+    const MassPoints mp = makeMassPoints(1.0, 0.1, 0.1, opt);
+    calcViaPointMassPoints(mp, mk);
+    for (int a = 0; a < mp.size(); ++a) {
+      const int i = mk.segment[a];
+      const double beta = mk.beta[a], ds = mk.s[i + 1] - mk.s[i];
+      const Vec3 F = (x[i + 1] - x[i]) / ds;
+      const double betadot = -((1.0 - beta) * mk.sdot[i] + beta * mk.sdot[i + 1]) / ds;
+      const Vec3 Fdot = (v[i + 1] - v[i] - F * (mk.sdot[i + 1] - mk.sdot[i])) / ds;
+      MatX J_zr(8, mk.J_xr.cols()), Jdot_zr(8, mk.J_xr.cols());
+      J_zr << mk.J_xr.middleRows<6>(3 * i), mk.J_sr.row(i), mk.J_sr.row(i + 1);
+      Jdot_zr << mk.Jdot_xr.middleRows<6>(3 * i), mk.Jdot_sr.row(i), mk.Jdot_sr.row(i + 1);
+      EXPECT_TRUE(nearRel(MatX(mk.J_ar.middleRows<3>(3 * a)), MatX(calcJ_az(beta, F) * J_zr), 1e-14));
+      EXPECT_TRUE(nearRel(MatX(mk.Jdot_ar.middleRows<3>(3 * a)),
+                          MatX(calcJdot_az(beta, betadot, F, Fdot) * J_zr + calcJ_az(beta, F) * Jdot_zr), 1e-14));
+    }
+  }
+}
+
 TEST(StraightPath, J_axIsTheWeightedAverage) {
   const Eigen::Matrix<double, 3, 6> J = calcJ_ax(0.3);
   const Vec3 v0(1, 2, 3), v1(-1, 0.5, 2);
