@@ -16,7 +16,6 @@
 // Only TUs that need Simbody include this header (BUILD_NOTES: ~15 s and 700 MB per TU; every such
 // TU must be compiled with -UNDEBUG, which the SimTKcommon target propagates).
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -24,36 +23,9 @@
 
 #include "core/skeleton/model.hpp"
 #include "core/skeleton/state.hpp"
+#include "plugin/simbody/simbody_options.hpp"
 
 namespace redmax::simbody {
-
-/// How a core SphericalEuler (XYZ) joint becomes a Simbody mobilizer.
-enum class SphericalAs {
-  Gimbal,  // q = body-fixed XYZ angles, u = qdot
-  Ball     // Euler-angle Ball: same q, u = angular velocity w_FM expressed in F
-};
-
-struct SimbodyBuildOptions {
-  SphericalAs spherical = SphericalAs::Gimbal;
-  /// Force::UniformGravity with the model's gravity
-  bool gravity = true;
-  /// Force::MobilityLinearSpring / MobilityLinearDamper for coordinates with nonzero stiffness or
-  /// damping. Only exact where u = qdot (the spring acts on q, the damper on u): a spring or damper
-  /// on a rotational coordinate of a Ball or Free mobilizer is rejected with SimbodyBuildError.
-  bool joint_springs = true;
-};
-
-enum class MobilizerKind { Weld, Pin, Slider, Gimbal, Ball, Universal, Free };
-
-/// Where one core joint lives in Simbody's q and u vectors.
-struct MobilizerMap {
-  MobilizerKind kind = MobilizerKind::Weld;
-  int q_index = 0;    // first core coordinate
-  int nq = 0;         // core coordinates (== Simbody nq == nu with Euler angles)
-  int simbody_q = 0;  // first Simbody q (matter subsystem indexing)
-  int simbody_u = 0;  // first Simbody u
-  bool u_is_qdot = true;  // false for Ball and Free: u = T qdot with T from calcVelocityMap
-};
 
 /// The Simbody system built from a core model. Not copyable (Simbody handles point into it).
 struct SimbodyModel {
@@ -70,13 +42,6 @@ struct SimbodyModel {
   int nu = 0;                                // Simbody u count (== core nr)
   /// default state: Euler angles on, realized to Stage::Model, q = core defaults, u = 0
   SimTK::State default_state;
-};
-
-/// Construction failed: a joint type without a Simbody counterpart, an invalid inertia, a spring on
-/// a mobilizer where q and u differ.
-class SimbodyBuildError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
 };
 
 /// Build the Simbody system. Throws SimbodyBuildError naming the offending body or joint.

@@ -16,6 +16,7 @@
 #include "core/dynamics/system.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "plugin/simbody/model_to_simbody.hpp"
+#include "validation/scenes/humanoid.hpp"
 #include "validation/scenes/scenes.hpp"
 
 namespace redmax {
@@ -201,6 +202,29 @@ TEST_P(Crosscheck, ForwardAccelerationsMatch) {
       EXPECT_TRUE(relClose(VecX(T * qddot + Tdot * s.qdot), simbody::fromSimTK(sm->matter.getUDot(sb)), kTol))
           << label(c, GetParam());
     }
+  }
+}
+
+// the benchmark humanoid (free pelvis, ball/universal/pin joints, 37 DoF) agrees as well
+TEST_P(Crosscheck, HumanoidMatches) {
+  const Model m = scenes::humanoid();
+  SimbodyBuildOptions opt;
+  opt.spherical = GetParam();
+  const auto sm = simbody::makeSimbodyModel(m, opt);
+  System sys(m);
+  DynamicsWorkspace ws(m);
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    State s = randomState(m, rng);
+    s.q = m.defaultQ() + 0.5 * s.q;
+    const VecX qddot = VecX::NullaryExpr(m.nr(), [&] { return u(rng); });
+    sys.calcMassAndForce(s, ws);
+    EXPECT_TRUE(relClose(ws.M, simbody::calcSimbodyMassCore(*sm, m, s), kTol));
+    const VecX tau_sb = simbody::calcSimbodyInverseDynamicsCore(*sm, m, s, qddot);
+    EXPECT_TRUE(relClose(sys.inverseDynamics(s, qddot, ws), tau_sb, kTol));
+    EXPECT_TRUE(relClose(inverseDynamicsRecursive(m, s, qddot), tau_sb, kTol));
+    EXPECT_TRUE(relClose(sys.forwardDynamics(s, ws), simbody::calcSimbodyForwardDynamicsCore(*sm, m, s), kTol));
   }
 }
 
