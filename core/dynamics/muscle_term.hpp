@@ -7,6 +7,9 @@
 // Muscle activation forces are not applied here: they act on the skeleton (other terms) and
 // move the mass points only kinematically, as in the dissertation.
 //
+// Implicit integrators: addStiffnessDamping is not overridden, so bdf1/sdirk2 treat the muscle
+// inertia's forces (gravity on the points, QVV) explicitly in K and D; M is still exact.
+//
 // Thread safety: the term caches the muscle kinematics of the last (q, qdot) it saw, so that
 // addMass, addForce and the energies of one state share one evaluation; a mutex guards the
 // cache, so one term may be shared, but concurrent callers then take turns.
