@@ -158,13 +158,13 @@ struct ModelCase {
   Model model;
 };
 
-// Random trees use the Simbody-comparable joints (revolute, prismatic, Euler-angle balls, free
-// ...): the difference tests here check the muscle chain, so they rely on Jdot_mr being right.
-// PointJacobianFactorsThroughMaximalCoordinates below also runs over every joint type.
+// Two random trees use the Simbody-comparable joints (revolute, prismatic, Euler-angle balls,
+// free ...), one every joint type (exponential spherical, composite, spline, function-based ...).
 std::vector<ModelCase> models() {
   using scenes::TreeJoints;
   return {{"randomTree6", scenes::randomTree(6, 11, TreeJoints::SimbodyComparable)},
           {"randomTree9", scenes::randomTree(9, 23, TreeJoints::SimbodyComparable)},
+          {"randomTreeAll7", scenes::randomTree(7, 31, TreeJoints::All)},
           {"revoluteChain4", scenes::revoluteChain(4)},
           {"doublePendulum", scenes::doublePendulum()}};
 }
