@@ -1,6 +1,7 @@
 // .osim reader: wrap objects on frames, the ForceSet, and the GeometryPath of every path force
 // (points, conditional and moving points, wraps), OPENSIM_SEMANTICS §6.
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "converter/detail/osim_functions.hpp"
@@ -223,6 +224,9 @@ void OsimReader::readPathForce(const XMLElement* e, const std::string& name,
                                         "' is not hybrid, midpoint or axial");
     if (const XMLElement* r = firstChild(w, "range"); r && !textOf(r).empty()) {
       const auto v = parseNumbersExactly(doc(), r, 2);
+      for (double x : v)
+        if (!(std::abs(x) < 1e6) || x != std::floor(x))
+          fail(r, "PathWrap range needs two path-point indices, found '" + textOf(r) + "'");
       pw.range_begin = static_cast<int>(v[0]);
       pw.range_end = static_cast<int>(v[1]);
     }

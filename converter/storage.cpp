@@ -165,7 +165,7 @@ Storage readStorage(const std::string& path) {
         double x;
         if (!parseDouble(w, x))
           throw ConvertError(path, static_cast<int>(li + 1), "'" + w + "' is not a number");
-        if (nr >= 1 && static_cast<int>(values.size()) == nr * ncol) {
+        if (nr >= 1 && static_cast<long long>(values.size()) == static_cast<long long>(nr) * ncol) {
           s.warnings.push_back("data after the " + std::to_string(nr) +
                                " rows announced by nRows are ignored (line " +
                                std::to_string(li + 1) + ")");
@@ -176,7 +176,7 @@ Storage readStorage(const std::string& path) {
         last_line = static_cast<int>(li + 1);
       }
     }
-    if (nr >= 1 && static_cast<int>(values.size()) < nr * ncol)
+    if (nr >= 1 && static_cast<long long>(values.size()) < static_cast<long long>(nr) * ncol)
       throw ConvertError(path, last_line,
                          "nRows=" + std::to_string(nr) + " rows of " + std::to_string(ncol) +
                              " values announced but the data ends after " +
