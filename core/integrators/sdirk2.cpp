@@ -73,10 +73,16 @@ void Sdirk2::solveStage(const System& sys, double t, const VecX& zq, const VecX&
       }
       if (!allFinite(dV)) break;
       V += dV;
-      if (converged(dV)) return;
       const double nrm = dV.norm();
-      // stalled or diverging: give up this phase
-      if (prev >= 0.0 && nrm > 0.9 * prev) break;
+      if (converged(dV)) return;
+      if (prev > 0.0) {
+        // linear convergence at rate theta leaves an error of about theta / (1 - theta) |dV|
+        // after this update (Hairer and Wanner's stopping rule): often one evaluation fewer
+        const double theta = nrm / prev;
+        if (theta < 0.9 && theta / (1.0 - theta) * nrm <= opt_.newton_tol * (1.0 + V.norm())) return;
+        // stalled or diverging: give up this phase
+        if (theta >= 0.9) break;
+      }
       prev = nrm;
     }
   }
@@ -91,8 +97,10 @@ void Sdirk2::step(const System& sys, State& s, double h, DynamicsWorkspace& ws) 
   const double hg = h * g;
   const VecX q0 = s.q, v0 = s.qdot;
 
-  // stage 1 at t + gamma h: Y1 = y0 + h gamma F(Y1)
-  VecX V1 = v0;
+  // stage 1 at t + gamma h: Y1 = y0 + h gamma F(Y1); predictor from the previous step's end
+  // acceleration when this step continues it, else the start velocity
+  const bool continues = a_end_.size() == v0.size() && end_.q == q0 && end_.qdot == v0;
+  VecX V1 = continues ? VecX(v0 + hg * a_end_) : v0;
   solveStage(sys, s.t + hg, q0, v0, hg, h, V1, ws);
   // F(Y1) = (Y1 - y0) / (h gamma), which avoids one more dynamics evaluation
   const VecX a1 = (V1 - v0) / hg;
@@ -107,6 +115,8 @@ void Sdirk2::step(const System& sys, State& s, double h, DynamicsWorkspace& ws) 
   s.q = zq + hg * V2;
   s.qdot = V2;
   s.t += h;
+  a_end_ = (V2 - zv) / hg;
+  end_ = s;
 }
 
 }  // namespace redmax

@@ -14,6 +14,9 @@ namespace redmax {
 /// steps this method is used with, while stiff springs/dampers are inverted exactly. If that
 /// iteration stalls or diverges the stage restarts with a full finite-difference Jacobian of
 /// the residual (ndof extra dynamics evaluations); if that fails too, SimulationError.
+/// Stopping rule: |dV| <= newton_tol (1 + |V|), or the error estimated from the contraction rate
+/// theta, theta / (1 - theta) |dV|, below the same bound. Stage 1 is predicted with the end
+/// acceleration of the previous step (free: the method is stiffly accurate).
 /// Constraints: qddot comes from the acceleration-level KKT system (System::forwardDynamics)
 /// with the System's Baumgarte stabilisation (System::stabilization); Newton steps are solved
 /// with the constraint rows in the KKT matrix. Without stabilisation the position drift of
@@ -32,6 +35,11 @@ class Sdirk2 final : public FixedStepIntegrator {
   /// solve V = zv + hg qddot(zq + hg V, V) at time t; V holds the initial guess on entry
   void solveStage(const System& sys, double t, const VecX& zq, const VecX& zv, double hg,
                   double h, VecX& V, DynamicsWorkspace& ws);
+
+  // the acceleration at the end of the last step, F(Y2) = (V2 - zv) / (h gamma) (stiffly
+  // accurate, so it is qddot(y+)), predicts the next stage 1 if the next step starts there
+  VecX a_end_;
+  State end_;
 };
 
 }  // namespace redmax

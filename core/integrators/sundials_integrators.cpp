@@ -370,9 +370,11 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
       }
       if (++steps_here > opt_.max_steps) {
         S.valid = false;
-        throw SimulationError(who + ": more than max_steps = " + std::to_string(opt_.max_steps) +
-                                  " internal steps in one advance() call",
-                              S.t_cur, S.lastStep());
+        std::ostringstream os;
+        os << who << ": more than max_steps = " << opt_.max_steps
+           << " internal steps in one advance() call, stuck at t = " << S.t_cur
+           << " with step h = " << S.lastStep() << " (stiff or singular dynamics?)";
+        throw SimulationError(os.str(), S.t_cur, S.lastStep());
       }
       const double t = S.step(t_out);
       S.syncStats(stats_);

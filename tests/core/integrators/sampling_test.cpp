@@ -271,6 +271,33 @@ TEST(Adaptive, SwitchingSystemSizeRebuildsSolver) {
   }
 }
 
+// A force that blows up in finite time (1 / (0.5 - t)^3) defeats every step-size controller:
+// the failure (SUNDIALS error, divergence or max_steps) is a SimulationError before t = 0.5.
+TEST(Adaptive, SolverFailureBecomesSimulationError) {
+  System sys(springDampedPendulum());
+  sys.addTerm(std::make_shared<LambdaForce>([](const State& s, VecX& f) {
+    const double d = 0.5 - s.t;
+    f[0] += 1.0 / (d * d * d);
+  }));
+  for (const std::string name : {"rk45", "cvode"}) {
+    IntegratorOptions opt;
+    opt.max_steps = 20000;
+    auto integ = makeIntegrator(name, opt);
+    State s = pendulumStart(sys);
+    try {
+      integ->advance(sys, s, 1.0);
+      ADD_FAILURE() << name << " passed a singularity";
+    } catch (const SimulationError& e) {
+      std::printf("%s\n", e.what());
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos);
+      EXPECT_GT(e.time, 0.4) << name;
+      EXPECT_LE(e.time, 0.5) << name;
+      EXPECT_GT(e.step, 0.0) << name;
+    }
+    EXPECT_EQ(s.t, 0.0);  // the adaptive methods leave the state as it was passed
+  }
+}
+
 // An exception thrown by the dynamics inside a SUNDIALS callback reaches the caller unchanged
 // (it is never unwound through C frames), and the integrator is usable afterwards.
 TEST(Adaptive, ExceptionInDynamicsPropagates) {
