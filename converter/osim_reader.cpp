@@ -204,12 +204,16 @@ ModelDescription OsimReader::read() {
   readHeader();
   if (legacy()) {
     readLegacyBodies();
+    registerComponents(firstChild(model_, "components"), "");
   } else {
+    // the Model's own components list precedes ground, BodySet and JointSet in OpenSim's
+    // component order (Component's properties are constructed before Model's), so bodies and
+    // joints found there come first
+    registerComponents(firstChild(model_, "components"), "");
     readGroundAndBodies();
     readModernJoints();
   }
-  // model-level components (4.0) and the 3.x ComponentSet may hold frames
-  registerComponents(firstChild(model_, "components"), "");
+  // the 3.x ComponentSet may hold frames
   if (const XMLElement* cs = firstChild(model_, "ComponentSet"))
     registerComponents(setObjects(cs), "/" + setName(cs, "ComponentSet"));
   collectConstraintFrames();
@@ -294,6 +298,10 @@ void OsimReader::registerComponents(const XMLElement* list, const std::string& o
       const std::string path = f.path;
       registerFrame(std::move(f));
       registerComponents(firstChild(c, "components"), path);
+    } else if (tag == "Body" && !legacy()) {
+      readBody(c, name, owner_path + "/" + name);
+    } else if (findJointType(tag) && !legacy()) {
+      readModernJoint(c, name, owner_path + "/" + name);
     } else {
       addUnsupported(c, "component '" + name + "' (" + tag + ") in a components list is not read");
     }
@@ -319,28 +327,35 @@ void OsimReader::readGroundAndBodies() {
   for (const XMLElement* b : childElements(setObjects(set))) {
     if (std::string(b->Name()) != "Body")
       fail(b, "<" + std::string(b->Name()) + "> in BodySet: only <Body> is a body type");
-    BodyDesc body;
-    body.name = componentName(b, names);
-    body.line = lineOf(b);
-    const XMLElement* m = firstChild(b, "mass");
-    if (!m || textOf(m).empty()) fail(b, "body '" + body.name + "' has no <mass>");
-    body.mass = parseNumbersExactly(doc_, m, 1)[0];
-    if (!(body.mass >= 0) || !std::isfinite(body.mass))
-      fail(m, "body '" + body.name + "' has an invalid mass " + textOf(m));
-    body.mass_center = childVec3(doc_, b, "mass_center", Vec3::Zero());
-    if (const XMLElement* in = firstChild(b, "inertia"); in && !textOf(in).empty()) {
-      const auto v = parseNumbersExactly(doc_, in, 6);
-      for (int i = 0; i < 6; ++i) body.inertia[i] = v[i];
-    }
-    d_.bodies.push_back(body);
-    FrameNode f;
-    f.kind = FrameNode::Kind::Body;
-    f.name = body.name;
-    f.path = set_path + "/" + body.name;
-    f.elem = b;
-    registerFrame(f);
-    registerComponents(firstChild(b, "components"), f.path);
+    const std::string name = componentName(b, names);
+    readBody(b, name, set_path + "/" + name);
   }
+}
+
+void OsimReader::readBody(const XMLElement* b, const std::string& name, const std::string& path) {
+  BodyDesc body;
+  body.name = name;
+  body.line = lineOf(b);
+  if (d_.findBody(name) >= 0 || name == d_.ground_name)
+    fail(b, "two bodies are named '" + name + "'; body names must be unique");
+  const XMLElement* m = firstChild(b, "mass");
+  if (!m || textOf(m).empty()) fail(b, "body '" + body.name + "' has no <mass>");
+  body.mass = parseNumbersExactly(doc_, m, 1)[0];
+  if (!(body.mass >= 0) || !std::isfinite(body.mass))
+    fail(m, "body '" + body.name + "' has an invalid mass " + textOf(m));
+  body.mass_center = childVec3(doc_, b, "mass_center", Vec3::Zero());
+  if (const XMLElement* in = firstChild(b, "inertia"); in && !textOf(in).empty()) {
+    const auto v = parseNumbersExactly(doc_, in, 6);
+    for (int i = 0; i < 6; ++i) body.inertia[i] = v[i];
+  }
+  d_.bodies.push_back(body);
+  FrameNode f;
+  f.kind = FrameNode::Kind::Body;
+  f.name = body.name;
+  f.path = path;
+  f.elem = b;
+  registerFrame(f);
+  registerComponents(firstChild(b, "components"), f.path);
 }
 
 void OsimReader::readLegacyBodies() {
@@ -479,29 +494,37 @@ void OsimReader::readModernJoints() {
   const std::string set_path = "/" + setName(set, "JointSet");
   std::set<std::string> names;
   for (const XMLElement* e : childElements(setObjects(set))) {
-    RawJoint rj;
-    rj.elem = e;
-    rj.desc.type = e->Name();
-    rj.desc.line = lineOf(e);
-    rj.desc.name = componentName(e, names);
-    rj.path = set_path + "/" + rj.desc.name;
-    rj.parent_socket = socketValue(e, "parent_frame", &rj.parent_socket_elem);
-    rj.child_socket = socketValue(e, "child_frame", &rj.child_socket_elem);
-    if (rj.parent_socket.empty())
-      fail(rj.parent_socket_elem, "joint '" + rj.desc.name + "' has no parent_frame socket");
-    if (rj.child_socket.empty())
-      fail(rj.child_socket_elem, "joint '" + rj.desc.name + "' has no child_frame socket");
-    if (version_ < 30514 && childBool(doc_, e, "reverse", false)) {
-      std::swap(rj.parent_socket, rj.child_socket);
-      rj.desc.reversed_in_file = true;
-    }
-    registerComponents(firstChild(e, "frames"), rj.path);
-    if (const XMLElement* cl = firstChild(e, "coordinates"))
-      rj.coordinate_elems = childElements(cl, "Coordinate");
-    else if (const XMLElement* cs = firstChild(e, "CoordinateSet"))
-      rj.coordinate_elems = childElements(setObjects(cs), "Coordinate");
-    raw_joints_.push_back(std::move(rj));
+    const std::string name = componentName(e, names);
+    readModernJoint(e, name, set_path + "/" + name);
   }
+}
+
+void OsimReader::readModernJoint(const XMLElement* e, const std::string& name,
+                                 const std::string& path) {
+  RawJoint rj;
+  rj.elem = e;
+  rj.desc.type = e->Name();
+  rj.desc.line = lineOf(e);
+  rj.desc.name = name;
+  rj.path = path;
+  for (const auto& other : raw_joints_)
+    if (other.desc.name == name) fail(e, "two joints are named '" + name + "'");
+  rj.parent_socket = socketValue(e, "parent_frame", &rj.parent_socket_elem);
+  rj.child_socket = socketValue(e, "child_frame", &rj.child_socket_elem);
+  if (rj.parent_socket.empty())
+    fail(rj.parent_socket_elem, "joint '" + rj.desc.name + "' has no parent_frame socket");
+  if (rj.child_socket.empty())
+    fail(rj.child_socket_elem, "joint '" + rj.desc.name + "' has no child_frame socket");
+  if (version_ < 30514 && childBool(doc_, e, "reverse", false)) {
+    std::swap(rj.parent_socket, rj.child_socket);
+    rj.desc.reversed_in_file = true;
+  }
+  registerComponents(firstChild(e, "frames"), rj.path);
+  if (const XMLElement* cl = firstChild(e, "coordinates"))
+    rj.coordinate_elems = childElements(cl, "Coordinate");
+  else if (const XMLElement* cs = firstChild(e, "CoordinateSet"))
+    rj.coordinate_elems = childElements(setObjects(cs), "Coordinate");
+  raw_joints_.push_back(std::move(rj));
 }
 
 void OsimReader::collectConstraintFrames() {
@@ -594,15 +617,21 @@ CoordinateDesc OsimReader::readCoordinate(const XMLElement* e) {
 
 void OsimReader::buildJoints() {
   for (auto& rj : raw_joints_) buildJoint(rj);
-  for (const auto& j : d_.joints)
-    for (int ci : j.coordinates)
-      coordinate_paths_["/" + setName(firstChild(model_, "JointSet"), "JointSet") + "/" + j.name +
-                        "/" + d_.coordinates[ci].name] = d_.coordinates[ci].name;
-  // legacy paths use /jointset whatever the set is called
-  for (const auto& j : d_.joints)
-    for (int ci : j.coordinates)
-      coordinate_paths_["/jointset/" + j.name + "/" + d_.coordinates[ci].name] =
-          d_.coordinates[ci].name;
+  // coordinate socket paths: <joint path>/<coordinate>; pre-4.0 conversions write /jointset
+  for (size_t k = 0; k < raw_joints_.size(); ++k) {
+    const auto& j = d_.joints[k];
+    for (int ci : j.coordinates) {
+      const std::string& cn = d_.coordinates[ci].name;
+      coordinate_paths_[raw_joints_[k].path + "/" + cn] = cn;
+      coordinate_paths_["/jointset/" + j.name + "/" + cn] = cn;
+    }
+  }
+  // coordinate names are how files (storage columns, couplers, legacy paths) refer to them
+  std::set<std::string> seen;
+  for (const auto& c : d_.coordinates)
+    if (!seen.insert(c.name).second)
+      warn(nullptr, "two coordinates are named '" + c.name +
+                        "': references by name use the first in file order");
 }
 
 void OsimReader::buildJoint(RawJoint& rj) {

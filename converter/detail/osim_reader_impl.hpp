@@ -76,6 +76,8 @@ class OsimReader {
   // model.cpp
   void readHeader();
   void readGroundAndBodies();
+  void readBody(const XMLElement* b, const std::string& name, const std::string& path);
+  void readModernJoint(const XMLElement* e, const std::string& name, const std::string& path);
   void readLegacyBodies();
   void readModernJoints();
   void registerFrame(FrameNode node);

@@ -146,6 +146,20 @@ TEST(MultibodyTree, UnconnectedBodiesGetFreeJointsToGround) {
   EXPECT_EQ(q.back(), "xy_q");
 }
 
+TEST(MultibodyTree, BodiesAndJointsInTheModelsComponentsComeFirst) {
+  // OpenSim's component order puts the Model's own components list before its JointSet
+  const std::string comps =
+      "<components>\n" + bodyXml("c") + pinXml("jc", "/ground", "/c") + "</components>\n";
+  std::string text = modernOsim(bodyXml("a"), pinXml("ja", "/ground", "/bodyset/a"));
+  text.insert(text.find("<Ground"), comps);
+  const auto d = readText(text);
+  ASSERT_EQ(d.bodies.size(), 2u);
+  EXPECT_EQ(d.bodies[0].name, "c");
+  EXPECT_EQ(mobilizerJoints(d), (std::vector<std::string>{"jc", "ja"}));
+  EXPECT_EQ(d.joints[0].child_frame, "/c");
+  EXPECT_TRUE(d.unsupported.empty());
+}
+
 TEST(MultibodyTree, BuilderRejectsJointsOnUnknownBodies) {
   ModelDescription d;
   d.source_file = "x.osim";
