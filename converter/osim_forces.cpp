@@ -116,8 +116,8 @@ void OsimReader::readWrapObjectSet(const XMLElement* set, const FrameNode& frame
 
 void OsimReader::readForces() {
   // pre-2.0 files call the ForceSet an ActuatorSet
-  const XMLElement* set = firstChild(model_, "ForceSet");
-  if (!set) set = firstChild(model_, "ActuatorSet");
+  const XMLElement* set = modelChild("ForceSet");
+  if (!set) set = modelChild("ActuatorSet");
   std::set<std::string> names;
   // old class names OpenSim registers as aliases (RegisterTypes_osimActuators)
   static const std::map<std::string, std::string> renamed = {

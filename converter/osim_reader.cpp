@@ -73,6 +73,11 @@ const char* kAxisNames[6] = {"rotation1",    "rotation2",    "rotation3",
 
 OsimReader::OsimReader(const std::string& path) : doc_(path) { d_.source_file = path; }
 
+const XMLElement* OsimReader::modelChild(const char* tag) const {
+  const XMLElement* e = firstChild(model_, tag);
+  return e ? e : firstChild(engine_, tag);
+}
+
 void OsimReader::addUnsupported(const XMLElement* e, const std::string& what) {
   d_.unsupported.push_back({lineOf(e), what});
 }
@@ -146,6 +151,8 @@ FrameNode& OsimReader::frameForSocket(const std::string& owner, const std::strin
   if (socket.empty()) fail(where, what + ": the socket is empty");
   const std::string p = resolvePath(owner, socket);
   auto it = frames_.find(p);
+  if (!p.empty() && it == frames_.end() && unsupported_frames_.count(p))
+    fail(where, what + ": '" + socket + "' is a StationDefinedFrame, which is not supported");
   if (p.empty() || it == frames_.end())
     fail(where, what + ": '" + socket + "' does not name a frame of the model" +
                     (p.empty() ? std::string(" (the path leaves the model)")
@@ -204,17 +211,17 @@ ModelDescription OsimReader::read() {
   readHeader();
   if (legacy()) {
     readLegacyBodies();
-    registerComponents(firstChild(model_, "components"), "");
+    registerComponents(modelChild("components"), "");
   } else {
     // the Model's own components list precedes ground, BodySet and JointSet in OpenSim's
     // component order (Component's properties are constructed before Model's), so bodies and
     // joints found there come first
-    registerComponents(firstChild(model_, "components"), "");
+    registerComponents(modelChild("components"), "");
     readGroundAndBodies();
     readModernJoints();
   }
   // the 3.x ComponentSet may hold frames
-  if (const XMLElement* cs = firstChild(model_, "ComponentSet"))
+  if (const XMLElement* cs = modelChild("ComponentSet"))
     registerComponents(setObjects(cs), "/" + setName(cs, "ComponentSet"));
   collectConstraintFrames();
   resolveFrames();
@@ -270,7 +277,15 @@ void OsimReader::readHeader() {
   model_ = firstChild(root, "Model");
   if (!model_) fail(root, "no <Model> element in <OpenSimDocument>");
   d_.name = attribute(model_, "name");
-  d_.gravity = childVec3(doc_, model_, "gravity", Vec3(0.0, -9.80665, 0.0));
+  // early 1.x files keep the bodies inside <DynamicsEngine><SimbodyEngine>
+  if (!firstChild(model_, "BodySet"))
+    if (const XMLElement* de = firstChild(model_, "DynamicsEngine")) {
+      engine_ = firstChild(de, "SimbodyEngine");
+      if (!engine_)
+        fail(de, "<DynamicsEngine> without a <SimbodyEngine> (e.g. SD/FAST models) is not supported");
+    }
+  const XMLElement* g = firstChild(model_, "gravity") ? model_ : engine_;
+  d_.gravity = childVec3(doc_, g, "gravity", Vec3(0.0, -9.80665, 0.0));
 }
 
 void OsimReader::registerFrame(FrameNode node) {
@@ -298,6 +313,9 @@ void OsimReader::registerComponents(const XMLElement* list, const std::string& o
       const std::string path = f.path;
       registerFrame(std::move(f));
       registerComponents(firstChild(c, "components"), path);
+    } else if (tag == "StationDefinedFrame") {
+      unsupported_frames_.insert(owner_path + "/" + name);
+      addUnsupported(c, "frame '" + name + "' (StationDefinedFrame) is not modelled");
     } else if (tag == "Body" && !legacy()) {
       readBody(c, name, owner_path + "/" + name);
     } else if (findJointType(tag) && !legacy()) {
@@ -310,7 +328,7 @@ void OsimReader::registerComponents(const XMLElement* list, const std::string& o
 
 void OsimReader::readGroundAndBodies() {
   // ground
-  const XMLElement* ground = firstChild(model_, "Ground");
+  const XMLElement* ground = modelChild("Ground");
   {
     FrameNode g;
     g.kind = FrameNode::Kind::Ground;
@@ -321,7 +339,7 @@ void OsimReader::readGroundAndBodies() {
     registerFrame(g);
     if (ground) registerComponents(firstChild(ground, "components"), "/" + g.name);
   }
-  const XMLElement* set = firstChild(model_, "BodySet");
+  const XMLElement* set = modelChild("BodySet");
   const std::string set_path = "/" + setName(set, "BodySet");
   std::set<std::string> names = {d_.ground_name};
   for (const XMLElement* b : childElements(setObjects(set))) {
@@ -359,7 +377,7 @@ void OsimReader::readBody(const XMLElement* b, const std::string& name, const st
 }
 
 void OsimReader::readLegacyBodies() {
-  const XMLElement* set = firstChild(model_, "BodySet");
+  const XMLElement* set = modelChild("BodySet");
   if (!set) fail(model_, "no <BodySet> in the model");
   std::set<std::string> body_names, joint_names;
   bool have_ground = false;
@@ -490,7 +508,7 @@ void OsimReader::readLegacyBodies() {
 }
 
 void OsimReader::readModernJoints() {
-  const XMLElement* set = firstChild(model_, "JointSet");
+  const XMLElement* set = modelChild("JointSet");
   const std::string set_path = "/" + setName(set, "JointSet");
   std::set<std::string> names;
   for (const XMLElement* e : childElements(setObjects(set))) {
@@ -528,7 +546,7 @@ void OsimReader::readModernJoint(const XMLElement* e, const std::string& name,
 }
 
 void OsimReader::collectConstraintFrames() {
-  const XMLElement* set = firstChild(model_, "ConstraintSet");
+  const XMLElement* set = modelChild("ConstraintSet");
   const std::string set_path = "/" + setName(set, "ConstraintSet");
   std::set<std::string> names;
   for (const XMLElement* e : childElements(setObjects(set))) {
@@ -844,7 +862,7 @@ void OsimReader::buildCustomJoint(RawJoint& rj, std::vector<CoordinateDesc>& coo
 // constraints
 
 void OsimReader::readConstraints() {
-  const XMLElement* set = firstChild(model_, "ConstraintSet");
+  const XMLElement* set = modelChild("ConstraintSet");
   const std::string set_path = "/" + setName(set, "ConstraintSet");
   std::set<std::string> names;
   for (const XMLElement* e : childElements(setObjects(set))) {
@@ -944,7 +962,7 @@ void OsimReader::readConstraints() {
 // markers and sets that are read only to be reported
 
 void OsimReader::readMarkers() {
-  const XMLElement* set = firstChild(model_, "MarkerSet");
+  const XMLElement* set = modelChild("MarkerSet");
   const std::string set_path = "/" + setName(set, "MarkerSet");
   std::set<std::string> names;
   for (const XMLElement* e : childElements(setObjects(set))) {
@@ -976,7 +994,7 @@ void OsimReader::noteIgnoredSets() {
       {"ControllerSet", "controllers are not run (excitations are zero)"},
   };
   for (const auto& s : sets) {
-    const XMLElement* set = firstChild(model_, s.tag);
+    const XMLElement* set = modelChild(s.tag);
     for (const XMLElement* e : childElements(setObjects(set)))
       addUnsupported(e, std::string(e->Name()) + " '" + attribute(e, "name") + "' in " + s.tag +
                             ": " + s.why);

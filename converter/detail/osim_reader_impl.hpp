@@ -74,6 +74,8 @@ class OsimReader {
 
  private:
   // model.cpp
+  /// a child of <Model>, or of the 1.x <SimbodyEngine> that held the model's sets
+  const XMLElement* modelChild(const char* tag) const;
   void readHeader();
   void readGroundAndBodies();
   void readBody(const XMLElement* b, const std::string& name, const std::string& path);
@@ -105,6 +107,8 @@ class OsimReader {
   ModelDescription d_;
   int version_ = 0;
   const XMLElement* model_ = nullptr;
+  const XMLElement* engine_ = nullptr;  ///< 1.x <DynamicsEngine><SimbodyEngine>, if any
+  std::set<std::string> unsupported_frames_;  ///< paths of frames we cannot place
   std::map<std::string, FrameNode> frames_;  ///< by absolute path
   std::vector<std::string> frame_order_;     ///< registration (component-list) order
   std::vector<RawJoint> raw_joints_;

@@ -201,6 +201,19 @@ TEST(LegacyUpgrade, LegacyConstraintsBecomeSocketsAndOffsetFrames) {
   EXPECT_EQ(cc.function->coefficients[0], 0.5);
 }
 
+TEST(LegacyUpgrade, Version10901WithTheSetsInsideTheSimbodyEngine) {
+  // 1.x files keep gravity and the sets in <DynamicsEngine><SimbodyEngine>
+  std::string text = legacyOsim(legacyBody("b", "", legacyPin("p", "ground", "q")), "", "10901");
+  text.replace(text.find("<BodySet"), 0,
+               "<DynamicsEngine><SimbodyEngine>\n<gravity>0 0 -9.81</gravity>\n");
+  text.replace(text.find("</Model>"), 0, "</SimbodyEngine></DynamicsEngine>\n");
+  const auto d = readText(text);
+  EXPECT_EQ(d.osim_version, 10901);
+  EXPECT_EQ(d.gravity, Vec3(0, 0, -9.81));
+  ASSERT_EQ(d.bodies.size(), 1u);
+  EXPECT_EQ(d.numDofs(), 1);
+}
+
 TEST(LegacyUpgrade, MixedFilesReadModernElementsWhateverTheVersion) {
   // OpenSim reads properties by tag: a 3.0 file may already use sockets in its paths
   const std::string forces =

@@ -136,6 +136,12 @@ TEST(Malformed, BrokenSocketPaths) {
   expectError(modernOsim(kTwoBodies, pinXml("j1", "/bodyset/a", "/bodyset/a") +
                                          pinXml("j2", "/bodyset/a", "/bodyset/b")),
               "<PinJoint name=\"j1\">", "both fixed to 'a'");
+  // a frame type that is read but not modelled cannot carry a joint
+  std::string sdf = modernOsim(kTwoBodies, pinXml("j1", "/ground", "/bodyset/a/sdf") +
+                                               pinXml("j2", "/bodyset/a", "/bodyset/b"));
+  sdf.insert(sdf.find("<mass>1.000000</mass>"),
+             "<components><StationDefinedFrame name=\"sdf\"/></components>\n");
+  expectError(sdf, "/bodyset/a/sdf", "is a StationDefinedFrame, which is not supported");
   // a cycle of offset frames (a frame's socket is relative to the frame itself: siblings are ../)
   const std::string cyc =
       "<PinJoint name=\"j1\">\n<socket_parent_frame>f1</socket_parent_frame>\n"
