@@ -29,7 +29,6 @@ void Sdirk2::solveStage(const System& sys, double t, const VecX& zq, const VecX&
     ++stats_.rhs_evals;
     return Vk - zv - hg * a;
   };
-  auto converged = [&](const VecX& dV) { return dV.norm() <= opt_.newton_tol * (1.0 + V.norm()); };
 
   // phase 1: approximate Newton with M + hg D + hg^2 K; phase 2: finite-difference Jacobian
   const VecX V_start = V;
@@ -39,7 +38,8 @@ void Sdirk2::solveStage(const System& sys, double t, const VecX& zq, const VecX&
       V = V_start;
     }
     double prev = -1.0;
-    MatX J;  // phase 2: dR/dV
+    Eigen::PartialPivLU<MatX> J_lu;  // phase 2: LU of dR/dV
+    bool refresh = true;             // phase 2: build dR/dV at the current iterate
     for (int it = 0; it < opt_.newton_max_iter; ++it) {
       const VecX R = residual(V);
       if (!allFinite(R)) {
@@ -58,9 +58,9 @@ void Sdirk2::solveStage(const System& sys, double t, const VecX& zq, const VecX&
         // rows keep G dV = -G R so the iterate stays consistent with the KKT accelerations
         dV = detail::solveImplicit(A, G, -(ws.M * R), G.rows() ? VecX(-(G * R)) : VecX(), nullptr);
       } else {
-        if (it == 0) {
-          // forward differences of R; ws is overwritten, R was taken before
-          J.resize(n, n);
+        if (refresh) {
+          // forward differences of R (ws is overwritten; R was taken before)
+          MatX J(n, n);
           ++stats_.jacobian_evals;
           for (int k = 0; k < n; ++k) {
             VecX Vp = V;
@@ -68,20 +68,29 @@ void Sdirk2::solveStage(const System& sys, double t, const VecX& zq, const VecX&
             Vp[k] += e;
             J.col(k) = (residual(Vp) - R) / e;
           }
+          J_lu.compute(J);
+          // a Jacobian kept from a far-off predictor converges only linearly when the
+          // velocity-product forces are large, so the fallback is full Newton: a new FD
+          // Jacobian at every iterate (quadratic convergence)
+          refresh = true;
         }
-        dV = -J.partialPivLu().solve(R);
+        dV = -J_lu.solve(R);
       }
       if (!allFinite(dV)) break;
       V += dV;
       const double nrm = dV.norm();
-      if (converged(dV)) return;
+      const double bound = opt_.newton_tol * (1.0 + V.norm());
+      if (nrm <= bound) return;
       if (prev > 0.0) {
         // linear convergence at rate theta leaves an error of about theta / (1 - theta) |dV|
         // after this update (Hairer and Wanner's stopping rule): often one evaluation fewer
         const double theta = nrm / prev;
-        if (theta < 0.9 && theta / (1.0 - theta) * nrm <= opt_.newton_tol * (1.0 + V.norm())) return;
-        // stalled or diverging: give up this phase
-        if (theta >= 0.9) break;
+        if (theta < 1.0 && theta / (1.0 - theta) * nrm <= bound) return;
+        if (phase == 0) {
+          // diverging, or too slow to reach the bound in the iterations left: give up early
+          const int left = opt_.newton_max_iter - it - 1;
+          if (theta >= 1.0 || std::pow(theta, left) / (1.0 - theta) * nrm > bound) break;
+        }
       }
       prev = nrm;
     }

@@ -12,8 +12,10 @@ namespace redmax {
 /// i.e. the derivatives of M, gravity and the velocity-product terms are neglected: for them
 /// the iteration contracts like (h gamma)^2 |M^-1 df/dq| + h gamma |M^-1 df/dqdot|, fast at the
 /// steps this method is used with, while stiff springs/dampers are inverted exactly. If that
-/// iteration stalls or diverges the stage restarts with a full finite-difference Jacobian of
-/// the residual (ndof extra dynamics evaluations); if that fails too, SimulationError.
+/// iteration diverges or is too slow to reach the tolerance in newton_max_iter iterations, the
+/// stage restarts with full Newton on a forward-difference Jacobian of the residual (ndof extra
+/// dynamics evaluations per iteration; counted in stats().failed_steps); if that fails too,
+/// SimulationError.
 /// Stopping rule: |dV| <= newton_tol (1 + |V|), or the error estimated from the contraction rate
 /// theta, theta / (1 - theta) |dV|, below the same bound. Stage 1 is predicted with the end
 /// acceleration of the previous step (free: the method is stiffly accurate).
