@@ -384,10 +384,14 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
     }
     // dense output at t_out; the returned state may switch chart on its own copy
     S.interpolate(t_out, S.yout);
-    toState(S.yout, n, t_out, s);
-    checkFinite(s, S.lastStep(), who.c_str());
-    sys.reparameterize(s);
-    S.last_out = s;
+    State out;
+    toState(S.yout, n, t_out, out);
+    checkFinite(out, S.lastStep(), who.c_str());
+    sys.reparameterize(out);
+    s.t = out.t;
+    s.q = out.q;
+    s.qdot = out.qdot;
+    S.last_out = out;
     S.last_sys = &sys;
   } catch (...) {
     S.valid = false;
