@@ -97,6 +97,16 @@ std::vector<std::string> splitWords(const std::string& text) {
   return out;
 }
 
+namespace {
+// "<tag>: " built by appending (GCC 12 warns falsely on "literal" + std::string temporaries)
+std::string tagPrefix(const XMLElement* e) {
+  std::string s = "<";
+  s += e ? e->Name() : "value";
+  s += ">: ";
+  return s;
+}
+}  // namespace
+
 double parseNumber(const XmlDocument& doc, const XMLElement* e, const std::string& word) {
   const std::string w = toLower(word);
   if (w == "inf" || w == "infinity" || w == "+inf" || w == "+infinity")
@@ -108,10 +118,7 @@ double parseNumber(const XmlDocument& doc, const XMLElement* e, const std::strin
   errno = 0;
   const double x = std::strtod(s, &end);
   // strtod also accepts hex floats and "infinity" prefixes; demand the whole word be a number
-  if (end == s || *end != '\0' || errno == ERANGE) {
-    const std::string tag = e ? e->Name() : "value";
-    doc.fail(e, "<" + tag + ">: '" + word + "' is not a number");
-  }
+  if (end == s || *end != '\0' || errno == ERANGE) doc.fail(e, tagPrefix(e) + "'" + word + "' is not a number");
   return x;
 }
 
@@ -128,7 +135,7 @@ std::vector<double> parseNumbers(const XmlDocument& doc, const XMLElement* e) {
 std::vector<double> parseNumbersExactly(const XmlDocument& doc, const XMLElement* e, size_t n) {
   auto v = parseNumbers(doc, e);
   if (v.size() != n)
-    doc.fail(e, "<" + std::string(e->Name()) + "> needs " + std::to_string(n) + " numbers, found " +
+    doc.fail(e, tagPrefix(e) + "needs " + std::to_string(n) + " numbers, found " +
                     std::to_string(v.size()));
   return v;
 }
@@ -137,7 +144,7 @@ bool parseBool(const XmlDocument& doc, const XMLElement* e) {
   const std::string t = toLower(textOf(e));
   if (t == "true" || t == "1" || t == "yes") return true;
   if (t == "false" || t == "0" || t == "no") return false;
-  doc.fail(e, "<" + std::string(e->Name()) + ">: '" + textOf(e) + "' is not true or false");
+  doc.fail(e, tagPrefix(e) + "'" + textOf(e) + "' is not true or false");
 }
 
 int parseInt(const XmlDocument& doc, const XMLElement* e) {
@@ -146,7 +153,7 @@ int parseInt(const XmlDocument& doc, const XMLElement* e) {
   errno = 0;
   const long v = std::strtol(t.c_str(), &end, 10);
   if (t.empty() || *end != '\0' || errno == ERANGE || v < -2147483647L || v > 2147483647L)
-    doc.fail(e, "<" + std::string(e->Name()) + ">: '" + t + "' is not an integer");
+    doc.fail(e, tagPrefix(e) + "'" + t + "' is not an integer");
   return static_cast<int>(v);
 }
 
