@@ -1,6 +1,7 @@
 // The `redmax` executable: thin dispatch to the subcommands in cli/cmd_*.cpp.
 #include <algorithm>
 #include <exception>
+#include <stdexcept>
 #include <iostream>
 
 #include "cli/command.hpp"
@@ -55,6 +56,10 @@ int main(int argc, char** argv) {
       return c.run(rest);
     } catch (const UsageError& e) {
       std::cerr << "error: " << e.message << "\n(see `redmax " << c.name << " --help`)\n";
+      return 2;
+    } catch (const std::invalid_argument& e) {
+      // bad option values reach the libraries as invalid_argument: still the user's input
+      std::cerr << "error: " << e.what() << "\n";
       return 2;
     } catch (const std::exception& e) {
       std::cerr << "error: " << e.what() << "\n";
