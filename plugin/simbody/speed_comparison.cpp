@@ -98,13 +98,15 @@ SpeedComparison::SpeedComparison(std::string scene, const Model& model, const Sp
                  [&I] {
                    I.engine.invalidatePositions();
                    I.engine.realizeVelocity();
-                 }});
+                 },
+                 nullptr});
   ops.push_back({"mass_matrix", "calcSkeletonMass (J_mr given)", "calcM (Position realized)",
                  [&I] { calcSkeletonMass(I.sys.model(), I.ws_mass, I.M_r); },
                  [&I] {
                    I.engine.realizePosition();  // no-op once realized
                    I.engine.calcMassMatrix(I.M_u);
-                 }});
+                 },
+                 nullptr});
   ops.push_back({"id_redmax", "System::inverseDynamics (kinematics, M_r, f_r, M qddot - f)",
                  "realize(Dynamics) + calcResidualForceIgnoringConstraints",
                  [&I] { I.tau = I.sys.inverseDynamics(I.s0, I.qddot, I.ws_id); },
@@ -112,7 +114,8 @@ SpeedComparison::SpeedComparison(std::string scene, const Model& model, const Sp
                    I.engine.invalidatePositions();
                    I.engine.realizeDynamics();
                    I.engine.calcResidualForces(I.udot, I.f_u);
-                 }});
+                 },
+                 nullptr});
   ops.push_back({"id_recursive", "inverseDynamicsRecursive (RNEA)",
                  "realize(Dynamics) + calcResidualForceIgnoringConstraints",
                  [&I] { I.tau = inverseDynamicsRecursive(I.sys.model(), I.s0, I.qddot); },
@@ -120,13 +123,15 @@ SpeedComparison::SpeedComparison(std::string scene, const Model& model, const Sp
                    I.engine.invalidatePositions();
                    I.engine.realizeDynamics();
                    I.engine.calcResidualForces(I.udot, I.f_u);
-                 }});
+                 },
+                 nullptr});
   ops.push_back({"forward_dynamics", "System::forwardDynamics (M_r, f_r, LDLT)", "realize(Acceleration)",
                  [&I] { I.qddot_out = I.sys.forwardDynamics(I.s0, I.ws_fd); },
                  [&I] {
                    I.engine.invalidatePositions();
                    I.engine.realizeAcceleration();
-                 }});
+                 },
+                 nullptr});
 
   // one step of each available integrator
   IntegratorOptions iopt;

@@ -87,7 +87,9 @@ TEST(SpeedComparison, RunsEveryOperationOnBothSides) {
     EXPECT_TRUE(std::isfinite(r.ratio())) << r.op;
     EXPECT_EQ(r.scene, "humanoid");
     EXPECT_EQ(r.dof, 37);
-    if (r.op.rfind("step_", 0) == 0) EXPECT_NE(r.note.find("internal steps per call"), std::string::npos);
+    if (r.op.rfind("step_", 0) == 0) {
+      EXPECT_NE(r.note.find("internal steps per call"), std::string::npos);
+    }
   }
 }
 
