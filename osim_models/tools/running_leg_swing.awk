@@ -16,7 +16,7 @@
 #   hip_flexion_r   =  15 - 25 cos(pi s) + 8 sin(pi s)      (-10 at toe-off, peak 41 near s = 0.9)
 #   hip_adduction_r = -2 + 4 sin(pi s)
 #   hip_rotation_r  =  4 sin(2 pi s)
-#   knee_angle_r    = -(20 - 8 s) - 90 sin(pi s)^2          (-20, about -106 mid-swing, -12)
+#   knee_angle_r    = -(25 - 13 s) - 90 sin(pi s)^2         (-25, about -108 mid-swing, -12)
 #   ankle_angle_r   = -20 + 22 s + 15 sin(pi s)             (plantarflexed at toe-off, then dorsiflexed)
 # Every curve is smooth (infinitely differentiable) on the interval.
 BEGIN {
@@ -45,7 +45,7 @@ BEGIN {
     v[7] = 15 - 25 * cos(a) + 8 * sin(a)
     v[8] = -2 + 4 * sin(a)
     v[9] = 4 * sin(2 * a)
-    v[10] = -(20 - 8 * s) - 90 * sin(a) ^ 2
+    v[10] = -(25 - 13 * s) - 90 * sin(a) ^ 2
     v[11] = -20 + 22 * s + 15 * sin(a)
     printf "%.8f", t
     for (k = 1; k <= 11; k++) {
