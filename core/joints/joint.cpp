@@ -63,7 +63,9 @@ std::string Joint::typeName() const {
                                [](const Free3D&) { return std::string("free3d"); },
                                [](const SplineCurve&) { return std::string("spline_curve"); },
                                [](const SplineSurface&) { return std::string("spline_surface"); },
-                               [](const FunctionBased&) { return std::string("function_based"); }},
+                               [](const FunctionBased&) { return std::string("function_based"); },
+                               [](const Ellipsoid&) { return std::string("ellipsoid"); },
+                               [](const Reversed& r) { return "reversed_" + r.inner->typeName(); }},
                     v);
 }
 

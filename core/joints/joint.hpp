@@ -11,15 +11,18 @@
 // (translational_joints.hpp); SphericalEuler (any of 12 sequences), Universal (euler_joints.hpp);
 // SphericalExp (spherical_exp.hpp); Composite (composite.hpp); Free2D, Free3D (free_joints.hpp);
 // SplineCurve, SplineSurface (spline_joints.hpp); FunctionBased = OpenSim CustomJoint
-// (function_based.hpp, functions in functions.hpp).
+// (function_based.hpp, functions in functions.hpp); Ellipsoid (ellipsoid.hpp, OpenSim
+// EllipsoidJoint); Reversed (reversed.hpp: any joint used in the opposite direction).
 #include <string>
 #include <variant>
 
 #include "core/joints/basic_joints.hpp"
 #include "core/joints/composite.hpp"
+#include "core/joints/ellipsoid.hpp"
 #include "core/joints/euler_joints.hpp"
 #include "core/joints/free_joints.hpp"
 #include "core/joints/function_based.hpp"
+#include "core/joints/reversed.hpp"
 #include "core/joints/spherical_exp.hpp"
 #include "core/joints/spline_joints.hpp"
 #include "core/joints/translational_joints.hpp"
@@ -28,7 +31,8 @@ namespace redmax {
 
 using JointVariant =
     std::variant<Fixed, Revolute, Prismatic, Planar, Translational, SphericalEuler, Universal,
-                 SphericalExp, Composite, Free2D, Free3D, SplineCurve, SplineSurface, FunctionBased>;
+                 SphericalExp, Composite, Free2D, Free3D, SplineCurve, SplineSurface, FunctionBased,
+                 Ellipsoid, Reversed>;
 
 /// A joint of any type. Value semantics: copying a Model copies its joints.
 struct Joint {

@@ -170,6 +170,13 @@ Joint randomJoint(std::size_t index, std::mt19937& rng) {
       return SplineSurface(C);
     }
     case 13: return randomFunctionBased(rng);
+    case 14: {
+      // semi-axes of either sign and unequal, so p = D n exercises every radius
+      Vec3 r;
+      for (int k = 0; k < 3; ++k) r[k] = (pick(rng, 4) == 0 ? -1.0 : 1.0) * uniform(rng, 0.05, 0.4);
+      return Ellipsoid{r};
+    }
+    case 15: return Reversed(randomJoint(static_cast<std::size_t>(pick(rng, 15)), rng));
     default:
       throw std::out_of_range("randomJoint: no generator for joint alternative " + std::to_string(index));
   }
