@@ -91,7 +91,9 @@ std::map<std::string, Mat4> chainPoses(const ModelDescription& d, const std::str
   return X;
 }
 
-Vec3 apply(const Mat4& X, const Vec3& p) { return X.topLeftCorner<3, 3>() * p + X.topRightCorner<3, 1>(); }
+Vec3 apply(const Mat4& X, const Vec3& p) {
+  return X.topLeftCorner<3, 3>() * p + X.topRightCorner<3, 1>();
+}
 
 /// path points of a muscle in the root frame
 std::vector<Vec3> pathPoints(const ModelDescription& d, const PathForceDesc& m,
@@ -118,7 +120,8 @@ double polylineLength(const ModelDescription& d, const PathForceDesc& m, const s
 double momentArm(const ModelDescription& d, const PathForceDesc& m, const std::string& root,
                  const std::string& coord, Coords q = {}) {
   const double h = 1e-6;
-  const double q0 = q.count(coord) ? q[coord] : d.coordinates[d.findCoordinate(coord)].default_value;
+  const double q0 =
+      q.count(coord) ? q[coord] : d.coordinates[d.findCoordinate(coord)].default_value;
   q[coord] = q0 + h;
   const double Lp = polylineLength(d, m, root, q);
   q[coord] = q0 - h;
@@ -202,8 +205,12 @@ TEST(OsimModels, EverySceneReadsStrictWithTheExpectedCounts) {
       EXPECT_GE(m.pennation_angle_at_optimal, 0.0) << m.name;
       EXPECT_LT(m.pennation_angle_at_optimal, 0.5) << m.name;
       const std::string xml = readText(scenePath(s.file));
-      EXPECT_NE(xml.find("<pennation_angle_at_optimal>", xml.find("name=\"" + m.name + "\"")),
-                std::string::npos);
+      const size_t begin = xml.find("<" + m.class_name + " name=\"" + m.name + "\"");
+      ASSERT_NE(begin, std::string::npos) << m.name;
+      const std::string element = xml.substr(begin, xml.find("</" + m.class_name, begin) - begin);
+      for (const char* tag : {"<max_isometric_force>", "<optimal_fiber_length>",
+                              "<tendon_slack_length>", "<pennation_angle_at_optimal>"})
+        EXPECT_NE(element.find(tag), std::string::npos) << m.name << " " << tag;
     }
     EXPECT_EQ(n[0], s.type1);
     EXPECT_EQ(n[1], s.type2);
@@ -234,8 +241,8 @@ TEST(OsimModels, EverySceneCarriesItsHeaderComment) {
 // double pendulums
 
 TEST(OsimModels, PendulumLinksAreOneMetreOneKilogram) {
-  for (const char* file : {"double_pendulum_via.osim", "double_pendulum_straight.osim",
-                           "double_pendulum_wrap.osim"}) {
+  for (const char* file :
+       {"double_pendulum_via.osim", "double_pendulum_straight.osim", "double_pendulum_wrap.osim"}) {
     SCOPED_TRACE(file);
     const ModelDescription d = readOsimModel(scenePath(file));
     for (const auto& b : d.bodies) {
@@ -336,11 +343,13 @@ TEST(OsimModels, PendulumCylinderSitsOnTheMiddleJointAndEngagesAtTheStatedAngle)
 TEST(OsimModels, FingerBonesChainAndFlexTowardsThePalm) {
   const ModelDescription d = readOsimModel(scenePath("finger.osim"));
   EXPECT_EQ(d.joints.at(d.findJoint("wrist_weld")).kind, JointKind::Weld);
-  for (const char* j : {"mcp", "pip", "dip"}) EXPECT_EQ(d.joints.at(d.findJoint(j)).kind, JointKind::Pin);
+  for (const char* j : {"mcp", "pip", "dip"})
+    EXPECT_EQ(d.joints.at(d.findJoint(j)).kind, JointKind::Pin);
   // masses: bone cylinders at 5 g/cm^3 (the dissertation's density), 4 significant digits
-  const std::map<std::string, std::pair<double, double>> bone = {
-      {"metacarpal", {0.065, 0.005}}, {"proximal", {0.045, 0.0045}},
-      {"middle", {0.025, 0.004}},     {"distal", {0.020, 0.0035}}};
+  const std::map<std::string, std::pair<double, double>> bone = {{"metacarpal", {0.065, 0.005}},
+                                                                 {"proximal", {0.045, 0.0045}},
+                                                                 {"middle", {0.025, 0.004}},
+                                                                 {"distal", {0.020, 0.0035}}};
   for (const auto& b : d.bodies) {
     const auto [L, r] = bone.at(b.name);
     EXPECT_NEAR(b.mass, 5000 * kPi * r * r * L, 5e-4 * b.mass) << b.name;
@@ -363,7 +372,9 @@ TEST(OsimModels, FingerBonesChainAndFlexTowardsThePalm) {
     const Vec3 tp = apply(chainPoses(d, "ground", c).at("distal"), tip_d);
     c[q] = -1e-6;
     const Vec3 tm = apply(chainPoses(d, "ground", c).at("distal"), tip_d);
-    const double lever = std::string(q) == "mcp_flexion" ? 0.09 : std::string(q) == "pip_flexion" ? 0.045 : 0.02;
+    const double lever = std::string(q) == "mcp_flexion"   ? 0.09
+                         : std::string(q) == "pip_flexion" ? 0.045
+                                                           : 0.02;
     EXPECT_NEAR((tp.y() - tm.y()) / 2e-6, -lever, 1e-8) << q;
   }
   // default pose lightly flexed with DIP at half of PIP (the dissertation's coupled IP joints)
@@ -381,7 +392,8 @@ TEST(OsimModels, FingerFlexorsHaveTheStatedMomentArms) {
   std::set<std::string> fdp_bodies, fds_bodies;
   for (const auto& p : fdp.points) fdp_bodies.insert(p.body);
   for (const auto& p : fds.points) fds_bodies.insert(p.body);
-  EXPECT_EQ(fdp_bodies, (std::set<std::string>{"ground", "metacarpal", "proximal", "middle", "distal"}));
+  EXPECT_EQ(fdp_bodies,
+            (std::set<std::string>{"ground", "metacarpal", "proximal", "middle", "distal"}));
   EXPECT_EQ(fds_bodies, (std::set<std::string>{"ground", "metacarpal", "proximal", "middle"}));
   // moment arms -dL/dq at the default pose, the values written in the header (0.05 mm)
   EXPECT_NEAR(momentArm(d, fdp, "ground", "mcp_flexion"), 0.0110, 5e-5);
@@ -437,7 +449,8 @@ TEST(OsimModels, RunningLegSegmentsFollowDeLeva) {
   EXPECT_EQ(d.joints.at(d.findJoint("knee_r")).kind, JointKind::Pin);
   EXPECT_EQ(d.joints.at(d.findJoint("ankle_r")).kind, JointKind::Pin);
   for (const auto& c : d.coordinates) {
-    const bool translation = c.name == "pelvis_tx" || c.name == "pelvis_ty" || c.name == "pelvis_tz";
+    const bool translation =
+        c.name == "pelvis_tx" || c.name == "pelvis_ty" || c.name == "pelvis_tz";
     EXPECT_EQ(c.motion_type, translation ? MotionType::Translational : MotionType::Rotational)
         << c.name;
   }
@@ -471,6 +484,13 @@ TEST(OsimModels, RunningLegAnkleMusclesHaveTheStatedPathsAndMomentArms) {
   EXPECT_NEAR(momentArm(d, ta, "femur_r", "ankle_angle_r"), 0.050, 5e-4);
   EXPECT_LT(std::abs(momentArm(d, sol, "femur_r", "knee_angle_r")), 1e-9);
   EXPECT_LT(std::abs(momentArm(d, ta, "femur_r", "knee_angle_r")), 1e-9);
+  // physiological masses density * F / 0.25 MPa * L_opt, as the header lists them (5 g)
+  const std::map<std::string, double> mass = {
+      {"soleus_r", 0.75}, {"tib_ant_r", 0.38}, {"med_gas_r", 0.40}, {"lat_gas_r", 0.19}};
+  for (const auto& m : d.muscles)
+    EXPECT_NEAR(1059.7 * m.max_isometric_force / 0.25e6 * m.optimal_fiber_length, mass.at(m.name),
+                5e-3)
+        << m.name;
   // tendon slack fitted to this geometry: fibre at its optimal length at the default pose
   for (const auto* m : {&sol, &ta})
     EXPECT_NEAR(polylineLength(d, *m, "femur_r", {}) - m->tendon_slack_length,
@@ -503,9 +523,11 @@ TEST(OsimModels, RunningLegGastrocnemiusWrapsTheCondylesOnlyNearExtension) {
     // the straight line would cut the cylinder at full extension and at 10 degrees of flexion,
     // not at 25 degrees or deeper: the header's "beyond about 18 degrees"
     for (double deg : {10.0, 0.0, -10.0})
-      EXPECT_LT(axisToSegment2d(d, m, "femur_r", {{"knee_angle_r", deg * kPi / 180}}), w.radius) << deg;
+      EXPECT_LT(axisToSegment2d(d, m, "femur_r", {{"knee_angle_r", deg * kPi / 180}}), w.radius)
+          << deg;
     for (double deg : {-25.0, -60.0, -110.0})
-      EXPECT_GT(axisToSegment2d(d, m, "femur_r", {{"knee_angle_r", deg * kPi / 180}}), w.radius) << deg;
+      EXPECT_GT(axisToSegment2d(d, m, "femur_r", {{"knee_angle_r", deg * kPi / 180}}), w.radius)
+          << deg;
   }
 }
 
