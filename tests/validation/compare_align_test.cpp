@@ -33,10 +33,6 @@ Table tableOf(const std::string& name, const std::vector<std::string>& labels, c
   return makeTable(name, labels, t, d);
 }
 
-bool contains(const std::vector<std::string>& v, const std::string& s) {
-  return std::find(v.begin(), v.end(), s) != v.end();
-}
-
 TEST(CompareAlign, MatchesColumnsByNameAcrossOrderAndReportsMissing) {
   const auto t = grid(3, 0, 1);
   const Table a = makeTable("a", {"x", "y", "z"}, t, MatX::Zero(3, 3));

@@ -191,7 +191,8 @@ TEST(ReportWriter, NamesAndSectionsAreGuarded) {
   rep.addComparison(makeComparison("cmp", 0.1, {}));
   EXPECT_THROW(rep.addComparison(makeComparison("cmp", 0.1, {})), std::invalid_argument);
   EXPECT_THROW(rep.addTable("cmp_metrics", CsvTable{}), std::invalid_argument);
-  EXPECT_THROW(rep.addPlot("summary", PlotFigure{}), std::invalid_argument);
+  EXPECT_THROW(rep.addPlot("cmp_difference", PlotFigure{}), std::invalid_argument);
+  EXPECT_NO_THROW(rep.addTable("cmp_overlay", CsvTable{}));  // a .csv beside the .png: no clash
   EXPECT_THROW(rep.section("comparisons"), std::invalid_argument);
   EXPECT_THROW(rep.section("passed"), std::invalid_argument);
   EXPECT_NO_THROW(rep.section("work_precision"));

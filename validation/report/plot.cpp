@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -260,13 +261,21 @@ std::string makeGnuplotScript(const PlotFigure& fig, const std::string& extensio
   s << "set multiplot layout " << rows << "," << cols;
   if (!fig.title.empty()) s << " title " << quoteGp(fig.title) << " font ',12'";
   s << "\n";
-  s << "set grid\nset key top right font ',8'\n";
+  s << "set grid\n";
   for (int p = 0; p < n_panels; ++p) {
     const auto& panel = fig.panels[p];
     // every panel sets all its state: nothing leaks from the previous one
     s << "set title " << quoteGp(panel.title) << "\n";
     s << "set xlabel " << quoteGp(panel.xlabel) << "\nset ylabel " << quoteGp(panel.ylabel) << "\n";
     s << "unset logscale\nset autoscale\nunset label\nset xtics\nset ytics\n";
+    // the legend over an opaque box, so that it stays legible over the curves
+    if (panel.key == "off") {
+      s << "unset key\n";
+    } else {
+      std::string where;
+      for (char c : panel.key) where += (std::isalpha(static_cast<unsigned char>(c)) || c == ' ') ? c : ' ';
+      s << "set key " << where << " opaque box font ',8'\n";
+    }
     // decades as 0.001, 1e-05 (noenhanced text cannot draw superscripts)
     if (panel.log_x) s << "set logscale x\nset format x '%g'\n";
     else s << "set format x '% h'\n";
@@ -390,6 +399,7 @@ PlotPanel makeLogLogPanel(const std::string& title, const std::string& xlabel, c
                           std::vector<PlotLine> lines) {
   PlotPanel p = makeXYPanel(title, xlabel, ylabel, std::move(lines));
   p.log_x = p.log_y = true;
+  p.key = "bottom left";  // work-precision curves fall from top left to bottom right
   for (auto& l : p.lines) {
     if (l.style == "lines") l.style = "linespoints";
   }
@@ -417,8 +427,9 @@ std::vector<PlotFigure> makeColumnGridFigures(const SeriesSet& set, const std::s
         line.x = set.time;
         line.y = set.values[s].at(k);
         // later series dashed and thinner, so that curves lying on top of each other stay visible
-        line.dash_type = static_cast<int>(s) + 1;
-        line.width = std::max(1.0, 2.5 - 0.75 * static_cast<double>(s));
+        // (dash types 1 solid, 2 dashed, then 4, 5... dash-dot patterns: 3's dots are too faint)
+        line.dash_type = s < 2 ? static_cast<int>(s) + 1 : static_cast<int>(s) + 2;
+        line.width = std::max(1.2, 2.5 - 0.6 * static_cast<double>(s));
         panel.lines.push_back(std::move(line));
       }
       fig.panels.push_back(std::move(panel));

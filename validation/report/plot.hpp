@@ -29,6 +29,7 @@ PlotLine makePlotLine(std::string label, std::vector<double> x, std::vector<doub
 struct PlotPanel {
   std::string title, xlabel, ylabel;
   bool log_x = false, log_y = false;
+  std::string key = "top right";  ///< legend position in gnuplot words ("bottom left", "off"...)
   std::vector<PlotLine> lines;
 };
 

@@ -158,13 +158,15 @@ std::string sanitizeFileStem(const std::string& name) {
 
 Report::Report(std::string dir, ReportOptions opt) : dir_(std::move(dir)), opt_(std::move(opt)) {
   if (dir_.empty()) throw std::invalid_argument("Report: empty directory name");
-  stems_ = {"summary", "report"};
+  stems_ = {"summary.json", "report.md"};
 }
 
-std::string Report::claimStem(const std::string& name) {
+std::string Report::claimStem(const std::string& name, const std::string& kind) {
+  // names are claimed per kind of output (".csv", ".img" for png/svg, ".cmp" for comparisons),
+  // so a table and a plot of the same data may share a name but two files never collide
   const std::string stem = sanitizeFileStem(name);
-  if (!stems_.insert(stem).second) {
-    throw std::invalid_argument("Report: the name '" + name + "' (file stem '" + stem + "') is already used");
+  if (!stems_.insert(stem + kind).second) {
+    throw std::invalid_argument("Report: the name '" + name + "' (file '" + stem + kind + "') is already used");
   }
   return stem;
 }
@@ -184,7 +186,11 @@ void Report::addWallTime(const std::string& what, double seconds) {
 void Report::addComparison(const Comparison& c, const std::string& ylabel) {
   const std::string stem = sanitizeFileStem(c.name);
   // claim every file stem the comparison will use, so that nothing else overwrites them
-  for (const char* suffix : {"", "_metrics", "_series", "_overlay", "_difference"}) claimStem(stem + suffix);
+  claimStem(stem, ".cmp");
+  claimStem(stem + "_metrics", ".csv");
+  claimStem(stem + "_series", ".csv");
+  claimStem(stem + "_overlay", ".img");
+  claimStem(stem + "_difference", ".img");
   comparisons_.push_back({c, stem, ylabel});
 
   // overlays of a and b, and the difference a - b, one panel per column
@@ -206,8 +212,8 @@ void Report::addComparison(const Comparison& c, const std::string& ylabel) {
                                           opt_.panels_per_figure);
   if (overlay.size() > 1) {
     for (size_t p = 1; p <= overlay.size(); ++p) {
-      claimStem(stem + "_overlay_" + std::to_string(p));
-      claimStem(stem + "_difference_" + std::to_string(p));
+      claimStem(stem + "_overlay_" + std::to_string(p), ".img");
+      claimStem(stem + "_difference_" + std::to_string(p), ".img");
     }
   }
   if (!overlay.empty()) {
@@ -218,7 +224,7 @@ void Report::addComparison(const Comparison& c, const std::string& ylabel) {
 
 void Report::addOverlay(const std::string& name, const AlignedTables& aligned, const std::string& title,
                         const std::string& ylabel) {
-  const std::string stem = claimStem(name);
+  const std::string stem = claimStem(name, ".img");
   SeriesSet set;
   set.time = aligned.time;
   set.columns = aligned.columns();
@@ -230,20 +236,20 @@ void Report::addOverlay(const std::string& name, const AlignedTables& aligned, c
   }
   auto figs = makeColumnGridFigures(set, title, ylabel, opt_.panels_per_figure);
   if (figs.size() > 1) {
-    for (size_t p = 1; p <= figs.size(); ++p) claimStem(stem + "_" + std::to_string(p));
+    for (size_t p = 1; p <= figs.size(); ++p) claimStem(stem + "_" + std::to_string(p), ".img");
   }
   overlays_.push_back({stem, title, aligned.names, aligned.columns(), aligned.t_begin, aligned.t_end});
   if (!figs.empty()) plots_.push_back({PlotKind::Overlay, stem, std::move(figs), title});
 }
 
 void Report::addPlot(const std::string& name, const PlotFigure& fig, const std::string& caption) {
-  plots_.push_back({PlotKind::Figure, claimStem(name), {fig}, caption.empty() ? fig.title : caption});
+  plots_.push_back({PlotKind::Figure, claimStem(name, ".img"), {fig}, caption.empty() ? fig.title : caption});
 }
 
 void Report::addTable(const std::string& name, const CsvTable& table, const std::string& caption) {
   // format now, so that a malformed table is reported where it is added
   formatCsv(table);
-  tables_.push_back({claimStem(name), caption, table});
+  tables_.push_back({claimStem(name, ".csv"), caption, table});
 }
 
 JsonValue& Report::section(const std::string& key) {
@@ -393,10 +399,10 @@ std::string Report::formatMarkdown(const ReportFiles& files,
   for (const auto& e : comparisons_) {
     const Comparison& c = e.c;
     md << "### " << mdText(c.name) << ": " << passText(c.passed) << "\n\n";
-    md << mdText(c.label_a) << " against the reference " << mdText(c.label_b) << " over t = " << fmt3(c.t_begin)
-       << " .. " << fmt3(c.t_end) << " s (" << c.time.size() << " samples on " << mdText(c.grid)
-       << "'s rows" << (c.grid == "uniform" ? ", uniform grid" : "") << ", " << toString(c.interpolation)
-       << " interpolation, " << toString(c.weighting) << "-weighted RMS).\n";
+    const std::string grid = c.grid == "uniform" ? std::string("a uniform grid") : mdText(c.grid) + "'s rows";
+    md << "a = " << mdText(c.label_a) << " against the reference b = " << mdText(c.label_b) << " over t = "
+       << fmt3(c.t_begin) << " .. " << fmt3(c.t_end) << " s (" << c.time.size() << " samples on " << grid << ", "
+       << toString(c.interpolation) << " interpolation, " << toString(c.weighting) << "-weighted RMS).\n";
     md << "Tolerance per column: " << toleranceText(c.tolerance) << " (peak = max |" << mdText(c.label_b)
        << "|); a column passes when both hold.\n\n";
     if (!c.only_in_a.empty()) md << "Only in " << mdText(c.label_a) << ": " << joinNames(c.only_in_a) << ".\n";

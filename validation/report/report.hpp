@@ -127,7 +127,7 @@ class Report {
     bool passed;
   };
 
-  std::string claimStem(const std::string& name);
+  std::string claimStem(const std::string& name, const std::string& kind);
   JsonValue comparisonJson(const ComparisonEntry& e, const std::vector<std::string>& plots) const;
   std::string formatMarkdown(const ReportFiles& files, const std::map<std::string, std::vector<std::string>>& plots_of,
                              const GnuplotInfo& gp, const std::string& created) const;
@@ -143,7 +143,7 @@ class Report {
   std::vector<std::pair<std::string, std::string>> markdown_;
   std::vector<Check> checks_;
   JsonValue sections_ = JsonValue::object();
-  std::set<std::string> stems_;
+  std::set<std::string> stems_;  // claimed output names, stem + kind
 };
 
 /// The file stem used for a name: characters other than [A-Za-z0-9._-] become '_' ("" -> "_").
