@@ -1,0 +1,400 @@
+#include "converter/id/inverse_dynamics_tool.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <sstream>
+
+#include "converter/osim_reader.hpp"
+#include "converter/signal/signal_error.hpp"
+
+namespace redmax::osim {
+
+namespace {
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string joinNames(const std::vector<std::string>& names, size_t max_names = 12) {
+  std::string out;
+  for (size_t k = 0; k < names.size() && k < max_names; ++k) out += (k ? ", " : "") + names[k];
+  if (names.size() > max_names) out += ", ... (" + std::to_string(names.size()) + " in all)";
+  return out;
+}
+
+std::vector<double> columnOf(const MatX& data, int c) {
+  std::vector<double> v(static_cast<size_t>(data.rows()));
+  for (Eigen::Index r = 0; r < data.rows(); ++r) v[static_cast<size_t>(r)] = data(r, c);
+  return v;
+}
+
+// a body name as ExternalLoads write it: "name", "/bodyset/name" or "/name"
+std::string bodyName(std::string n) {
+  if (n.rfind("/bodyset/", 0) == 0) n = n.substr(9);
+  if (!n.empty() && n[0] == '/') n = n.substr(1);
+  return n;
+}
+
+// label path elements, e.g. "/jointset/r_shoulder/r_shoulder_elev/value" -> {..., "value"}
+std::vector<std::string> pathElements(const std::string& label) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : label) {
+    if (c == '/') {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
+}  // namespace
+
+double degreesToRadians() {
+  // SimTK_DEGREE_TO_RADIAN is computed in long double and used as a double
+  return static_cast<double>(3.14159265358979323846264338327950288L / 180.0L);
+}
+
+// ---------------------------------------------------------------------------------------------
+IdToolConfig resolveIdSettings(const IdToolSettings& s) {
+  IdToolConfig c;
+  c.opensim_compat = s.opensim_compat;
+  if (!s.setup_file.empty()) {
+    const InverseDynamicsSetup setup = readInverseDynamicsSetup(s.setup_file);
+    c.setup_file = s.setup_file;
+    c.model_file = setup.model_file;
+    c.coordinates_file = setup.coordinates_file;
+    c.external_loads_file = setup.external_loads_file;
+    c.loads_working_dir = setup.directory;
+    c.output_file = setup.output_gen_force_file;
+    c.lowpass_cutoff_hz = setup.lowpass_cutoff_frequency_for_coordinates;
+    c.t0 = setup.time_start;
+    c.t1 = setup.time_end;
+    c.forces_to_exclude = setup.forces_to_exclude;
+    c.warnings = setup.warnings;
+    if (!setup.joints_to_report_body_forces.empty())
+      c.warnings.push_back("joints_to_report_body_forces is not supported: no body forces are written");
+  } else {
+    // redmax computes no muscle forces, so the flag-only default excludes them
+    c.forces_to_exclude = {"Muscles"};
+  }
+  // flags override the setup
+  if (s.model_file) c.model_file = *s.model_file;
+  if (s.coordinates_file) c.coordinates_file = *s.coordinates_file;
+  if (s.external_loads_file) c.external_loads_file = *s.external_loads_file;
+  if (s.output_file) c.output_file = *s.output_file;
+  if (s.lowpass_cutoff_hz) c.lowpass_cutoff_hz = *s.lowpass_cutoff_hz;
+  if (s.t0) c.t0 = *s.t0;
+  if (s.t1) c.t1 = *s.t1;
+  if (s.forces_to_exclude) c.forces_to_exclude = *s.forces_to_exclude;
+
+  const std::string where = c.setup_file;
+  if (c.model_file.empty())
+    throw ConvertError(where, 0, "no model file: give --model or a setup file with <model_file>");
+  if (c.coordinates_file.empty())
+    throw ConvertError(where, 0,
+                       "no coordinates file: give --coordinates or a setup file with <coordinates_file>");
+  if (std::isnan(c.lowpass_cutoff_hz) || std::isinf(c.lowpass_cutoff_hz))
+    throw ConvertError(where, 0, "the low-pass cutoff must be a finite number of Hz (< 0: no filter)");
+  if (std::isnan(c.t0) || std::isnan(c.t1) || c.t0 > c.t1) {
+    std::ostringstream os;
+    os << "the time range [" << c.t0 << ", " << c.t1 << "] is empty or not a number";
+    throw ConvertError(where, 0, os.str());
+  }
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+InverseDynamicsTool::InverseDynamicsTool(IdToolConfig config) : config_(std::move(config)) {
+  warnings_ = config_.warnings;
+  description_ = readOsimModel(config_.model_file);
+
+  // the model as OpenSim's ID sees it: no constraints (calcResidualForceIgnoringConstraints), no
+  // muscles (redmax models no muscle forces; see checkForces)
+  BuildOptions bo;
+  bo.simbody_compat = config_.opensim_compat;
+  bo.constraints = false;
+  bo.muscles = false;
+  try {
+    build_ = std::make_unique<BuildResult>(buildCoreModel(description_, bo));
+  } catch (const ConvertError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw ConvertError(config_.model_file, 0, std::string("the core cannot build this model: ") + e.what());
+  }
+  for (const auto& w : build_->warnings) warnings_.push_back(w);
+  for (size_t ci = 0; ci < description_.coordinates.size(); ++ci) {
+    if (build_->coordinate_index[ci] >= 0) continue;
+    const CoordinateDesc& c = description_.coordinates[ci];
+    const JointDesc* j = c.joint_index >= 0 ? &description_.joints[c.joint_index] : nullptr;
+    throw ConvertError(config_.model_file, j ? j->line : c.line,
+                       "coordinate " + quoted(c.name) + (j ? " of " + j->type + " " + quoted(j->name) : "") +
+                           " is not modelled by the core, so its generalized force cannot be computed");
+  }
+
+  // OpenSim's u for Ball/Free/Ellipsoid joints: the data's rates read as angular velocity in F
+  engine_options_.rates_as_u.assign(model().nb(), false);
+  if (config_.opensim_compat) {
+    for (const JointDesc& j : description_.joints) {
+      if (j.kind != JointKind::Ball && j.kind != JointKind::Free && j.kind != JointKind::Ellipsoid &&
+          j.kind != JointKind::Scapulothoracic)
+        continue;
+      if (j.coordinates.empty()) continue;
+      const int k = build_->coordinate_index[j.coordinates.front()];
+      engine_options_.rates_as_u[model().coordinates[k].joint] = true;
+    }
+  }
+
+  checkForces();
+  prepareCoordinates();
+  prepareLoads();
+}
+
+// forces_to_exclude as OpenSim applies it (§7 step 7), and the forces it leaves that redmax lacks
+void InverseDynamicsTool::checkForces() {
+  const auto& excl = config_.forces_to_exclude;
+  auto excluded = [&](const std::string& name, bool is_actuator, bool is_muscle) {
+    for (const std::string& e : excl) {
+      const std::string l = lower(e);
+      if (l == "all") return true;
+      if (l == "actuators" && is_actuator) return true;
+      if (l == "muscles" && is_muscle) return true;
+      for (const ForceGroupDesc& g : description_.force_groups)
+        if (g.name == e && std::find(g.members.begin(), g.members.end(), name) != g.members.end())
+          return true;
+      if (e == name) return true;
+    }
+    return false;
+  };
+  std::vector<std::string> muscles;
+  for (const PathForceDesc& m : description_.muscles) {
+    if (!m.applies_force) continue;
+    const bool actuator = m.is_muscle || m.class_name.find("Actuator") != std::string::npos;
+    if (excluded(m.name, actuator, m.is_muscle)) continue;
+    // an actuator without a controller has zero control, hence zero force
+    if (!m.is_muscle && actuator) continue;
+    (m.is_muscle ? muscles : unmodelled_forces_).push_back(m.name + " (" + m.class_name + ")");
+  }
+  for (const ForceDesc& f : description_.forces) {
+    if (!f.applies_force) continue;
+    const bool actuator = f.class_name.find("Actuator") != std::string::npos;
+    if (excluded(f.name, actuator, false) || actuator) continue;
+    unmodelled_forces_.push_back(f.name + " (" + f.class_name + ")");
+  }
+  if (!muscles.empty()) {
+    warnings_.push_back(std::to_string(muscles.size()) +
+                        " muscles are not in forces_to_exclude: OpenSim would apply their forces at "
+                        "default muscle states; redmax leaves them out (" + joinNames(muscles, 6) + ")");
+    unmodelled_forces_.insert(unmodelled_forces_.end(), muscles.begin(), muscles.end());
+  }
+  const size_t others = unmodelled_forces_.size() - muscles.size();
+  if (others > 0) {
+    std::vector<std::string> list(unmodelled_forces_.begin(),
+                                  unmodelled_forces_.begin() + static_cast<long>(others));
+    warnings_.push_back("OpenSim would also apply these forces, which redmax does not model (add "
+                        "them to forces_to_exclude to silence this): " + joinNames(list));
+  }
+}
+
+void InverseDynamicsTool::prepareCoordinates() {
+  const std::string& file = config_.coordinates_file;
+  coordinates_ = readStorage(file);
+  for (const auto& w : coordinates_.warnings) warnings_.push_back(file + ": " + w);
+  if (coordinates_.numRows() == 0) throw ConvertError(file, 0, "the coordinates file has no rows");
+
+  // q functions by exact column name (§7 step 6); every other column is carried and ignored
+  const Model& m = model();
+  std::vector<int> used;
+  std::vector<double> scale;
+  std::vector<std::string> missing;
+  sources_.resize(static_cast<size_t>(m.nr()));
+  for (int k = 0; k < m.nr(); ++k) {
+    IdCoordinateSource& s = sources_[k];
+    s.name = m.coordinates[k].name;
+    s.constant = m.coordinates[k].default_value;
+    s.data_column = coordinates_.findColumn(s.name);
+    if (s.data_column < 0) {
+      missing.push_back(s.name);
+      continue;
+    }
+    // deg -> rad only for Rotational coordinates (§3.4, §7 step 4)
+    const int ci = description_.findCoordinate(s.name);
+    s.converted = coordinates_.in_degrees && ci >= 0 &&
+                  description_.coordinates[ci].motion_type == MotionType::Rotational;
+    s.spline = static_cast<int>(used.size());
+    used.push_back(s.data_column);
+    scale.push_back(s.converted ? degreesToRadians() : 1.0);
+  }
+  if (used.empty())
+    throw ConvertError(file, 0, "none of the model's " + std::to_string(m.nr()) +
+                                    " coordinates is a column of this file (columns: " +
+                                    joinNames(coordinates_.labels) + ")");
+  if (!missing.empty())
+    warnings_.push_back("coordinates not in " + file + " are held at their default values (qdot = "
+                        "qddot = 0), as OpenSim does: " + joinNames(missing));
+
+  // columns whose path names a coordinate are not matched (OpenSim matches exact names only)
+  std::vector<std::string> path_labels;
+  for (const std::string& label : coordinates_.labels) {
+    const auto el = pathElements(label);
+    if (el.size() < 2 || m.findCoordinate(label) >= 0) continue;
+    for (size_t back = 1; back <= 2 && back <= el.size(); ++back)
+      if (m.findCoordinate(el[el.size() - back]) >= 0) {
+        path_labels.push_back(label);
+        break;
+      }
+  }
+  if (!path_labels.empty())
+    warnings_.push_back("columns labelled with a path are not used for q (OpenSim matches exact "
+                        "coordinate names): " + joinNames(path_labels));
+
+  MatX cols(coordinates_.numRows(), static_cast<Eigen::Index>(used.size()));
+  for (size_t c = 0; c < used.size(); ++c) cols.col(static_cast<Eigen::Index>(c)) = coordinates_.data.col(used[c]);
+  signal::CoordinateProcessingOptions opt;
+  opt.lowpass_cutoff_hz = config_.lowpass_cutoff_hz;
+  opt.column_scale = scale;
+  try {
+    processed_ = signal::processCoordinates(coordinates_.time, cols, opt);
+    window_ = processed_.selectWindow(config_.t0, config_.t1);
+  } catch (const signal::SignalError& e) {
+    throw ConvertError(file, 0, e.what());
+  }
+  for (const auto& n : processed_.notes) warnings_.push_back(file + ": " + n);
+  if (config_.t0 > processed_.time.back() || config_.t1 < processed_.time.front()) {
+    std::ostringstream os;
+    os << "the time range [" << config_.t0 << ", " << config_.t1 << "] lies outside the data ["
+       << processed_.time.front() << ", " << processed_.time.back() << "]; OpenSim solves the "
+       << "nearest row only";
+    warnings_.push_back(os.str());
+  }
+}
+
+void InverseDynamicsTool::prepareLoads() {
+  if (config_.external_loads_file.empty()) return;
+  ExternalLoads el = readExternalLoads(config_.external_loads_file, config_.loads_working_dir);
+  checkExternalLoads(el, description_);
+  for (const auto& w : el.warnings) warnings_.push_back(config_.external_loads_file + ": " + w);
+
+  auto coreBody = [&](const std::string& name, int line) -> int {
+    const std::string n = bodyName(name);
+    if (n == description_.ground_name) return -1;
+    const int bi = description_.findBody(n);
+    const int core = bi >= 0 ? build_->body_index[bi] : -1;
+    if (core < 0)
+      throw ConvertError(config_.external_loads_file, line,
+                         "body " + quoted(name) + " is not part of the core model");
+    return core;
+  };
+  const Storage& data = el.data;
+  for (const ExternalForceDesc& f : el.forces) {
+    if (!f.applies_force) continue;
+    IdLoadSource src;
+    src.name = f.name;
+    src.frame.body = coreBody(f.applied_to_body, f.line);
+    if (src.frame.body < 0) {
+      warnings_.push_back("ExternalForce " + quoted(f.name) + " is applied to ground: it has no effect");
+      continue;
+    }
+    src.frame.force_frame = coreBody(f.force_expressed_in_body, f.line);
+    src.frame.point_frame = coreBody(f.point_expressed_in_body, f.line);
+    src.frame.has_force = f.hasForce();
+    src.frame.has_point = f.hasForce() && f.hasPoint();
+    src.frame.has_torque = f.hasTorque();
+    try {
+      for (int k = 0; k < 3; ++k) {
+        if (f.hasForce()) src.force[k] = signal::LoadInterpolant(data.time, columnOf(data.data, f.force_columns[k]));
+        if (f.hasPoint()) src.point[k] = signal::LoadInterpolant(data.time, columnOf(data.data, f.point_columns[k]));
+        if (f.hasTorque())
+          src.torque[k] = signal::LoadInterpolant(data.time, columnOf(data.data, f.torque_columns[k]));
+      }
+    } catch (const signal::SignalError& e) {
+      throw ConvertError(el.datafile_path, 0, "ExternalForce " + quoted(f.name) + ": " + e.what());
+    }
+    loads_.push_back(std::move(src));
+  }
+  if (!data.time.empty() && numFrames() > 0 &&
+      (frameTime(0) < data.time.front() || frameTime(numFrames() - 1) > data.time.back()))
+    warnings_.push_back("the output times extend beyond the external-load data (" + el.datafile_path +
+                        "); the loads are extrapolated as OpenSim extrapolates them");
+}
+
+// ---------------------------------------------------------------------------------------------
+std::vector<std::string> InverseDynamicsTool::outputLabels() const {
+  std::vector<std::string> labels;
+  for (const Coordinate& c : model().coordinates) {
+    const int ci = description_.findCoordinate(c.name);
+    const bool rot = ci >= 0 && description_.coordinates[ci].motion_type == MotionType::Rotational;
+    labels.push_back(c.name + (rot ? "_moment" : "_force"));
+  }
+  return labels;
+}
+
+void InverseDynamicsTool::calcInputs(double t, VecX& q, VecX& v, VecX& vdot,
+                                     std::vector<IdLoadSample>& loads) const {
+  const int nr = model().nr();
+  q.resize(nr);
+  v.resize(nr);
+  vdot.resize(nr);
+  double d[3];
+  for (int k = 0; k < nr; ++k) {
+    const IdCoordinateSource& s = sources_[k];
+    if (s.spline < 0) {
+      q[k] = s.constant;
+      v[k] = vdot[k] = 0.0;
+      continue;
+    }
+    processed_.splines[s.spline].calcDerivatives(t, d);
+    q[k] = d[0];
+    v[k] = d[1];
+    vdot[k] = d[2];
+  }
+  loads.clear();
+  for (const IdLoadSource& src : loads_) {
+    IdLoadSample l = src.frame;
+    for (int k = 0; k < 3; ++k) {
+      if (l.has_force) l.force[k] = src.force[k].calcValue(t);
+      if (l.has_point) l.point[k] = src.point[k].calcValue(t);
+      if (l.has_torque) l.torque[k] = src.torque[k].calcValue(t);
+    }
+    loads.push_back(l);
+  }
+}
+
+Storage InverseDynamicsTool::run(IdEngine& engine, const std::function<void(int, int)>& progress) const {
+  Storage out;
+  out.name = kIdStorageName;
+  out.version = 1;
+  out.in_degrees = false;
+  out.labels = outputLabels();
+  const int n = numFrames(), nr = model().nr();
+  out.time.resize(static_cast<size_t>(n));
+  out.data.resize(n, nr);
+  VecX q, v, vdot, tau;
+  std::vector<IdLoadSample> loads;
+  for (int k = 0; k < n; ++k) {
+    const double t = frameTime(k);
+    calcInputs(t, q, v, vdot, loads);
+    engine.calcGeneralizedForces(t, q, v, vdot, loads, tau);
+    if (!tau.allFinite()) {
+      int bad = 0;
+      while (bad < nr && std::isfinite(tau[bad])) ++bad;
+      std::ostringstream os;
+      os << engine.name() << " engine: non-finite generalized force " << out.labels[bad]
+         << " at t = " << t;
+      throw IdEngineError(os.str());
+    }
+    out.time[k] = t;
+    out.data.row(k) = tau.transpose();
+    if (progress) progress(k + 1, n);
+  }
+  return out;
+}
+
+}  // namespace redmax::osim

@@ -1,0 +1,38 @@
+#pragma once
+// The Simbody engine of the inverse-dynamics tool (converter/id/inverse_dynamics_tool.hpp): the
+// core model rebuilt as a Simbody system (model_to_simbody.hpp) and solved as OpenSim's
+// InverseDynamicsSolver does, with SimbodyMatterSubsystem::calcResidualForceIgnoringConstraints:
+//   tau_u = M udot + c(q, u) - (gravity + external loads as station forces and body torques).
+// Joints marked IdEngineOptions::rates_as_u become Ball/Free mobilizers whose u and udot are the
+// given rates as they are (what OpenSim does); for the others u = T qdot, udot = T qddot + Tdot
+// qdot and tau = T^T tau_u (model_to_simbody.hpp's velocity map), so both engines answer in the
+// same convention. The header is Simbody-free (pimpl) so that the command line compiles quickly.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "converter/id/id_engine.hpp"
+#include "core/skeleton/model.hpp"
+
+namespace redmax::simbody {
+
+class SimbodyIdEngine final : public osim::IdEngine {
+ public:
+  /// Builds the Simbody system (Ball mobilizers for spherical joints when any of them is marked,
+  /// Gimbal otherwise). Throws SimbodyBuildError (simbody_options.hpp) when the model has a joint
+  /// without a Simbody counterpart, or a marked joint that does not become a Ball or Free mobilizer.
+  explicit SimbodyIdEngine(const Model& model, const osim::IdEngineOptions& options = {});
+  ~SimbodyIdEngine() override;
+  SimbodyIdEngine(const SimbodyIdEngine&) = delete;
+  SimbodyIdEngine& operator=(const SimbodyIdEngine&) = delete;
+
+  std::string name() const override { return "simbody"; }
+  void calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,
+                             const std::vector<osim::IdLoadSample>& loads, VecX& tau) override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace redmax::simbody
