@@ -31,9 +31,19 @@ const ColumnMetrics& column(const Comparison& c, const std::string& name) {
   throw std::runtime_error("no column " + name);
 }
 
+// removed however the test ends
+struct TempDir {
+  fs::path path = fs::temp_directory_path() / ("redmax_demo_report_" + std::to_string(::getpid()));
+  TempDir() { fs::remove_all(path); }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
 TEST(ReportDemo, RunsTheWholeReportOnSyntheticTables) {
-  const fs::path dir = fs::temp_directory_path() / ("redmax_demo_report_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const TempDir tmp;
+  const fs::path& dir = tmp.path;
   const DemoReportResult r = writeDemoReport(dir.string());
 
   // engines: core + 1e-12 sin(6 pi t) -> rms 1e-12 / sqrt(2) on every column (trapezoid, whole
@@ -90,8 +100,6 @@ TEST(ReportDemo, RunsTheWholeReportOnSyntheticTables) {
     std::printf("gnuplot unavailable (%s): plot files not checked\n", gp.why_not.c_str());
     EXPECT_TRUE(s.at("plots").at("skipped").asBool());
   }
-  std::error_code ec;
-  fs::remove_all(dir, ec);
 }
 
 TEST(ReportDemo, DemoTablesAreWellFormed) {
