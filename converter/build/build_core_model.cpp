@@ -157,7 +157,22 @@ class Builder {
       if (r_.body_index[k] < 0)
         r_.warnings.push_back("body " + quoted(d_.bodies[k].name) +
                               " is reached by no mobilizer and is left out");
-    r_.model = mb_.finalize();
+    for (size_t ci = 0; ci < d_.coordinates.size(); ++ci) {
+      const CoordinateDesc& c = d_.coordinates[ci];
+      if (r_.coordinate_index[ci] >= 0 || c.joint_index < 0) continue;
+      const JointDesc& j = d_.joints[c.joint_index];
+      if (j.kind != JointKind::Unsupported)
+        r_.unsupported.push_back({c.line, "coordinate " + quoted(c.name) + " of " + j.type + " " +
+                                              quoted(j.name) +
+                                              " has no mobilizer (the joint closes a loop) and "
+                                              "is left out"});
+    }
+    try {
+      r_.model = mb_.finalize();
+    } catch (const ModelError& e) {
+      // mass properties the reader passed but the core rejects (negative mass, NaN inertia)
+      throw ConvertError(d_.source_file, 0, e.what());
+    }
     if (opt_.constraints) buildConstraints();
     if (opt_.muscles) buildMuscles();
     return std::move(r_);
@@ -195,11 +210,16 @@ class Builder {
       throw ConvertError(d_.source_file, j.line,
                          "joint " + quoted(j.name) + " moves unknown body " + quoted(mass_body));
     const BodyDesc& b = d_.bodies[bi];
+    if (!(b.mass >= 0.0) || !std::isfinite(b.mass) || !b.mass_center.allFinite() ||
+        !b.inertia.allFinite())
+      throw ConvertError(d_.source_file, b.line,
+                         "body " + quoted(b.name) +
+                             ": mass must be finite and >= 0, mass_center and inertia finite");
     auto cp = copies_.find(mass_body);
     const double share = cp == copies_.end() ? 1.0 : 1.0 / (1.0 + cp->second);
     double mass = b.mass * share;
     Mat3 I = b.inertiaMatrix() * share;
-    if (mass == 0.0 && !I.isZero(0.0)) {
+    if (std::abs(mass) <= 1e-14 && !I.isZero(0.0)) {
       I.setZero();
       r_.warnings.push_back("body " + quoted(b.name) +
                             " is massless; its nonzero inertia is set to zero, as Simbody does");
@@ -226,8 +246,13 @@ class Builder {
     Joint joint = m.reversed ? Joint(Reversed(std::move(cj.joint))) : std::move(cj.joint);
     const Mat4& E_pf = m.reversed ? X_BM : X_PF;
     const Mat4& E_bm = m.reversed ? X_PF : X_BM;
-    const int body = mb_.addBody(m.outboard_body, mass, b.mass_center, I, parent, j.name,
-                                 std::move(joint), E_pf, E_bm);
+    int body = -1;
+    try {
+      body = mb_.addBody(m.outboard_body, mass, b.mass_center, I, parent, j.name, std::move(joint),
+                         E_pf, E_bm);
+    } catch (const ModelError& e) {
+      throw ConvertError(d_.source_file, j.line, "joint " + quoted(j.name) + ": " + e.what());
+    }
     core_body_[m.outboard_body] = body;
     if (sm == slave_master_.end()) r_.body_index[bi] = body;
 
