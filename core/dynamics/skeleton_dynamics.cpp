@@ -1,26 +1,32 @@
 #include "core/dynamics/skeleton_dynamics.hpp"
 
+#include <vector>
+
 namespace redmax {
 
 void calcSkeletonMass(const Model& model, const SkeletonWorkspace& ws, MatX& M_r) {
   const int nr = model.nr();
   M_r.setZero(nr, nr);
-  // sum over bodies of J_i^T M_i J_i, restricted to the columns of i's ancestors
-  Eigen::Matrix<double, 6, Eigen::Dynamic> MJ(6, nr);
+  // sum over bodies of J_i^T M_i J_i, restricted to the columns of i's ancestors: gather those
+  // columns into one compact 6 x k block so each body costs one product, then scatter back
+  // (one small product per ancestor pair was cubic in chain length)
+  Eigen::Matrix<double, 6, Eigen::Dynamic> Jc(6, nr), MJc(6, nr);
+  MatX Mc(nr, nr);
+  std::vector<int> cols;
+  cols.reserve(nr);
   for (int i = 0; i < model.nb(); ++i) {
-    const auto Ji = ws.J_mr.middleRows<6>(6 * i);
-    MJ.noalias() = model.bodies[i].M * Ji;
-    const auto& an = model.ancestors(i);
-    for (int a : an) {
+    cols.clear();
+    for (int a : model.ancestors(i)) {
       const JointSlot& sa = model.joints[a];
-      if (sa.nq == 0) continue;
-      for (int b : an) {
-        const JointSlot& sb = model.joints[b];
-        if (sb.nq == 0) continue;
-        M_r.block(sa.q_index, sb.q_index, sa.nq, sb.nq).noalias() +=
-            Ji.middleCols(sa.q_index, sa.nq).transpose() * MJ.middleCols(sb.q_index, sb.nq);
-      }
+      for (int k = 0; k < sa.nq; ++k) cols.push_back(sa.q_index + k);
     }
+    const int k = static_cast<int>(cols.size());
+    if (k == 0) continue;
+    for (int c = 0; c < k; ++c) Jc.col(c) = ws.J_mr.block<6, 1>(6 * i, cols[c]);
+    MJc.leftCols(k).noalias() = model.bodies[i].M * Jc.leftCols(k);
+    Mc.topLeftCorner(k, k).noalias() = Jc.leftCols(k).transpose() * MJc.leftCols(k);
+    for (int c = 0; c < k; ++c)
+      for (int r = 0; r < k; ++r) M_r(cols[r], cols[c]) += Mc(r, c);
   }
 }
 
