@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cctype>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <numbers>
@@ -68,6 +69,9 @@ const std::vector<std::string>& sharedModels() {
       "opensim-models@a26e12c/Tutorials/Computed_Muscle_Control/OutputReference/arm26.osim",
       "opensim-models@a26e12c/Pipelines/Gait2392_Simbody/OutputReference/subject01_simbody.osim",
       "opensim-models@a26e12c/Pipelines/Gait10dof18musc/OutputReference/subject01.osim",
+      "opensim-models/Pipelines/Gait2392_Simbody/OutputReference/subject01_simbody.osim",
+      "opensim-models/Pipelines/Gait10dof18musc/OutputReference/subject01.osim",
+      "opensim-models/Tutorials/Computed_Muscle_Control/OutputReference/arm26.osim",
   };
   return m;
 }
@@ -474,6 +478,36 @@ TEST(BuildCompat, SimbodyVelocityTermsDifferOnlyForCoupledRotations) {
   std::cout << "exact vs Simbody-compatible inverse dynamics, max |tau| difference over 5 random "
                "states: gait2392 "
             << gait << ", Rajagopal2016 " << raj << " (max |Jdot_mr| difference " << jdot << ")\n";
+}
+
+}  // namespace
+}  // namespace redmax::osim
+
+namespace redmax::osim {
+namespace {
+
+// the project's own scenes (osim_models/, written by the scenes work) run in the core too
+TEST(BuildProjectScenes, EveryOsimModelBuildsWithMatchingPosesAndJacobians) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(REDMAX_SOURCE_DIR) / "osim_models";
+  if (!fs::is_directory(dir)) GTEST_SKIP() << "no osim_models folder at " << dir;
+  int built = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() != ".osim") continue;
+    const std::string name = e.path().filename().string();
+    const ModelDescription d = readOsimModel(e.path().string());
+    const BuildResult r = buildCoreModel(d);
+    ASSERT_EQ(r.model.nr(), d.numDofs()) << name;
+    for (const auto& u : r.unsupported) ADD_FAILURE() << name << ": " << u.what;
+    EXPECT_EQ(r.muscles.size(), d.muscles.size()) << name;
+    std::mt19937 rng(41);
+    expectPosesMatchReference(d, r, defaultQ(d), name);
+    expectPosesMatchReference(d, r, randomQ(d, rng), name);
+    VecX qdot = VecX::Ones(d.numDofs());
+    expectJacobiansMatchDifferences(r.model, randomQ(d, rng), qdot, name);
+    ++built;
+  }
+  if (built == 0) GTEST_SKIP() << "no .osim files in " << dir;
 }
 
 }  // namespace
