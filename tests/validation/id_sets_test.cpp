@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,8 @@ struct IdSet {
   double t0, t1, lowpass;
   std::string opensim46, published;
 };
+
+void PrintTo(const IdSet& s, std::ostream* os) { *os << s.name; }
 
 std::vector<IdSet> sets() {
   const std::string cmc = "Tutorials/Computed_Muscle_Control/OutputReference/";
@@ -175,14 +178,16 @@ TEST_P(IdSets, PublishedResultsAndExactKinematics) {
   const Storage published = readStorage(shared(s.published));
   const auto pub = compare(compat, published, 2e-6);
   print("set " + s.name + ": core (opensim-compat) vs published result", pub);
-  double worst = 0;
-  for (const auto& c : pub) worst = std::max(worst, c.maxRel());
-  // OpenSim 4.6 reproduces A exactly and F to 1.4e-6 of the peak; E is an OpenSim 3.x result that
-  // differs by up to 5.5% (lumbar_rotation_moment)
-  if (s.name == "E") {
-    EXPECT_LT(worst, 0.06);
-  } else {
-    for (const auto& c : pub) EXPECT_LE(c.max_abs, 2e-6 * c.peak + 1e-8) << s.name << " " << c.label;
+  // OpenSim 4.6 reproduces A exactly and F to 1.4e-6 of the peak (RMS); E is an OpenSim 3.x
+  // result that differs by up to 5.5% RMS (lumbar_rotation_moment). Our difference from the
+  // published files must be OpenSim 4.6's own, column by column.
+  const auto ref46 = compare(readStorage(shared(s.opensim46)), published, 2e-6);
+  ASSERT_EQ(ref46.size(), pub.size());
+  for (size_t k = 0; k < pub.size(); ++k) {
+    const ColumnDiff& c = pub[k];
+    EXPECT_LE(c.rms, (s.name == "E" ? 0.06 : 2e-6) * c.peak + 1e-8) << s.name << " " << c.label;
+    EXPECT_NEAR(c.rms, ref46[k].rms, 1e-6 * c.peak + 1e-8) << s.name << " " << c.label
+                                                           << ": not OpenSim 4.6's difference";
   }
 
   // exact kinematics: CustomJoints' velocity terms (knees whose coordinate drives rotations and
@@ -191,7 +196,10 @@ TEST_P(IdSets, PublishedResultsAndExactKinematics) {
   const Storage exact = solveCore(exact_tool);
   const auto ex = compare(exact, compat, 0.0);
   print("set " + s.name + ": exact vs opensim-compat (relative to the compat column peak)", ex);
-  for (const auto& c : ex) EXPECT_TRUE(std::isfinite(c.max_abs));
+  // none of these models has a coordinate driving several rotations of one CustomJoint, a nonzero
+  // constant rotation before a driven one, or a Ball/Free/Ellipsoid joint, so the switch changes
+  // nothing beyond round-off (measured <= 3e-15 of the peak)
+  for (const auto& c : ex) EXPECT_LE(c.max_abs, 1e-12 * c.peak) << s.name << " " << c.label;
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, IdSets, ::testing::ValuesIn(sets()),
