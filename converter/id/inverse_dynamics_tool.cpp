@@ -232,14 +232,6 @@ void InverseDynamicsTool::prepareCoordinates() {
     used.push_back(s.data_column);
     scale.push_back(s.converted ? degreesToRadians() : 1.0);
   }
-  if (used.empty())
-    throw ConvertError(file, 0, "none of the model's " + std::to_string(m.nr()) +
-                                    " coordinates is a column of this file (columns: " +
-                                    joinNames(coordinates_.labels) + ")");
-  if (!missing.empty())
-    warnings_.push_back("coordinates not in " + file + " are held at their default values (qdot = "
-                        "qddot = 0), as OpenSim does: " + joinNames(missing));
-
   // columns whose path names a coordinate are not matched (OpenSim matches exact names only)
   std::vector<std::string> path_labels;
   for (const std::string& label : coordinates_.labels) {
@@ -251,6 +243,18 @@ void InverseDynamicsTool::prepareCoordinates() {
         break;
       }
   }
+  // OpenSim would solve with every coordinate at its default; that is almost surely not what the
+  // user meant, so it is an input error here
+  if (used.empty())
+    throw ConvertError(file, 0, "none of the model's " + std::to_string(m.nr()) +
+                                    " coordinates is a column of this file (columns: " +
+                                    joinNames(coordinates_.labels) + ")" +
+                                    (path_labels.empty() ? std::string()
+                                                         : "; columns are matched by exact coordinate "
+                                                           "name, as OpenSim's ID does, not by path"));
+  if (!missing.empty())
+    warnings_.push_back("coordinates not in " + file + " are held at their default values (qdot = "
+                        "qddot = 0), as OpenSim does: " + joinNames(missing));
   if (!path_labels.empty())
     warnings_.push_back("columns labelled with a path are not used for q (OpenSim matches exact "
                         "coordinate names): " + joinNames(path_labels));
