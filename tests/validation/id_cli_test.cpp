@@ -206,6 +206,30 @@ TEST_F(IdCli, BadInputExitsWithTwoAndNamesTheFile) {
   EXPECT_NE(r.err.find("error: bad.osim:"), std::string::npos) << r.err;
 }
 
+TEST_F(IdCli, GimbalLockOfABallJointIsARunFailure) {
+  // OpenSim-compatible mode reads a ball joint's Euler rates as angular velocity; the core maps
+  // them back to rates, which is impossible at gimbal lock (middle angle 90 degrees): exit 1 with
+  // the joint and time named. Exact mode needs no such map.
+  write("ball.osim",
+        "<?xml version=\"1.0\"?>\n<OpenSimDocument Version=\"40000\"><Model name=\"b\"><Ground name=\"ground\"/>\n"
+        "<BodySet><objects><Body name=\"a\"><mass>1</mass><mass_center>0 -0.2 0</mass_center>"
+        "<inertia>0.1 0.1 0.1 0 0 0</inertia></Body></objects></BodySet>\n<JointSet><objects>"
+        "<BallJoint name=\"ball\"><socket_parent_frame>/ground</socket_parent_frame><socket_child_frame>"
+        "/bodyset/a</socket_child_frame><coordinates><Coordinate name=\"b1\"/><Coordinate name=\"b2\"/>"
+        "<Coordinate name=\"b3\"/></coordinates></BallJoint></objects></JointSet>\n</Model></OpenSimDocument>\n");
+  std::ostringstream os;
+  os << "m\nversion=1\nnRows=11\nnColumns=4\ninDegrees=yes\nendheader\ntime\tb1\tb2\tb3\n";
+  for (int i = 0; i <= 10; ++i) os << 0.1 * i << "\t" << 10.0 * i << "\t90\t" << -5.0 * i << "\n";
+  write("ball.mot", os.str());
+  const CmdResult r = run("id --model ball.osim --coordinates ball.mot --out ball.sto");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("gimbal lock"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("ball"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "ball.sto"));
+  const CmdResult e = run("id --model ball.osim --coordinates ball.mot --exact --out ball.sto");
+  EXPECT_EQ(e.code, 0) << e.err;
+}
+
 TEST_F(IdCli, SetEMatchesOpenSim46ThroughTheCommandLine) {
   const std::string sh = std::string(REDMAX_SHARED_DIR) + "/opensim/";
   const std::string e = sh + "opensim-models/Pipelines/Gait2392_Simbody/";
