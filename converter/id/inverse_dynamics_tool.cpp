@@ -323,8 +323,10 @@ void InverseDynamicsTool::prepareLoads() {
     }
     loads_.push_back(std::move(src));
   }
+  // (accumulated resampling times may step a rounding error outside, e.g. -5e-7 s in set F)
+  constexpr double kSlack = 1e-6;
   if (!data.time.empty() && numFrames() > 0 &&
-      (frameTime(0) < data.time.front() || frameTime(numFrames() - 1) > data.time.back()))
+      (frameTime(0) < data.time.front() - kSlack || frameTime(numFrames() - 1) > data.time.back() + kSlack))
     warnings_.push_back("the output times extend beyond the external-load data (" + el.datafile_path +
                         "); the loads are extrapolated as OpenSim extrapolates them");
 }

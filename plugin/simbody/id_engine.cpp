@@ -50,10 +50,11 @@ SimbodyIdEngine::SimbodyIdEngine(const Model& model, const osim::IdEngineOptions
   m.sm = makeSimbodyModel(model, opt);
   for (int j = 0; j < model.nb(); ++j) {
     if (!options.marked(j)) continue;
-    const MobilizerKind k = m.sm->map[j].kind;
-    if (k != MobilizerKind::Ball && k != MobilizerKind::Free)
+    // Ball, Free (and any mobilizer whose u is not qdot, e.g. Ellipsoid): u = w_FM in F
+    if (m.sm->map[j].u_is_qdot)
       throw SimbodyBuildError("joint '" + model.joints[j].name +
-                              "': OpenSim's Euler-rate speeds need a Simbody Ball or Free mobilizer");
+                              "': OpenSim's Euler-rate speeds need a Simbody mobilizer whose u is the "
+                              "angular velocity (Ball, Free), not its q rates");
   }
   m.state = m.sm->default_state;
   m.E_wi.resize(model.nb());

@@ -20,7 +20,7 @@ class SimbodyIdEngine final : public osim::IdEngine {
  public:
   /// Builds the Simbody system (Ball mobilizers for spherical joints when any of them is marked,
   /// Gimbal otherwise). Throws SimbodyBuildError (simbody_options.hpp) when the model has a joint
-  /// without a Simbody counterpart, or a marked joint that does not become a Ball or Free mobilizer.
+  /// without a Simbody counterpart, or a marked joint whose mobilizer has u = qdot (not Ball/Free).
   explicit SimbodyIdEngine(const Model& model, const osim::IdEngineOptions& options = {});
   ~SimbodyIdEngine() override;
   SimbodyIdEngine(const SimbodyIdEngine&) = delete;

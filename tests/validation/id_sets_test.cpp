@@ -229,6 +229,28 @@ TEST(IdCoupledKnee, ExactAndCompatibleDiffer) {
   }
 }
 
+// The same coupled-knee model through Simbody's own FunctionBased mobilizers: the core's
+// OpenSim-compatible mode must reproduce them (exact mode would differ by up to ~2%, above)
+TEST(IdCoupledKnee, CompatibleMatchesSimbodyEngine) {
+  const std::string dir = shared("opensim-core/OpenSim/Moco/Test/");
+  if (!fs::exists(dir + "subject_walk_armless_18musc.osim")) GTEST_SKIP() << "shared OpenSim data not found: " << dir;
+  IdToolSettings st;
+  st.model_file = dir + "subject_walk_armless_18musc.osim";
+  st.coordinates_file = dir + "subject_walk_armless_coordinates.mot";
+  st.external_loads_file = dir + "subject_walk_armless_external_loads.xml";
+  st.lowpass_cutoff_hz = 6.0;
+  const InverseDynamicsTool tool(resolveIdSettings(st));
+  std::unique_ptr<simbody::SimbodyIdEngine> sim;
+  try {
+    sim = std::make_unique<simbody::SimbodyIdEngine>(tool.model(), tool.engineOptions());
+  } catch (const simbody::SimbodyBuildError& e) {
+    GTEST_SKIP() << "the Simbody engine cannot build subject_walk_armless yet: " << e.what();
+  }
+  const auto diff = compare(solveCore(tool), tool.run(*sim), 0.0);
+  print("subject_walk_armless: core (opensim-compat) vs Simbody engine", diff);
+  for (const auto& c : diff) EXPECT_LE(c.max_abs, 1e-9 * c.peak) << c.label;
+}
+
 INSTANTIATE_TEST_SUITE_P(Shared, IdSets, ::testing::ValuesIn(sets()),
                          [](const ::testing::TestParamInfo<IdSet>& info) { return info.param.name; });
 
