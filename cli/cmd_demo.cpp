@@ -42,8 +42,8 @@ int runDemo(const std::vector<std::string>& argv) {
 }
 
 CommandRegistration reg({"demo", "run the built-in double pendulum and print its energy",
-                         "usage: redmax demo [--integrator euler|bdf1|sdirk2|rk45|cvode] [--dt S]\n"
-                         "                   [--duration S] [--rtol R] [--atol A]\n"
+                         "usage: redmax demo [--integrator euler|symplectic|bdf1|sdirk2|rk45|cvode]\n"
+                         "                   [--dt S] [--duration S] [--rtol R] [--atol A]\n"
                          "Integrates a double pendulum released from rest at q = (1, 0.5) rad and prints q and the\n"
                          "kinetic, potential and total energy at 10 instants.\n",
                          runDemo});

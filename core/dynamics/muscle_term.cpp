@@ -75,6 +75,31 @@ void MuscleTerm::addForce(const Model& model, const State& s, const SkeletonWork
   }
 }
 
+void MuscleTerm::addMassDotTimesVelocity(const Model& model, const State& s, const SkeletonWorkspace& sk,
+                                         VecX& Mdot_v) const {
+  if (massive_.empty()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  update(model, s, sk);
+  // d/dt (J_ar^T M_a J_ar) qdot with M_a constant [D Eq. 5.7b], in compact columns
+  for (size_t m = 0; m < massive_.size(); ++m) {
+    const MassPoints& mp = massive_[m].mass_points;
+    const MuscleKinematics& mk = ws_.muscles[m];
+    const int k = static_cast<int>(mk.cols.size());
+    qdot_c_.resize(k);
+    for (int j = 0; j < k; ++j) qdot_c_[j] = s.qdot[mk.cols[j]];
+    fc_.setZero(k);
+    for (int a = 0; a < mp.size(); ++a) {
+      const auto J = mk.J_ar.middleRows<3>(3 * a);
+      const auto Jd = mk.Jdot_ar.middleRows<3>(3 * a);
+      const Vec3 m_xdot = mp.mass[a] * (J * qdot_c_);
+      const Vec3 m_Jdv = mp.mass[a] * (Jd * qdot_c_);
+      fc_.noalias() += Jd.transpose() * m_xdot;
+      fc_.noalias() += J.transpose() * m_Jdv;
+    }
+    for (int j = 0; j < k; ++j) Mdot_v[mk.cols[j]] += fc_[j];
+  }
+}
+
 double MuscleTerm::kineticEnergy(const Model& model, const State& s, const SkeletonWorkspace& sk) const {
   if (massive_.empty()) return 0.0;
   std::lock_guard<std::mutex> lock(mutex_);

@@ -36,6 +36,9 @@ class MuscleTerm final : public ForceTerm {
   std::string name() const override { return "muscle_mass"; }
   void addMass(const Model& model, const State& s, const SkeletonWorkspace& sk, MatX& M) const override;
   void addForce(const Model& model, const State& s, const SkeletonWorkspace& sk, VecX& f) const override;
+  /// analytic Mdot qdot of the mass points: sum_a m_a (Jdot_ar^T J_ar + J_ar^T Jdot_ar) qdot
+  void addMassDotTimesVelocity(const Model& model, const State& s, const SkeletonWorkspace& sk,
+                               VecX& Mdot_v) const override;
   double kineticEnergy(const Model& model, const State& s, const SkeletonWorkspace& sk) const override;
   double potentialEnergy(const Model& model, const State& s, const SkeletonWorkspace& sk) const override;
 

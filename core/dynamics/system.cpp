@@ -119,6 +119,43 @@ void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
   ws.f.noalias() = ws.J_rR.transpose() * fr;
 }
 
+namespace {
+// Mdot_r qdot_r of the bare skeleton (nr): per body Jdot_i^T M_i phi_i + J_i^T M_i Jdot_i qdot,
+// the time derivative of M_r = sum_i J_i^T M_i J_i [D Eq. 4.18] along qdot; needs Stage::Velocity
+void skeletonMassDotTimesVelocity(const Model& model, const State& s, const SkeletonWorkspace& sk, VecX& out) {
+  const int nr = model.nr();
+  out.setZero(nr);
+  for (int i = 0; i < model.nb(); ++i) {
+    const Body& b = model.bodies[i];
+    const auto Ji = sk.J_mr.middleRows<6>(6 * i);
+    const auto Jdi = sk.Jdot_mr.middleRows<6>(6 * i);
+    const Vec6 Mphi = b.M * sk.phi[i];
+    const Vec6 MJdv = b.M * (Jdi * s.qdot.head(nr));
+    for (int a : model.ancestors(i)) {
+      const JointSlot& sa = model.joints[a];
+      if (sa.nq == 0) continue;
+      out.segment(sa.q_index, sa.nq).noalias() += Jdi.middleCols(sa.q_index, sa.nq).transpose() * Mphi;
+      out.segment(sa.q_index, sa.nq).noalias() += Ji.middleCols(sa.q_index, sa.nq).transpose() * MJdv;
+    }
+  }
+}
+}  // namespace
+
+void System::calcMassDotTimesVelocity(const State& s, DynamicsWorkspace& ws, VecX& Mdot_v) const {
+  const State& s_sk = map_ ? ws.s_r : s;
+  VecX Mdot_r;
+  skeletonMassDotTimesVelocity(model_, s_sk, ws.sk, Mdot_r);
+  for (const auto& t : terms_) t->addMassDotTimesVelocity(model_, s_sk, ws.sk, Mdot_r);
+  if (!map_) {
+    Mdot_v = std::move(Mdot_r);
+    return;
+  }
+  // chain rule through q_r = g(q_R) (ws.J_rR, ws.Jdot_rR, ws.M_r from calcMassAndForce)
+  Mdot_r.noalias() += ws.M_r * (ws.Jdot_rR * s.qdot);
+  Mdot_v.noalias() = ws.J_rR.transpose() * Mdot_r;
+  Mdot_v.noalias() += ws.Jdot_rR.transpose() * (ws.M_r * ws.s_r.qdot);
+}
+
 void System::calcStiffnessDamping(const State& s, DynamicsWorkspace& ws) const {
   if (!map_) {
     ws.K.setZero(ndof(), ndof());

@@ -102,6 +102,14 @@ class System {
   void calcStiffnessDamping(const State& s, DynamicsWorkspace& ws) const;
   /// constraint G, rhs (stabilised) and errors, after calcMassAndForce
   void calcConstraints(const State& s, DynamicsWorkspace& ws) const;
+  /// Mdot(q, qdot) qdot (ndof), Mdot = sum_j dM/dq_j qdot_j, after calcMassAndForce at the same
+  /// s (reads its kinematics). With it the Lagrangian's dL/dq plus the non-conservative forces is
+  ///   dL/dq + f_nc = f + Mdot qdot        (from d/dt(M qdot) = dL/dq + f_nc and M qddot = f),
+  /// which the variational integrator needs. Skeleton: M_r = J_mr^T M_m J_mr with M_m constant, so
+  /// Mdot_r qdot = Jdot_mr^T M_m phi + J_mr^T M_m Jdot_mr qdot (analytic); ForceTerms add theirs
+  /// (ForceTerm::addMassDotTimesVelocity). With a CoordinateMap, M = J_rR^T M_r J_rR gives
+  ///   Mdot qdot = Jdot_rR^T M_r qdot_r + J_rR^T (Mdot_r qdot_r + M_r Jdot_rR qdot).
+  void calcMassDotTimesVelocity(const State& s, DynamicsWorkspace& ws, VecX& Mdot_v) const;
 
   /// accelerations; solves the KKT system when there are constraints. Multipliers in ws.lambda.
   VecX forwardDynamics(const State& s, DynamicsWorkspace& ws) const;

@@ -7,6 +7,7 @@
 #include "core/integrators/sdirk2.hpp"
 #include "core/integrators/sundials_integrators.hpp"
 #include "core/integrators/symplectic_euler.hpp"
+#include "core/integrators/variational_euler.hpp"
 #include "core/skeleton/kinematics.hpp"
 
 namespace redmax {
@@ -31,13 +32,14 @@ void checkOptions(const std::string& name, const IntegratorOptions& opt) {
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const IntegratorOptions& opt) {
   std::unique_ptr<Integrator> integ;
   if (name == "euler") integ = std::make_unique<SymplecticEuler>(opt);
+  else if (name == "symplectic") integ = std::make_unique<VariationalEuler>(opt);
   else if (name == "bdf1") integ = std::make_unique<LinearlyImplicitEuler>(opt);
   else if (name == "sdirk2") integ = std::make_unique<Sdirk2>(opt);
   else if (name == "rk45") integ = std::make_unique<ArkodeRk45>(opt);
   else if (name == "cvode") integ = std::make_unique<CvodeBdf>(opt);
   else
     throw std::invalid_argument("unknown integrator '" + name +
-                                "' (expected euler, bdf1, sdirk2, rk45 or cvode)");
+                                "' (expected euler, symplectic, bdf1, sdirk2, rk45 or cvode)");
   checkOptions(name, opt);
   return integ;
 }
