@@ -1,0 +1,169 @@
+// `redmax validate`: the inputs of `redmax id`, solved by the core and by Simbody, compared with
+// each other and with reference results, written as a report directory (DESIGN.md §3). The work
+// is validation/id_validation.hpp; this file parses flags and maps errors to exit codes:
+// 0 every comparison passed, 1 one failed (or a frame could not be solved, or the report could
+// not be written), 2 bad input or usage.
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "cli/args.hpp"
+#include "validation/id_validation.hpp"
+
+namespace redmax::cli {
+namespace {
+
+// --reference and --published may be repeated; Args keeps only the last value of a flag, so
+// they are taken out of argv first
+std::vector<std::string> takeReferences(const std::vector<std::string>& argv,
+                                        std::vector<validation::IdReference>& refs) {
+  std::vector<std::string> rest;
+  for (size_t i = 0; i < argv.size(); ++i) {
+    const std::string& a = argv[i];
+    bool matched = false;
+    for (const std::string flag : {"reference", "published"}) {
+      const std::string f = "--" + flag;
+      std::string value;
+      if (a == f) {
+        if (i + 1 >= argv.size()) throw UsageError{f + " needs a value"};
+        value = argv[++i];
+      } else if (a.rfind(f + "=", 0) == 0) {
+        value = a.substr(f.size() + 1);
+      } else {
+        continue;
+      }
+      if (value.empty()) throw UsageError{f + " needs a file name"};
+      refs.push_back({value, flag});
+      matched = true;
+      break;
+    }
+    if (!matched) rest.push_back(a);
+  }
+  return rest;
+}
+
+double nonNegative(const Args& a, const std::string& name, double fallback) {
+  const double x = a.getDouble(name, fallback);
+  if (x < 0) throw UsageError{"--" + name + " must be >= 0"};
+  return x;
+}
+
+int runValidate(const std::vector<std::string>& argv_in) {
+  validation::IdValidationOptions opt;
+  const std::vector<std::string> argv = takeReferences(argv_in, opt.references);
+  const Args a(argv,
+               {"setup", "model", "coordinates", "external-loads", "lowpass", "t0", "t1", "report",
+                "forces-to-exclude", "muscle-mass", "tolerance", "max-tolerance", "engine-tolerance",
+                "interpolation", "gnuplot"},
+               {"exact", "opensim-compat", "quiet", "no-simbody", "no-plots"});
+  if (!a.positionals().empty())
+    throw UsageError{"validate takes no positional arguments (got '" + a.positionals().front() + "')"};
+
+  // the same inputs as `redmax id`
+  osim::IdToolSettings& s = opt.settings;
+  s.setup_file = a.get("setup", "");
+  if (s.setup_file.empty() && (!a.has("model") || !a.has("coordinates")))
+    throw UsageError{"validate needs --setup ID_SETUP.xml, or --model M.osim and --coordinates Q.mot"};
+  if (auto v = a.get("model")) s.model_file = *v;
+  if (auto v = a.get("coordinates")) s.coordinates_file = *v;
+  if (auto v = a.get("external-loads")) s.external_loads_file = *v;
+  if (a.has("lowpass")) s.lowpass_cutoff_hz = a.getDouble("lowpass", -1.0);
+  if (a.has("t0")) s.t0 = a.getDouble("t0", 0.0);
+  if (a.has("t1")) s.t1 = a.getDouble("t1", 0.0);
+  if (s.t0 && s.t1 && *s.t0 > *s.t1) throw UsageError{"--t0 is after --t1"};
+  if (auto v = a.get("forces-to-exclude")) {
+    std::vector<std::string> list;
+    std::string cur;
+    for (char c : *v + ",") {
+      if (c == ',' || c == ' ' || c == '\t') {
+        if (!cur.empty()) list.push_back(cur);
+        cur.clear();
+      } else {
+        cur += c;
+      }
+    }
+    s.forces_to_exclude = list;
+  }
+  if (a.has("exact") && a.has("opensim-compat"))
+    throw UsageError{"--exact and --opensim-compat exclude each other"};
+  s.opensim_compat = !a.has("exact");
+  const std::string mm = a.get("muscle-mass", "none");
+  if (mm != "none")
+    throw UsageError{"--muscle-mass " + mm + " is not available in `redmax validate` yet (only none)"};
+
+  // the report and the comparisons
+  opt.report_dir = a.get("report", "");
+  if (opt.report_dir.empty()) throw UsageError{"validate needs --report DIR"};
+  opt.reference_rms_rel = nonNegative(a, "tolerance", opt.reference_rms_rel);
+  if (a.has("max-tolerance")) opt.reference_max_rel = nonNegative(a, "max-tolerance", 0);
+  opt.engine_rel = nonNegative(a, "engine-tolerance", opt.engine_rel);
+  opt.run_simbody = !a.has("no-simbody");
+  if (auto v = a.get("interpolation")) {
+    try {
+      opt.interpolation = validation::parseInterpolation(*v);
+    } catch (const validation::CompareError&) {
+      throw UsageError{"--interpolation must be linear or cubic, got '" + *v + "'"};
+    }
+  }
+  opt.gnuplot = a.has("no-plots") ? "none" : a.get("gnuplot", "");
+  const bool quiet = a.has("quiet");
+  opt.progress = !quiet;
+
+  validation::IdValidationResult r;
+  try {
+    r = validation::runIdValidation(opt);
+  } catch (const osim::ConvertError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const validation::CompareError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const osim::IdEngineError& e) {
+    std::cerr << "error: " << s.coordinates_file.value_or(s.setup_file) << ": " << e.what() << "\n";
+    return 1;
+  } catch (const validation::ReportError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  if (!quiet) {
+    for (const auto& w : r.warnings) std::cerr << "warning: " << w << "\n";
+    for (const auto& e : r.files.plot_errors) std::cerr << "warning: plot: " << e << "\n";
+    std::cout << validation::formatIdValidationSummary(r);
+    std::cout << "report: " << opt.report_dir << "/report.md, summary.json"
+              << (r.files.plots_skipped ? " (plots skipped: " + r.files.plots_note + ")" : "") << "\n";
+  }
+  return r.passed ? 0 : 1;
+}
+
+CommandRegistration reg(
+    {"validate", "inverse dynamics by core and Simbody, compared with each other and with references",
+     "usage: redmax validate (--setup ID_SETUP.xml | --model M.osim --coordinates Q.mot)\n"
+     "                 [--external-loads LOADS.xml] [--lowpass HZ] [--t0 S] [--t1 S]\n"
+     "                 [--forces-to-exclude LIST] [--exact]\n"
+     "                 [--reference OPENSIM_ID.sto]... [--published ID.sto]...\n"
+     "                 [--tolerance REL] [--max-tolerance REL] [--engine-tolerance REL]\n"
+     "                 [--interpolation linear|cubic] [--no-simbody] [--no-plots] [--gnuplot PATH]\n"
+     "                 [--quiet] --report DIR\n"
+     "Processes the inputs once, as `redmax id` does (see `redmax id --help` for the input flags),\n"
+     "solves every frame with the core engine and with the Simbody engine, and compares:\n"
+     "  core_vs_simbody      every column and frame: |core - simbody| <= REL * column peak\n"
+     "                       (--engine-tolerance, default 1e-9; absolute floor 1e-10)\n"
+     "  core_vs_<label>      each --reference (label 'reference') or --published (label\n"
+     "                       'published') result: columns matched by name over the overlapping\n"
+     "                       time range, the reference's rows as the grid and the core interpolated\n"
+     "                       (--interpolation, default linear); passes when RMS <= REL * peak\n"
+     "                       (--tolerance, default 1e-6; absolute floor 1e-9) and, with\n"
+     "                       --max-tolerance REL, max |diff| <= REL * peak\n"
+     "If the Simbody engine cannot build the model, the reason goes into the report and the run\n"
+     "continues with the core only (--no-simbody skips it on purpose).\n"
+     "DIR receives: summary.json (inputs, per-comparison per-column metrics, PASS/FAIL, the speed\n"
+     "of each engine: frames, seconds, frames per second), <cmp>_metrics.csv, <cmp>_series.csv,\n"
+     "overlay and difference plots (gnuplot; skipped with a note when absent or --no-plots),\n"
+     "overlay_all (every series), core_id.sto and simbody_id.sto (full precision), report.md.\n"
+     "Prints one line per engine and per comparison (worst column, PASS/FAIL).\n"
+     "Exit codes: 0 every comparison passed, 1 a comparison failed (or a frame could not be solved,\n"
+     "or the report could not be written), 2 bad input or usage.\n",
+     runValidate});
+
+}  // namespace
+}  // namespace redmax::cli

@@ -1,0 +1,269 @@
+#include "validation/id_validation.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include "converter/id/core_id_engine.hpp"
+#include "plugin/simbody/id_engine.hpp"
+#include "validation/report/progress.hpp"
+
+namespace redmax::validation {
+namespace {
+
+// solve the trial with one engine, timing construction and the frames separately
+osim::Storage runEngine(const osim::InverseDynamicsTool& tool, osim::IdEngine& engine, IdEngineRun& run,
+                        bool show_progress) {
+  ProgressOptions po;
+  po.stream = show_progress ? stderr : nullptr;
+  Progress progress("validate: " + run.name, tool.numFrames(), po);
+  Stopwatch sw;
+  osim::Storage s = tool.run(engine, [&](int done, int) { progress.set(done); });
+  run.seconds = sw.seconds();
+  progress.finish();
+  run.frames = s.numRows();
+  run.ran = true;
+  return s;
+}
+
+JsonValue engineJson(const IdEngineRun& e) {
+  JsonValue j = JsonValue::object();
+  j["ran"] = e.ran;
+  if (!e.ran) j["skipped"] = e.skipped;
+  j["frames"] = e.frames;
+  j["build_seconds"] = e.build_seconds;
+  j["seconds"] = e.seconds;
+  j["frames_per_second"] = e.framesPerSecond();
+  return j;
+}
+
+std::string fmt(const char* f, double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, x);
+  return buf;
+}
+
+}  // namespace
+
+IdValidationResult runIdValidation(const IdValidationOptions& opt) {
+  if (opt.report_dir.empty()) throw osim::ConvertError("", 0, "no report directory given (--report DIR)");
+  if (!(opt.engine_rel >= 0) || !(opt.reference_rms_rel >= 0) || !(opt.reference_max_rel >= 0) ||
+      !(opt.engine_abs >= 0) || !(opt.reference_abs >= 0))
+    throw osim::ConvertError("", 0, "tolerances must be non-negative numbers");
+  IdValidationResult r;
+
+  // inputs processed once; both engines see the same processed coordinates and loads
+  osim::IdToolConfig config = osim::resolveIdSettings(opt.settings);
+  if (!opt.loads_working_dir.empty()) config.loads_working_dir = opt.loads_working_dir;
+  const osim::InverseDynamicsTool tool(config);
+  r.warnings = tool.warnings();
+
+  // references are read before any engine runs, so a bad file is reported at once
+  std::vector<osim::Storage> refs;
+  std::vector<std::string> ref_labels;
+  std::set<std::string> used = {"core", "simbody"};
+  for (size_t i = 0; i < opt.references.size(); ++i) {
+    refs.push_back(osim::readStorage(opt.references[i].path));
+    checkTable(refs.back(), opt.references[i].path);
+    std::string label = opt.references[i].label.empty() ? "reference" : opt.references[i].label;
+    // labels name files and legends: keep them unique
+    for (int k = 2; used.count(label); ++k) label = opt.references[i].label + "_" + std::to_string(k);
+    used.insert(label);
+    ref_labels.push_back(label);
+  }
+
+  ReportOptions ro;
+  ro.title = "redmax validate: inverse dynamics, core vs Simbody vs reference";
+  ro.gnuplot = opt.gnuplot;
+  Report report(opt.report_dir, ro);
+  report.setInput("setup", config.setup_file);
+  report.setInput("model", config.model_file);
+  report.setInput("coordinates", config.coordinates_file);
+  report.setInput("external_loads", config.external_loads_file);
+  report.setInput("lowpass_cutoff_hz", config.lowpass_cutoff_hz);
+  report.setInput("t0", std::isfinite(config.t0) ? JsonValue(config.t0) : JsonValue());
+  report.setInput("t1", std::isfinite(config.t1) ? JsonValue(config.t1) : JsonValue());
+  report.setInput("mode", config.opensim_compat ? "opensim-compat" : "exact");
+  report.setInput("frames", tool.numFrames());
+  JsonValue jrefs = JsonValue::array();
+  for (size_t i = 0; i < refs.size(); ++i) {
+    JsonValue& j = jrefs.push(JsonValue::object());
+    j["label"] = ref_labels[i];
+    j["path"] = opt.references[i].path;
+  }
+  report.setInput("references", jrefs);
+  JsonValue tol = JsonValue::object();
+  tol["engine_rel"] = opt.engine_rel;
+  tol["engine_abs"] = opt.engine_abs;
+  tol["reference_rms_rel"] = opt.reference_rms_rel;
+  tol["reference_max_rel"] = std::isfinite(opt.reference_max_rel) ? JsonValue(opt.reference_max_rel) : JsonValue("unlimited");
+  tol["reference_abs"] = opt.reference_abs;
+  report.setInput("tolerances", tol);
+
+  // the core engine: a failure here is the run failing (IdEngineError propagates)
+  IdEngineRun core_run;
+  core_run.name = "core";
+  Stopwatch sw;
+  osim::CoreIdEngine core(tool.model(), tool.engineOptions());
+  core_run.build_seconds = sw.seconds();
+  osim::Storage core_result = runEngine(tool, core, core_run, opt.progress);
+  core_result.name = "core";
+  r.engines.push_back(core_run);
+
+  // the Simbody engine: a model it cannot build is recorded, and the run goes on with core only
+  IdEngineRun sb_run;
+  sb_run.name = "simbody";
+  osim::Storage sb_result;
+  if (!opt.run_simbody) {
+    sb_run.skipped = "disabled (--no-simbody)";
+  } else {
+    std::unique_ptr<simbody::SimbodyIdEngine> sb;
+    try {
+      sw.restart();
+      sb = std::make_unique<simbody::SimbodyIdEngine>(tool.model(), tool.engineOptions());
+      sb_run.build_seconds = sw.seconds();
+    } catch (const std::exception& e) {
+      sb_run.skipped = std::string("the Simbody engine cannot build this model: ") + e.what();
+    }
+    if (sb) {
+      try {
+        sb_result = runEngine(tool, *sb, sb_run, opt.progress);
+        sb_result.name = "simbody";
+      } catch (const std::exception& e) {
+        // an engine that fails where the core succeeds is a disagreement: it fails validation
+        sb_run.ran = false;
+        sb_run.skipped = std::string("the Simbody engine failed: ") + e.what();
+        report.addCheck("simbody engine solves every frame", false, e.what());
+      }
+    }
+  }
+  if (!sb_run.ran) r.warnings.push_back("simbody: " + sb_run.skipped);
+  r.engines.push_back(sb_run);
+
+  // speed: frames, seconds, frames per second of each engine
+  // (one section at a time: creating a section may move the others)
+  for (const auto& e : r.engines)
+    report.section("engines")[e.name] = e.ran ? JsonValue("ran") : JsonValue(e.skipped);
+  JsonValue& speed = report.section("speed");
+  for (const auto& e : r.engines) {
+    speed[e.name] = engineJson(e);
+    if (e.ran) report.addWallTime(e.name, e.seconds);
+  }
+  if (r.engines[0].ran && r.engines[1].ran && r.engines[0].seconds > 0)
+    speed["simbody_over_core_seconds"] = r.engines[1].seconds / r.engines[0].seconds;
+
+  // core vs simbody on identical frames: round-off agreement, every column and frame
+  if (sb_run.ran) {
+    CompareOptions co;
+    co.tolerance = {opt.engine_abs, opt.engine_rel, opt.engine_abs, opt.engine_rel};
+    co.align.grid_table = 0;
+    co.missing_columns_fail = true;
+    r.comparisons.push_back(compareTables("core_vs_simbody", core_result, "core", sb_result, "simbody", co));
+  }
+
+  // core vs each reference: the reference's rows in the overlap are the grid, core interpolated
+  for (size_t i = 0; i < refs.size(); ++i) {
+    CompareOptions co;
+    co.tolerance = {opt.reference_abs, opt.reference_rms_rel, opt.reference_abs, opt.reference_max_rel};
+    co.align.grid_table = 1;
+    co.align.interpolation = opt.interpolation;
+    try {
+      r.comparisons.push_back(
+          compareTables("core_vs_" + ref_labels[i], core_result, "core", refs[i], ref_labels[i], co));
+    } catch (const CompareError& e) {
+      throw CompareError(opt.references[i].path + ": " + e.what());
+    }
+  }
+  for (const auto& c : r.comparisons) {
+    report.addComparison(c, "generalized force [N m or N]");
+    for (const auto& w : c.warnings) r.warnings.push_back(c.name + ": " + w);
+  }
+
+  // every series on one grid: overlaid torques of all engines and references
+  std::vector<const Table*> all = {&core_result};
+  std::vector<std::string> names = {"core"};
+  if (sb_run.ran) {
+    all.push_back(&sb_result);
+    names.push_back("simbody");
+  }
+  for (size_t i = 0; i < refs.size(); ++i) {
+    all.push_back(&refs[i]);
+    names.push_back(ref_labels[i]);
+  }
+  if (all.size() > 1) {
+    try {
+      AlignOptions ao;
+      ao.interpolation = opt.interpolation;
+      report.addOverlay("overlay_all", alignTables(all, names, ao), "inverse dynamics: all engines and references",
+                        "generalized force [N m or N]");
+    } catch (const CompareError& e) {
+      r.warnings.push_back(std::string("overlay of all series skipped: ") + e.what());
+    }
+  }
+
+  // the engines' own results, at full precision, beside the report
+  std::error_code ec;
+  std::filesystem::create_directories(opt.report_dir, ec);
+  osim::StorageWriteOptions wo;
+  wo.scientific = true;
+  wo.decimals = 16;
+  try {
+    core_result.name = osim::kIdStorageName;
+    osim::writeStorage((std::filesystem::path(opt.report_dir) / "core_id.sto").string(), core_result, wo);
+    if (sb_run.ran) {
+      sb_result.name = osim::kIdStorageName;
+      osim::writeStorage((std::filesystem::path(opt.report_dir) / "simbody_id.sto").string(), sb_result, wo);
+    }
+  } catch (const osim::ConvertError& e) {
+    throw ReportError(opt.report_dir, e.what());
+  }
+
+  std::ostringstream md;
+  md << "Each engine solved the same processed inputs (" << tool.numFrames() << " frames, "
+     << (config.opensim_compat ? "OpenSim-compatible" : "exact") << " mode).\n\n";
+  md << "| engine | frames | build [s] | solve [s] | frames/s | note |\n|---|---|---|---|---|---|\n";
+  for (const auto& e : r.engines)
+    md << "| " << e.name << " | " << e.frames << " | " << fmt("%.4g", e.build_seconds) << " | "
+       << fmt("%.4g", e.seconds) << " | " << fmt("%.0f", e.framesPerSecond()) << " | "
+       << (e.ran ? "" : e.skipped) << " |\n";
+  report.addMarkdown("Engines and speed", md.str());
+  if (!r.warnings.empty()) {
+    std::ostringstream w;
+    for (const auto& s : r.warnings) w << "- " << s << "\n";
+    report.addMarkdown("Warnings", w.str());
+  }
+
+  r.files = report.write();
+  r.passed = report.passed();
+  return r;
+}
+
+std::string formatIdValidationSummary(const IdValidationResult& r) {
+  std::ostringstream os;
+  for (const auto& e : r.engines) {
+    if (e.ran)
+      os << "engine " << e.name << ": " << e.frames << " frames, " << fmt("%.4f", e.seconds) << " s, "
+         << fmt("%.0f", e.framesPerSecond()) << " frames/s\n";
+    else
+      os << "engine " << e.name << ": skipped (" << e.skipped << ")\n";
+  }
+  for (const auto& c : r.comparisons) {
+    os << c.name << ": " << c.metrics.size() << " columns over [" << fmt("%.6g", c.t_begin) << ", "
+       << fmt("%.6g", c.t_end) << "] s, " << c.time.size() << " samples";
+    if (c.worst >= 0) {
+      const ColumnMetrics& m = c.metrics[static_cast<size_t>(c.worst)];
+      os << "; worst " << m.name << " rms/peak " << fmt("%.3g", m.rms_rel) << " max/peak "
+         << fmt("%.3g", m.max_rel);
+    }
+    if (!c.only_in_a.empty()) os << "; " << c.only_in_a.size() << " only in " << c.label_a;
+    if (!c.only_in_b.empty()) os << "; " << c.only_in_b.size() << " only in " << c.label_b;
+    os << " -> " << (c.passed ? "PASS" : "FAIL") << "\n";
+  }
+  os << "validate: " << (r.passed ? "PASS" : "FAIL") << "\n";
+  return os.str();
+}
+
+}  // namespace redmax::validation
