@@ -147,9 +147,10 @@ void FunctionBased::calcSimbody(const VecJ& q, const VecJ& qdot, JointKinematics
   const Mat3X Hdang = Wdot * Fth + W * Fqdot.topRows<3>();
   const Mat3X Hdlin = At * Fqdot.bottomRows<3>();
 
-  // to M: S = R^T H; d/dt R^T = -[w] R^T with the true body angular velocity w
+  // to M: S = R^T H; d/dt R^T = -[w] R^T with w = R^T H_ang qdot, the angular velocity Simbody
+  // gives the body (V_FM = H u); it differs from the true one only for nonzero Constant rotations
   const Mat3 Rt = R.transpose();
-  const Vec3 w = Rt * (W * (Fth * qdot));
+  const Vec3 w = Rt * (Hang * qdot);
   const Mat3 Wx = skew(w);
   out.S.topRows<3>() = Rt * Hang;
   out.S.bottomRows<3>() = Rt * Hlin;

@@ -18,7 +18,8 @@
 //     Wdot = [0, w_a x W_2, w_b x W_3], w_a = angular part of H (u_0, 0, ...), w_b = angular part
 //     of H u with u_2 zeroed (when nq > 2); W here uses the true constants.
 //   S = blockdiag(R^T, R^T) H,  Sdot = -blockdiag([w], [w]) S + blockdiag(R^T, R^T) Hdot,
-//   where w = R^T omega_FM is the true angular velocity of M (R(q(t)) is the true rotation).
+//   where w = R^T H_ang qdot is the angular velocity Simbody gives M (V_FM = H u; the true one
+//   except for nonzero Constant rotations).
 // It equals exact kinematics when rotation k depends only on mobility k-1 (pelvis/hip-like
 // joints) and no Constant rotation is nonzero; it differs, in Sdot, when one coordinate drives
 // several rotations (coupled knees), and in S when a nonzero Constant rotation precedes others.

@@ -6,6 +6,8 @@
 
 #include <Eigen/Dense>
 
+#include "plugin/simbody/function_adapter.hpp"
+
 namespace redmax::simbody {
 
 namespace {
@@ -34,8 +36,9 @@ SimTK::MassProperties massProperties(const Body& b) {
   const Mat3 I_o = b.inertia_com + b.mass * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
   const Mat3 Is = 0.5 * (I_o + I_o.transpose());
   const SimTK::SymMat33 sym(Is(0, 0), Is(1, 0), Is(1, 1), Is(2, 0), Is(2, 1), Is(2, 2));
+  const SimTK::Vec3 com(c.x(), c.y(), c.z());
   try {
-    return SimTK::MassProperties(b.mass, SimTK::Vec3(c.x(), c.y(), c.z()), SimTK::Inertia(sym));
+    return SimTK::MassProperties(b.mass, com, SimTK::Inertia(sym));
   } catch (const std::exception& e) {
     throw SimbodyBuildError("body '" + b.name + "': Simbody rejects its mass properties: " + e.what());
   }
@@ -45,9 +48,12 @@ SimTK::MassProperties massProperties(const Body& b) {
 struct MobilizerChoice {
   MobilizerKind kind = MobilizerKind::Weld;
   Mat3 R_frame = Mat3::Identity();  // F' = F R_frame, M' = M R_frame
+  const FunctionBased* function_based = nullptr;  // kind == FunctionBased
+  Vec3 radii = Vec3::Ones();                      // kind == Ellipsoid
+  bool reversed = false;                          // Direction::Reverse
 };
 
-MobilizerChoice chooseMobilizer(const JointSlot& slot, const SimbodyBuildOptions& opt) {
+MobilizerChoice chooseMobilizer(const Joint& joint, const std::string& name, const SimbodyBuildOptions& opt) {
   return std::visit(
       [&](const auto& j) -> MobilizerChoice {
         using T = std::decay_t<decltype(j)>;
@@ -62,7 +68,7 @@ MobilizerChoice chooseMobilizer(const JointSlot& slot, const SimbodyBuildOptions
           c.R_frame = rotationWithColumn(j.axis, 0);
         } else if constexpr (std::is_same_v<T, SphericalEuler>) {
           if (j.sequence != EulerSequence::XYZ)
-            throw SimbodyBuildError("joint '" + slot.name + "': Euler sequence " +
+            throw SimbodyBuildError("joint '" + name + "': Euler sequence " +
                                     eulerSequenceName(j.sequence) +
                                     " has no Simbody mobilizer (Gimbal and Ball use body-fixed XYZ)");
           c.kind = opt.spherical == SphericalAs::Ball ? MobilizerKind::Ball : MobilizerKind::Gimbal;
@@ -72,17 +78,56 @@ MobilizerChoice chooseMobilizer(const JointSlot& slot, const SimbodyBuildOptions
           const Free3D os = Free3D::opensim();
           if (j.rotation != os.rotation || j.sequence != os.sequence || j.order != os.order ||
               j.layout != os.layout)
-            throw SimbodyBuildError("joint '" + slot.name +
+            throw SimbodyBuildError("joint '" + name +
                                     "': only the OpenSim free-joint layout (Euler XYZ rotation first, "
                                     "X_FM = (R, p in F)) maps to Simbody's Free mobilizer");
           c.kind = MobilizerKind::Free;
+        } else if constexpr (std::is_same_v<T, FunctionBased>) {
+          // Simbody's FunctionBased has the approximate Hdot of OPENSIM_SEMANTICS 3.3; the core
+          // joint matches it only with simbody_compat (exact mode differs for coupled rotations)
+          c.kind = MobilizerKind::FunctionBased;
+          c.function_based = &j;
+        } else if constexpr (std::is_same_v<T, Ellipsoid>) {
+          c.kind = MobilizerKind::Ellipsoid;
+          c.radii = j.radii;
+        } else if constexpr (std::is_same_v<T, Reversed>) {
+          if (!j.inner) throw SimbodyBuildError("joint '" + name + "': reversed joint without an inner joint");
+          c = chooseMobilizer(*j.inner, name, opt);
+          if (c.reversed)
+            throw SimbodyBuildError("joint '" + name + "': a reversed reversed joint has no Simbody mobilizer");
+          // with Direction::Reverse Simbody's u is the forward mobilizer's u; the velocity map of
+          // Ball/Free/Ellipsoid (u = angular velocity in F) would then refer to the other frame
+          if (c.kind == MobilizerKind::Ball || c.kind == MobilizerKind::Free ||
+              c.kind == MobilizerKind::Ellipsoid)
+            throw SimbodyBuildError("joint '" + name + "': a reversed " + j.inner->typeName() +
+                                    " joint maps to a reversed Simbody mobilizer whose u is not qdot; "
+                                    "only joints with u = qdot (pin, slider, gimbal, universal, "
+                                    "function-based, weld) are mapped reversed");
+          c.reversed = true;
         } else {
-          throw SimbodyBuildError("joint '" + slot.name + "' of type " + slot.joint.typeName() +
+          throw SimbodyBuildError("joint '" + name + "' of type " + joint.typeName() +
                                   " has no exact Simbody mobilizer counterpart");
         }
         return c;
       },
-      slot.joint.v);
+      joint.v);
+}
+
+// the FunctionBased mobilizer as OpenSim's CustomJoint builds it: six functions (rotations then
+// translations) with their coordinate lists in mobility order, and the six (unit) axes
+SimTK::MobilizedBody makeFunctionBased(SimTK::MobilizedBody& parent, const SimTK::Transform& X_PF,
+                                       const SimTK::Body& body, const SimTK::Transform& X_BM,
+                                       const FunctionBased& fb, SimTK::MobilizedBody::Direction dir) {
+  std::vector<const SimTK::Function*> functions;
+  std::vector<std::vector<int>> coords;
+  std::vector<SimTK::Vec3> axes;
+  for (const TransformAxis& ax : fb.axes()) {
+    // Simbody takes ownership of the functions
+    functions.push_back(new AxisFunctionAdapter(ax.function));
+    coords.push_back(ax.coordinates);
+    axes.emplace_back(ax.axis.x(), ax.axis.y(), ax.axis.z());
+  }
+  return SimTK::MobilizedBody::FunctionBased(parent, X_PF, body, X_BM, fb.nq(), functions, coords, axes, dir);
 }
 
 }  // namespace
@@ -122,7 +167,7 @@ std::unique_ptr<SimbodyModel> makeSimbodyModel(const Model& model, const Simbody
 
   for (int i = 0; i < nb; ++i) {
     const JointSlot& s = model.joints[i];
-    const MobilizerChoice c = chooseMobilizer(s, opt);
+    const MobilizerChoice c = chooseMobilizer(s.joint, s.name, opt);
     SimTK::MobilizedBody& parent = s.parent < 0 ? sm->matter.updGround() : sm->mobods[s.parent];
     const Mat4 E_rot = makeE(c.R_frame, Vec3::Zero());
     const SimTK::Transform X_PF = toTransform(s.E_pf * E_rot);
@@ -132,30 +177,49 @@ std::unique_ptr<SimbodyModel> makeSimbodyModel(const Model& model, const Simbody
     m.kind = c.kind;
     m.q_index = s.q_index;
     m.nq = s.nq;
-    switch (c.kind) {
-      case MobilizerKind::Weld:
-        sm->mobods.push_back(SimTK::MobilizedBody::Weld(parent, X_PF, body, X_BM));
-        break;
-      case MobilizerKind::Pin:
-        sm->mobods.push_back(SimTK::MobilizedBody::Pin(parent, X_PF, body, X_BM));
-        break;
-      case MobilizerKind::Slider:
-        sm->mobods.push_back(SimTK::MobilizedBody::Slider(parent, X_PF, body, X_BM));
-        break;
-      case MobilizerKind::Gimbal:
-        sm->mobods.push_back(SimTK::MobilizedBody::Gimbal(parent, X_PF, body, X_BM));
-        break;
-      case MobilizerKind::Ball:
-        sm->mobods.push_back(SimTK::MobilizedBody::Ball(parent, X_PF, body, X_BM));
-        m.u_is_qdot = false;
-        break;
-      case MobilizerKind::Universal:
-        sm->mobods.push_back(SimTK::MobilizedBody::Universal(parent, X_PF, body, X_BM));
-        break;
-      case MobilizerKind::Free:
-        sm->mobods.push_back(SimTK::MobilizedBody::Free(parent, X_PF, body, X_BM));
-        m.u_is_qdot = false;
-        break;
+    m.reversed = c.reversed;
+    const auto dir = c.reversed ? SimTK::MobilizedBody::Reverse : SimTK::MobilizedBody::Forward;
+    try {
+      switch (c.kind) {
+        case MobilizerKind::Weld:
+          // a weld has no direction
+          sm->mobods.push_back(SimTK::MobilizedBody::Weld(parent, X_PF, body, X_BM));
+          break;
+        case MobilizerKind::Pin:
+          sm->mobods.push_back(SimTK::MobilizedBody::Pin(parent, X_PF, body, X_BM, dir));
+          break;
+        case MobilizerKind::Slider:
+          sm->mobods.push_back(SimTK::MobilizedBody::Slider(parent, X_PF, body, X_BM, dir));
+          break;
+        case MobilizerKind::Gimbal:
+          sm->mobods.push_back(SimTK::MobilizedBody::Gimbal(parent, X_PF, body, X_BM, dir));
+          break;
+        case MobilizerKind::Ball:
+          sm->mobods.push_back(SimTK::MobilizedBody::Ball(parent, X_PF, body, X_BM, dir));
+          m.u_is_qdot = false;
+          break;
+        case MobilizerKind::Universal:
+          sm->mobods.push_back(SimTK::MobilizedBody::Universal(parent, X_PF, body, X_BM, dir));
+          break;
+        case MobilizerKind::Free:
+          sm->mobods.push_back(SimTK::MobilizedBody::Free(parent, X_PF, body, X_BM, dir));
+          m.u_is_qdot = false;
+          break;
+        case MobilizerKind::FunctionBased:
+          sm->mobods.push_back(makeFunctionBased(parent, X_PF, body, X_BM, *c.function_based, dir));
+          break;
+        case MobilizerKind::Ellipsoid: {
+          // u = angular velocity of M in F, expressed in F (as Ball): calcVelocityMap
+          const SimTK::Vec3 radii(c.radii.x(), c.radii.y(), c.radii.z());
+          sm->mobods.push_back(SimTK::MobilizedBody::Ellipsoid(parent, X_PF, body, X_BM, radii, dir));
+          m.u_is_qdot = false;
+          break;
+        }
+      }
+    } catch (const SimbodyBuildError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw SimbodyBuildError("joint '" + s.name + "': Simbody rejects the mobilizer: " + e.what());
     }
   }
 
@@ -231,8 +295,9 @@ void calcVelocityMap(const SimbodyModel& sm, const Model& model, const State& s,
       T.block(m.simbody_u, m.q_index, m.nq, m.nq).setIdentity();
       continue;
     }
-    // Ball/Free: u = (w_FM; v_FM) in F = diag(R_FM, R_FM) S qdot, S being the twist of M in F
-    // expressed in M; its time derivative adds diag(R [w], R [w]) S with w = (S qdot)_w in M
+    // Ball/Free/Ellipsoid: u = (w_FM; v_FM) in F (Ellipsoid: w_FM only) = diag(R_FM, R_FM) S qdot,
+    // S being the twist of M in F expressed in M; its time derivative adds diag(R [w], R [w]) S
+    // with w = (S qdot)_w in M
     const auto q = s.q.segment(m.q_index, m.nq);
     const auto qd = s.qdot.segment(m.q_index, m.nq);
     model.joints[i].joint.calc(q, qd, jk);

@@ -6,10 +6,14 @@
 // One MobilizedBody per JointSlot, in core body order (parents first):
 //   Fixed -> Weld, Revolute(axis) -> Pin, Prismatic(axis) -> Slider (F and M are rotated by the
 //   same rotation so that Simbody's z (Pin) or x (Slider) axis lies along the core axis),
-//   SphericalEuler XYZ -> Gimbal or Ball, Universal -> Universal, Free3D (OpenSim layout) -> Free.
+//   SphericalEuler XYZ -> Gimbal or Ball, Universal -> Universal, Free3D (OpenSim layout) -> Free,
+//   FunctionBased -> FunctionBased (six AxisFunctionAdapters, coordinate lists and axes, as OpenSim's
+//   CustomJoint; Simbody's approximate Hdot, so compare with a simbody_compat core joint),
+//   Ellipsoid -> Ellipsoid (u = angular velocity in F, as Ball), Reversed(inner) -> inner's
+//   mobilizer with Direction::Reverse (only inner joints with u = qdot).
 // Ball and Free always run with Euler angles (SimbodyMatterSubsystem::setUseEulerAngles), so
 // Simbody's q equals the core q for every joint. Simbody's generalized speeds u equal qdot except
-// for Ball (u = w_FM expressed in F) and Free (u = [w_FM; v_FM], both in F). The velocity map
+// for Ball and Ellipsoid (u = w_FM expressed in F) and Free (u = [w_FM; v_FM], both in F). The velocity map
 //   u = T(q) qdot,   udot = T qddot + Tdot qdot        (T block diagonal, nu x nr)
 // converts between the two spaces: M_core = T^T M_u T, tau_core = T^T f_u.
 //

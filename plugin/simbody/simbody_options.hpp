@@ -21,7 +21,7 @@ struct SimbodyBuildOptions {
   bool joint_springs = true;
 };
 
-enum class MobilizerKind { Weld, Pin, Slider, Gimbal, Ball, Universal, Free };
+enum class MobilizerKind { Weld, Pin, Slider, Gimbal, Ball, Universal, Free, FunctionBased, Ellipsoid };
 
 /// Where one core joint lives in Simbody's q and u vectors.
 struct MobilizerMap {
@@ -30,7 +30,8 @@ struct MobilizerMap {
   int nq = 0;         // core coordinates (== Simbody nq == nu with Euler angles)
   int simbody_q = 0;  // first Simbody q (matter subsystem indexing)
   int simbody_u = 0;  // first Simbody u
-  bool u_is_qdot = true;  // false for Ball and Free: u = T qdot with T from calcVelocityMap
+  bool u_is_qdot = true;  // false for Ball, Free and Ellipsoid: u = T qdot (calcVelocityMap)
+  bool reversed = false;  // Direction::Reverse (core Reversed joint); kind is the inner joint's
 };
 
 /// Construction failed: a joint type without a Simbody counterpart, an invalid inertia, a spring on
