@@ -1,0 +1,328 @@
+// `redmax validate` (validation/id_validation.hpp, cli/cmd_validate.cpp): a project-authored
+// double pendulum with a closed-form motion and closed-form torques as the reference (runs
+// everywhere): the report has every file and passes; a deliberately wrong reference fails with
+// exit 1; bad inputs exit 2; Simbody disabled is recorded and core-only still passes; set F
+// (gait10dof18musc) passes against OpenSim 4.6's own result when ../shared is present.
+// Correctness only; timings are recorded, never asserted.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "converter/storage.hpp"
+#include "validation/id_validation.hpp"
+#include "validation/report/json_value.hpp"
+#include "validation/report/plot.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using redmax::validation::JsonValue;
+
+// the redmax executable of the same build: <build>/tests/validation_tests -> <build>/cli/redmax
+fs::path redmaxExe() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  const fs::path exe = self.parent_path().parent_path() / "cli" / "redmax";
+  return fs::exists(exe) ? exe : fs::path{};
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string num(double x) {
+  std::ostringstream os;
+  os.precision(17);
+  os << x;
+  return os.str();
+}
+
+struct CmdResult {
+  int code;
+  std::string out, err;
+};
+
+// closed-form torques of the pendulum below (Lagrange; link inertia Izz 0.05 about the COM),
+// for q1 = 0.7 sin(2 pi 0.8 t), q2 = 0.9 sin(2 pi 1.1 t)
+Eigen::Vector2d closedFormTau(double t) {
+  const double m1 = 1.3, c1 = 0.45, I1 = 0.05, L1 = 0.9, m2 = 0.8, c2 = 0.35, I2 = 0.05, g = 9.80665;
+  const double w1 = 2 * M_PI * 0.8, w2 = 2 * M_PI * 1.1;
+  const double a = 0.7 * std::sin(w1 * t), b = 0.9 * std::sin(w2 * t);
+  const double ad = 0.7 * w1 * std::cos(w1 * t), bd = 0.9 * w2 * std::cos(w2 * t);
+  const double add = -w1 * w1 * a, bdd = -w2 * w2 * b;
+  const double h = m2 * L1 * c2 * std::sin(b);
+  const double M11 = I1 + m1 * c1 * c1 + I2 + m2 * (L1 * L1 + c2 * c2 + 2 * L1 * c2 * std::cos(b));
+  const double M12 = I2 + m2 * (c2 * c2 + L1 * c2 * std::cos(b)), M22 = I2 + m2 * c2 * c2;
+  return {M11 * add + M12 * bdd - h * (2 * ad * bd + bd * bd) + (m1 * c1 + m2 * L1) * g * std::sin(a) +
+              m2 * c2 * g * std::sin(a + b),
+          M12 * add + M22 * bdd + h * ad * ad + m2 * c2 * g * std::sin(a + b)};
+}
+
+class Validate : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("redmax_validate_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    writePendulum();
+  }
+  void TearDown() override {
+    if (!dir_.empty()) fs::remove_all(dir_);
+  }
+
+  CmdResult run(const std::string& args) const {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = "cd " + dir_.string() + " && " + redmaxExe().string() + " " + args + " >" +
+                            out.string() + " 2>" + err.string();
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+  }
+  void write(const std::string& name, const std::string& text) const {
+    fs::create_directories((dir_ / name).parent_path());
+    std::ofstream(dir_ / name) << text;
+  }
+
+  // a planar double pendulum (Pin, Pin), the motion above in degrees, 2 s at 500 Hz
+  void writePendulum() {
+    auto body = [](const std::string& n, double m, double c) {
+      return "<Body name=\"" + n + "\"><mass>" + num(m) + "</mass><mass_center>0 " + num(-c) +
+             " 0</mass_center><inertia>0.1 0.1 0.05 0 0 0</inertia></Body>\n";
+    };
+    auto pin = [](const std::string& n, const std::string& parent, const std::string& child,
+                  const std::string& at, const std::string& q) {
+      return "<PinJoint name=\"" + n + "\"><socket_parent_frame>" + n + "_p</socket_parent_frame>"
+             "<socket_child_frame>" + n + "_c</socket_child_frame><coordinates><Coordinate name=\"" + q +
+             "\"/></coordinates><frames><PhysicalOffsetFrame name=\"" + n + "_p\"><socket_parent>" + parent +
+             "</socket_parent><translation>" + at + "</translation><orientation>0 0 0</orientation>"
+             "</PhysicalOffsetFrame><PhysicalOffsetFrame name=\"" + n + "_c\"><socket_parent>" + child +
+             "</socket_parent><translation>0 0 0</translation><orientation>0 0 0</orientation>"
+             "</PhysicalOffsetFrame></frames></PinJoint>\n";
+    };
+    write("dp.osim", "<?xml version=\"1.0\" encoding=\"UTF-8\" ?>\n<OpenSimDocument Version=\"40000\">\n"
+                     "<Model name=\"dp\"><Ground name=\"ground\"/><gravity>0 -9.80665 0</gravity>\n"
+                     "<BodySet name=\"bodyset\"><objects>\n" + body("l1", 1.3, 0.45) + body("l2", 0.8, 0.35) +
+                     "</objects></BodySet>\n<JointSet name=\"jointset\"><objects>\n" +
+                     pin("j1", "/ground", "/bodyset/l1", "0 0 0", "q1") +
+                     pin("j2", "/bodyset/l1", "/bodyset/l2", "0 -0.9 0", "q2") +
+                     "</objects></JointSet>\n</Model>\n</OpenSimDocument>\n");
+    std::ostringstream os;
+    os.precision(17);
+    os << "motion\nversion=1\nnRows=1001\nnColumns=3\ninDegrees=yes\nendheader\ntime\tq1\tq2\n";
+    for (int i = 0; i <= 1000; ++i) {
+      const double t = 0.002 * i;
+      os << t << "\t" << 0.7 * std::sin(2 * M_PI * 0.8 * t) * 180 / M_PI << "\t"
+         << 0.9 * std::sin(2 * M_PI * 1.1 * t) * 180 / M_PI << "\n";
+    }
+    write("dp.mot", os.str());
+  }
+
+  // the closed-form torques as an OpenSim-style reference: every 5th frame of the data grid over
+  // 0.4..1.6 s (wider than the trial window, so the overlap is what is compared), columns in
+  // another order, an extra column the model lacks; q2 scaled by q2_scale (1 = the true torques)
+  void writeReference(const std::string& name, double q2_scale) const {
+    std::ostringstream os;
+    os.precision(17);
+    os << "Inverse Dynamics Generalized Forces\nversion=1\nnRows=121\nnColumns=4\ninDegrees=no\nendheader\n"
+          "time\tq2_moment\textra_moment\tq1_moment\n";
+    for (int i = 0; i <= 120; ++i) {
+      const double t = 0.4 + 0.01 * i;
+      const Eigen::Vector2d tau = closedFormTau(t);
+      os << t << "\t" << q2_scale * tau(1) << "\t" << 1.0 << "\t" << tau(0) << "\n";
+    }
+    write(name, os.str());
+  }
+
+  JsonValue summary(const std::string& report) const {
+    return JsonValue::parse(slurp(dir_ / report / "summary.json"));
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Validate, PendulumReportHasEveryFileAndPassesAgainstTheClosedForm) {
+  if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to validation_tests (build target redmax)";
+  writeReference("ref.sto", 1.0);
+  const CmdResult r =
+      run("validate --model dp.osim --coordinates dp.mot --t0 0.5 --t1 1.5 --reference ref.sto --report rep");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  // the printed summary: both engines with their speed, each comparison, the verdict
+  EXPECT_NE(r.out.find("engine core: 501 frames"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("engine simbody: 501 frames"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("core_vs_simbody: 2 columns"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("core_vs_reference: 2 columns"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("validate: PASS"), std::string::npos) << r.out;
+
+  for (const std::string f : {"summary.json", "report.md", "core_vs_simbody_metrics.csv", "core_vs_simbody_series.csv",
+                              "core_vs_reference_metrics.csv", "core_vs_reference_series.csv", "core_id.sto",
+                              "simbody_id.sto"})
+    EXPECT_TRUE(fs::exists(dir_ / "rep" / f)) << f;
+  // plots when gnuplot can draw them (the report says why not otherwise)
+  if (redmax::validation::findGnuplot().available) {
+    int images = 0;
+    for (const auto& e : fs::directory_iterator(dir_ / "rep"))
+      if (e.path().extension() == ".png" || e.path().extension() == ".svg") ++images;
+    EXPECT_GE(images, 5) << "overlay + difference per comparison, and overlay_all";
+  }
+
+  const JsonValue s = summary("rep");
+  EXPECT_TRUE(s.at("passed").asBool());
+  // speed: frames, seconds, frames per second of each engine
+  for (const std::string e : {"core", "simbody"}) {
+    const JsonValue& sp = s.at("speed").at(e);
+    EXPECT_TRUE(sp.at("ran").asBool()) << e;
+    EXPECT_EQ(sp.at("frames").asNumber(), 501) << e;
+    EXPECT_GT(sp.at("seconds").asNumber(), 0) << e;
+    EXPECT_GT(sp.at("frames_per_second").asNumber(), 0) << e;
+  }
+  // two comparisons; the reference's extra column is reported, not compared
+  const JsonValue& cmps = s.at("comparisons");
+  ASSERT_EQ(cmps.size(), 2u);
+  EXPECT_EQ(cmps.at(size_t{0}).at("name").asString(), "core_vs_simbody");
+  EXPECT_EQ(cmps.at(size_t{1}).at("name").asString(), "core_vs_reference");
+  EXPECT_EQ(cmps.at(size_t{1}).at("columns_compared").asNumber(), 2);
+  EXPECT_NE(cmps.at(size_t{1}).at("missing").dump().find("extra_moment"), std::string::npos);
+
+  // the engines' results agree with the closed form to 1e-7 of the peak (as `redmax id`)
+  const redmax::osim::Storage core = redmax::osim::readStorage((dir_ / "rep/core_id.sto").string());
+  const redmax::osim::Storage sb = redmax::osim::readStorage((dir_ / "rep/simbody_id.sto").string());
+  ASSERT_EQ(core.numRows(), 501);
+  ASSERT_EQ(sb.numRows(), 501);
+  double worst = 0, peak = 0;
+  for (int k = 0; k < core.numRows(); ++k) {
+    const Eigen::Vector2d ref = closedFormTau(core.time[k]);
+    worst = std::max(worst, (core.data.row(k).transpose() - ref).cwiseAbs().maxCoeff());
+    peak = std::max(peak, ref.cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-7 * peak);
+  EXPECT_LE((core.data - sb.data).cwiseAbs().maxCoeff(), 1e-9 * peak);
+}
+
+TEST_F(Validate, WrongReferenceFailsWithExitOne) {
+  if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to validation_tests (build target redmax)";
+  // q2 1% too large: RMS/peak ~ 1e-2 >> 1e-6
+  writeReference("wrong.sto", 1.01);
+  const CmdResult r = run("validate --model dp.osim --coordinates dp.mot --t0 0.5 --t1 1.5 --reference wrong.sto "
+                          "--no-plots --quiet --report rep");
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  const JsonValue s = summary("rep");
+  EXPECT_FALSE(s.at("passed").asBool());
+  const JsonValue& cmps = s.at("comparisons");
+  ASSERT_EQ(cmps.size(), 2u);
+  EXPECT_TRUE(cmps.at(size_t{0}).at("passed").asBool());   // the engines still agree
+  EXPECT_FALSE(cmps.at(size_t{1}).at("passed").asBool());  // the reference does not
+  EXPECT_EQ(cmps.at(size_t{1}).at("worst_column").dump().find("q1_moment"), std::string::npos);
+  EXPECT_NE(cmps.at(size_t{1}).at("worst_column").dump().find("q2_moment"), std::string::npos);
+
+  // printed: the worst column and FAIL; a loose tolerance makes the same reference pass
+  const CmdResult p = run("validate --model dp.osim --coordinates dp.mot --t0 0.5 --t1 1.5 --reference wrong.sto "
+                          "--no-plots --report rep2");
+  EXPECT_EQ(p.code, 1);
+  EXPECT_NE(p.out.find("worst q2_moment"), std::string::npos) << p.out;
+  EXPECT_NE(p.out.find("validate: FAIL"), std::string::npos) << p.out;
+  const CmdResult loose = run("validate --model dp.osim --coordinates dp.mot --t0 0.5 --t1 1.5 --reference wrong.sto "
+                              "--tolerance 0.05 --no-plots --quiet --report rep3");
+  EXPECT_EQ(loose.code, 0) << loose.err;
+}
+
+TEST_F(Validate, BadInputExitsTwoWithAnError) {
+  if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to validation_tests (build target redmax)";
+  writeReference("ref.sto", 1.0);
+  write("nocommon.sto", "x\nversion=1\nnRows=2\nnColumns=2\ninDegrees=no\nendheader\ntime\tfoo\n0\t1\n2\t1\n");
+  write("late.sto", "x\nversion=1\nnRows=2\nnColumns=2\ninDegrees=no\nendheader\ntime\tq1_moment\n5\t1\n6\t1\n");
+  const std::string in = "validate --model dp.osim --coordinates dp.mot --t0 0.5 --t1 1.5 --no-plots ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {in + "--reference ref.sto", "--report"},                                  // no report directory
+      {"validate --model dp.osim --report rep", "needs --setup"},                // no coordinates
+      {in + "--reference missing.sto --report rep", "missing.sto"},              // unreadable reference
+      {in + "--reference nocommon.sto --report rep", "nocommon.sto"},            // no common column
+      {in + "--reference late.sto --report rep", "late.sto"},                    // no overlapping time
+      {in + "--reference ref.sto --tolerance -1 --report rep", "--tolerance"},   // negative tolerance
+      {in + "--reference ref.sto --tolerance abc --report rep", "--tolerance"},  // not a number
+      {in + "--interpolation quadratic --report rep", "--interpolation"},
+      {in + "--bogus --report rep", "unknown option --bogus"},
+      {"validate --model nomodel.osim --coordinates dp.mot --report rep", "nomodel.osim"},
+      {"validate --model dp.osim --coordinates dp.mot --t0 2 --t1 1 --report rep", "--t0"},
+  };
+  for (const auto& [args, what] : cases) {
+    const CmdResult r = run(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.out << r.err;
+    EXPECT_NE(r.err.find("error: "), std::string::npos) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(what), std::string::npos) << args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "rep" / "summary.json")) << args;
+  }
+}
+
+TEST_F(Validate, CoreOnlyIsRecordedAndStillPasses) {
+  redmax::validation::IdValidationOptions opt;
+  opt.settings.model_file = (dir_ / "dp.osim").string();
+  opt.settings.coordinates_file = (dir_ / "dp.mot").string();
+  opt.settings.t0 = 0.5;
+  opt.settings.t1 = 1.0;
+  writeReference("ref.sto", 1.0);
+  opt.references = {{(dir_ / "ref.sto").string(), "closed_form"}};
+  opt.report_dir = (dir_ / "core_only").string();
+  opt.run_simbody = false;
+  opt.gnuplot = "none";
+  const auto r = redmax::validation::runIdValidation(opt);
+  EXPECT_TRUE(r.passed);
+  ASSERT_EQ(r.engines.size(), 2u);
+  EXPECT_TRUE(r.engines[0].ran);
+  EXPECT_EQ(r.engines[0].frames, 251);
+  EXPECT_FALSE(r.engines[1].ran);
+  EXPECT_FALSE(r.engines[1].skipped.empty());
+  ASSERT_EQ(r.comparisons.size(), 1u);
+  EXPECT_EQ(r.comparisons[0].name, "core_vs_closed_form");
+  EXPECT_TRUE(r.files.plots_skipped);
+  const JsonValue s = summary("core_only");
+  EXPECT_TRUE(s.at("passed").asBool());
+  EXPECT_FALSE(s.at("speed").at("simbody").at("ran").asBool());
+  EXPECT_NE(s.at("engines").at("simbody").asString().find("disabled"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "core_only" / "simbody_id.sto"));
+  // the printed summary names the skipped engine
+  EXPECT_NE(redmax::validation::formatIdValidationSummary(r).find("engine simbody: skipped"), std::string::npos);
+}
+
+// set F (gait10dof18musc, ../shared/opensim/README.md) through its setup file, the 2017 model
+// given by flag, against OpenSim 4.6's own ID result
+TEST_F(Validate, SetFPassesAgainstOpenSim46) {
+  const std::string base = std::string(REDMAX_SHARED_DIR) + "/opensim/";
+  const std::string setup = base + "opensim-models/Pipelines/Gait10dof18musc/OutputReference/ID/walk_Setup_ID.xml";
+  const std::string model = base + "opensim-models@a26e12c/Pipelines/Gait10dof18musc/OutputReference/subject01.osim";
+  const std::string ref = base + "opensim-4.6-results/F.sto";
+  for (const auto& f : {setup, model, ref})
+    if (!fs::exists(f)) GTEST_SKIP() << "shared OpenSim data not found: " << f << " (needs ../shared/opensim)";
+  redmax::validation::IdValidationOptions opt;
+  opt.settings.setup_file = setup;
+  opt.settings.model_file = model;
+  opt.references = {{ref, "opensim46"}};
+  opt.report_dir = (dir_ / "setF").string();
+  opt.gnuplot = "none";
+  const auto r = redmax::validation::runIdValidation(opt);
+  ASSERT_EQ(r.comparisons.size(), 2u) << (r.engines.size() > 1 ? r.engines[1].skipped : "");
+  EXPECT_TRUE(r.comparisons[0].passed) << "core vs simbody";
+  EXPECT_TRUE(r.comparisons[1].passed) << "core vs OpenSim 4.6";
+  EXPECT_TRUE(r.passed);
+  EXPECT_EQ(r.comparisons[1].metrics.size(), 10u);
+  EXPECT_EQ(r.engines[0].frames, 151);
+  const auto& worst = r.comparisons[1].metrics[static_cast<size_t>(r.comparisons[1].worst)];
+  EXPECT_LT(worst.rms_rel, 1e-6);
+  std::printf("[ measured ] set F: core vs simbody worst max/peak %.3g; core vs OpenSim 4.6 worst %s rms/peak %.3g\n",
+              r.comparisons[0].metrics[static_cast<size_t>(r.comparisons[0].worst)].max_rel, worst.name.c_str(),
+              worst.rms_rel);
+  std::printf("[ measured ] set F speed: core %.0f frames/s, simbody %.0f frames/s\n", r.engines[0].framesPerSecond(),
+              r.engines[1].framesPerSecond());
+}
+
+}  // namespace
