@@ -325,4 +325,33 @@ TEST_F(Validate, SetFPassesAgainstOpenSim46) {
               r.engines[1].framesPerSecond());
 }
 
+// set E (gait2392): the Simbody engine cannot build this model (a body whose inertia breaks the
+// triangle inequality); the reason is recorded and the core alone is validated against OpenSim 4.6
+TEST_F(Validate, SetESimbodyRejectionIsRecordedAndCoreStillPasses) {
+  const std::string base = std::string(REDMAX_SHARED_DIR) + "/opensim/";
+  const std::string setup = base + "opensim-models/Pipelines/Gait2392_Simbody/subject01_Setup_InverseDynamics.xml";
+  const std::string model =
+      base + "opensim-models@a26e12c/Pipelines/Gait2392_Simbody/OutputReference/subject01_simbody.osim";
+  const std::string ref = base + "opensim-4.6-results/E.sto";
+  for (const auto& f : {setup, model, ref})
+    if (!fs::exists(f)) GTEST_SKIP() << "shared OpenSim data not found: " << f << " (needs ../shared/opensim)";
+  redmax::validation::IdValidationOptions opt;
+  opt.settings.setup_file = setup;
+  opt.settings.model_file = model;
+  opt.references = {{ref, "opensim46"}};
+  opt.report_dir = (dir_ / "setE").string();
+  opt.gnuplot = "none";
+  const auto r = redmax::validation::runIdValidation(opt);
+  ASSERT_EQ(r.engines.size(), 2u);
+  if (r.engines[1].ran) GTEST_SKIP() << "the Simbody engine now builds set E: this case no longer applies";
+  EXPECT_NE(r.engines[1].skipped.find("cannot build"), std::string::npos) << r.engines[1].skipped;
+  ASSERT_EQ(r.comparisons.size(), 1u);
+  EXPECT_TRUE(r.comparisons[0].passed);
+  EXPECT_TRUE(r.passed);
+  const JsonValue s = summary("setE");
+  EXPECT_TRUE(s.at("passed").asBool());
+  EXPECT_NE(s.at("engines").at("simbody").asString().find("cannot build"), std::string::npos);
+  EXPECT_NE(slurp(dir_ / "setE" / "report.md").find("cannot build"), std::string::npos);
+}
+
 }  // namespace
