@@ -24,7 +24,18 @@ void System::addConstraint(std::shared_ptr<const Constraint> c) {
   constraints_.push_back(std::move(c));
 }
 
+int System::addExtraCoordinates(int n) {
+  if (n < 0) throw ModelError("System::addExtraCoordinates: negative count");
+  if (map_) throw ModelError("System::addExtraCoordinates: not supported together with a coordinate map");
+  const int first = ndof_;
+  ndof_ += n;
+  n_extra_ += n;
+  return first;
+}
+
 void System::setCoordinateMap(std::shared_ptr<const CoordinateMap> map) {
+  if (map && n_extra_ > 0)
+    throw ModelError("System::setCoordinateMap: not supported together with extra coordinates");
   if (map && map->nr() != model_.nr())
     throw ModelError("System::setCoordinateMap: map built for " + std::to_string(map->nr()) +
                      " coordinates, model has " + std::to_string(model_.nr()));
@@ -35,6 +46,7 @@ void System::setCoordinateMap(std::shared_ptr<const CoordinateMap> map) {
 State System::defaultState() const {
   State s;
   s.q = map_ ? map_->reduce(model_.defaultQ()) : model_.defaultQ();
+  s.q.conservativeResizeLike(VecX::Zero(ndof()));  // extra coordinates start at zero
   s.qdot = VecX::Zero(ndof());
   return s;
 }
@@ -98,6 +110,11 @@ void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
     calcKinematics(model_, s, ws.sk);
     calcSkeletonMass(model_, ws.sk, ws.M);
     calcSkeletonForce(model_, s, ws.sk, ws.f);
+    if (n_extra_ > 0) {
+      // the skeleton fills the q_r block; terms own the extra coordinates' mass and force
+      ws.M.conservativeResizeLike(MatX::Zero(ndof_, ndof_));
+      ws.f.conservativeResizeLike(VecX::Zero(ndof_));
+    }
     for (const auto& t : terms_) {
       t->addMass(model_, s, ws.sk, ws.M);
       t->addForce(model_, s, ws.sk, ws.f);
@@ -145,6 +162,7 @@ void System::calcMassDotTimesVelocity(const State& s, DynamicsWorkspace& ws, Vec
   const State& s_sk = map_ ? ws.s_r : s;
   VecX Mdot_r;
   skeletonMassDotTimesVelocity(model_, s_sk, ws.sk, Mdot_r);
+  if (n_extra_ > 0) Mdot_r.conservativeResizeLike(VecX::Zero(ndof_));
   for (const auto& t : terms_) t->addMassDotTimesVelocity(model_, s_sk, ws.sk, Mdot_r);
   if (!map_) {
     Mdot_v = std::move(Mdot_r);
@@ -186,7 +204,8 @@ void System::calcConstraints(const State& s, DynamicsWorkspace& ws) const {
     int row = 0;
     for (const auto& c : constraints_) {
       const int m = c->rows();
-      c->calcAcceleration(model_, s, ws.sk, ws.G.middleRows(row, m), ws.rhs.segment(row, m));
+      // constraints act on q_r: the columns of extra coordinates stay zero
+      c->calcAcceleration(model_, s, ws.sk, ws.G.block(row, 0, m, model_.nr()), ws.rhs.segment(row, m));
       c->calcErrors(model_, s, ws.sk, ws.pos_err.segment(row, m), ws.vel_err.segment(row, m));
       row += m;
     }

@@ -61,6 +61,12 @@ class System {
   const Model& model() const { return model_; }
   /// number of system coordinates: nr, or the map's nR with hyper-reduced coordinates
   int ndof() const { return ndof_; }
+  /// Append n coordinates that the skeleton does not own (e.g. free nodes of a deformable body
+  /// [D Sec. 4.6.3]): they follow q_r in the state, start at zero, and only ForceTerms give them
+  /// mass and force (the skeleton's blocks of M and f are zero there; constraints act on q_r).
+  /// Returns the index of the first one. Not combinable with a coordinate map.
+  int addExtraCoordinates(int n);
+  int numExtraCoordinates() const { return n_extra_; }
   int numConstraintRows() const { return nc_; }
 
   void addTerm(std::shared_ptr<const ForceTerm> term) { terms_.push_back(std::move(term)); }
@@ -135,6 +141,7 @@ class System {
   int nc_ = 0;
   std::shared_ptr<const CoordinateMap> map_;
   int ndof_ = 0;
+  int n_extra_ = 0;  // coordinates after q_r that only ForceTerms see
   /// with a map: ws.s_r, ws.J_rR, ws.Jdot_rR from a system state
   void expandInto(const State& s, DynamicsWorkspace& ws) const;
 };
