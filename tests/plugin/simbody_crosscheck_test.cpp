@@ -298,7 +298,9 @@ TEST(CrosscheckCoverage, TreesUseEveryMobilizer) {
       const Model m = scenes::randomTree(c.n, c.seed, scenes::TreeJoints::SimbodyComparable);
       SimbodyBuildOptions opt;
       opt.spherical = mode;
-      for (const auto& mm : simbody::makeSimbodyModel(m, opt)->map) seen.insert(mm.kind);
+      // keep the model alive for the loop: a temporary in the range expression dies before it
+      const auto sb = simbody::makeSimbodyModel(m, opt);
+      for (const auto& mm : sb->map) seen.insert(mm.kind);
     }
   }
   using K = simbody::MobilizerKind;
