@@ -62,16 +62,14 @@ void MuscleTerm::addForce(const Model& model, const State& s, const SkeletonWork
   for (size_t m = 0; m < massive_.size(); ++m) {
     const MassPoints& mp = massive_[m].mass_points;
     const MuscleKinematics& mk = ws_.muscles[m];
-    const int k = static_cast<int>(mk.cols.size());
-    qdot_c_.resize(k);
-    for (int j = 0; j < k; ++j) qdot_c_[j] = s.qdot[mk.cols[j]];
-    fc_.setZero(k);
+    gatherColumns(s.qdot, mk, qdot_c_);
+    fc_.setZero(qdot_c_.size());
     for (int a = 0; a < mp.size(); ++a) {
       Vec3 fa = mp.mass[a] * model.gravity;
       if (options_.quadratic_velocity) fa.noalias() -= mp.mass[a] * (mk.Jdot_ar.middleRows<3>(3 * a) * qdot_c_);
       fc_.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * fa;
     }
-    for (int j = 0; j < k; ++j) f[mk.cols[j]] += fc_[j];
+    scatterAddColumns(fc_, mk, f);
   }
 }
 
@@ -84,10 +82,8 @@ void MuscleTerm::addMassDotTimesVelocity(const Model& model, const State& s, con
   for (size_t m = 0; m < massive_.size(); ++m) {
     const MassPoints& mp = massive_[m].mass_points;
     const MuscleKinematics& mk = ws_.muscles[m];
-    const int k = static_cast<int>(mk.cols.size());
-    qdot_c_.resize(k);
-    for (int j = 0; j < k; ++j) qdot_c_[j] = s.qdot[mk.cols[j]];
-    fc_.setZero(k);
+    gatherColumns(s.qdot, mk, qdot_c_);
+    fc_.setZero(qdot_c_.size());
     for (int a = 0; a < mp.size(); ++a) {
       const auto J = mk.J_ar.middleRows<3>(3 * a);
       const auto Jd = mk.Jdot_ar.middleRows<3>(3 * a);
@@ -96,7 +92,7 @@ void MuscleTerm::addMassDotTimesVelocity(const Model& model, const State& s, con
       fc_.noalias() += Jd.transpose() * m_xdot;
       fc_.noalias() += J.transpose() * m_Jdv;
     }
-    for (int j = 0; j < k; ++j) Mdot_v[mk.cols[j]] += fc_[j];
+    scatterAddColumns(fc_, mk, Mdot_v);
   }
 }
 

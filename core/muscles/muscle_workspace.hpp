@@ -72,6 +72,10 @@ void initMuscleKinematics(const Model& model, const MusclePath& path, MuscleKine
 MatX expandColumns(const MatX& J, const MuscleKinematics& mk, int nr);
 /// v restricted to mk.cols (k), e.g. qdot for J_ar * qdot
 VecX gatherColumns(const VecX& v, const MuscleKinematics& mk);
+/// the same into a caller-owned buffer (no allocation once it has the size)
+void gatherColumns(const VecX& v, const MuscleKinematics& mk, VecX& out);
+/// full[cols[j]] += compact[j]: a compact generalized force back into all coordinates
+void scatterAddColumns(const VecX& compact, const MuscleKinematics& mk, VecX& full);
 
 /// One MuscleKinematics per muscle, in the order of the muscle list it was built for.
 struct MuscleWorkspace {

@@ -58,9 +58,18 @@ MatX expandColumns(const MatX& J, const MuscleKinematics& mk, int nr) {
 }
 
 VecX gatherColumns(const VecX& v, const MuscleKinematics& mk) {
-  VecX g(mk.cols.size());
-  for (int j = 0; j < static_cast<int>(mk.cols.size()); ++j) g[j] = v[mk.cols[j]];
+  VecX g;
+  gatherColumns(v, mk, g);
   return g;
+}
+
+void gatherColumns(const VecX& v, const MuscleKinematics& mk, VecX& out) {
+  out.resize(static_cast<int>(mk.cols.size()));
+  for (int j = 0; j < out.size(); ++j) out[j] = v[mk.cols[j]];
+}
+
+void scatterAddColumns(const VecX& compact, const MuscleKinematics& mk, VecX& full) {
+  for (int j = 0; j < compact.size(); ++j) full[mk.cols[j]] += compact[j];
 }
 
 namespace {
