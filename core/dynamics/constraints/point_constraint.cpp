@@ -86,16 +86,30 @@ HingePointConstraint::HingePointConstraint(const Model& model, int body_a, const
   U_.col(1) = v2;
 }
 
-void HingePointConstraint::calcAcceleration(const Model& model, const State& s, const SkeletonWorkspace& ws,
-                                            Eigen::Ref<MatX> G, Eigen::Ref<VecX> rhs) const {
-  detail::checkModelSize(model, nb_, nr_, name_);
+struct HingePointConstraint::Geometry {
   PointKinematics a, b;
   RotationKinematics k;
-  calcPointKinematics(model, ws, s.qdot, body_a_, x_a_, a);
-  calcPointKinematics(model, ws, s.qdot, body_b_, x_b_, b);
-  calcRotationKinematics(model, ws, s.qdot, axis_body_, k);
-  const Vec3 d = a.p - b.p;
-  const Vec3 ddot = a.v - b.v;
+  Vec3 d, ddot;
+};
+
+HingePointConstraint::Geometry HingePointConstraint::calcGeometry(const Model& model, const State& s,
+                                                                  const SkeletonWorkspace& ws) const {
+  detail::checkModelSize(model, nb_, nr_, name_);
+  Geometry g;
+  calcPointKinematics(model, ws, s.qdot, body_a_, x_a_, g.a);
+  calcPointKinematics(model, ws, s.qdot, body_b_, x_b_, g.b);
+  calcRotationKinematics(model, ws, s.qdot, axis_body_, g.k);
+  g.d = g.a.p - g.b.p;
+  g.ddot = g.a.v - g.b.v;
+  return g;
+}
+
+void HingePointConstraint::calcAcceleration(const Model& model, const State& s, const SkeletonWorkspace& ws,
+                                            Eigen::Ref<MatX> G, Eigen::Ref<VecX> rhs) const {
+  const Geometry g = calcGeometry(model, s, ws);
+  const PointKinematics &a = g.a, &b = g.b;
+  const RotationKinematics& k = g.k;
+  const Vec3 &d = g.d, &ddot = g.ddot;
   for (int j = 0; j < 2; ++j) {
     // C_j = v_j . d with v_j = R_k u_j; vdot_j = omega x v_j. The terms in d vanish on the
     // constraint manifold (and entirely for a world axis, the dissertation's case [D Eq. 4.98,
@@ -112,14 +126,10 @@ void HingePointConstraint::calcAcceleration(const Model& model, const State& s, 
 
 void HingePointConstraint::calcErrors(const Model& model, const State& s, const SkeletonWorkspace& ws,
                                       Eigen::Ref<VecX> pos_err, Eigen::Ref<VecX> vel_err) const {
-  detail::checkModelSize(model, nb_, nr_, name_);
-  PointKinematics a, b;
-  RotationKinematics k;
-  calcPointKinematics(model, ws, s.qdot, body_a_, x_a_, a);
-  calcPointKinematics(model, ws, s.qdot, body_b_, x_b_, b);
-  calcRotationKinematics(model, ws, s.qdot, axis_body_, k);
-  const Vec3 d = a.p - b.p;
-  const Vec3 ddot = a.v - b.v;
+  const Geometry g = calcGeometry(model, s, ws);
+  const PointKinematics &a = g.a, &b = g.b;
+  const RotationKinematics& k = g.k;
+  const Vec3 &d = g.d, &ddot = g.ddot;
   for (int j = 0; j < 2; ++j) {
     const Vec3 v = k.R * U_.col(j);
     pos_err[j] = v.dot(d);

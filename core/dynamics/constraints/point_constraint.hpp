@@ -55,6 +55,8 @@ class HingePointConstraint final : public Constraint {
   const Eigen::Matrix<double, 3, 2>& directions() const { return U_; }
 
  private:
+  struct Geometry;  // both points, the axis frame, their separation d and its rate
+  Geometry calcGeometry(const Model& model, const State& s, const SkeletonWorkspace& ws) const;
   std::string name_;
   int body_a_, body_b_, axis_body_;
   Vec3 x_a_, x_b_;
