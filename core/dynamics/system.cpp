@@ -108,12 +108,19 @@ int System::reparameterize(State& s) const {
 void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
   if (!map_) {
     calcKinematics(model_, s, ws.sk);
-    calcSkeletonMass(model_, ws.sk, ws.M);
-    calcSkeletonForce(model_, s, ws.sk, ws.f);
-    if (n_extra_ > 0) {
-      // the skeleton fills the q_r block; terms own the extra coordinates' mass and force
-      ws.M.conservativeResizeLike(MatX::Zero(ndof_, ndof_));
-      ws.f.conservativeResizeLike(VecX::Zero(ndof_));
+    if (n_extra_ == 0) {
+      calcSkeletonMass(model_, ws.sk, ws.M);
+      calcSkeletonForce(model_, s, ws.sk, ws.f);
+    } else {
+      // the skeleton fills the q_r block; terms own the extra coordinates' mass and force.
+      // Assembled through the q_r scratch so M and f keep their size (no reallocation per call).
+      const int nr = model_.nr();
+      calcSkeletonMass(model_, ws.sk, ws.M_r);
+      calcSkeletonForce(model_, s, ws.sk, ws.f_r);
+      ws.M.setZero(ndof_, ndof_);
+      ws.f.setZero(ndof_);
+      ws.M.topLeftCorner(nr, nr) = ws.M_r;
+      ws.f.head(nr) = ws.f_r;
     }
     for (const auto& t : terms_) {
       t->addMass(model_, s, ws.sk, ws.M);
