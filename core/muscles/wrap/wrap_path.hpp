@@ -1,0 +1,49 @@
+#pragma once
+// A whole musculotendon path with wrap objects, as OpenSim's GeometryPath computes it
+// (computePath + applyWrapObjects + calcLengthAfterPathComputation; OPENSIM_SEMANTICS.md 6):
+//   1. the active path points, in order;
+//   2. each PathWrap in order: its previous tangent points are removed; every segment of the
+//      current path between the first active point at/after range_begin and the last active point
+//      at/before range_end is tried (except a segment joining the two tangent points of one
+//      surface); the first MandatoryWrap wins at once, otherwise the Wrapped segment whose
+//      |P1 r1| + l + |r2 P2| - |P1 P2| is smallest; the two tangent points are inserted before the
+//      segment's end point;
+//   3. with two or more wrap objects, up to 8 passes until the length changes by < 0.5 mm; after
+//      pass 1, if object 0 gave NoWrap and object 1 InsideRadius, their order is swapped;
+//   4. length = sum of straight segments, except between the two tangent points of one surface,
+//      where the surface length l is added (OpenSim's sphere quirk included: l may be negative).
+// Points are taken to the surface frame through the world: x_s = E_bs^-1 E_wb^-1 E_wc x_c.
+#include <vector>
+
+#include "core/muscles/path.hpp"
+#include "core/muscles/wrap/wrap_surface.hpp"
+
+namespace redmax {
+
+/// One point of the wrapped path.
+struct WrappedPathPoint {
+  int point = -1;            ///< index into MusclePath::points, or -1 for a tangent point
+  int wrap = -1;             ///< tangent point: index into MusclePath::wraps
+  int which = 0;             ///< tangent point: 1 (r1) or 2 (r2)
+  Vec3 x_w = Vec3::Zero();   ///< position in the world
+};
+
+/// The wrapped path at one configuration.
+struct WrappedPath {
+  std::vector<WrappedPathPoint> points;  ///< origin ... insertion, tangent points inserted
+  std::vector<WrapResult> results;       ///< per wrap object (frame s); NoWrap when unused
+  std::vector<bool> used;                ///< per wrap object: its tangent points are in `points`
+  double length = 0.0;                   ///< total path length (m), OpenSim's definition
+};
+
+/// The wrapped path at configuration q with body poses E_wi (calcBodyPoses). A path without
+/// wraps gives the polyline through the active points.
+WrappedPath calcWrappedPath(const Model& model, const MusclePath& path, const VecX& q,
+                            const std::vector<Mat4>& E_wi);
+
+/// The world position of the point at fraction alpha in [0, 1] of the wrapped path's geometric
+/// length (straight segments and surface arcs; a sphere's negative length counts as its arc).
+Vec3 calcWrappedPathPointWorld(const MusclePath& path, const WrappedPath& wp,
+                               const std::vector<Mat4>& E_wi, double alpha);
+
+}  // namespace redmax
