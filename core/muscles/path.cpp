@@ -49,7 +49,7 @@ bool isPathPointActive(const PathPoint& p, const VecX& q) {
 }
 
 PathType pathType(const MusclePath& path) {
-  if (path.num_wraps > 0) return PathType::III;
+  if (path.num_wraps > 0 || !path.wraps.empty()) return PathType::III;
   if (path.points.size() == 2 && path.points[0].kind == PathPointKind::Fixed &&
       path.points[1].kind == PathPointKind::Fixed)
     return PathType::I;
@@ -71,6 +71,21 @@ void validatePath(const Model& model, const MusclePath& path, const std::string&
   if (np < 2)
     throw ModelError(who + "a path needs at least two points (origin and insertion), got " + std::to_string(np));
   if (path.num_wraps < 0) throw ModelError(who + "negative number of wrap objects");
+  for (const PathWrap& w : path.wraps) {
+    const std::string where = who + "wrap object '" + w.name + "': ";
+    if (w.body < -1 || w.body >= model.nb())
+      throw ModelError(where + "body index " + std::to_string(w.body) + " is not a body of model '" +
+                       model.name + "' (" + std::to_string(model.nb()) + " bodies; -1 = world)");
+    if (!w.E_bs.allFinite()) throw ModelError(where + "non-finite pose");
+    const WrapSurface& s = w.surface;
+    const bool ok = s.type == WrapType::Cylinder    ? (s.radius > 0.0 && s.length >= 0.0)
+                    : s.type == WrapType::Sphere    ? s.radius > 0.0
+                    : s.type == WrapType::Ellipsoid ? (s.dimensions.array() > 0.0).all()
+                                                    : (s.inner_radius > 0.0 && s.outer_radius > 0.0);
+    if (!ok) throw ModelError(where + "surface dimensions must be positive");
+    if (s.quadrant_sign != 0 && (s.quadrant_axis < 0 || s.quadrant_axis > 2))
+      throw ModelError(where + "quadrant axis must be 0, 1 or 2");
+  }
   for (int k = 0; k < np; ++k) {
     const PathPoint& p = path.points[k];
     const std::string where = who + pointLabel(path, k) + ": ";

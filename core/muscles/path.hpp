@@ -12,7 +12,9 @@
 //                body frame; a component without a function keeps `location`'s value. Its velocity
 //                gains a term through q_k, so J_xr gets a column that does not go through J_mr.
 // Path types (DESIGN.md): I = two fixed points, III = any wrap object, II = everything else.
-// Wrap objects are not modelled here; `num_wraps` only marks Type III paths, which stay lumped.
+// Wrap objects: `wraps` lists the path's PathWraps (surface, body, pose, range) in OpenSim's
+// order; core/muscles/wrap/wrap_path.hpp computes the wrapped path. `num_wraps` marks Type III
+// paths (it equals wraps.size() when the converter fills both; a path may carry only the count).
 //
 // Conditional switching: when a conditional point becomes active or inactive the set of path
 // points changes, so the polyline changes. The mass points keep their material coordinate (arc
@@ -32,6 +34,7 @@
 #include <vector>
 
 #include "core/joints/functions.hpp"
+#include "core/muscles/wrap/wrap_surface.hpp"
 #include "core/skeleton/model.hpp"
 
 namespace redmax {
@@ -78,10 +81,24 @@ inline constexpr double kConditionalTolerance = 1e-5;
 /// true if the point is in the path at configuration q (Fixed and Moving: always)
 bool isPathPointActive(const PathPoint& p, const VecX& q);
 
-/// Ordered path points (origin first, insertion last) plus a marker for wrap objects.
+/// One wrap object on a path (OpenSim PathWrap + the WrapObject it names). The surface frame s
+/// has pose E_bs in body `body` (-1 = world): x_b = E_bs * x_s.
+struct PathWrap {
+  std::string name;                   // the WrapObject's name
+  WrapSurface surface;
+  int body = -1;
+  Mat4 E_bs = Mat4::Identity();
+  WrapMethod method = WrapMethod::Hybrid;
+  // OpenSim's 1-based range into `points` (all points, active or not); < 1 = first / last point
+  int range_begin = -1;
+  int range_end = -1;
+};
+
+/// Ordered path points (origin first, insertion last) plus the wrap objects.
 struct MusclePath {
   std::vector<PathPoint> points;
   int num_wraps = 0;                  // wrap objects on the path (Type III when > 0)
+  std::vector<PathWrap> wraps;        // the wrap objects themselves, in PathWrapSet order
 };
 
 enum class PathType { I, II, III };

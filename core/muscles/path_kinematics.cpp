@@ -1,4 +1,5 @@
 #include "core/muscles/path_kinematics.hpp"
+#include "core/muscles/wrap/wrap_path.hpp"
 
 #include <algorithm>
 
@@ -203,6 +204,12 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
     if (c >= 0) Jd.col(cc) += R * (omega.cross(dx_b) + ddx_b * qdot_c);
   }
 
+  calcPathSegments(mk, velocity);
+  mk.velocity = velocity;
+}
+
+void calcPathSegments(MuscleKinematics& mk, bool velocity) {
+  const int P = static_cast<int>(mk.x_w.size());
   // segments [D Eq. 5.17-5.19, 5.27]
   const int ns = std::max(P - 1, 0);
   mk.l.resize(ns);
@@ -220,12 +227,12 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
       mk.lengthening_speed += mk.ldot[i];
     }
   }
-  mk.velocity = velocity;
 }
 
 double calcPathLength(const Model& model, const MusclePath& path, const VecX& q,
                       const std::vector<Mat4>& E_wi) {
-  (void)model;
+  // Type III: OpenSim's wrapped path (core/muscles/wrap/wrap_path.hpp)
+  if (!path.wraps.empty()) return calcWrappedPath(model, path, q, E_wi).length;
   double length = 0.0;
   Vec3 prev = Vec3::Zero();
   bool first = true;

@@ -22,9 +22,15 @@ namespace redmax {
 void calcPathPoints(const Model& model, const State& state, const SkeletonWorkspace& sk,
                     const MusclePath& path, MuscleKinematics& mk, bool velocity = true);
 
+/// Segment stage of calcPathPoints from mk.x_w (and mk.xdot_w with `velocity`) alone: l, dxbar,
+/// length (and ldot, lengthening_speed) [D Eq. 5.17-5.19, 5.27]. Used by core/muscles/path_map.hpp,
+/// which fills the points from another source.
+void calcPathSegments(MuscleKinematics& mk, bool velocity);
+
 /// Path length (m) at configuration q from body poses only (no Jacobians), e.g. for length
-/// reports: polyline through the active points; wrap objects are ignored (Type III paths need the
-/// wrap code). E_wi from calcBodyPoses(model, q, E_wi).
+/// reports: polyline through the active points; with wrap objects in `path.wraps`, OpenSim's
+/// wrapped length (calcWrappedPath in core/muscles/wrap/wrap_path.hpp); a path that only counts
+/// its wraps (num_wraps > 0, wraps empty) gets the polyline. E_wi from calcBodyPoses(model, q, E_wi).
 double calcPathLength(const Model& model, const MusclePath& path, const VecX& q,
                       const std::vector<Mat4>& E_wi);
 
