@@ -9,14 +9,18 @@ void calcMuscleKinematics(const Model& model, const State& state, const Skeleton
   if (mp.size() == 0) return;
   if (pathType(muscle.path) == PathType::III)
     throw std::logic_error("muscle '" + muscle.name + "': Type III paths cannot carry mass points yet");
+  calcMassPointStage(mp, mk, muscle.name);
+}
+
+void calcMassPointStage(const MassPoints& mp, MuscleKinematics& mk, const std::string& muscle_name) {
   // two active points: Type I [D Sec. 5.3.1]; more: EOL [D Sec. 5.3.2]
   if (mk.x_w.size() == 2) {
     if (!(mk.length > 0.0))
-      throw MuscleError("muscle '" + muscle.name + "': origin and insertion coincide here; mass points need a path of positive length");
+      throw MuscleError("muscle '" + muscle_name + "': origin and insertion coincide here; mass points need a path of positive length");
     calcStraightMassPoints(mp, mk);
     return;
   }
-  calcEulerianCoordinates(mk, muscle.name);
+  calcEulerianCoordinates(mk, muscle_name);
   calcViaPointMassPoints(mp, mk);
 }
 

@@ -16,6 +16,11 @@ namespace redmax {
 void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
                           const Muscle& muscle, MuscleKinematics& mk, bool velocity = true);
 
+/// The mass-point stage alone, after the path stage (mk.x_w, J_xr, segments; velocity fields with
+/// mk.velocity): Type I formulas for two active points, else Eulerian coordinates and the EOL
+/// construction. Throws MuscleError (naming `muscle_name`) for a degenerate path.
+void calcMassPointStage(const MassPoints& mp, MuscleKinematics& mk, const std::string& muscle_name = "");
+
 /// Every muscle of `muscles` into ws.muscles (built as MuscleWorkspace(model, muscles)).
 void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
                           const std::vector<Muscle>& muscles, MuscleWorkspace& ws, bool velocity = true);
