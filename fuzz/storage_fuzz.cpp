@@ -1,0 +1,30 @@
+// Fuzz target for the .sto/.mot reader (converter/storage.hpp). The file extension changes how
+// degrees are decided, so the input's length picks it (even: .sto, odd: .mot). A successful read
+// is also written back and read again: the writer's output must be readable.
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+
+#include "converter/storage.hpp"
+#include "fuzz/fuzz_common.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string path =
+      redmax::fuzz::writeInput(size % 2 ? "input.mot" : "input.sto", data, size);
+  redmax::osim::Storage s;
+  try {
+    s = redmax::osim::readStorage(path);
+  } catch (const std::exception& e) {
+    redmax::fuzz::acceptError(e);
+    return 0;
+  }
+  try {
+    const std::string text = redmax::osim::formatStorage(s);
+    const std::string again = redmax::fuzz::writeInput(
+        "again.sto", reinterpret_cast<const std::uint8_t*>(text.data()), text.size());
+    (void)redmax::osim::readStorage(again);
+  } catch (const std::exception& e) {
+    redmax::fuzz::acceptError(e);
+  }
+  return 0;
+}
