@@ -1,0 +1,356 @@
+#include "core/muscles/wrap/smooth.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+namespace redmax {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// dual numbers: x = a + b eps with eps^2 = 0; nesting Dual<Dual<double>> gives a second
+// (mixed) directional derivative in b.b
+
+template <class T>
+struct Dual {
+  T a{}, b{};
+  Dual() = default;
+  Dual(double v) : a(v), b(0.0) {}  // a constant
+  Dual(const T& a_, const T& b_) : a(a_), b(b_) {}
+};
+
+inline double value(double x) { return x; }
+template <class T>
+double value(const Dual<T>& x) { return value(x.a); }
+
+template <class T> Dual<T> operator+(const Dual<T>& x, const Dual<T>& y) { return {x.a + y.a, x.b + y.b}; }
+template <class T> Dual<T> operator-(const Dual<T>& x, const Dual<T>& y) { return {x.a - y.a, x.b - y.b}; }
+template <class T> Dual<T> operator-(const Dual<T>& x) { return {-x.a, -x.b}; }
+template <class T> Dual<T> operator*(const Dual<T>& x, const Dual<T>& y) { return {x.a * y.a, x.a * y.b + x.b * y.a}; }
+template <class T> Dual<T> operator/(const Dual<T>& x, const Dual<T>& y) {
+  const T inv = 1.0 / y.a;
+  const T q = x.a * inv;
+  return {q, (x.b - q * y.b) * inv};
+}
+template <class T> Dual<T> operator+(const Dual<T>& x, double y) { return {x.a + y, x.b}; }
+template <class T> Dual<T> operator+(double y, const Dual<T>& x) { return {x.a + y, x.b}; }
+template <class T> Dual<T> operator-(const Dual<T>& x, double y) { return {x.a - y, x.b}; }
+template <class T> Dual<T> operator-(double y, const Dual<T>& x) { return {y - x.a, -x.b}; }
+template <class T> Dual<T> operator*(const Dual<T>& x, double y) { return {x.a * y, x.b * y}; }
+template <class T> Dual<T> operator*(double y, const Dual<T>& x) { return {x.a * y, x.b * y}; }
+template <class T> Dual<T> operator/(const Dual<T>& x, double y) { return {x.a / y, x.b / y}; }
+template <class T> Dual<T> operator/(double y, const Dual<T>& x) { return Dual<T>{T(y), T(0.0)} / x; }
+
+// elementary functions for double and, recursively, for duals
+inline double dsqrt(double x) { return std::sqrt(x); }
+inline double dsin(double x) { return std::sin(x); }
+inline double dcos(double x) { return std::cos(x); }
+inline double dacos(double x) { return std::acos(x); }
+inline double dasin(double x) { return std::asin(x); }
+inline double datan2(double y, double x) { return std::atan2(y, x); }
+template <class T> Dual<T> dsqrt(const Dual<T>& x) {
+  const T s = dsqrt(x.a);
+  return {s, x.b / (2.0 * s)};
+}
+template <class T> Dual<T> dsin(const Dual<T>& x) { return {dsin(x.a), dcos(x.a) * x.b}; }
+template <class T> Dual<T> dcos(const Dual<T>& x) { return {dcos(x.a), -(dsin(x.a) * x.b)}; }
+template <class T> Dual<T> dacos(const Dual<T>& x) { return {dacos(x.a), -(x.b / dsqrt(1.0 - x.a * x.a))}; }
+template <class T> Dual<T> dasin(const Dual<T>& x) { return {dasin(x.a), x.b / dsqrt(1.0 - x.a * x.a)}; }
+template <class T> Dual<T> datan2(const Dual<T>& y, const Dual<T>& x) {
+  return {datan2(y.a, x.a), (x.a * y.b - y.a * x.b) / (x.a * x.a + y.a * y.a)};
+}
+
+// 3-vectors of any scalar
+template <class T> using V3 = std::array<T, 3>;
+template <class T> V3<T> operator+(const V3<T>& u, const V3<T>& v) { return {u[0] + v[0], u[1] + v[1], u[2] + v[2]}; }
+template <class T> V3<T> operator-(const V3<T>& u, const V3<T>& v) { return {u[0] - v[0], u[1] - v[1], u[2] - v[2]}; }
+template <class T, class S> V3<T> operator*(const S& s, const V3<T>& v) { return {s * v[0], s * v[1], s * v[2]}; }
+template <class T> T dot(const V3<T>& u, const V3<T>& v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; }
+template <class T> V3<T> cross(const V3<T>& u, const V3<T>& v) {
+  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+}
+template <class T> T norm(const V3<T>& v) { return dsqrt(dot(v, v)); }
+template <class T> V3<T> normalize(const V3<T>& v) {
+  const T n = norm(v);
+  return (1.0 / n) * v;
+}
+template <class T> Vec3 values(const V3<T>& v) { return Vec3(value(v[0]), value(v[1]), value(v[2])); }
+template <class T> V3<T> constant(const Vec3& v) { return {T(v[0]), T(v[1]), T(v[2])}; }
+template <class T> V3<T> zAxis() { return {T(0.0), T(0.0), T(1.0)}; }
+
+// rotation of v by angle phi about the unit axis k (Rodrigues)
+template <class T> V3<T> rotate(const V3<T>& k, const T& phi, const V3<T>& v) {
+  const T c = dcos(phi), s = dsin(phi);
+  return c * v + s * cross(k, v) + (dot(k, v) * (1.0 - c)) * k;
+}
+
+// point at fraction alpha of p1 -> r1 -> arc -> r2 -> p2; the arc turns r1 about the unit axis k
+// through the origin by angle phi (with rise h along k): the library's calcWrappedPathPoint
+template <class T>
+V3<T> pathPoint(const V3<T>& p1, const V3<T>& p2, const V3<T>& r1, const V3<T>& r2, const V3<T>& k, const T& phi,
+                const T& h, double alpha) {
+  const T l1 = norm(r1 - p1);
+  const V3<T> r1_perp = r1 - dot(r1, k) * k;
+  const T rho_phi = norm(r1_perp) * phi;
+  const T la = dsqrt(rho_phi * rho_phi + h * h);
+  const T l2 = norm(p2 - r2);
+  const T total = l1 + la + l2;
+  T s = alpha * total;
+  if (value(s) <= value(l1)) return p1 + (s / l1) * (r1 - p1);
+  s = s - l1;
+  if (value(s) <= value(la)) {
+    const T f = s / la;
+    return rotate(k, f * phi, r1) + (f * h) * k;
+  }
+  s = s - la;
+  const T f = s / l2;
+  return value(f) < 1.0 ? r2 + f * (p2 - r2) : p2;
+}
+
+// ---------------------------------------------------------------------------------------------
+// penetration of the straight segment into the surface (see the header)
+
+template <class T>
+T penetration(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2) {
+  const V3<T> u = p2 - p1;
+  if (surf.type == WrapType::Cylinder) {
+    // distance between the segment's line and the axis, where they come closest (2D projection)
+    const T ux = u[0], uy = u[1];
+    const T uu = ux * ux + uy * uy;
+    if (!(value(uu) > 1e-300)) return T(-1.0);  // parallel to the axis: the library never wraps
+    const T t = -(p1[0] * ux + p1[1] * uy) / uu;
+    const T cx = p1[0] + t * ux, cy = p1[1] + t * uy;
+    const T d = surf.radius - dsqrt(cx * cx + cy * cy);
+    if (value(t) > 0.0 && value(t) < 1.0) return d;
+    return value(d) > 0.0 ? -d : d;
+  }
+  // sphere: distance from the centre to the line
+  const T t = -dot(p1, u) / dot(u, u);
+  const V3<T> c = p1 + t * u;
+  const T d = surf.radius - norm(c);
+  if (value(t) > 0.0 && value(t) < 1.0) return d;
+  return value(d) > 0.0 ? -d : d;
+}
+
+// ---------------------------------------------------------------------------------------------
+// the exact library's unconstrained cylinder, single wrap (wrap_cylinder.cpp), over any scalar.
+// Returns false when the library would not wrap for a reason other than penetration (both
+// tangent points beyond the cylinder's ends).
+
+template <class T>
+void cylinderCandidates(double R, const V3<T>& p, V3<T>& pa, V3<T>& a, V3<T>& b, T& rho) {
+  // tangent candidates in the plane through p normal to the axis
+  pa = {T(0.0), T(0.0), p[2]};
+  const V3<T> radial{p[0], p[1], T(0.0)};
+  rho = norm(radial);
+  const V3<T> vv = (1.0 / rho) * radial;
+  const T dist = R * (R / rho);
+  const V3<T> pp = pa + dist * vv;
+  const T dist2 = dsqrt(R * R - dist * dist);
+  const V3<T> uu = cross(zAxis<T>(), vv);
+  a = pp + dist2 * uu;
+  b = pp - dist2 * uu;
+}
+
+template <class T>
+bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double alpha, V3<T>& x) {
+  const double R = surf.radius;
+  V3<T> p11, p22, r1a, r1b, r2a, r2b, r1, r2;
+  T rho1, rho2;
+  cylinderCandidates(R, p1, p11, r1a, r1b, rho1);
+  cylinderCandidates(R, p2, p22, r2a, r2b, rho2);
+  {
+    // the candidate pair whose radial directions agree best (decided on values)
+    const Vec3 u1a = (values(r1a) - values(p11)).normalized(), u1b = (values(r1b) - values(p11)).normalized();
+    const Vec3 u2a = (values(r2a) - values(p22)).normalized(), u2b = (values(r2b) - values(p22)).normalized();
+    const double d1 = u1a.dot(u2a), d2 = u1a.dot(u2b), d3 = u1b.dot(u2a), d4 = u1b.dot(u2b);
+    if (d1 > d2 && d1 > d3 && d1 > d4) r1 = r1a, r2 = r2a;
+    else if (d2 > d3 && d2 > d4) r1 = r1a, r2 = r2b;
+    else if (d3 > d4) r1 = r1b, r2 = r2a;
+    else r1 = r1b, r2 = r2b;
+  }
+  // apex on the near side of the axis-normal plane through the muscle line's point at fraction
+  // rho1 / (rho1 + rho2)
+  const T t = rho1 / (rho1 + rho2);
+  const V3<T> mpt = p1 + t * (p2 - p1);
+  const V3<T> axispt{T(0.0), T(0.0), mpt[2]};
+  const V3<T> l1 = normalize(p1 - axispt), l2 = normalize(p2 - axispt);
+  const V3<T> n = normalize(cross(l1, l2));
+  const V3<T> apex1 = axispt + R * normalize(cross(zAxis<T>(), n));
+  const V3<T> apex2 = axispt + R * normalize(cross(n, zAxis<T>()));
+  const double dist1 = (values(mpt) - values(apex1)).squaredNorm(), dist2 = (values(mpt) - values(apex2)).squaredNorm();
+  const V3<T> apex = dist1 < dist2 ? apex1 : apex2;
+  // slide r1, r2 along the axis into the plane through p1, p2 and the apex (each only when that
+  // moves it toward the other end; the library's tests, decided on values)
+  const V3<T> pn = normalize(cross(normalize(p1 - apex), normalize(p2 - apex)));
+  const T dplane = -dot(p1, pn);
+  auto slide = [&](const V3<T>& r, V3<T>& out) {
+    const T dp = 20.0 * pn[2];
+    if (!(std::abs(value(dp)) >= 1e-5)) return false;
+    const T s = (-dplane - (dot(pn, r) - 10.0 * pn[2])) / dp;
+    if (value(s) < -1e-5 || value(s) > 1.0 + 1e-5) return false;
+    out = {r[0], r[1], r[2] - 10.0 + 20.0 * s};
+    return true;
+  };
+  // the library's closest point on the line through p11 with direction p22 (as OpenSim does)
+  auto closestOnP11Line = [&](const Vec3& pt) {
+    const Vec3 a = values(p11), dir = values(p22).normalized();
+    return Vec3(a + (pt - a).dot(dir) * dir);
+  };
+  V3<T> r1p, r2p;
+  const bool r1_inter = slide(r1, r1p), r2_inter = slide(r2, r2p);
+  const Vec3 p11v = values(p11), p22v = values(p22);
+  if (r1_inter && (closestOnP11Line(values(r1p)) - p22v).squaredNorm() < (p11v - p22v).squaredNorm()) r1 = r1p;
+  if (r2_inter && (closestOnP11Line(values(r2p)) - p11v).squaredNorm() < (p22v - p11v).squaredNorm()) r2 = r2p;
+  const double half = 0.5 * surf.length;
+  const double z1 = value(r1[2]), z2 = value(r2[2]);
+  if ((z1 < -half || z1 > half) && (z2 < -half || z2 > half)) return false;
+  // helix about the axis
+  const T theta = datan2(r1[0] * r2[1] - r1[1] * r2[0], r1[0] * r2[0] + r1[1] * r2[1]);
+  x = pathPoint(p1, p2, r1, r2, zAxis<T>(), theta, r2[2] - r1[2], alpha);
+  return true;
+}
+
+// the exact library's unconstrained sphere (wrap_sphere.cpp), over any scalar
+template <class T>
+void sphereTangents(double R, const V3<T>& p, const V3<T>& n, V3<T>& a, V3<T>& b) {
+  const V3<T> y = normalize((-1.0) * p);
+  const V3<T> z = cross(n, y);
+  const T pn = norm(p);
+  const T ang = dasin(R / pn);
+  const T c = dcos(ang), s = dsin(ang);
+  a = p + (pn * c) * (c * y - s * z);
+  b = p + (pn * c) * (c * y + s * z);
+}
+
+template <class T>
+bool spherePoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double alpha, V3<T>& x) {
+  const double R = surf.radius;
+  const V3<T> p1p2 = normalize(p1 - p2);
+  V3<T> hp2 = cross(p1p2, normalize(p2));
+  if (values(hp2).norm() < 1e-5) {
+    // the library's history-free choice for a line through the centre
+    const Vec3 d = values(p1p2);
+    int k = 0;
+    for (int i = 1; i < 3; ++i)
+      if (std::abs(d[i]) < std::abs(d[k])) k = i;
+    hp2 = cross(p1p2, constant<T>(Vec3::Unit(k)));
+  }
+  const V3<T> n = normalize(hp2);
+  V3<T> r1a, r1b, r2a, r2b, r1, r2;
+  sphereTangents(R, p1, n, r1a, r1b);
+  sphereTangents(R, p2, n, r2a, r2b);
+  {
+    const Vec3 u1a = values(r1a).normalized(), u1b = values(r1b).normalized();
+    const Vec3 u2a = values(r2a).normalized(), u2b = values(r2b).normalized();
+    const double j1 = u1a.dot(u2a), j2 = u1a.dot(u2b), j3 = u1b.dot(u2a), j4 = u1b.dot(u2b);
+    if (j1 > j2 && j1 > j3 && j1 > j4) r1 = r1a, r2 = r2a;
+    else if (j2 > j3 && j2 > j4) r1 = r1a, r2 = r2b;
+    else if (j3 > j4) r1 = r1b, r2 = r2a;
+    else r1 = r1b, r2 = r2b;
+  }
+  const V3<T> r1n = normalize(r1), r2n = normalize(r2);
+  const T angle = dacos(dot(r1n, r2n));
+  const V3<T> c = cross(r1n, r2n);
+  const V3<T> ax = values(c).squaredNorm() > 0.0 ? normalize(c) : n;
+  x = pathPoint(p1, p2, r1, r2, ax, angle, T(0.0), alpha);
+  return true;
+}
+
+// the blended point over any scalar
+template <class T>
+V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double alpha, double width, T* d_out,
+                  T* w_out) {
+  const V3<T> straight = p1 + alpha * (p2 - p1);
+  const T d = penetration(surf, p1, p2);
+  if (d_out) *d_out = d;
+  if (w_out) *w_out = T(0.0);
+  // below u = 1e-6 the blend weight is < 1e-17 and the wrapped branch is not evaluated: its
+  // derivatives grow like d^(-1/2) at the contact (the arc angle ~ sqrt(d)), and inf * 0 would
+  // poison the dual parts
+  if (!(value(d) > 1e-6 * width)) return straight;
+  V3<T> wrapped;
+  const bool ok = surf.type == WrapType::Cylinder ? cylinderPoint(surf, p1, p2, alpha, wrapped)
+                                                  : spherePoint(surf, p1, p2, alpha, wrapped);
+  if (!ok) return straight;  // the library's finite-length cut-off (not smoothed)
+  if (value(d) >= width) {
+    if (w_out) *w_out = T(1.0);
+    return wrapped;
+  }
+  // quintic smoothstep: C2 at both ends of the band [D-independent; see the header]
+  const T u = d / width;
+  const T w = u * u * u * (10.0 + u * (-15.0 + 6.0 * u));
+  if (w_out) *w_out = w;
+  return straight + w * (wrapped - straight);
+}
+
+void checkInputs(const WrapSurface& surf, const Vec3& p1, const Vec3& p2) {
+  const std::string why = smoothWrapUnsupportedReason(surf);
+  if (!why.empty()) throw std::invalid_argument("smooth wrap: " + why);
+  const double R = surf.radius;
+  const bool inside = surf.type == WrapType::Cylinder
+                          ? (p1.head<2>().norm() < R || p2.head<2>().norm() < R)
+                          : (p1.norm() < R || p2.norm() < R);
+  if (inside) throw std::invalid_argument("smooth wrap: an end point lies inside the surface");
+  if (!p1.allFinite() || !p2.allFinite() || p1 == p2) throw std::invalid_argument("smooth wrap: degenerate end points");
+}
+
+double widthOf(const WrapSurface& surf, const SmoothWrapOptions& o) { return o.width > 0.0 ? o.width : 0.05 * surf.radius; }
+
+}  // namespace
+
+std::string smoothWrapUnsupportedReason(const WrapSurface& s) {
+  if (!s.active) return "the surface is inactive";
+  if (s.type == WrapType::Ellipsoid)
+    return "ellipsoids are not supported (OpenSim's ellipsoid path is a polyline whose segment count changes, not C1)";
+  if (s.type == WrapType::Torus) return "tori are not supported (OpenSim's torus wrap is an iterative search)";
+  if (s.quadrant_sign != 0) return "quadrant-constrained surfaces are not supported (the side choice switches discontinuously)";
+  if (!(s.radius > 0.0)) return "the radius must be positive";
+  return "";
+}
+
+double calcWrapPenetration(const WrapSurface& surface, const Vec3& p1, const Vec3& p2) {
+  return penetration(surface, constant<double>(p1), constant<double>(p2));
+}
+
+Vec3 calcSmoothWrapPoint(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, double alpha,
+                         const SmoothWrapOptions& options) {
+  checkInputs(surface, p1, p2);
+  alpha = std::clamp(alpha, 0.0, 1.0);
+  return values(smoothPoint<double>(surface, constant<double>(p1), constant<double>(p2), alpha,
+                                    widthOf(surface, options), nullptr, nullptr));
+}
+
+SmoothWrapPoint calcSmoothWrapPointDerivatives(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                                               double alpha, const Vec3& p1dot, const Vec3& p2dot,
+                                               const SmoothWrapOptions& options) {
+  checkInputs(surface, p1, p2);
+  alpha = std::clamp(alpha, 0.0, 1.0);
+  using D2 = Dual<Dual<double>>;
+  const double width = widthOf(surface, options);
+  SmoothWrapPoint out;
+  // one pass per input direction e_i; every pass also carries the velocity direction, so b.b is
+  // the mixed derivative d^2 x / (d e_i d v) = column i of Jdot
+  for (int i = 0; i < 6; ++i) {
+    V3<D2> q1, q2;
+    for (int k = 0; k < 3; ++k) {
+      q1[k] = D2{Dual<double>{p1[k], p1dot[k]}, Dual<double>{i == k ? 1.0 : 0.0, 0.0}};
+      q2[k] = D2{Dual<double>{p2[k], p2dot[k]}, Dual<double>{i == k + 3 ? 1.0 : 0.0, 0.0}};
+    }
+    D2 d, w;
+    const V3<D2> x = smoothPoint(surface, q1, q2, alpha, width, &d, &w);
+    for (int k = 0; k < 3; ++k) {
+      out.J(k, i) = x[k].b.a;
+      out.Jdot(k, i) = x[k].b.b;
+    }
+    if (i == 0) {
+      for (int k = 0; k < 3; ++k) out.x[k] = x[k].a.a;
+      out.penetration = d.a.a;
+      out.weight = w.a.a;
+    }
+  }
+  return out;
+}
+
+}  // namespace redmax
