@@ -3,6 +3,7 @@
 #include <variant>
 
 #include "plugin/simbody/model_to_simbody.hpp"
+#include "plugin/simbody/muscle_inertia.hpp"
 
 namespace redmax::simbody {
 
@@ -31,6 +32,8 @@ struct SimbodyIdEngine::Impl {
   std::vector<PointForce> point_forces;
   std::vector<BodyWrench> wrenches;
   MatX T, Tdot;
+  std::unique_ptr<MuscleInertia> muscles;  // null without muscle mass
+  SimTK::Vector f_muscles;
 };
 
 SimbodyIdEngine::SimbodyIdEngine(const Model& model, const osim::IdEngineOptions& options)
@@ -58,6 +61,14 @@ SimbodyIdEngine::SimbodyIdEngine(const Model& model, const osim::IdEngineOptions
   }
   m.state = m.sm->default_state;
   m.E_wi.resize(model.nb());
+}
+
+SimbodyIdEngine::SimbodyIdEngine(const Model& model, std::vector<Muscle> muscles,
+                                 const osim::IdEngineOptions& options)
+    : SimbodyIdEngine(model, options) {
+  bool any = false;
+  for (const Muscle& mu : muscles) any = any || mu.mass_points.size() > 0;
+  if (any) impl_->muscles = std::make_unique<MuscleInertia>(*impl_->sm, impl_->model, std::move(muscles));
 }
 
 SimbodyIdEngine::~SimbodyIdEngine() = default;
@@ -112,7 +123,13 @@ void SimbodyIdEngine::calcGeneralizedForces(double t, const VecX& q, const VecX&
   }
 
   SimTK::Vector f_u;
-  sm.matter.calcResidualForceIgnoringConstraints(sb, mobility_forces, body_forces, toSimTK(udot), f_u);
+  const SimTK::Vector udot_sb = toSimTK(udot);
+  sm.matter.calcResidualForceIgnoringConstraints(sb, mobility_forces, body_forces, udot_sb, f_u);
+  // muscle mass points: their share of the residual, in the same u space
+  if (m.muscles) {
+    m.muscles->calcGeneralizedForces(sb, udot_sb, m.f_muscles);
+    f_u += m.f_muscles;
+  }
   const VecX fu = fromSimTK(f_u);
   // back to the caller's convention: tau = T^T f_u (power balance), f_u itself for marked joints
   tau = m.T.transpose() * fu;

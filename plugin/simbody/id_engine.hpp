@@ -6,12 +6,15 @@
 // Joints marked IdEngineOptions::rates_as_u become Ball/Free mobilizers whose u and udot are the
 // given rates as they are (what OpenSim does); for the others u = T qdot, udot = T qddot + Tdot
 // qdot and tau = T^T tau_u (model_to_simbody.hpp's velocity map), so both engines answer in the
-// same convention. The header is Simbody-free (pimpl) so that the command line compiles quickly.
+// same convention. With muscles that carry mass points (second constructor), their generalized
+// forces from plugin/simbody/muscle_inertia.hpp (Simbody station kinematics + the core's path
+// maps) are added to Simbody's residual in u space before the map back. The header is Simbody-free (pimpl) so that the command line compiles quickly.
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "converter/id/id_engine.hpp"
+#include "core/muscles/mass_points.hpp"
 #include "core/skeleton/model.hpp"
 
 namespace redmax::simbody {
@@ -22,6 +25,9 @@ class SimbodyIdEngine final : public osim::IdEngine {
   /// Gimbal otherwise). Throws SimbodyBuildError (simbody_options.hpp) when the model has a joint
   /// without a Simbody counterpart, or a marked joint whose mobilizer has u = qdot (not Ball/Free).
   explicit SimbodyIdEngine(const Model& model, const osim::IdEngineOptions& options = {});
+  /// The same, plus the inertia and weight of the mass points of `muscles` (muscles without mass
+  /// points add nothing). Throws ModelError for a muscle that does not fit the model (validateMuscle).
+  SimbodyIdEngine(const Model& model, std::vector<Muscle> muscles, const osim::IdEngineOptions& options = {});
   ~SimbodyIdEngine() override;
   SimbodyIdEngine(const SimbodyIdEngine&) = delete;
   SimbodyIdEngine& operator=(const SimbodyIdEngine&) = delete;

@@ -1,0 +1,264 @@
+// Muscle inertia inside Simbody (plugin/simbody/muscle_inertia.hpp, SimbodyIdEngine with muscles)
+// against the core's MuscleTerm [D Eq. 5.6-5.7]. The Simbody side takes the path points' motion from
+// Simbody's station Jacobians and biases, the core side from J_mr; both share only the path maps.
+//   - component: T^T f_u (Simbody, mapped to core velocities) == M_muscle qddot - f_muscle (core),
+//     and the mass points' kinetic and potential energies, on random trees (Gimbal, Ball, Free
+//     mobilizers) with Type I, Type II (1-5 via points), moving and conditional points;
+//   - engine: SimbodyIdEngine(model, muscles) == core System + MuscleTerm inverse dynamics on the
+//     project's scenes (double pendulums with a Type I and a Type II muscle, finger, running leg) and
+//     on set F (gait10dof18musc) with 20% and 80% of tibia_r's mass moved into its muscles.
+// Agreement: max |a - b| <= 1e-9 max |b| (relative to the peak of the reference column) at random
+// states. Each case also checks that the muscles change the torques by more than 1e-4 of the peak,
+// so a plugin that dropped them would fail.
+#include "plugin/simbody/muscle_inertia.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "converter/build/build_core_model.hpp"
+#include "converter/osim_reader.hpp"
+#include "core/dynamics/muscle_term.hpp"
+#include "core/dynamics/system.hpp"
+#include "core/muscles/path_kinematics.hpp"
+#include "core/skeleton/kinematics.hpp"
+#include "plugin/simbody/id_engine.hpp"
+#include "validation/scenes/scenes.hpp"
+
+namespace redmax {
+namespace {
+
+constexpr double kTol = 1e-9;
+
+double g_worst = 0.0;  // largest max|a - b| / max|b| of the current test, printed at its end
+class WorstLog : public ::testing::EmptyTestEventListener {
+  void OnTestStart(const ::testing::TestInfo&) override { g_worst = 0.0; }
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    if (g_worst > 0.0)
+      std::printf("  [%s.%s] largest difference / peak: %.3e\n", info.test_suite_name(), info.name(), g_worst);
+  }
+};
+const bool g_log_installed = [] {
+  ::testing::UnitTest::GetInstance()->listeners().Append(new WorstLog);
+  return true;
+}();
+
+::testing::AssertionResult closeToPeak(const VecX& a, const VecX& b, double tol) {
+  const double err = (a - b).cwiseAbs().maxCoeff();
+  const double peak = b.cwiseAbs().maxCoeff();
+  g_worst = std::max(g_worst, err / peak);
+  if (err <= tol * peak) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "max difference " << err << " > " << tol << " x peak " << peak
+                                       << "\nsimbody " << a.transpose() << "\ncore    " << b.transpose();
+}
+
+Vec3 randomVec(std::mt19937& rng, double scale) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  return Vec3(u(rng), u(rng), u(rng)) * scale;
+}
+
+State randomState(int nr, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  State s;
+  s.q = VecX::NullaryExpr(nr, [&] { return u(rng); });
+  s.qdot = VecX::NullaryExpr(nr, [&] { return 2.0 * u(rng); });
+  return s;
+}
+
+// the muscle-mass part of inverse dynamics in the core: M_muscle qddot - f_muscle
+VecX coreMuscleTau(const Model& model, const MuscleTerm& term, const State& s, const VecX& qddot) {
+  SkeletonWorkspace sk(model);
+  calcKinematics(model, s, sk);
+  MatX M = MatX::Zero(model.nr(), model.nr());
+  VecX f = VecX::Zero(model.nr());
+  term.addMass(model, s, sk, M);
+  term.addForce(model, s, sk, f);
+  return M * qddot - f;
+}
+
+// the same from the Simbody component, mapped to core velocities: tau = T^T f_u(udot = T qddot + Tdot qdot)
+VecX simbodyMuscleTau(const simbody::SimbodyModel& sm, simbody::MuscleInertia& mi, const Model& model,
+                      const State& s, const VecX& qddot) {
+  SimTK::State sb = sm.default_state;
+  simbody::setSimbodyState(sm, model, s, sb);
+  sm.system.realize(sb, SimTK::Stage::Velocity);
+  MatX T, Tdot;
+  simbody::calcVelocityMap(sm, model, s, T, &Tdot);
+  const VecX udot = T * qddot + Tdot * s.qdot;
+  return T.transpose() * mi.calcGeneralizedForces(sb, udot);
+}
+
+int randomBody(const Model& m, std::mt19937& rng, bool allow_world) {
+  const int lo = allow_world ? -1 : 0;
+  return lo + static_cast<int>(rng() % static_cast<unsigned>(m.nb() - lo));
+}
+
+// variant 0: Type I; 1-5: that many via points; 6: moving points; 7: conditional points
+Muscle randomMuscle(const Model& m, int variant, std::mt19937& rng, const State& s) {
+  Muscle mu;
+  mu.name = "random" + std::to_string(variant);
+  auto& pts = mu.path.points;
+  pts.push_back(makeFixedPoint(randomBody(m, rng, true), randomVec(rng, 0.3)));
+  const int nvia = variant <= 5 ? variant : 1;
+  for (int k = 0; k < nvia; ++k) pts.push_back(makeFixedPoint(randomBody(m, rng, false), randomVec(rng, 0.3)));
+  const int c = static_cast<int>(rng() % m.nr());
+  if (variant == 6) {
+    auto cubic = std::make_shared<PolynomialFunction>(std::vector<double>{0.05, -0.1, 0.2, 0.1});
+    auto line = std::make_shared<LinearFunction>(0.3, 0.2);
+    pts.push_back(makeMovingPoint(randomBody(m, rng, false), c, {cubic, nullptr, line}, Vec3(0, 0.1, 0)));
+    pts.push_back(makeMovingPoint(-1, static_cast<int>(rng() % m.nr()), {line, cubic, nullptr}, Vec3(0, 0, 0.2)));
+  }
+  if (variant == 7) {
+    pts.push_back(makeConditionalPoint(randomBody(m, rng, false), randomVec(rng, 0.3), c, s.q[c] - 0.3, s.q[c] + 0.3));
+    pts.push_back(makeConditionalPoint(randomBody(m, rng, false), randomVec(rng, 0.3), c, s.q[c] + 1.0, s.q[c] + 2.0));
+  }
+  pts.push_back(makeFixedPoint(randomBody(m, rng, false), randomVec(rng, 0.3)));
+  MassPointOptions opt;
+  opt.count = 7;
+  mu.mass_points = makeMassPoints(0.8, 0.5, 0.3, opt);
+  mu.optimal_fiber_length = 0.5;
+  mu.tendon_slack_length = 0.3;
+  return mu;
+}
+
+TEST(SimbodyMuscleInertia, MatchesCoreMuscleTermOnRandomTrees) {
+  using scenes::TreeJoints;
+  using simbody::SphericalAs;
+  struct Case {
+    Model model;
+    SphericalAs spherical;
+  };
+  const std::vector<Case> cases{{scenes::randomTree(6, 11, TreeJoints::SimbodyComparable), SphericalAs::Gimbal},
+                                {scenes::randomTree(8, 29, TreeJoints::SimbodyComparable), SphericalAs::Ball},
+                                {scenes::doublePendulum(), SphericalAs::Gimbal}};
+  std::mt19937 rng(2024);
+  int checked = 0;
+  for (size_t ci = 0; ci < cases.size(); ++ci) {
+    const Model& m = cases[ci].model;
+    simbody::SimbodyBuildOptions opt;
+    opt.spherical = cases[ci].spherical;
+    const auto sm = simbody::makeSimbodyModel(m, opt);
+    for (int variant = 0; variant <= 7; ++variant) {
+      for (int trial = 0; trial < 2; ++trial) {
+        SCOPED_TRACE("case " + std::to_string(ci) + " variant " + std::to_string(variant) + " trial " +
+                     std::to_string(trial));
+        const State s = randomState(m.nr(), rng);
+        // two muscles per system, so the batch of stations spans muscles
+        std::vector<Muscle> muscles{randomMuscle(m, variant, rng, s), randomMuscle(m, (variant + 3) % 8, rng, s)};
+        for (Muscle& mu : muscles) validateMuscle(m, mu);
+        const MuscleTerm term(m, muscles);
+        simbody::MuscleInertia mi(*sm, m, muscles);
+        const VecX qddot = VecX::NullaryExpr(m.nr(), [&] { return randomVec(rng, 3.0)[0]; });
+        VecX core;
+        try {
+          core = coreMuscleTau(m, term, s, qddot);
+        } catch (const MuscleError&) {
+          continue;  // two random points coincide at this state
+        }
+        const VecX sb = simbodyMuscleTau(*sm, mi, m, s, qddot);
+        EXPECT_TRUE(closeToPeak(sb, core, kTol));
+
+        // energies of the mass points (the core's from its own kinematics)
+        SkeletonWorkspace sk(m);
+        calcKinematics(m, s, sk);
+        SimTK::State st = sm->default_state;
+        simbody::setSimbodyState(*sm, m, s, st);
+        sm->system.realize(st, SimTK::Stage::Velocity);
+        const double T_core = term.kineticEnergy(m, s, sk), V_core = term.potentialEnergy(m, s, sk);
+        EXPECT_NEAR(mi.kineticEnergy(st), T_core, kTol * (1.0 + std::abs(T_core)));
+        EXPECT_NEAR(mi.potentialEnergy(st), V_core, kTol * (1.0 + std::abs(V_core)));
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GE(checked, 40);
+}
+
+TEST(SimbodyMuscleInertia, MasslessMusclesAddNothingAndBadMusclesThrow) {
+  const Model m = scenes::doublePendulum();
+  const auto sm = simbody::makeSimbodyModel(m);
+  Muscle mu;
+  mu.name = "lumped";
+  mu.path.points = {makeFixedPoint(-1, Vec3(0.1, 0, 0)), makeFixedPoint(1, Vec3(0, -0.5, 0))};
+  simbody::MuscleInertia mi(*sm, m, {mu});
+  SimTK::State sb = sm->default_state;
+  sm->system.realize(sb, SimTK::Stage::Velocity);
+  EXPECT_EQ(mi.calcGeneralizedForces(sb, VecX::Ones(2)).norm(), 0.0);
+  // a point on a body the model does not have
+  mu.path.points.back().body = 5;
+  EXPECT_THROW(simbody::MuscleInertia(*sm, m, {mu}), ModelError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// engines on the project's scenes and on set F
+
+std::string scenePath(const std::string& file) { return std::string(REDMAX_SOURCE_DIR) + "/osim_models/" + file; }
+
+// engine with muscles vs the core's System + MuscleTerm, at random states with q within the
+// coordinates' ranges; returns how many states were compared
+int compareEngines(const osim::ModelDescription& d, const Model& model, const std::vector<Muscle>& muscles,
+                   int states, std::uint32_t seed) {
+  simbody::SimbodyIdEngine with(model, muscles), without(model);
+  System sys(model);
+  sys.addTerm(std::make_shared<MuscleTerm>(model, muscles));
+  DynamicsWorkspace ws(sys.model());
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int compared = 0;
+  for (int k = 0; k < states; ++k) {
+    SCOPED_TRACE("state " + std::to_string(k));
+    State s;
+    s.q.resize(model.nr());
+    for (int c = 0; c < model.nr(); ++c) {
+      const auto& cd = d.coordinates[c];
+      const double lo = std::max(cd.range_min, -1.5), hi = std::min(cd.range_max, 1.5);
+      s.q[c] = lo + (hi - lo) * u(rng);
+    }
+    s.qdot = VecX::NullaryExpr(model.nr(), [&] { return 4.0 * (u(rng) - 0.5); });
+    const VecX qddot = VecX::NullaryExpr(model.nr(), [&] { return 20.0 * (u(rng) - 0.5); });
+    VecX tau_sb, tau_plain;
+    with.calcGeneralizedForces(s.t, s.q, s.qdot, qddot, {}, tau_sb);
+    without.calcGeneralizedForces(s.t, s.q, s.qdot, qddot, {}, tau_plain);
+    const VecX tau_core = sys.inverseDynamics(s, qddot, ws);
+    EXPECT_TRUE(closeToPeak(tau_sb, tau_core, kTol));
+    // the muscles matter at this state (else the comparison above proves little)
+    EXPECT_GT((tau_sb - tau_plain).cwiseAbs().maxCoeff(), 1e-4 * tau_core.cwiseAbs().maxCoeff());
+    ++compared;
+  }
+  return compared;
+}
+
+// every muscle that can carry mass gets `mass` kg over 10 points; Type III stays lumped
+std::vector<Muscle> withMass(const std::vector<Muscle>& muscles, double mass) {
+  std::vector<double> masses;
+  for (const Muscle& mu : muscles) masses.push_back(pathType(mu.path) == PathType::III ? 0.0 : mass);
+  MassPointOptions opt;
+  opt.count = 10;
+  return osim::addMusclePointMasses(muscles, masses, opt);
+}
+
+TEST(SimbodyIdEngineMuscles, MatchesCoreOnProjectScenes) {
+  struct Scene {
+    const char* file;
+    double mass;
+  };
+  for (const Scene& sc : {Scene{"double_pendulum_straight.osim", 0.5}, Scene{"double_pendulum_via.osim", 0.5},
+                          Scene{"finger.osim", 0.2}, Scene{"running_leg.osim", 0.4}}) {
+    SCOPED_TRACE(sc.file);
+    const osim::ModelDescription d = osim::readOsimModel(scenePath(sc.file));
+    osim::BuildOptions bo;
+    bo.simbody_compat = true;  // CustomJoints: Simbody's velocity terms (model_to_simbody.hpp)
+    bo.constraints = false;
+    const osim::BuildResult r = osim::buildCoreModel(d, bo);
+    const std::vector<Muscle> muscles = withMass(r.muscles, sc.mass);
+    EXPECT_EQ(compareEngines(d, r.model, muscles, 6, 5), 6);
+  }
+}
+
+}  // namespace
+}  // namespace redmax
