@@ -8,6 +8,8 @@
 namespace redmax {
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+
 // ---------------------------------------------------------------------------------------------
 // dual numbers: x = a + b eps with eps^2 = 0; nesting Dual<Dual<double>> gives a second
 // (mixed) directional derivative in b.b
@@ -160,7 +162,8 @@ bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, do
   T rho1, rho2;
   cylinderCandidates(R, p1, p11, r1a, r1b, rho1);
   cylinderCandidates(R, p2, p22, r2a, r2b, rho2);
-  {
+  bool far_side_wrap = false, long_wrap = false;
+  if (surf.quadrant_sign == 0) {
     // the candidate pair whose radial directions agree best (decided on values)
     const Vec3 u1a = (values(r1a) - values(p11)).normalized(), u1b = (values(r1b) - values(p11)).normalized();
     const Vec3 u2a = (values(r2a) - values(p22)).normalized(), u2b = (values(r2b) - values(p22)).normalized();
@@ -169,6 +172,37 @@ bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, do
     else if (d2 > d3 && d2 > d4) r1 = r1a, r2 = r2b;
     else if (d3 > d4) r1 = r1b, r2 = r2a;
     else r1 = r1b, r2 = r2b;
+  } else {
+    // the library's candidate table for a quadrant (decided on values)
+    const int axis = surf.quadrant_axis, sign = surf.quadrant_sign;
+    auto dsign = [](double v) { return v >= 0.0 ? 1 : -1; };
+    const Vec3 r1am = values(r1a) - values(p11), r1bm = values(r1b) - values(p11);
+    const Vec3 r2am = values(r2a) - values(p22), r2bm = values(r2b) - values(p22);
+    const double al = std::acos(r1am.dot(r2bm) / (r1am.norm() * r2bm.norm()));
+    const double be = std::acos(r1bm.dot(r2am) / (r1bm.norm() * r2am.norm()));
+    const bool a1 = dsign(value(r1a[axis])) == sign, b1 = dsign(value(r1b[axis])) == sign;
+    const bool a2 = dsign(value(r2a[axis])) == sign, b2 = dsign(value(r2b[axis])) == sign;
+    auto pick_ba = [&](bool far_if) { r1 = r1b, r2 = r2a, far_side_wrap = (al > be) == far_if; };
+    auto pick_ab = [&](bool far_if) { r1 = r1a, r2 = r2b, far_side_wrap = (al > be) == far_if; };
+    if (a1 && b1) {
+      if (a2) pick_ba(false);
+      else pick_ab(true);
+    } else if (a1 && !b1) {
+      pick_ab(true);
+    } else if (!a1 && b1) {
+      pick_ba(false);
+    } else if (a2) {
+      pick_ba(false);
+    } else if (b2) {
+      pick_ab(true);
+    } else {
+      if (al > be) r1 = r1a, r2 = r2b;
+      else r1 = r1b, r2 = r2a;
+      far_side_wrap = true;
+    }
+    const Vec3 sum_musc = (values(r1) - values(p1)) + (values(r2) - values(p2));
+    const Vec3 sum_r = (values(r1) - values(p11)) + (values(r2) - values(p22));
+    long_wrap = sum_r.dot(sum_musc) < 0.0;
   }
   // apex on the near side of the axis-normal plane through the muscle line's point at fraction
   // rho1 / (rho1 + rho2)
@@ -180,7 +214,7 @@ bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, do
   const V3<T> apex1 = axispt + R * normalize(cross(zAxis<T>(), n));
   const V3<T> apex2 = axispt + R * normalize(cross(n, zAxis<T>()));
   const double dist1 = (values(mpt) - values(apex1)).squaredNorm(), dist2 = (values(mpt) - values(apex2)).squaredNorm();
-  const V3<T> apex = dist1 < dist2 ? apex1 : apex2;
+  const V3<T> apex = far_side_wrap ? (dist1 < dist2 ? apex2 : apex1) : (dist1 < dist2 ? apex1 : apex2);
   // slide r1, r2 along the axis into the plane through p1, p2 and the apex (each only when that
   // moves it toward the other end; the library's tests, decided on values)
   const V3<T> pn = normalize(cross(normalize(p1 - apex), normalize(p2 - apex)));
@@ -207,7 +241,8 @@ bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, do
   const double z1 = value(r1[2]), z2 = value(r2[2]);
   if ((z1 < -half || z1 > half) && (z2 < -half || z2 > half)) return false;
   // helix about the axis
-  const T theta = datan2(r1[0] * r2[1] - r1[1] * r2[0], r1[0] * r2[0] + r1[1] * r2[1]);
+  T theta = datan2(r1[0] * r2[1] - r1[1] * r2[0], r1[0] * r2[0] + r1[1] * r2[1]);
+  if (long_wrap) theta = -(2.0 * kPi - theta);  // the long way round, turning the other way
   x = pathPoint(p1, p2, r1, r2, zAxis<T>(), theta, r2[2] - r1[2], alpha);
   return true;
 }
@@ -263,7 +298,25 @@ template <class T>
 V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double alpha, double width, T* d_out,
                   T* w_out) {
   const V3<T> straight = p1 + alpha * (p2 - p1);
-  const T d = penetration(surf, p1, p2);
+  T d = penetration(surf, p1, p2);
+  if (surf.type == WrapType::Cylinder && surf.quadrant_sign != 0) {
+    // the library's quadrant logic: with an end on the active side it wraps exactly when the
+    // segment meets the cylinder (blended below); otherwise it may force a wrap round the
+    // active side, which has no contact change to smooth: the exact wrapped path (w = 1)
+    const int axis = surf.quadrant_axis, sign = surf.quadrant_sign;
+    auto dsign = [](double v) { return v >= 0.0 ? 1 : -1; };
+    const Vec3 a = values(p1), b = values(p2), u = b - a;
+    const bool s1 = dsign(a[axis]) == sign, s2 = dsign(b[axis]) == sign;
+    const double uu = u.head<2>().squaredNorm();
+    const Vec3 near12 = a + (uu > 0.0 ? -a.head<2>().dot(u.head<2>()) / uu : 0.0) * u;
+    const bool forced = (!s1 && !s2) || (value(d) <= 0.0 && dsign(a[axis]) != dsign(b[axis]) && dsign(near12[axis]) != sign);
+    if (forced) {
+      if (d_out) *d_out = d;
+      if (w_out) *w_out = T(1.0);
+      V3<T> wrapped;
+      return cylinderPoint(surf, p1, p2, alpha, wrapped) ? wrapped : straight;
+    }
+  }
   if (d_out) *d_out = d;
   if (w_out) *w_out = T(0.0);
   // below u = 1e-6 the blend weight is < 1e-17 and the wrapped branch is not evaluated: its
@@ -305,7 +358,7 @@ std::string smoothWrapUnsupportedReason(const WrapSurface& s) {
   if (s.type == WrapType::Ellipsoid)
     return "ellipsoids are not supported (OpenSim's ellipsoid path is a polyline whose segment count changes, not C1)";
   if (s.type == WrapType::Torus) return "tori are not supported (OpenSim's torus wrap is an iterative search)";
-  if (s.quadrant_sign != 0) return "quadrant-constrained surfaces are not supported (the side choice switches discontinuously)";
+  if (s.type == WrapType::Sphere && s.quadrant_sign != 0) return "quadrant-constrained spheres are not supported";
   if (!(s.radius > 0.0)) return "the radius must be positive";
   return "";
 }

@@ -18,14 +18,18 @@
 // Jdot = dJ/dt along (p1dot, p2dot) are exact to round-off (forward-over-forward differentiation,
 // 6 passes: one per input direction, each also carrying the velocity direction).
 //
-// Supported: Cylinder and Sphere without a quadrant, single wrap (OpenSim's unconstrained
-// algorithms). Not supported (smoothWrapSupports() says why): quadrant-constrained surfaces (the
-// exact library's side choice switches discontinuously), ellipsoids (OpenSim's result is a
-// polyline of floor(chord / 1 mm) segments whose count changes, so even the exact path is not C1)
-// and tori (an iterative closest-point search). Also not smoothed: a mass point crossing a
-// tangent point (the path's curvature changes there; OpenSim's cylinder construction is not
-// exactly tangent, so J has a small jump there too), and the cylinder's finite length (both
-// tangent points beyond the ends: the exact library stops wrapping).
+// Supported: Cylinder (also with a quadrant) and Sphere without a quadrant, single wrap (OpenSim's
+// algorithms as the exact library reproduces them). A quadrant cylinder is blended as above when an
+// end point lies on the active side and the library wraps only on contact; when it forces a wrap
+// round the active side (neither end active, or ends on opposite sides with the line passing on
+// the inactive side) the model is the exact wrapped path: those switches (an end point crossing
+// the quadrant plane) are not smoothed. Not supported (smoothWrapUnsupportedReason() says why):
+// spheres with a quadrant, ellipsoids (OpenSim's result is a polyline of floor(chord / 1 mm)
+// segments whose count changes, so even the exact path is not C1) and tori (an iterative
+// closest-point search). Also not smoothed: a mass point crossing a tangent point (the path's
+// curvature changes there; OpenSim's cylinder construction is not exactly tangent, so J has a
+// small jump there too), and the cylinder's finite length (both tangent points beyond the ends:
+// the exact library stops wrapping).
 #include <string>
 
 #include "core/muscles/wrap/wrap_surface.hpp"
