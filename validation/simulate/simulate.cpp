@@ -1,0 +1,451 @@
+#include "validation/simulate/simulate.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+
+#include "converter/osim_reader.hpp"
+#include "core/dynamics/body_loads.hpp"
+
+namespace redmax::validation {
+
+namespace {
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : s) {
+    if (c == sep) {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+// strict number parse: the whole text must be a finite number
+bool parseNumber(const std::string& text, double& v) {
+  try {
+    size_t used = 0;
+    v = std::stod(text, &used);
+    return used == text.size() && std::isfinite(v);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+bool parseVec3(const std::string& text, Vec3& v) {
+  const auto parts = split(text, ',');
+  if (parts.size() != 3) return false;
+  for (int k = 0; k < 3; ++k)
+    if (!parseNumber(parts[k], v[k])) return false;
+  return true;
+}
+
+bool isAdaptive(const std::string& name) { return name == "rk45" || name == "cvode"; }
+
+// the skeleton coordinate behind system coordinate k (with a coordinate map, only independents)
+int skeletonIndex(const System& sys, int k) {
+  if (sys.coordinateMap()) return sys.coordinateMap()->independent()[k];
+  return k;
+}
+
+// rewrite "q[k]" / "qdot[k]" in an integrator's message so that it names the coordinate
+std::string nameCoordinates(const SimulationModel& m, const std::string& what) {
+  static const std::regex re(R"((qdot|q)\[(\d+)\])");
+  std::string out;
+  auto begin = std::sregex_iterator(what.begin(), what.end(), re);
+  size_t last = 0;
+  for (auto it = begin; it != std::sregex_iterator(); ++it) {
+    const std::smatch& mt = *it;
+    out += what.substr(last, mt.position() - last);
+    const int k = std::stoi(mt[2].str());
+    out += mt.str();
+    if (k >= 0 && k < m.system->ndof()) {
+      const int i = skeletonIndex(*m.system, k);
+      if (i < static_cast<int>(m.coordinate_names.size()))
+        out += std::string(" (") + (mt[1].str() == "q" ? "value" : "speed") + " of coordinate '" +
+               m.coordinate_names[i] + "')";
+    }
+    last = mt.position() + mt.length();
+  }
+  out += what.substr(last);
+  return out;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// impulses
+
+ImpulseSpec parseImpulse(const std::string& text) {
+  // TARGET may itself hold a comma list after '@' but never a ':'
+  const auto parts = split(text, ':');
+  auto bad = [&](const std::string& why) {
+    return std::invalid_argument("--impulse '" + text + "': " + why +
+                                 " (expected BODY|MARKER|BODY@X,Y,Z:FX,FY,FZ:DURATION)");
+  };
+  if (parts.size() != 3) throw bad("needs three ':'-separated parts");
+  ImpulseSpec s;
+  s.target = parts[0];
+  if (s.target.empty()) throw bad("no body or marker");
+  if (!parseVec3(parts[1], s.force_w)) throw bad("the force must be three numbers FX,FY,FZ in N");
+  if (!parseNumber(parts[2], s.duration) || !(s.duration > 0.0))
+    throw bad("the duration must be a positive number of seconds");
+  return s;
+}
+
+bool ImpulseLoads::active(double t) const {
+  for (const Load& l : loads_)
+    if (t < l.t_end - 1e-12) return true;
+  return false;
+}
+
+void ImpulseLoads::addForce(const Model& model, const State& s, const SkeletonWorkspace& sk, VecX& f) const {
+  // the switch-off is a step in time; 1e-12 s of slack keeps a step that starts at t_end (up to
+  // round-off in t) out of the impulse
+  BodyLoads on;
+  for (const Load& l : loads_)
+    if (s.t < l.t_end - 1e-12) on.point_forces.push_back({l.body, l.point_i, l.force_w});
+  if (!on.point_forces.empty()) on.addForce(model, s, sk, f);
+}
+
+// ---------------------------------------------------------------------------------------------
+// model
+
+SimulationModel loadSimulationModel(const std::string& osim_path, const SimulationModelOptions& options) {
+  return makeSimulationModel(osim::readOsimModel(osim_path), options);
+}
+
+SimulationModel makeSimulationModel(const osim::ModelDescription& d, const SimulationModelOptions& options) {
+  SimulationModel m;
+  const bool explicit_mass = !options.explicit_masses.empty();
+  if (explicit_mass && options.muscle_mass.source != osim::MuscleMassOptions::Source::None)
+    throw std::invalid_argument("--muscle-mass-kg excludes a --muscle-mass source other than none");
+  if (options.muscle_mass.source != osim::MuscleMassOptions::Source::None) {
+    // TODO(simulate): applyMuscleMass once converter/build/muscle_mass.cpp lands
+    throw std::invalid_argument("--muscle-mass physiological/transfer is not available yet (use none, or "
+                                "--muscle-mass-kg)");
+  }
+  m.description = d;
+  m.build = osim::buildCoreModel(m.description, options.build);
+  m.muscles = m.build.muscles;
+
+  // explicit masses: added to the muscles, no body gives any
+  if (explicit_mass) {
+    if (options.muscle_mass.mass_points < 1)
+      throw std::invalid_argument("--mass-points must be at least 1");
+    std::vector<double> masses(m.muscles.size(), 0.0);
+    for (const auto& [name, kg] : options.explicit_masses) {
+      int found = -1;
+      for (size_t k = 0; k < m.muscles.size(); ++k)
+        if (m.muscles[k].name == name) found = static_cast<int>(k);
+      if (found < 0) throw std::invalid_argument("--muscle-mass-kg: the model has no muscle '" + name + "'");
+      if (!(kg >= 0.0) || !std::isfinite(kg))
+        throw std::invalid_argument("--muscle-mass-kg: mass of '" + name + "' must be a finite number >= 0");
+      masses[found] = kg;
+    }
+    MassPointOptions mp;
+    mp.count = options.muscle_mass.mass_points;
+    mp.region = options.muscle_mass.region;
+    m.muscles = osim::addMusclePointMasses(m.muscles, masses, mp);
+    std::ostringstream os;
+    for (size_t k = 0; k < m.muscles.size(); ++k) {
+      if (masses[k] <= 0.0) continue;
+      os << "  muscle " << m.muscles[k].name << ": " << masses[k] << " kg on " << m.muscles[k].mass_points.size()
+         << " points (added; no body gives mass)\n";
+      m.added_mass += masses[k];
+    }
+    m.mass_summary = os.str();
+  }
+  for (const Muscle& mu : m.muscles) m.muscle_mass += mu.mass_points.totalMass();
+
+  m.system = std::make_shared<System>(m.build.makeSystem());
+  if (m.muscle_mass > 0.0) {
+    MuscleTermOptions mo;
+    mo.quadratic_velocity = options.quadratic_velocity;
+    auto term = std::make_shared<MuscleTerm>(m.system->model(), m.muscles, mo);
+    m.muscle_term = term;
+    m.system->addTerm(term);
+  }
+
+  // impulses: body, marker or BODY@x,y,z
+  if (!options.impulses.empty()) {
+    std::vector<ImpulseLoads::Load> loads;
+    for (const ImpulseSpec& spec : options.impulses) {
+      ImpulseLoads::Load l;
+      l.force_w = spec.force_w;
+      l.t_end = spec.duration;
+      std::string body = spec.target;
+      const size_t at = spec.target.find('@');
+      if (at != std::string::npos) {
+        body = spec.target.substr(0, at);
+        if (!parseVec3(spec.target.substr(at + 1), l.point_i))
+          throw std::invalid_argument("--impulse: point of '" + spec.target + "' must be X,Y,Z in m");
+      }
+      int b = d.findBody(body);
+      if (b < 0 && at == std::string::npos) {
+        for (const auto& mk : d.markers) {
+          if (mk.name != body) continue;
+          b = d.findBody(mk.body);
+          l.point_i = transformPoint(mk.X_body_frame, mk.location);
+          break;
+        }
+      }
+      if (b < 0 || m.build.body_index[b] < 0)
+        throw std::invalid_argument("--impulse: '" + body + "' is not a moving body or a marker of the model");
+      l.body = m.build.body_index[b];
+      loads.push_back(l);
+    }
+    auto term = std::make_shared<ImpulseLoads>(std::move(loads));
+    m.impulses = term;
+    m.system->addTerm(term);
+  }
+
+  // output labels: OpenSim's absolute state paths
+  const Model& model = m.system->model();
+  m.coordinate_names.resize(model.nr());
+  m.q_labels.resize(model.nr());
+  m.u_labels.resize(model.nr());
+  for (int i = 0; i < model.nr(); ++i) {
+    m.coordinate_names[i] = model.coordinates[i].name;
+    m.q_labels[i] = model.coordinates[i].name + "/value";
+    m.u_labels[i] = model.coordinates[i].name + "/speed";
+  }
+  for (size_t k = 0; k < d.coordinates.size(); ++k) {
+    const int i = k < m.build.coordinate_index.size() ? m.build.coordinate_index[k] : -1;
+    if (i < 0) continue;
+    const auto& c = d.coordinates[k];
+    const std::string joint = c.joint_index >= 0 ? d.joints[c.joint_index].name : c.joint;
+    const std::string path = "/jointset/" + joint + "/" + c.name;
+    m.coordinate_names[i] = c.name;
+    m.q_labels[i] = path + "/value";
+    m.u_labels[i] = path + "/speed";
+  }
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------
+// initial states
+
+namespace {
+State finishInitialState(const SimulationModel& m, State s_r) {
+  const System& sys = *m.system;
+  State s = sys.reduceState(s_r);
+  s.t = s_r.t;
+  if (sys.numConstraintRows() > 0) {
+    DynamicsWorkspace ws(sys.model());
+    sys.projectPositions(s, ws);
+    sys.projectVelocities(s, ws);
+  }
+  return s;
+}
+
+State defaultSkeletonState(const SimulationModel& m) {
+  const Model& model = m.system->model();
+  State s;
+  s.t = 0.0;
+  s.q = model.defaultQ();
+  s.qdot = VecX::Zero(model.nr());
+  for (size_t k = 0; k < m.description.coordinates.size(); ++k) {
+    const int i = k < m.build.coordinate_index.size() ? m.build.coordinate_index[k] : -1;
+    if (i >= 0) s.qdot[i] = m.description.coordinates[k].default_speed_value;
+  }
+  return s;
+}
+}  // namespace
+
+State defaultInitialState(const SimulationModel& m) { return finishInitialState(m, defaultSkeletonState(m)); }
+
+State initialStateFromStorage(const SimulationModel& m, const osim::Storage& table, const std::string& file,
+                              double time) {
+  if (table.numRows() == 0) throw osim::ConvertError(file, 0, "the table has no rows");
+  int row = 0;
+  if (std::isnan(time)) {
+    for (int r = 0; r < table.numRows(); ++r)
+      if (std::abs(table.time[r]) <= 1e-9) {
+        row = r;
+        break;
+      }
+  } else {
+    row = -1;
+    for (int r = 0; r < table.numRows(); ++r)
+      if (std::abs(table.time[r] - time) <= 1e-9) row = r;
+    if (row < 0) {
+      std::ostringstream os;
+      os << "no row at t = " << time << " (rows span " << table.time.front() << " to " << table.time.back() << ")";
+      throw osim::ConvertError(file, 0, os.str());
+    }
+  }
+  State s = defaultSkeletonState(m);
+  s.t = table.time[row];
+  int matched = 0;
+  for (size_t k = 0; k < m.description.coordinates.size(); ++k) {
+    const int i = k < m.build.coordinate_index.size() ? m.build.coordinate_index[k] : -1;
+    if (i < 0) continue;
+    const auto& c = m.description.coordinates[k];
+    const double scale =
+        table.in_degrees && c.motion_type == osim::MotionType::Rotational ? M_PI / 180.0 : 1.0;
+    int col = table.findColumn(m.q_labels[i]);
+    if (col < 0) col = table.findColumn(c.name);
+    if (col >= 0) {
+      s.q[i] = scale * table.data(row, col);
+      ++matched;
+    }
+    int ucol = table.findColumn(m.u_labels[i]);
+    if (ucol < 0) ucol = table.findColumn(c.name + "_u");
+    if (ucol >= 0) {
+      s.qdot[i] = scale * table.data(row, ucol);
+      ++matched;
+    }
+  }
+  if (matched == 0)
+    throw osim::ConvertError(file, 0,
+                             "no column names a coordinate of the model (expected names such as '" +
+                                 (m.q_labels.empty() ? std::string("?") : m.q_labels[0]) + "' or '" +
+                                 (m.coordinate_names.empty() ? std::string("?") : m.coordinate_names[0]) + "')");
+  if (!s.q.allFinite() || !s.qdot.allFinite())
+    throw osim::ConvertError(file, 0, "the initial row holds a non-finite value");
+  return finishInitialState(m, s);
+}
+
+// ---------------------------------------------------------------------------------------------
+// simulation
+
+std::pair<double, double> calcEnergies(const SimulationModel& m, const State& s) {
+  DynamicsWorkspace ws(m.system->model());
+  return {m.system->kineticEnergy(s, ws), m.system->potentialEnergy(s, ws)};
+}
+
+SimulationResult simulate(const SimulationModel& m, const State& initial, const SimulateOptions& options) {
+  const System& sys = *m.system;
+  if (!(options.duration > 0.0) || !std::isfinite(options.duration))
+    throw std::invalid_argument("the duration must be a positive number of seconds");
+  if (!(options.output_dt >= 0.0) || !std::isfinite(options.output_dt))
+    throw std::invalid_argument("the output interval must be a positive number of seconds");
+  const bool adaptive = isAdaptive(options.integrator);
+  auto integ = makeIntegrator(options.integrator, options.integrator_options);  // validates the name
+  const double dt = options.integrator_options.dt;
+
+  // output times: t0 + k h_out, the last one t0 + duration
+  double h_out = options.output_dt > 0.0 ? options.output_dt : (!adaptive && dt > 0.01 ? dt : 0.01);
+  if (!adaptive) h_out = std::max(1.0, std::round(h_out / dt)) * dt;
+  const double t0 = initial.t, t1 = t0 + options.duration;
+  const long n_rows = std::max(1L, static_cast<long>(std::ceil(options.duration / h_out - 1e-9)));
+  if (n_rows > 50'000'000) throw std::invalid_argument("more than 5e7 output rows: raise the output interval");
+  struct Target {
+    double t;
+    bool row;    // an output row
+    bool brk;    // an impulse switches off here
+  };
+  std::vector<Target> targets;
+  for (long k = 1; k < n_rows; ++k) targets.push_back({t0 + k * h_out, true, false});
+  targets.push_back({t1, true, false});
+  // impulse switch-offs inside the run are breakpoints
+  if (m.impulses) {
+    for (const auto& l : m.impulses->loads()) {
+      if (!(l.t_end > t0 && l.t_end < t1)) continue;
+      bool on_row = false;
+      for (auto& tg : targets)
+        if (std::abs(tg.t - l.t_end) <= 1e-12 * std::max(1.0, std::abs(l.t_end))) on_row = tg.brk = true;
+      if (!on_row) targets.push_back({l.t_end, false, true});
+    }
+  }
+  std::sort(targets.begin(), targets.end(), [](const Target& a, const Target& b) { return a.t < b.t; });
+
+  SimulationResult res;
+  res.states.name = "redmax simulate states";
+  res.states.version = 1;
+  res.states.in_degrees = false;
+  res.states.labels = m.q_labels;
+  res.states.labels.insert(res.states.labels.end(), m.u_labels.begin(), m.u_labels.end());
+  for (const char* e : {"kinetic_energy", "potential_energy", "total_energy"}) res.states.labels.push_back(e);
+  const int nr = sys.model().nr();
+  std::vector<VecX> rows;
+  DynamicsWorkspace ws(sys.model());
+  double max_ke = 0.0;
+
+  auto record = [&](const State& s) -> bool {
+    const double K = sys.kineticEnergy(s, ws), V = sys.potentialEnergy(s, ws);
+    const State s_r = sys.expandState(s);
+    VecX row(2 * nr + 3);
+    row << s_r.q, s_r.qdot, K, V, K + V;
+    if (!row.allFinite()) {
+      std::ostringstream os;
+      os << "non-finite energy at t = " << s.t << " s";
+      res.failed = true;
+      res.failure = os.str();
+      res.failure_time = s.t;
+      return false;
+    }
+    if (rows.empty()) res.energy_initial = K + V;
+    res.energy_final = K + V;
+    max_ke = std::max(max_ke, K);
+    res.energy_drift_abs = std::max(res.energy_drift_abs, std::abs(K + V - res.energy_initial));
+    res.states.time.push_back(s.t);
+    rows.push_back(row);
+    if (options.check) {
+      const std::string why = options.check(s, K, V);
+      if (!why.empty()) {
+        res.failed = true;
+        res.failure = why;
+        res.failure_time = s.t;
+        return false;
+      }
+    }
+    return true;
+  };
+
+  auto add_stats = [&](const IntegratorStats& st) {
+    res.stats.steps += st.steps;
+    res.stats.rhs_evals += st.rhs_evals;
+    res.stats.jacobian_evals += st.jacobian_evals;
+    res.stats.reparameterizations += st.reparameterizations;
+    res.stats.failed_steps += st.failed_steps;
+  };
+
+  const auto start = std::chrono::steady_clock::now();
+  State s = initial;
+  checkAdvanceArguments(sys, s, t1, "simulate");
+  bool ok = record(s);
+  bool restart = false;
+  for (size_t k = 0; ok && k < targets.size(); ++k) {
+    if (restart) {
+      // a new adaptive integrator after a breakpoint: no dense output across the switch
+      add_stats(integ->stats());
+      integ = makeIntegrator(options.integrator, options.integrator_options);
+      restart = false;
+    }
+    try {
+      integ->advance(sys, s, targets[k].t);
+    } catch (const SimulationError& e) {
+      res.failed = true;
+      res.failure = nameCoordinates(m, e.what());
+      res.failure_time = e.time;
+      res.failure_step = e.step;
+      break;
+    }
+    restart = adaptive && targets[k].brk;
+    if (!targets[k].row) continue;
+    ok = record(s);
+    if (options.on_row) options.on_row(s.t);
+  }
+  add_stats(integ->stats());
+  if (res.failed && res.failure_step == 0.0) res.failure_step = adaptive ? 0.0 : dt;
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  res.final_state = s;
+  const double scale = std::max(std::abs(res.energy_initial), max_ke);
+  res.energy_drift_rel = scale > 0.0 ? res.energy_drift_abs / scale : 0.0;
+  res.states.data.resize(static_cast<Eigen::Index>(rows.size()), 2 * nr + 3);
+  for (size_t r = 0; r < rows.size(); ++r) res.states.data.row(static_cast<Eigen::Index>(r)) = rows[r].transpose();
+  return res;
+}
+
+}  // namespace redmax::validation
