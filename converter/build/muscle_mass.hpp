@@ -5,11 +5,18 @@
 //   none           the model as OpenSim sees it (muscles lumped into the bones).
 //   physiological  m = density * (max_isometric_force / specific_tension) * optimal_fiber_length
 //                  (PCSA * l_opt * rho). Each mass point's mass is removed from the body it was
-//                  lumped into: the body of the path point nearest to it along the path at the
-//                  default pose. The point's default-pose position, expressed in that body, is
-//                  subtracted exactly (mass, centre of mass, inertia by the parallel-axis theorem),
-//                  so total mass and whole-body centre of mass at the default pose are unchanged
-//                  to round-off.
+//                  lumped into: among the bodies with mass on the tree path between the bodies of
+//                  the muscle's path points (its span, ground excluded), the one whose bone is
+//                  nearest to the point at the default pose, a body's bone being the segments from
+//                  its origin to its centre of mass and to its child bodies' origins. (Segment
+//                  masses such as de Leva's count all tissue inside the segment: a point of the
+//                  vasti beside the femur belongs to the femur although the vasti have no path
+//                  point on it. The nearest path point along the path would hand half of a
+//                  straight soleus to the foot.) The point's default-pose position, expressed in
+//                  that body, is subtracted exactly (mass, centre of mass, inertia by the
+//                  parallel-axis theorem), so total mass and whole-body centre of mass at the
+//                  default pose are unchanged to round-off, and so is the inertia of any rigid
+//                  motion of the whole model there.
 //   transfer       fraction F of one body's mass moves into the muscles that span it (those with
 //                  a path point on it, narrowed by `muscles`), split in proportion to their
 //                  physiological masses; the body's mass and its inertia about its centre of mass
@@ -87,8 +94,9 @@ struct MuscleMassModel {
 };
 
 /// Apply the options to a description. `samples` are coordinate vectors in the core's q order
-/// (e.g. frames of the trial) over which top:K ranks muscles; top:K without samples ranks at the
-/// default pose. Throws ConvertError (FILE:LINE of the offending element) for a body that would
+/// (e.g. frames of the trial) over which top:K ranks muscles (at most 100 of them, evenly spaced,
+/// are used); top:K without samples ranks at the default pose. The result's build always has the
+/// muscles built (whatever build_options.muscles says): they carry the mass. Throws ConvertError (FILE:LINE of the offending element) for a body that would
 /// become non-physical (negative or zero mass with inertia left, inertia not positive
 /// semi-definite, triangle inequality broken), an unknown transfer body, a transfer body no
 /// selected muscle spans, and std::invalid_argument for bad options (regex, counts, ranges).
