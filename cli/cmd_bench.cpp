@@ -9,7 +9,9 @@
 #include <vector>
 
 #include "cli/args.hpp"
+#include "converter/error.hpp"
 #include "plugin/simbody/speed_comparison.hpp"
+#include "validation/id_speed.hpp"
 #include "validation/scenes/humanoid.hpp"
 #include "validation/scenes/scenes.hpp"
 
@@ -41,12 +43,28 @@ std::vector<std::string> splitList(const std::string& s) {
 }
 
 int runBench(const std::vector<std::string>& argv) {
-  Args a(argv, {"scene", "repeats", "batches", "json", "integrators", "spherical", "dt"}, {});
+  Args a(argv, {"scene", "repeats", "batches", "json", "integrators", "spherical", "dt", "id-setup", "id-model"}, {});
   if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
   const long repeats = a.getInt("repeats", 200);
   const long batches = a.getInt("batches", 5);
   if (repeats < 1 || repeats > 100000000) throw UsageError{"--repeats must be between 1 and 1e8"};
   if (batches < 1 || batches > 1000) throw UsageError{"--batches must be between 1 and 1000"};
+
+  // inverse dynamics on a real trial, both engines (validation/id_speed.hpp)
+  if (a.has("id-model") && !a.has("id-setup")) throw UsageError{"--id-model needs --id-setup"};
+  if (auto setup = a.get("id-setup")) {
+    validation::IdSpeedOptions o;
+    o.settings.setup_file = *setup;
+    if (auto m = a.get("id-model")) o.settings.model_file = *m;
+    o.batches = static_cast<int>(batches);
+    try {
+      std::cout << validation::formatIdSpeed(validation::timeIdEngines(o));
+    } catch (const osim::ConvertError& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 2;
+    }
+    if (!a.has("scene")) return 0;
+  }
 
   simbody::SpeedOptions opt;
   opt.dt = a.getDouble("dt", 1e-3);
@@ -101,6 +119,7 @@ CommandRegistration reg(
     {"bench", "time the core against Simbody on built-in scenes (ratios)",
      "usage: redmax bench [--scene NAME[,NAME...]|all] [--repeats N] [--batches B] [--json OUT]\n"
      "                    [--integrators LIST|none] [--spherical gimbal|ball] [--dt S]\n"
+     "       redmax bench --id-setup ID_SETUP.xml [--id-model M.osim] [--batches B] [--scene ...]\n"
      "Times, on the same tree and state, each core operation next to Simbody's equivalent:\n"
      "  kinematics        calcKinematics                     vs realize(Velocity)\n"
      "  mass_matrix       calcSkeletonMass                   vs calcM\n"
@@ -118,6 +137,12 @@ CommandRegistration reg(
      "  --integrators comma-separated subset of euler,bdf1,sdirk2,rk45,cvode (default all), or none\n"
      "  --spherical   map spherical joints to Simbody Gimbal (u = qdot, default) or Ball (Euler angles)\n"
      "  --dt          integrator step / reporting interval in seconds (default 0.001)\n"
+     "  --id-setup    time inverse dynamics on a real trial instead (an InverseDynamicsTool setup;\n"
+     "                --id-model overrides its model): microseconds per frame of each engine on the\n"
+     "                same processed inputs (fastest of --batches passes over all frames), the ratio,\n"
+     "                and the wall time of a whole `redmax id` run against its frame count. Where\n"
+     "                Debian's Simbody rejects an inertia (gait2392's toes) both engines are timed\n"
+     "                with OpenSim's isotropic fallback for it. Scenes run too only if --scene is given.\n"
      "Timing only: nothing here is checked for correctness (see plugin_tests for the cross-checks).\n",
      runBench});
 

@@ -1,0 +1,122 @@
+#include "validation/id_speed.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "converter/build/inertia_fallback.hpp"
+#include "converter/id/core_id_engine.hpp"
+#include "converter/storage.hpp"
+#include "plugin/simbody/id_engine.hpp"
+#include "plugin/simbody/simbody_options.hpp"
+
+namespace redmax::validation {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+struct Frame {
+  double t = 0;
+  VecX q, v, vdot;
+  std::vector<osim::IdLoadSample> loads;
+};
+
+// fastest of `batches` solves of every frame, seconds
+double timeEngine(osim::IdEngine& engine, const std::vector<Frame>& frames, int batches) {
+  VecX tau;
+  double best = std::numeric_limits<double>::infinity();
+  for (int b = 0; b < batches; ++b) {
+    const auto t0 = Clock::now();
+    for (const Frame& f : frames) engine.calcGeneralizedForces(f.t, f.q, f.v, f.vdot, f.loads, tau);
+    best = std::min(best, since(t0));
+  }
+  return best;
+}
+
+}  // namespace
+
+IdSpeedResult timeIdEngines(const IdSpeedOptions& options) {
+  IdSpeedResult r;
+  const osim::IdToolConfig config = osim::resolveIdSettings(options.settings);
+  r.model = config.model_file;
+
+  // the whole `redmax id` run: read and process, solve with the core, write
+  const auto t_setup = Clock::now();
+  const osim::InverseDynamicsTool tool(config);
+  r.setup_seconds = since(t_setup);
+  {
+    const auto t0 = Clock::now();
+    osim::CoreIdEngine engine(tool.model(), tool.engineOptions());
+    const osim::Storage out = tool.run(engine);
+    const auto tmp = std::filesystem::temp_directory_path() /
+                     ("redmax_id_speed_" + std::to_string(std::random_device{}()) + ".sto");
+    osim::writeStorage(tmp.string(), out);
+    std::filesystem::remove(tmp);
+    r.whole_run_seconds = r.setup_seconds + since(t0);
+  }
+
+  r.frames = tool.numFrames();
+  r.dofs = static_cast<int>(tool.model().nr());
+  std::vector<Frame> frames(static_cast<size_t>(r.frames));
+  for (int k = 0; k < r.frames; ++k) {
+    Frame& f = frames[static_cast<size_t>(k)];
+    f.t = tool.frameTime(k);
+    tool.calcInputs(f.t, f.q, f.v, f.vdot, f.loads);
+  }
+  const int batches = std::max(1, options.batches);
+
+  // both engines on the same model; Debian's Simbody rejects some inertias OpenSim keeps, and
+  // then both get OpenSim's isotropic fallback (converter/build/inertia_fallback.hpp)
+  Model model = tool.model();
+  std::unique_ptr<osim::IdEngine> simbody;
+  if (options.simbody) {
+    try {
+      simbody = std::make_unique<simbody::SimbodyIdEngine>(model, tool.engineOptions());
+    } catch (const simbody::SimbodyBuildError& e) {
+      const auto replaced = osim::applyOpenSimInertiaFallback(model);
+      if (replaced.empty()) {
+        r.simbody_note = std::string("Simbody cannot build the model: ") + e.what();
+      } else {
+        simbody = std::make_unique<simbody::SimbodyIdEngine>(model, tool.engineOptions());
+        r.simbody_note = "both engines timed with OpenSim's isotropic fallback inertia on";
+        for (const auto& b : replaced) r.simbody_note += " " + b;
+      }
+    }
+  } else {
+    r.simbody_note = "not requested";
+  }
+  osim::CoreIdEngine core(model, tool.engineOptions());
+  const double n = std::max(1, r.frames);
+  r.core_us_per_frame = 1e6 * timeEngine(core, frames, batches) / n;
+  if (simbody) r.simbody_us_per_frame = 1e6 * timeEngine(*simbody, frames, batches) / n;
+  return r;
+}
+
+std::string formatIdSpeed(const IdSpeedResult& r) {
+  char buf[1024];
+  std::string s;
+  std::snprintf(buf, sizeof buf, "inverse dynamics on %s: %d frames, %d DoF\n", r.model.c_str(), r.frames, r.dofs);
+  s += buf;
+  if (r.simbody_us_per_frame > 0)
+    std::snprintf(buf, sizeof buf, "  per frame (fastest batch): core %.2f us, Simbody %.2f us, ratio core/Simbody %.3f\n",
+                  r.core_us_per_frame, r.simbody_us_per_frame, r.ratio());
+  else
+    std::snprintf(buf, sizeof buf, "  per frame (fastest batch): core %.2f us, Simbody -\n", r.core_us_per_frame);
+  s += buf;
+  if (!r.simbody_note.empty()) s += "  note: " + r.simbody_note + "\n";
+  std::snprintf(buf, sizeof buf,
+                "  whole `redmax id` run (read, process, solve with core, write): %.3f s = %.3f s setup + %.2f ms "
+                "for %d frames (%.0f frames/s after setup)\n",
+                r.whole_run_seconds, r.setup_seconds, 1e3 * (r.whole_run_seconds - r.setup_seconds), r.frames,
+                r.whole_run_seconds > r.setup_seconds ? r.frames / (r.whole_run_seconds - r.setup_seconds) : 0.0);
+  s += buf;
+  return s;
+}
+
+}  // namespace redmax::validation
