@@ -1,0 +1,52 @@
+#pragma once
+// Forward dynamics of muscle inertia in Simbody: every mass point a becomes a particle (a
+// MobilizedBody::Translation from Ground carrying a point mass m_a), and each muscle gets one
+// holonomic Constraint::Custom with 3N equations that keeps its particles at their path positions:
+//   perr   = x_p - x_a(x)                       (x: the active path points, Simbody stations)
+//   pverr  = v_p - J_ax xdot                    [D Eq. 5.4]
+//   paerr  = a_p - (J_ax xddot + Jdot_ax xdot)  [D Eq. 5.5]
+// with the path maps of core/muscles/path_map.hpp; the constraint forces are G^T lambda: lambda_a on
+// particle a and -(J_ax^T lambda)_i at path point i. Eliminating the particles recovers the core's
+// M += m_a J_ar^T J_ar, f += J_ar^T m_a (g - Jdot_ar qdot) [D Eq. 5.6-5.7], so the trajectories agree
+// (Simbody's gravity force acts on the particles as on any body).
+//
+// Limits: fixed path points only (a conditional point would change the constraint's bodies, a
+// moving one needs its coordinate as a constrained mobilizer); such muscles are rejected. Muscles
+// without mass points are skipped.
+#include <vector>
+
+#include "plugin/simbody/model_to_simbody.hpp"
+
+#include "core/muscles/mass_points.hpp"
+
+namespace redmax::simbody {
+
+/// Adds the particles and constraints to `sm` (before any state other than its default is made):
+/// realizes the topology again and replaces sm.default_state (Euler angles kept on). The particles'
+/// q and u come after the skeleton's in Simbody's vectors; sm.nq and sm.nu keep the skeleton's counts.
+class ParticleMuscles {
+ public:
+  /// Throws ModelError for a muscle that does not fit `model` (validateMuscle), SimbodyBuildError for
+  /// one with conditional or moving points.
+  ParticleMuscles(SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles);
+
+  /// Put every particle at its mass point's position and velocity for the skeleton state already in
+  /// `sb` (q and u of the skeleton set, e.g. by setSimbodyState): the constraints then hold exactly.
+  void placeParticles(SimTK::State& sb) const;
+
+  /// The skeleton's core state (t, q, qdot = T^-1 u) from a state of the system with particles
+  /// (model_to_simbody.hpp's getCoreState expects the skeleton's u alone).
+  State coreState(const Model& model, const SimTK::State& sb) const;
+
+  int numParticles() const { return static_cast<int>(particles_.size()); }
+  /// particle k (muscles in order, their mass points in order)
+  const SimTK::MobilizedBody& particle(int k) const { return particles_.at(k); }
+
+ private:
+  const SimbodyModel& sm_;
+  std::vector<Muscle> muscles_;
+  std::vector<SimTK::MobilizedBody> particles_;
+  std::vector<int> first_particle_;  // per muscle (-1 when it has no mass points)
+};
+
+}  // namespace redmax::simbody
