@@ -169,8 +169,8 @@ int runSimulate(const std::vector<std::string>& argv) {
   if (progress) progress->finish();
   if (res.failed) {
     std::cerr << "error: " << model_path << ": simulation failed: " << res.failure << "\n"
-              << "(" << res.states.numRows() - 1 << " output rows were reached; nothing written to " << out_path
-              << ")\n";
+              << "(the run reached t = " << (res.states.numRows() > 0 ? res.states.time.back() : initial.t)
+              << " s of " << initial.t + so.duration << " s; nothing written to " << out_path << ")\n";
     return 1;
   }
 

@@ -130,12 +130,17 @@ SimulationModel makeSimulationModel(const osim::ModelDescription& d, const Simul
   if (explicit_mass && options.muscle_mass.source != osim::MuscleMassOptions::Source::None)
     throw std::invalid_argument("--muscle-mass-kg excludes a --muscle-mass source other than none");
   if (options.muscle_mass.source != osim::MuscleMassOptions::Source::None) {
-    // TODO(simulate): applyMuscleMass once converter/build/muscle_mass.cpp lands
-    throw std::invalid_argument("--muscle-mass physiological/transfer is not available yet (use none, or "
-                                "--muscle-mass-kg)");
+    // mass moves from the bodies into the muscles (converter/build/muscle_mass.hpp); top:K ranks at
+    // the default pose
+    osim::MuscleMassModel mm = osim::applyMuscleMass(d, options.build, options.muscle_mass);
+    m.description = std::move(mm.description);
+    m.build = std::move(mm.build);
+    m.mass_summary = osim::describeMuscleMass(mm.plan);
+  } else {
+    m.description = d;
+    m.build = osim::buildCoreModel(m.description, options.build);
   }
-  m.description = d;
-  m.build = osim::buildCoreModel(m.description, options.build);
+  if (options.gravity) m.build.model.gravity = *options.gravity;
   m.muscles = m.build.muscles;
 
   // explicit masses: added to the muscles, no body gives any

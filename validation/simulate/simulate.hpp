@@ -19,6 +19,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -58,6 +59,8 @@ struct SimulationModelOptions {
   /// keep the muscles' quadratic velocity vector (false: the dissertation's energy experiment 6.2.4)
   bool quadratic_velocity = true;
   std::vector<ImpulseSpec> impulses;
+  /// replaces the model's gravity (m/s^2, ground frame) when set, e.g. zero for a flick study
+  std::optional<Vec3> gravity;
   osim::BuildOptions build;  ///< constraints on by default
 };
 
