@@ -21,7 +21,9 @@
 //     neither end on the active side -> the wrap goes round the active (far) side. Tangent points
 //     are chosen by OpenSim's candidate table, then slid along the axis into the plane through
 //     P1, P2 and the apex; long wraps (> half turn) by OpenSim's sign test. Surface length is the
-//     helix sqrt((R theta)^2 + dz^2). With `single_wrap` false (several wrap objects on the path)
+//     helix sqrt((R theta)^2 + dz^2). OpenSim's slide test passes the point P2's axis projection
+//     as a line direction; when that projection is the origin (P2 at z = 0 exactly) r1 does not
+//     slide: reproduced. With `single_wrap` false (several wrap objects on the path)
 //     OpenSim's iterative tangency correction (0.1 degree, at most 100 passes, 2 mm sampling) runs.
 //   - Sphere: wraps only when both roots of the line-sphere intersection lie in (0, 1) (also with a
 //     quadrant); returns Wrapped (not Mandatory) unless the constrained test finds an
