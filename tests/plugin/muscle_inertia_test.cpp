@@ -22,6 +22,7 @@
 #include <string>
 
 #include "converter/build/build_core_model.hpp"
+#include "converter/build/muscle_mass.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/system.hpp"
@@ -257,6 +258,29 @@ TEST(SimbodyIdEngineMuscles, MatchesCoreOnProjectScenes) {
     const osim::BuildResult r = osim::buildCoreModel(d, bo);
     const std::vector<Muscle> muscles = withMass(r.muscles, sc.mass);
     EXPECT_EQ(compareEngines(d, r.model, muscles, 6, 5), 6);
+  }
+}
+
+// set F: gait10dof18musc (OpenSim's 2017 copy), with 20% and 80% of tibia_r's mass moved into the
+// muscles that span it (converter/build/muscle_mass.hpp), CustomJoints in Simbody-compatible form
+TEST(SimbodyIdEngineMuscles, MatchesCoreOnSetFWithTibiaTransfer) {
+  const std::string file = std::string(REDMAX_SHARED_DIR) +
+                           "/opensim/opensim-models@a26e12c/Pipelines/Gait10dof18musc/OutputReference/subject01.osim";
+  if (!std::filesystem::exists(file))
+    GTEST_SKIP() << "shared OpenSim data not found at " << file << "; this test needs set F's model";
+  const osim::ModelDescription d = osim::readOsimModel(file);
+  osim::BuildOptions bo;
+  bo.simbody_compat = true;
+  bo.constraints = false;
+  for (double fraction : {0.2, 0.8}) {
+    SCOPED_TRACE("tibia_r transfer " + std::to_string(fraction));
+    osim::MuscleMassOptions mo;
+    mo.source = osim::MuscleMassOptions::Source::Transfer;
+    mo.transfer_body = "tibia_r";
+    mo.transfer_fraction = fraction;
+    const osim::MuscleMassModel mm = osim::applyMuscleMass(d, bo, mo);
+    ASSERT_GT(mm.plan.total_muscle_mass, 0.0);
+    EXPECT_EQ(compareEngines(mm.description, mm.build.model, mm.build.muscles, 8, 17), 8);
   }
 }
 
