@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <ctime>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -261,6 +262,32 @@ TEST(SimbodyIdEngineMuscles, MatchesCoreOnProjectScenes) {
   }
 }
 
+// CPU time per inverse-dynamics call (printed, not asserted): Simbody with and without the muscles,
+// and the core with them
+void printIdCost(const Model& model, const std::vector<Muscle>& muscles) {
+  simbody::SimbodyIdEngine with(model, muscles), without(model);
+  System sys(model);
+  sys.addTerm(std::make_shared<MuscleTerm>(model, muscles));
+  DynamicsWorkspace ws(sys.model());
+  std::mt19937 rng(3);
+  const State s = randomState(model.nr(), rng);
+  const VecX qddot = VecX::Constant(model.nr(), 0.5);
+  VecX tau;
+  const int n = 300;
+  auto time = [&](auto&& f) {
+    const std::clock_t t0 = std::clock();
+    for (int k = 0; k < n; ++k) f();
+    return 1e6 * double(std::clock() - t0) / CLOCKS_PER_SEC / n;
+  };
+  const double t_with = time([&] { with.calcGeneralizedForces(0.0, s.q, s.qdot, qddot, {}, tau); });
+  const double t_without = time([&] { without.calcGeneralizedForces(0.0, s.q, s.qdot, qddot, {}, tau); });
+  const double t_core = time([&] { tau = sys.inverseDynamics(s, qddot, ws); });
+  int points = 0;
+  for (const Muscle& mu : muscles) points += mu.mass_points.size();
+  std::printf("  ID per call (%d mass points): simbody %.1f us with muscles, %.1f us without; core %.1f us with muscles\n",
+              points, t_with, t_without, t_core);
+}
+
 // set F: gait10dof18musc (OpenSim's 2017 copy), with 20% and 80% of tibia_r's mass moved into the
 // muscles that span it (converter/build/muscle_mass.hpp), CustomJoints in Simbody-compatible form
 TEST(SimbodyIdEngineMuscles, MatchesCoreOnSetFWithTibiaTransfer) {
@@ -281,6 +308,7 @@ TEST(SimbodyIdEngineMuscles, MatchesCoreOnSetFWithTibiaTransfer) {
     const osim::MuscleMassModel mm = osim::applyMuscleMass(d, bo, mo);
     ASSERT_GT(mm.plan.total_muscle_mass, 0.0);
     EXPECT_EQ(compareEngines(mm.description, mm.build.model, mm.build.muscles, 8, 17), 8);
+    if (fraction == 0.8) printIdCost(mm.build.model, mm.build.muscles);
   }
 }
 
