@@ -42,6 +42,50 @@ std::vector<std::string> takeReferences(const std::vector<std::string>& argv,
   return rest;
 }
 
+// "a,b c" -> {"a", "b", "c"}
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> list;
+  std::string cur;
+  for (char c : text + ",") {
+    if (c == ',' || c == ' ' || c == '\t') {
+      if (!cur.empty()) list.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  return list;
+}
+
+// the MUSCLE-MASS OPTIONS (DESIGN.md §3); in a sweep the transfer fraction comes from the sweep
+osim::MuscleMassOptions muscleMassOptions(const Args& a, bool sweep) {
+  osim::MuscleMassOptions o;
+  o.source = osim::parseMuscleMassSource(a.get("muscle-mass", "none"));
+  o.muscles = a.get("muscles", o.muscles);
+  if (a.has("mass-points")) o.mass_points = static_cast<int>(a.getInt("mass-points", o.mass_points));
+  o.specific_tension = a.getDouble("specific-tension", o.specific_tension);
+  o.density = a.getDouble("muscle-density", o.density);
+  o.transfer_body = a.get("transfer-body", "");
+  o.transfer_fraction = a.getDouble("transfer-fraction", 0.0);
+  const bool transfer = o.source == osim::MuscleMassOptions::Source::Transfer;
+  if (o.source == osim::MuscleMassOptions::Source::None) {
+    for (const char* f : {"muscles", "mass-points", "specific-tension", "muscle-density", "transfer-body",
+                          "transfer-fraction"})
+      if (a.has(f)) throw UsageError{std::string("--") + f + " needs --muscle-mass physiological or transfer"};
+  }
+  if (transfer && o.transfer_body.empty()) throw UsageError{"--muscle-mass transfer needs --transfer-body BODY"};
+  if (transfer && !sweep && !a.has("transfer-fraction"))
+    throw UsageError{"--muscle-mass transfer needs --transfer-fraction F (or --mass-sweep F1,F2,...)"};
+  if (!transfer && (a.has("transfer-body") || a.has("transfer-fraction")))
+    throw UsageError{"--transfer-body and --transfer-fraction need --muscle-mass transfer"};
+  if (o.mass_points < 1) throw UsageError{"--mass-points must be >= 1"};
+  if (!(o.specific_tension > 0)) throw UsageError{"--specific-tension must be > 0 (Pa)"};
+  if (!(o.density > 0)) throw UsageError{"--muscle-density must be > 0 (kg/m^3)"};
+  if (transfer && !sweep && !(o.transfer_fraction >= 0 && o.transfer_fraction < 1))
+    throw UsageError{"--transfer-fraction must be in [0, 1)"};
+  return o;
+}
+
 double nonNegative(const Args& a, const std::string& name, double fallback) {
   const double x = a.getDouble(name, fallback);
   if (x < 0) throw UsageError{"--" + name + " must be >= 0"};
@@ -53,8 +97,9 @@ int runValidate(const std::vector<std::string>& argv_in) {
   const std::vector<std::string> argv = takeReferences(argv_in, opt.references);
   const Args a(argv,
                {"setup", "model", "coordinates", "external-loads", "lowpass", "t0", "t1", "report",
-                "forces-to-exclude", "muscle-mass", "tolerance", "max-tolerance", "engine-tolerance",
-                "interpolation", "gnuplot"},
+                "forces-to-exclude", "muscle-mass", "muscles", "mass-points", "specific-tension",
+                "muscle-density", "transfer-body", "transfer-fraction", "mass-sweep", "sweep-columns",
+                "tolerance", "max-tolerance", "engine-tolerance", "interpolation", "gnuplot"},
                {"exact", "opensim-compat", "quiet", "no-simbody", "no-plots"});
   if (!a.positionals().empty())
     throw UsageError{"validate takes no positional arguments (got '" + a.positionals().front() + "')"};
@@ -72,24 +117,25 @@ int runValidate(const std::vector<std::string>& argv_in) {
   if (a.has("t1")) s.t1 = a.getDouble("t1", 0.0);
   if (s.t0 && s.t1 && *s.t0 > *s.t1) throw UsageError{"--t0 is after --t1"};
   if (auto v = a.get("forces-to-exclude")) {
-    std::vector<std::string> list;
-    std::string cur;
-    for (char c : *v + ",") {
-      if (c == ',' || c == ' ' || c == '\t') {
-        if (!cur.empty()) list.push_back(cur);
-        cur.clear();
-      } else {
-        cur += c;
-      }
-    }
-    s.forces_to_exclude = list;
+    s.forces_to_exclude = splitList(*v);
   }
   if (a.has("exact") && a.has("opensim-compat"))
     throw UsageError{"--exact and --opensim-compat exclude each other"};
   s.opensim_compat = !a.has("exact");
-  const std::string mm = a.get("muscle-mass", "none");
-  if (mm != "none")
-    throw UsageError{"--muscle-mass " + mm + " is not available in `redmax validate` yet (only none)"};
+  // muscle mass: one extra core run ("inertial effect") or, with --mass-sweep, a sweep
+  if (a.has("mass-sweep")) {
+    if (!a.has("muscle-mass") || a.get("muscle-mass", "none") == "none")
+      throw UsageError{"--mass-sweep needs --muscle-mass transfer (fractions) or physiological (scales)"};
+    if (a.has("transfer-fraction"))
+      throw UsageError{"--mass-sweep gives the transfer fractions; leave out --transfer-fraction"};
+    opt.mass_sweep = validation::parseMassSweepValues(*a.get("mass-sweep"));
+  } else if (a.has("sweep-columns")) {
+    throw UsageError{"--sweep-columns needs --mass-sweep"};
+  }
+  opt.muscle_mass = muscleMassOptions(a, !opt.mass_sweep.empty());
+  if (!opt.mass_sweep.empty())
+    opt.mass_sweep = validation::checkMassSweepValues(opt.muscle_mass, opt.mass_sweep);
+  if (auto v = a.get("sweep-columns")) opt.sweep_columns = splitList(*v);
 
   // the report and the comparisons
   opt.report_dir = a.get("report", "");
@@ -118,6 +164,10 @@ int runValidate(const std::vector<std::string>& argv_in) {
   } catch (const validation::CompareError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
+  } catch (const std::invalid_argument& e) {
+    // bad muscle-mass options the model rejects (an unknown body, a regular expression)
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
   } catch (const osim::IdEngineError& e) {
     std::cerr << "error: " << s.coordinates_file.value_or(s.setup_file) << ": " << e.what() << "\n";
     return 1;
@@ -143,6 +193,7 @@ CommandRegistration reg(
      "                 [--reference OPENSIM_ID.sto]... [--published ID.sto]...\n"
      "                 [--tolerance REL] [--max-tolerance REL] [--engine-tolerance REL]\n"
      "                 [--interpolation linear|cubic] [--no-simbody] [--no-plots] [--gnuplot PATH]\n"
+     "                 [MUSCLE-MASS OPTIONS] [--mass-sweep V1,V2,... [--sweep-columns LIST]]\n"
      "                 [--quiet] --report DIR\n"
      "Processes the inputs once, as `redmax id` does (see `redmax id --help` for the input flags),\n"
      "solves every frame with the core engine and with the Simbody engine, and compares:\n"
@@ -160,6 +211,22 @@ CommandRegistration reg(
      "of each engine: frames, seconds, frames per second), <cmp>_metrics.csv, <cmp>_series.csv,\n"
      "overlay and difference plots (gnuplot; skipped with a note when absent or --no-plots),\n"
      "overlay_all (every series), core_id.sto and simbody_id.sto (full precision), report.md.\n"
+     "Muscle mass (MUSCLE-MASS OPTIONS as in DESIGN.md: --muscle-mass none|physiological|transfer,\n"
+     "--muscles all|REGEX|top:K, --mass-points N, --specific-tension PA, --muscle-density KG_M3,\n"
+     "--transfer-body BODY, --transfer-fraction F). Simbody has no muscle inertia, so the comparisons\n"
+     "above always use the zero-mass core. With muscle mass the core solves the trial again and\n"
+     "the per-column difference from the zero-mass core is reported as the inertial effect\n"
+     "(inertial_effect.csv, an overlay, core_mass_id.sto, summary.inertial_effect), never a failure.\n"
+     "--mass-sweep V1,V2,...  solve once per value on the same processed inputs: transfer fractions\n"
+     "                       in [0, 1) with --muscle-mass transfer --transfer-body BODY (e.g.\n"
+     "                       0,0.2,0.4,0.6,0.8), or scales >= 0 of the physiological mass with\n"
+     "                       --muscle-mass physiological (e.g. 0,0.25,0.5,1); 0 is added if absent.\n"
+     "                       Writes mass_sweep_tau_<v>.csv per value, mass_sweep_peaks.csv (peak\n"
+     "                       |tau| and its change), mass_sweep_fit.csv (R^2 of tau(s) - tau(0)\n"
+     "                       against s), plots mass_sweep_torques (--sweep-columns, default ankle,\n"
+     "                       knee and hip of the transfer side) and mass_sweep_peak_change, and\n"
+     "                       summary.mass_sweep. Only its zero check (the value 0 reproduces the\n"
+     "                       zero-mass result to 1e-12 of each column's peak) can fail the run.\n"
      "Prints one line per engine and per comparison (worst column, PASS/FAIL).\n"
      "Exit codes: 0 every comparison passed, 1 a comparison failed (or a frame could not be solved,\n"
      "or the report could not be written), 2 bad input or usage.\n",

@@ -3,9 +3,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "converter/id/core_id_engine.hpp"
 #include "plugin/simbody/id_engine.hpp"
@@ -46,6 +48,93 @@ std::string fmt(const char* f, double x) {
   return buf;
 }
 
+// an engine's result at full precision beside the report
+void writeResult(const std::string& dir, const std::string& file, const osim::Storage& s) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  osim::StorageWriteOptions wo;
+  wo.scientific = true;
+  wo.decimals = 16;
+  try {
+    osim::writeStorage((std::filesystem::path(dir) / file).string(), s, wo);
+  } catch (const osim::ConvertError& e) {
+    throw ReportError(dir, e.what());
+  }
+}
+
+JsonValue jnum(double x) { return std::isfinite(x) ? JsonValue(x) : JsonValue(); }
+
+// the core with muscle mass (a) against the zero-mass core (b), per column, into the report: a
+// measurement, so the metrics are written as a table and a section, not as a comparison
+void addInertialEffect(InertialEffect& ie, const osim::Storage& mass, const osim::Storage& zero,
+                       const osim::Storage* simbody, Report& report) {
+  CompareOptions co;
+  co.align.grid_table = 1;
+  const double inf = std::numeric_limits<double>::infinity();
+  co.tolerance = {inf, inf, inf, inf};
+  const Comparison c = compareTables("inertial_effect", mass, "core_mass", zero, "core", co);
+  ie.metrics = c.metrics;
+  ie.largest = -1;
+  for (size_t k = 0; k < ie.metrics.size(); ++k)
+    if (ie.largest < 0 || ie.metrics[k].max_rel > ie.metrics[static_cast<size_t>(ie.largest)].max_rel)
+      ie.largest = static_cast<int>(k);
+
+  CsvTable t;
+  t.header = {"column", "peak_zero_mass", "rms", "max_abs", "t_max_abs", "rms_rel", "max_rel", "mean"};
+  for (const ColumnMetrics& m : ie.metrics)
+    t.addRow(m.name, {m.peak_ref, m.rms, m.max_abs, m.t_max_abs, m.rms_rel, m.max_rel, m.mean});
+  report.addTable("inertial_effect", t,
+                  "core with muscle mass minus zero-mass core, per column (relative to the zero-mass peak); "
+                  "a measurement, not a failure");
+
+  JsonValue& js = report.section("inertial_effect");
+  js["source"] = osim::toString(ie.options.source);
+  if (ie.options.source == osim::MuscleMassOptions::Source::Transfer) {
+    js["transfer_body"] = ie.options.transfer_body;
+    js["transfer_fraction"] = ie.options.transfer_fraction;
+  }
+  js["muscle_mass_kg"] = ie.muscle_mass;
+  js["muscles_with_mass"] = ie.muscles_with_mass;
+  js["seconds"] = ie.seconds;
+  js["note"] = "core with muscle mass vs the zero-mass core; Simbody has no muscle inertia and is the zero-mass "
+               "reference; reported, never a failure";
+  JsonValue& cols = js["columns"] = JsonValue::object();
+  for (const ColumnMetrics& m : ie.metrics) {
+    JsonValue& o = cols[m.name] = JsonValue::object();
+    o["peak_zero_mass"] = m.peak_ref;
+    o["rms"] = m.rms;
+    o["max_abs"] = m.max_abs;
+    o["t_max_abs"] = m.t_max_abs;
+    o["rms_rel"] = jnum(m.rms_rel);
+    o["max_rel"] = jnum(m.max_rel);
+  }
+  if (ie.largest >= 0) js["largest_column"] = ie.metrics[static_cast<size_t>(ie.largest)].name;
+
+  // overlay: with mass, zero mass, Simbody (zero mass)
+  std::vector<const Table*> all = {&mass, &zero};
+  std::vector<std::string> names = {"core_mass", "core"};
+  if (simbody) {
+    all.push_back(simbody);
+    names.push_back("simbody");
+  }
+  report.addOverlay("inertial_effect_overlay", alignTables(all, names),
+                    "inverse dynamics with and without muscle mass", "generalized force [N m or N]");
+
+  std::ostringstream md;
+  md << "The core solved the trial again with " << fmt("%.4g", ie.muscle_mass) << " kg in the mass points of "
+     << ie.muscles_with_mass << " muscles (" << osim::toString(ie.options.source);
+  if (ie.options.source == osim::MuscleMassOptions::Source::Transfer)
+    md << ", " << fmt("%g", 100 * ie.options.transfer_fraction) << "% of " << ie.options.transfer_body;
+  md << "). Simbody has no muscle inertia: it is the zero-mass reference. Differences from the zero-mass "
+        "core are the inertial effect, not failures.\n\n| column | zero-mass peak | max diff | max / peak | "
+        "RMS / peak |\n|---|---|---|---|---|\n";
+  for (const ColumnMetrics& m : ie.metrics)
+    md << "| `" << m.name << "` | " << fmt("%.4g", m.peak_ref) << " | " << fmt("%.4g", m.max_abs) << " | "
+       << fmt("%.3g", m.max_rel) << " | " << fmt("%.3g", m.rms_rel) << " |\n";
+  if (!ie.description.empty()) md << "\n```\n" << ie.description << "```\n";
+  report.addMarkdown("Inertial effect", md.str());
+}
+
 }  // namespace
 
 IdValidationResult runIdValidation(const IdValidationOptions& opt) {
@@ -60,6 +149,24 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
   if (!opt.loads_working_dir.empty()) config.loads_working_dir = opt.loads_working_dir;
   const osim::InverseDynamicsTool tool(config);
   r.warnings = tool.warnings();
+
+  // muscle-mass options are checked before any engine runs (bad options are bad input): the
+  // engine of the largest mass is built once here
+  const bool mass_run = opt.muscle_mass.source != osim::MuscleMassOptions::Source::None;
+  if (!opt.mass_sweep.empty() && !mass_run)
+    throw std::invalid_argument("--mass-sweep needs --muscle-mass transfer or physiological");
+  MassSweepEngineFactory mass_factory;
+  MassSweepEngine mass_engine;
+  std::vector<double> sweep_values;
+  if (mass_run) {
+    mass_factory = makeCoreMassEngineFactory(tool);
+    if (!opt.mass_sweep.empty()) {
+      sweep_values = checkMassSweepValues(opt.muscle_mass, opt.mass_sweep);
+      mass_factory(massOptionsForValue(opt.muscle_mass, sweep_values.back()));
+    } else {
+      mass_engine = mass_factory(opt.muscle_mass);
+    }
+  }
 
   // references are read before any engine runs, so a bad file is reported at once
   std::vector<osim::Storage> refs;
@@ -102,6 +209,20 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
   tol["reference_max_rel"] = std::isfinite(opt.reference_max_rel) ? JsonValue(opt.reference_max_rel) : JsonValue("unlimited");
   tol["reference_abs"] = opt.reference_abs;
   report.setInput("tolerances", tol);
+  if (mass_run) {
+    JsonValue m = JsonValue::object();
+    m["source"] = osim::toString(opt.muscle_mass.source);
+    m["muscles"] = opt.muscle_mass.muscles;
+    m["mass_points"] = opt.muscle_mass.mass_points;
+    m["specific_tension_pa"] = opt.muscle_mass.specific_tension;
+    m["density_kg_m3"] = opt.muscle_mass.density;
+    if (opt.muscle_mass.source == osim::MuscleMassOptions::Source::Transfer) {
+      m["transfer_body"] = opt.muscle_mass.transfer_body;
+      if (opt.mass_sweep.empty()) m["transfer_fraction"] = opt.muscle_mass.transfer_fraction;
+    }
+    if (!opt.mass_sweep.empty()) m["sweep_values"] = sweep_values;
+    report.setInput("muscle_mass", m);
+  }
 
   // the core engine: a failure here is the run failing (IdEngineError propagates)
   IdEngineRun core_run;
@@ -204,21 +325,44 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
     }
   }
 
+  // muscle mass: one extra core run (inertial effect) or a sweep; Simbody stays the zero-mass
+  // reference, so nothing here changes the comparisons above
+  if (mass_run && opt.mass_sweep.empty()) {
+    r.has_inertial_effect = true;
+    InertialEffect& ie = r.inertial_effect;
+    ie.options = opt.muscle_mass;
+    ie.muscle_mass = mass_engine.muscle_mass;
+    ie.muscles_with_mass = mass_engine.muscles_with_mass;
+    ie.description = mass_engine.description;
+    IdEngineRun mass_run_info;
+    mass_run_info.name = "core_mass";
+    osim::Storage mass_result = runEngine(tool, *mass_engine.engine, mass_run_info, opt.progress);
+    ie.seconds = mass_run_info.seconds;
+    report.addWallTime("core_mass", ie.seconds);
+    addInertialEffect(ie, mass_result, core_result, sb_run.ran ? &sb_result : nullptr, report);
+    mass_result.name = osim::kIdStorageName;
+    writeResult(opt.report_dir, "core_mass_id.sto", mass_result);
+  }
+  if (!opt.mass_sweep.empty()) {
+    r.has_mass_sweep = true;
+    MassSweepOptions so;
+    so.base = opt.muscle_mass;
+    so.values = sweep_values;
+    so.main_columns = opt.sweep_columns;
+    so.progress = opt.progress;
+    r.mass_sweep = runMassSweep(tool, core_result, so, mass_factory);
+    double secs = 0;
+    for (const auto& p : r.mass_sweep.points) secs += p.seconds;
+    report.addWallTime("mass_sweep", secs);
+    addMassSweepToReport(r.mass_sweep, core_result, report);
+  }
+
   // the engines' own results, at full precision, beside the report
-  std::error_code ec;
-  std::filesystem::create_directories(opt.report_dir, ec);
-  osim::StorageWriteOptions wo;
-  wo.scientific = true;
-  wo.decimals = 16;
-  try {
-    core_result.name = osim::kIdStorageName;
-    osim::writeStorage((std::filesystem::path(opt.report_dir) / "core_id.sto").string(), core_result, wo);
-    if (sb_run.ran) {
-      sb_result.name = osim::kIdStorageName;
-      osim::writeStorage((std::filesystem::path(opt.report_dir) / "simbody_id.sto").string(), sb_result, wo);
-    }
-  } catch (const osim::ConvertError& e) {
-    throw ReportError(opt.report_dir, e.what());
+  core_result.name = osim::kIdStorageName;
+  writeResult(opt.report_dir, "core_id.sto", core_result);
+  if (sb_run.ran) {
+    sb_result.name = osim::kIdStorageName;
+    writeResult(opt.report_dir, "simbody_id.sto", sb_result);
   }
 
   std::ostringstream md;
@@ -262,6 +406,19 @@ std::string formatIdValidationSummary(const IdValidationResult& r) {
     if (!c.only_in_b.empty()) os << "; " << c.only_in_b.size() << " only in " << c.label_b;
     os << " -> " << (c.passed ? "PASS" : "FAIL") << "\n";
   }
+  if (r.has_inertial_effect) {
+    const InertialEffect& ie = r.inertial_effect;
+    os << "inertial effect (" << osim::toString(ie.options.source);
+    if (ie.options.source == osim::MuscleMassOptions::Source::Transfer)
+      os << " " << fmt("%g", 100 * ie.options.transfer_fraction) << "% of " << ie.options.transfer_body;
+    os << ", " << fmt("%.4g", ie.muscle_mass) << " kg in " << ie.muscles_with_mass << " muscles)";
+    if (ie.largest >= 0) {
+      const ColumnMetrics& m = ie.metrics[static_cast<size_t>(ie.largest)];
+      os << ": largest " << m.name << " max/peak " << fmt("%.3g", m.max_rel) << " rms/peak " << fmt("%.3g", m.rms_rel);
+    }
+    os << " (measured, not pass/fail)\n";
+  }
+  if (r.has_mass_sweep) os << formatMassSweepSummary(r.mass_sweep);
   os << "validate: " << (r.passed ? "PASS" : "FAIL") << "\n";
   return os.str();
 }

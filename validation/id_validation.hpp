@@ -11,12 +11,22 @@
 // with each engine's wall time (frames, seconds, frames per second) in summary.speed.
 // If the Simbody engine cannot build the model, the reason is recorded (summary.engines.simbody)
 // and validation continues with core only; that alone does not fail the run.
+//
+// Muscle mass (issue 6). Simbody has no muscle inertia: it stays the zero-mass reference, and the
+// comparisons above always use the zero-mass core. With IdValidationOptions::muscle_mass set, the
+// core is also solved with that muscle mass and its difference from the zero-mass core is
+// reported per column as the "inertial effect" (summary.inertial_effect, inertial_effect.csv, an
+// overlay, core_mass_id.sto): a measurement, never a failure. With mass_sweep values, the core is
+// solved once per value instead (validation/mass_sweep.hpp; summary.mass_sweep); only the sweep's
+// zero check (the value 0 reproduces the zero-mass result) can fail.
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "converter/build/muscle_mass.hpp"
 #include "converter/id/inverse_dynamics_tool.hpp"
 #include "validation/compare/metrics.hpp"
+#include "validation/mass_sweep.hpp"
 #include "validation/report/report.hpp"
 
 namespace redmax::validation {
@@ -44,6 +54,24 @@ struct IdValidationOptions {
   Interpolation interpolation = Interpolation::Linear;
   std::string gnuplot;  ///< Report's hint: "" auto, "none" no plots, or a path
   bool progress = false;  ///< progress lines on stderr while the engines run
+  /// muscle mass of the core's extra run (Source::None: none); with mass_sweep, the sweep's base
+  osim::MuscleMassOptions muscle_mass;
+  /// non-empty: a muscle-mass sweep over these values (mass_sweep.hpp) instead of one extra run
+  std::vector<double> mass_sweep;
+  /// columns the sweep's figures show (empty: chooseMainColumns)
+  std::vector<std::string> sweep_columns;
+};
+
+/// The core with muscle mass against the zero-mass core: per-column differences (a = with mass,
+/// b = zero mass; rms_rel and max_rel relative to the zero-mass peak). Not pass/fail.
+struct InertialEffect {
+  osim::MuscleMassOptions options;
+  double muscle_mass = 0;      ///< kg in mass points
+  int muscles_with_mass = 0;
+  std::string description;     ///< osim::describeMuscleMass
+  double seconds = 0;          ///< solving every frame with mass
+  std::vector<ColumnMetrics> metrics;  ///< every column, table order
+  int largest = -1;            ///< the column with the largest max_rel (-1 if none)
 };
 
 /// Wall time of one engine over the trial.
@@ -63,10 +91,15 @@ struct IdValidationResult {
   std::vector<std::string> warnings;     ///< the tool's warnings and the harness's own
   ReportFiles files;
   bool passed = false;                   ///< every comparison and check passed
+  bool has_inertial_effect = false;      ///< options.muscle_mass set without a sweep
+  InertialEffect inertial_effect;
+  bool has_mass_sweep = false;           ///< options.mass_sweep given
+  MassSweepResult mass_sweep;
 };
 
 /// Run the validation and write the report into opt.report_dir.
-/// Throws osim::ConvertError (bad model, coordinates, loads, setup or reference file) and
+/// Throws osim::ConvertError (bad model, coordinates, loads, setup or reference file, muscle-mass
+/// options the model rejects), std::invalid_argument (bad muscle-mass options or sweep values) and
 /// CompareError (a reference with no common column or no overlapping time): bad input, exit 2.
 /// Throws osim::IdEngineError when the core cannot solve a frame, ReportError when the report
 /// cannot be written: the run failed, exit 1. A Simbody engine that fails on a frame is recorded
@@ -74,7 +107,8 @@ struct IdValidationResult {
 IdValidationResult runIdValidation(const IdValidationOptions& opt);
 
 /// The short summary `redmax validate` prints: one line per engine (frames, seconds, frames/s),
-/// one per comparison (worst column, its RMS/peak and max/peak, PASS/FAIL), then the verdict.
+/// one per comparison (worst column, its RMS/peak and max/peak, PASS/FAIL), the inertial effect or
+/// the mass sweep when run, then the verdict.
 std::string formatIdValidationSummary(const IdValidationResult& r);
 
 }  // namespace redmax::validation
