@@ -1,9 +1,11 @@
 #include "plugin/simbody/particle_muscles.hpp"
 
+#include <algorithm>
 #include <map>
 
 #include <Eigen/LU>
 
+#include "core/muscles/path_kinematics.hpp"
 #include "core/muscles/path_map.hpp"
 
 namespace redmax::simbody {
@@ -13,33 +15,56 @@ namespace {
 SimTK::Vec3 toSimTKVec3(const Vec3& v) { return SimTK::Vec3(v.x(), v.y(), v.z()); }
 Vec3 fromSimTKVec3(const SimTK::Vec3& v) { return Vec3(v[0], v[1], v[2]); }
 
-// one muscle's 3N holonomic equations x_p - x_a(x) = 0 (header)
+// one muscle's 3N holonomic equations x_p - x_a(x) = 0 (header). A moving point x_b(q_c) in body b
+// reads q_c, qdot_c, qddot_c through its coordinate's mobilizer (a constrained mobilizer):
+//   x = X_AB x_b,  xdot = v_station + R x_b' qdot_c,
+//   xddot = a_station + 2 w x (R x_b' qdot_c) + R (x_b'' qdot_c^2 + x_b' qddot_c),
+// and its constraint force gets the q-force (R x_b')^T F on q_c.
 class PathConstraint : public SimTK::Constraint::Custom::Implementation {
  public:
+  // point_bodies: per path point; coord_mobods: per path point, the mobilizer of a moving point's
+  // coordinate (or null) and the coordinate's index within it
   PathConstraint(SimTK::SimbodyMatterSubsystem& matter, const Muscle& mu,
                  const std::vector<SimTK::MobilizedBody>& point_bodies,
+                 const std::vector<const SimTK::MobilizedBody*>& coord_mobods, const std::vector<int>& coord_in_mobod,
                  const std::vector<SimTK::MobilizedBody>& particles)
-      : Implementation(matter, 3 * mu.mass_points.size(), 0, 0), mp_(mu.mass_points), name_(mu.name) {
-    // a body carrying several points is one constrained body
+      : Implementation(matter, 3 * mu.mass_points.size(), 0, 0),
+        points_(mu.path.points), mp_(mu.mass_points), name_(mu.name) {
+    // a body (mobilizer) carrying several points (coordinates) is constrained once
     std::map<int, SimTK::ConstrainedBodyIndex> cb_of;
-    for (size_t i = 0; i < point_bodies.size(); ++i) {
+    std::map<int, SimTK::ConstrainedMobilizerIndex> cm_of;
+    const int P = static_cast<int>(point_bodies.size());
+    cm_.resize(P);
+    mq_.resize(P);
+    for (int i = 0; i < P; ++i) {
       const int b = point_bodies[i].getMobilizedBodyIndex();
       auto it = cb_of.find(b);
       if (it == cb_of.end()) it = cb_of.emplace(b, addConstrainedBody(point_bodies[i])).first;
       point_cb_.push_back(it->second);
-      station_.push_back(toSimTKVec3(mu.path.points[i].location));
+      if (!coord_mobods[i]) continue;
+      const int c = coord_mobods[i]->getMobilizedBodyIndex();
+      auto jt = cm_of.find(c);
+      if (jt == cm_of.end()) jt = cm_of.emplace(c, addConstrainedMobilizer(*coord_mobods[i])).first;
+      cm_[i] = jt->second;
+      mq_[i] = SimTK::MobilizerQIndex(coord_in_mobod[i]);
     }
     for (const SimTK::MobilizedBody& p : particles) particle_cb_.push_back(addConstrainedBody(p));
-    x_.resize(point_cb_.size());
-    xdot_.resize(point_cb_.size());
+    x_.resize(P);
+    xdot_.resize(P);
+    x_b_.resize(P);
+    dx_b_.resize(P);
+    ddx_b_.resize(P);
   }
 
   Implementation* clone() const override { return new PathConstraint(*this); }
 
-  void calcPositionErrors(const SimTK::State&, const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>& X_AB,
-                          const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+  void calcPositionErrors(const SimTK::State& s, const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>& X_AB,
+                          const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& cq,
                           SimTK::Array_<SimTK::Real>& perr) const override {
-    for (size_t i = 0; i < x_.size(); ++i) x_[i] = fromSimTKVec3(findStationLocation(X_AB, point_cb_[i], station_[i]));
+    for (size_t i = 0; i < x_.size(); ++i) {
+      locate(i, moving(i) ? getOneQ(s, cq, cm_[i], mq_[i]) : 0.0);
+      x_[i] = fromSimTKVec3(findStationLocation(X_AB, point_cb_[i], toSimTKVec3(x_b_[i])));
+    }
     calcPathMap(x_, nullptr, mp_, map_, name_);
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& p = X_AB[particle_cb_[a]].p();
@@ -48,11 +73,16 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   }
 
   void calcPositionDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& V_AB,
-                             const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                             const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& cqdot,
                              SimTK::Array_<SimTK::Real>& pverr) const override {
     for (size_t i = 0; i < x_.size(); ++i) {
-      x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station_[i]));
-      xdot_[i] = fromSimTKVec3(findStationVelocity(s, V_AB, point_cb_[i], station_[i]));
+      locate(i, moving(i) ? getOneQFromState(s, cm_[i], mq_[i]) : 0.0);
+      const SimTK::Vec3 station = toSimTKVec3(x_b_[i]);
+      x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station));
+      SimTK::Vec3 v = findStationVelocity(s, V_AB, point_cb_[i], station);
+      if (moving(i))
+        v += getBodyRotationFromState(s, point_cb_[i]) * toSimTKVec3(dx_b_[i]) * getOneQDot(s, cqdot, cm_[i], mq_[i]);
+      xdot_[i] = fromSimTKVec3(v);
     }
     calcPathMap(x_, nullptr, mp_, map_, name_);
     // xdot_a = J_ax xdot [D Eq. 5.4]
@@ -64,13 +94,26 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   }
 
   void calcPositionDotDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& A_AB,
-                                const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                                const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& cqddot,
                                 SimTK::Array_<SimTK::Real>& paerr) const override {
     VecX xddot(3 * static_cast<int>(x_.size()));
     for (size_t i = 0; i < x_.size(); ++i) {
-      x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station_[i]));
-      xdot_[i] = fromSimTKVec3(findStationVelocityFromState(s, point_cb_[i], station_[i]));
-      xddot.segment<3>(3 * static_cast<int>(i)) = fromSimTKVec3(findStationAcceleration(s, A_AB, point_cb_[i], station_[i]));
+      locate(i, moving(i) ? getOneQFromState(s, cm_[i], mq_[i]) : 0.0);
+      const SimTK::Vec3 station = toSimTKVec3(x_b_[i]);
+      x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station));
+      SimTK::Vec3 v = findStationVelocityFromState(s, point_cb_[i], station);
+      SimTK::Vec3 acc = findStationAcceleration(s, A_AB, point_cb_[i], station);
+      if (moving(i)) {
+        const SimTK::Rotation& R = getBodyRotationFromState(s, point_cb_[i]);
+        const double qd = getOneQDotFromState(s, cm_[i], mq_[i]);
+        const double qdd = getOneQDotDot(s, cqddot, cm_[i], mq_[i]);
+        const SimTK::Vec3 v_rel = R * toSimTKVec3(dx_b_[i]) * qd;
+        v += v_rel;
+        acc += 2.0 * SimTK::cross(getBodyAngularVelocityFromState(s, point_cb_[i]), v_rel) +
+               R * toSimTKVec3(ddx_b_[i] * qd * qd + dx_b_[i] * qdd);
+      }
+      xdot_[i] = fromSimTKVec3(v);
+      xddot.segment<3>(3 * static_cast<int>(i)) = fromSimTKVec3(acc);
     }
     calcPathMap(x_, &xdot_, mp_, map_, name_);
     // a_a = J_ax xddot + Jdot_ax xdot [D Eq. 5.5]
@@ -83,8 +126,11 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
 
   void addInPositionConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& lambda,
                                      SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& bodyForcesInA,
-                                     SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&) const override {
-    for (size_t i = 0; i < x_.size(); ++i) x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station_[i]));
+                                     SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qForces) const override {
+    for (size_t i = 0; i < x_.size(); ++i) {
+      locate(i, moving(i) ? getOneQFromState(s, cm_[i], mq_[i]) : 0.0);
+      x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], toSimTKVec3(x_b_[i])));
+    }
     calcPathMap(x_, nullptr, mp_, map_, name_);
     // G^T lambda with G = (I on the particles, -J_ax on the path points)
     VecX l(3 * mp_.size());
@@ -92,16 +138,37 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
     for (int a = 0; a < mp_.size(); ++a)
       addInStationForce(s, particle_cb_[a], SimTK::Vec3(0), toSimTKVec3(l.segment<3>(3 * a)), bodyForcesInA);
     const VecX F = -(map_.J_ax.transpose() * l);
-    for (size_t i = 0; i < x_.size(); ++i)
-      addInStationForce(s, point_cb_[i], station_[i], toSimTKVec3(F.segment<3>(3 * static_cast<int>(i))), bodyForcesInA);
+    for (size_t i = 0; i < x_.size(); ++i) {
+      const SimTK::Vec3 Fi = toSimTKVec3(F.segment<3>(3 * static_cast<int>(i)));
+      addInStationForce(s, point_cb_[i], toSimTKVec3(x_b_[i]), Fi, bodyForcesInA);
+      // a moving point's column through its coordinate: (R x_b')^T F
+      if (moving(i))
+        addInOneQForce(s, cm_[i], mq_[i], ~(getBodyRotationFromState(s, point_cb_[i]) * toSimTKVec3(dx_b_[i])) * Fi, qForces);
+    }
   }
 
  private:
+  bool moving(size_t i) const { return cm_[i].isValid(); }
+  // x_b and its derivatives along the coordinate, for the coordinate's value q_c (moving points)
+  void locate(size_t i, double q_c) const {
+    const PathPoint& p = points_[i];
+    if (p.kind != PathPointKind::Moving || p.coordinate < 0) {
+      calcPointLocation(p, VecX(), x_b_[i], dx_b_[i], ddx_b_[i]);
+      return;
+    }
+    if (q_.size() <= p.coordinate) q_.setZero(p.coordinate + 1);
+    q_[p.coordinate] = q_c;
+    calcPointLocation(p, q_, x_b_[i], dx_b_[i], ddx_b_[i]);
+  }
+
+  std::vector<PathPoint> points_;
   MassPoints mp_;
   std::string name_;
   std::vector<SimTK::ConstrainedBodyIndex> point_cb_, particle_cb_;
-  std::vector<SimTK::Vec3> station_;
-  mutable std::vector<Vec3> x_, xdot_;
+  std::vector<SimTK::ConstrainedMobilizerIndex> cm_;  // per point; invalid for non-moving points
+  std::vector<SimTK::MobilizerQIndex> mq_;
+  mutable std::vector<Vec3> x_, xdot_, x_b_, dx_b_, ddx_b_;
+  mutable VecX q_;  // scratch core q holding only the coordinate being evaluated
   mutable PathMap map_;
 };
 
@@ -116,9 +183,9 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
       continue;
     }
     for (const PathPoint& p : mu.path.points)
-      if (p.kind != PathPointKind::Fixed)
+      if (p.kind == PathPointKind::Conditional)
         throw SimbodyBuildError("muscle '" + mu.name + "': point '" + p.name +
-                                "' is conditional or moving; Simbody particles support fixed path points only");
+                                "' is conditional; Simbody particles support fixed and moving path points only");
     for (double m : mu.mass_points.mass)
       if (!(m > 0.0))
         throw SimbodyBuildError("muscle '" + mu.name + "': a mass point without mass cannot be a Simbody particle");
@@ -133,9 +200,24 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
       particles_.push_back(p);
     }
     std::vector<SimTK::MobilizedBody> point_bodies;
-    for (const PathPoint& p : mu.path.points)
+    std::vector<const SimTK::MobilizedBody*> coord_mobods;
+    std::vector<int> coord_in_mobod;
+    for (const PathPoint& p : mu.path.points) {
       point_bodies.push_back(p.body >= 0 ? sm.mobods[p.body] : SimTK::MobilizedBody(sm.matter.updGround()));
-    SimTK::Constraint::Custom(new PathConstraint(sm.matter, mu, point_bodies, mine));
+      // a moving point's coordinate: the mobilizer holding it (Simbody q = core q, Euler angles)
+      const SimTK::MobilizedBody* mob = nullptr;
+      int k_in = 0;
+      if (p.kind == PathPointKind::Moving && p.coordinate >= 0)
+        for (size_t j = 0; j < sm.map.size(); ++j) {
+          const MobilizerMap& mm = sm.map[j];
+          if (p.coordinate < mm.q_index || p.coordinate >= mm.q_index + mm.nq) continue;
+          mob = &sm.mobods[j];
+          k_in = p.coordinate - mm.q_index;
+        }
+      coord_mobods.push_back(mob);
+      coord_in_mobod.push_back(k_in);
+    }
+    SimTK::Constraint::Custom(new PathConstraint(sm.matter, mu, point_bodies, coord_mobods, coord_in_mobod, mine));
   }
   // the topology changed: a new default state, Euler angles on as makeSimbodyModel sets them
   try {
@@ -150,6 +232,17 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
 void ParticleMuscles::placeParticles(SimTK::State& sb) const {
   sm_.system.realize(sb, SimTK::Stage::Velocity);
   std::vector<SimTK::Vec3> x_p(particles_.size()), v_p(particles_.size());
+  // the skeleton's q and qdot in core order (Simbody q = core q with Euler angles)
+  const SimTK::Vector& q_sb = sm_.matter.getQ(sb);
+  const SimTK::Vector& qdot_sb = sm_.matter.getQDot(sb);
+  int nr = 0;
+  for (const MobilizerMap& mm : sm_.map) nr = std::max(nr, mm.q_index + mm.nq);
+  VecX q(nr), qdot(nr);
+  for (const MobilizerMap& mm : sm_.map)
+    for (int k = 0; k < mm.nq; ++k) {
+      q[mm.q_index + k] = q_sb[mm.simbody_q + k];
+      qdot[mm.q_index + k] = qdot_sb[mm.simbody_q + k];
+    }
   PathMap map;
   for (size_t m = 0; m < muscles_.size(); ++m) {
     if (first_particle_[m] < 0) continue;
@@ -157,8 +250,14 @@ void ParticleMuscles::placeParticles(SimTK::State& sb) const {
     std::vector<Vec3> x, xdot;
     for (const PathPoint& p : mu.path.points) {
       const SimTK::MobilizedBody& B = p.body >= 0 ? sm_.mobods[p.body] : sm_.matter.getGround();
-      x.push_back(fromSimTKVec3(B.findStationLocationInGround(sb, toSimTKVec3(p.location))));
-      xdot.push_back(fromSimTKVec3(B.findStationVelocityInGround(sb, toSimTKVec3(p.location))));
+      Vec3 x_b, dx_b, ddx_b;
+      calcPointLocation(p, q, x_b, dx_b, ddx_b);
+      x.push_back(fromSimTKVec3(B.findStationLocationInGround(sb, toSimTKVec3(x_b))));
+      SimTK::Vec3 v = B.findStationVelocityInGround(sb, toSimTKVec3(x_b));
+      // moving point: R x_b' qdot_c
+      if (p.kind == PathPointKind::Moving && p.coordinate >= 0)
+        v += B.getBodyRotation(sb) * toSimTKVec3(dx_b) * qdot[p.coordinate];
+      xdot.push_back(fromSimTKVec3(v));
     }
     calcPathMap(x, &xdot, mu.mass_points, map, mu.name);
     const VecX xdot_a = map.J_ax * stackPoints(xdot);

@@ -10,9 +10,11 @@
 // M += m_a J_ar^T J_ar, f += J_ar^T m_a (g - Jdot_ar qdot) [D Eq. 5.6-5.7], so the trajectories agree
 // (Simbody's gravity force acts on the particles as on any body).
 //
-// Limits: fixed path points only (a conditional point would change the constraint's bodies, a
-// moving one needs its coordinate as a constrained mobilizer); such muscles are rejected. Muscles
-// without mass points are skipped.
+// A moving point x_b(q_c) makes its coordinate's mobilizer a constrained mobilizer: its position,
+// velocity and acceleration gain the terms of muscle_inertia.hpp, its force a q-force (R x_b')^T F.
+// Limits: conditional points are rejected (switching would change the path, and the particles'
+// velocities would have to jump); so is a mass point without mass. Muscles without mass points are
+// skipped.
 #include <vector>
 
 #include "plugin/simbody/model_to_simbody.hpp"
@@ -27,7 +29,7 @@ namespace redmax::simbody {
 class ParticleMuscles {
  public:
   /// Throws ModelError for a muscle that does not fit `model` (validateMuscle), SimbodyBuildError for
-  /// one with conditional or moving points.
+  /// one with conditional points or a massless mass point.
   ParticleMuscles(SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles);
 
   /// Put every particle at its mass point's position and velocity for the skeleton state already in

@@ -4,7 +4,8 @@
 // joint, 0.6 kg and 0.8 kg over 5 points each), released from a swinging state: q agrees to 1e-6
 // (radians) at t = 0.25, 0.5, 0.75 and 1 s, with tolerances well below that (core rtol 1e-11,
 // Simbody accuracy 1e-10, constraint tolerance 1e-11); without the muscles q differs by > 1e-2 at
-// 1 s, so the agreement is the muscles'. CPU times of both are printed (not asserted).
+// 1 s, so the agreement is the muscles'. Also a Type II muscle (no mass point crossing its via point)
+// and moving points (functions of q1 and q2, on link1 and on the world). CPU times of both are printed (not asserted).
 #include "plugin/simbody/particle_muscles.hpp"
 
 #include <gtest/gtest.h>
@@ -164,7 +165,58 @@ TEST(SimbodyParticleMuscles, DoublePendulumTypeIIMatchesCoreRk45) {
   std::printf("  Type II particles vs core rk45 over 1 s: max |dq| %.3e rad\n", worst);
 }
 
-TEST(SimbodyParticleMuscles, RejectsMovingAndConditionalPoints) {
+// moving points: a Type I muscle whose origin on link1 moves with q2 (a line and a cubic), and one
+// from a world point that moves with q1 to link2; their coordinates become constrained mobilizers
+TEST(SimbodyParticleMuscles, DoublePendulumMovingPointsMatchCoreRk45) {
+  const Model m = scenes::doublePendulum();
+  MassPointOptions opt;
+  opt.count = 5;
+  opt.region = MassPointOptions::Region::WholePath;
+  auto line = std::make_shared<LinearFunction>(0.03, 0.08);
+  auto cubic = std::make_shared<PolynomialFunction>(std::vector<double>{0.02, -0.03, 0.01, -0.8});
+  Muscle a;
+  a.name = "moving_on_link1";
+  a.path.points = {makeMovingPoint(0, 1, {line, cubic, nullptr}), makeFixedPoint(1, Vec3(0.05, -0.5, 0.0))};
+  a.mass_points = makeMassPoints(0.6, 1.0, 0.0, opt);
+  Muscle b;
+  b.name = "moving_world";
+  b.path.points = {makeMovingPoint(-1, 0, {line, nullptr, nullptr}, Vec3(0.0, 0.1, 0.02)),
+                   makeFixedPoint(1, Vec3(-0.04, -0.3, 0.0))};
+  b.mass_points = makeMassPoints(0.5, 1.0, 0.0, opt);
+  const std::vector<Muscle> muscles{a, b};
+  State s0;
+  s0.t = 0.0;
+  s0.q = Vec2(0.6, -0.7);
+  s0.qdot = Vec2(-0.3, 0.5);
+
+  double core_s = 0.0, plain_s = 0.0;
+  const std::vector<VecX> q_core = coreTrajectory(m, muscles, s0, core_s);
+  const std::vector<VecX> q_plain = coreTrajectory(m, {}, s0, plain_s);
+  auto sm = simbody::makeSimbodyModel(m);
+  simbody::ParticleMuscles particles(*sm, m, muscles);
+  SimTK::State st = sm->default_state;
+  simbody::setSimbodyState(*sm, m, s0, st);
+  particles.placeParticles(st);
+  sm->system.realize(st, SimTK::Stage::Velocity);
+  EXPECT_LT(st.getQErr().normInf(), 1e-14);
+  EXPECT_LT(st.getUErr().normInf(), 1e-13);
+  SimTK::RungeKuttaMersonIntegrator integ(sm->system);
+  integ.setAccuracy(1e-10);
+  integ.setConstraintTolerance(1e-11);
+  SimTK::TimeStepper ts(sm->system, integ);
+  ts.initialize(st);
+  double worst = 0.0;
+  for (size_t k = 0; k < kTimes.size(); ++k) {
+    ts.stepTo(kTimes[k]);
+    const State s = particles.coreState(m, ts.getState());
+    worst = std::max(worst, (s.q - q_core[k]).cwiseAbs().maxCoeff());
+    EXPECT_LT((s.q - q_core[k]).cwiseAbs().maxCoeff(), 1e-6) << "t = " << kTimes[k];
+  }
+  EXPECT_GT((q_core.back() - q_plain.back()).cwiseAbs().maxCoeff(), 1e-2);
+  std::printf("  moving points, particles vs core rk45 over 1 s: max |dq| %.3e rad\n", worst);
+}
+
+TEST(SimbodyParticleMuscles, RejectsConditionalPoints) {
   const Model m = scenes::doublePendulum();
   auto sm = simbody::makeSimbodyModel(m);
   std::vector<Muscle> muscles = pendulumMuscles();
