@@ -22,8 +22,11 @@
 #include <random>
 #include <string>
 
+#include <Eigen/LU>
+
 #include "converter/build/build_core_model.hpp"
 #include "converter/build/muscle_mass.hpp"
+#include "converter/id/core_id_engine.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/system.hpp"
@@ -194,6 +197,55 @@ TEST(SimbodyMuscleInertia, MasslessMusclesAddNothingAndBadMusclesThrow) {
   // a point on a body the model does not have
   mu.path.points.back().body = 5;
   EXPECT_THROW(simbody::MuscleInertia(*sm, m, {mu}), ModelError);
+}
+
+// OpenSim's Euler-rate speeds (IdEngineOptions::rates_as_u) with muscles: for marked Ball/Free joints
+// the engine is given u and udot and answers conjugate to u. Reference: the core engine without
+// muscles (which converts to the core's qdot, qddot: lastState, lastQddot) plus the core MuscleTerm's
+// share at that (qdot, qddot), mapped per marked joint by tau_u = T^-T tau_qdot.
+TEST(SimbodyIdEngineMuscles, RatesAsUMatchesCoreOnRandomTrees) {
+  using scenes::TreeJoints;
+  std::mt19937 rng(99);
+  int marked_total = 0;
+  for (std::uint32_t seed : {5u, 41u, 77u}) {
+    const Model m = scenes::randomTree(7, seed, TreeJoints::SimbodyComparable);
+    osim::IdEngineOptions opt;
+    opt.rates_as_u.assign(m.nb(), false);
+    for (int j = 0; j < m.nb(); ++j) opt.rates_as_u[j] = osim::hasOpenSimSpeedMap(m.joints[j].joint);
+    for (int j = 0; j < m.nb(); ++j) marked_total += opt.rates_as_u[j] ? 1 : 0;
+    const State s_any = randomState(m.nr(), rng);
+    std::vector<Muscle> muscles{randomMuscle(m, 2, rng, s_any), randomMuscle(m, 6, rng, s_any)};
+    for (Muscle& mu : muscles) validateMuscle(m, mu);
+    simbody::SimbodyIdEngine sb_engine(m, muscles, opt);
+    osim::CoreIdEngine core_engine(m, opt);
+    const MuscleTerm term(m, muscles);
+    for (int k = 0; k < 3; ++k) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " state " + std::to_string(k));
+      const State s = randomState(m.nr(), rng);
+      const VecX vdot = VecX::NullaryExpr(m.nr(), [&] { return randomVec(rng, 3.0)[0]; });
+      VecX tau_sb, tau_core;
+      sb_engine.calcGeneralizedForces(0.0, s.q, s.qdot, vdot, {}, tau_sb);
+      core_engine.calcGeneralizedForces(0.0, s.q, s.qdot, vdot, {}, tau_core);
+      // the muscles' share in the core's convention, then conjugate to u on marked joints
+      VecX tau_mus;
+      try {
+        tau_mus = coreMuscleTau(m, term, core_engine.lastState(), core_engine.lastQddot());
+      } catch (const MuscleError&) {
+        continue;
+      }
+      for (int j = 0; j < m.nb(); ++j) {
+        if (!opt.marked(j)) continue;
+        const JointSlot& slot = m.joints[j];
+        MatJ T;
+        osim::calcOpenSimSpeedMap(slot.joint, s.q.segment(slot.q_index, slot.nq),
+                                  core_engine.lastState().qdot.segment(slot.q_index, slot.nq), T, nullptr);
+        tau_mus.segment(slot.q_index, slot.nq) =
+            T.transpose().partialPivLu().solve(VecJ(tau_mus.segment(slot.q_index, slot.nq)));
+      }
+      EXPECT_TRUE(closeToPeak(tau_sb, VecX(tau_core + tau_mus), kTol));
+    }
+  }
+  EXPECT_GT(marked_total, 0) << "no Ball/Free joint in the random trees: the test proves nothing";
 }
 
 // ---------------------------------------------------------------------------------------------
