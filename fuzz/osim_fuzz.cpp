@@ -1,12 +1,15 @@
 // Fuzz target for the .osim reader (converter/osim_reader.hpp) and, on what it returns, the core
 // builder (converter/build/build_core_model.hpp): a model that parses but is inconsistent must be
-// rejected with an exception, never crash the builder.
+// rejected with an exception, never crash the builder. A model that builds is also evaluated
+// (kinematics with J_mr and Jdot_mr at the default pose and a perturbed one): the functions and
+// joints the reader let through must not crash or hang there either (NaN results are allowed).
 #include <cstddef>
 #include <cstdint>
 #include <exception>
 
 #include "converter/build/build_core_model.hpp"
 #include "converter/osim_reader.hpp"
+#include "core/skeleton/kinematics.hpp"
 #include "fuzz/fuzz_common.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -24,7 +27,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     redmax::osim::BuildOptions opt;
     opt.simbody_compat = compat;
     try {
-      (void)redmax::osim::buildCoreModel(d, opt);
+      const redmax::osim::BuildResult r = redmax::osim::buildCoreModel(d, opt);
+      const redmax::Model& m = r.model;
+      redmax::VecX q(m.nr()), qdot = redmax::VecX::Ones(m.nr());
+      for (int k = 0; k < m.nr(); ++k) q[k] = m.coordinates[k].default_value;
+      redmax::SkeletonWorkspace ws(m);
+      redmax::calcKinematics(m, redmax::State{0.0, q, qdot}, ws);
+      q.array() += 0.5;
+      redmax::calcKinematics(m, redmax::State{0.0, q, qdot}, ws);
     } catch (const std::exception& e) {
       redmax::fuzz::acceptError(e);
     }

@@ -6,7 +6,8 @@
 //   TARGET [--seconds S] [--runs N] [--seed K] [--timeout S] [--max-len BYTES]
 //          [--crash-dir DIR] CORPUS_DIR_OR_FILE...
 //
-// A crash (signal), a hang (> --timeout seconds for one input) or an uncaught exception (abort
+// A crash (signal), a hang (> --timeout CPU seconds for one input: CPU time, so that a loaded
+// machine does not make a slow input look like a hang) or an uncaught exception (abort
 // through std::terminate) saves the input as CRASH_DIR/crash-<target>-<pid> and exits 1 with a
 // message; a clean finish prints the counts and exits 0. A file argument with no mutation budget
 // (--runs 0) just replays it, as libFuzzer does for a reproducer.
@@ -52,7 +53,7 @@ void writeAll(int fd, const char* p, std::size_t n) {
 
 void onSignal(int sig) {
   // async-signal-safe only: open/write/close/_exit
-  const char* what = sig == SIGALRM ? "hang (timeout)" : "crash (signal)";
+  const char* what = sig == SIGPROF ? "hang (timeout)" : "crash (signal)";
   writeAll(2, "\n==fuzz== ", 10);
   writeAll(2, what, std::strlen(what));
   if (g_in_input && g_current != nullptr) {
@@ -75,10 +76,10 @@ void runOne(const Bytes& in, double timeout_s) {
   itimerval t{};
   t.it_value.tv_sec = static_cast<time_t>(timeout_s);
   t.it_value.tv_usec = static_cast<suseconds_t>((timeout_s - static_cast<double>(t.it_value.tv_sec)) * 1e6);
-  ::setitimer(ITIMER_REAL, &t, nullptr);
+  ::setitimer(ITIMER_PROF, &t, nullptr);
   LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(in.data()), in.size());
   itimerval off{};
-  ::setitimer(ITIMER_REAL, &off, nullptr);
+  ::setitimer(ITIMER_PROF, &off, nullptr);
   g_in_input = 0;
 }
 
@@ -264,7 +265,7 @@ int main(int argc, char** argv) {
   const std::string target = std::filesystem::path(argv[0]).filename().string();
   std::snprintf(g_crash_path, sizeof g_crash_path, "%s/crash-%s-%d", crash_dir.c_str(),
                 target.c_str(), static_cast<int>(::getpid()));
-  for (int sig : {SIGSEGV, SIGABRT, SIGFPE, SIGBUS, SIGILL, SIGALRM}) ::signal(sig, onSignal);
+  for (int sig : {SIGSEGV, SIGABRT, SIGFPE, SIGBUS, SIGILL, SIGPROF}) ::signal(sig, onSignal);
 
   const auto t_start = std::chrono::steady_clock::now();
   auto elapsed = [&] {
