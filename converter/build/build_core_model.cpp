@@ -426,6 +426,42 @@ class Builder {
     return pp;
   }
 
+  // a PathWrap and the wrap object it names -> core PathWrap (surface frame pose in its body)
+  PathWrap makeWrap(const PathWrapDesc& pw, const std::string& what) const {
+    if (pw.wrap_index < 0 || pw.wrap_index >= static_cast<int>(d_.wrap_objects.size()))
+      throw ConvertError(d_.source_file, pw.line,
+                         what + ": wrap object " + quoted(pw.wrap_object) + " does not exist");
+    const WrapObjectDesc& wo = d_.wrap_objects[pw.wrap_index];
+    PathWrap w;
+    w.name = wo.name;
+    if (wo.body != d_.ground_name) {
+      auto it = core_body_.find(wo.body);
+      if (it == core_body_.end())
+        throw ConvertError(d_.source_file, wo.line,
+                           what + ": wrap object " + quoted(wo.name) + " is on unknown body " +
+                               quoted(wo.body));
+      w.body = it->second;
+    }
+    w.E_bs = wo.X_body;
+    const int axis = wo.quadrant_sign == 0 ? -1 : wo.quadrant_axis;
+    if (wo.type == "WrapCylinder")
+      w.surface = WrapSurface::makeCylinder(wo.radius, wo.length, axis, wo.quadrant_sign);
+    else if (wo.type == "WrapSphere")
+      w.surface = WrapSurface::makeSphere(wo.radius, axis, wo.quadrant_sign);
+    else if (wo.type == "WrapEllipsoid")
+      w.surface = WrapSurface::makeEllipsoid(wo.dimensions, axis, wo.quadrant_sign);
+    else
+      w.surface = WrapSurface::makeTorus(wo.inner_radius, wo.outer_radius, axis, wo.quadrant_sign);
+    w.surface.active = wo.active;
+    // OpenSim's PathWrap method: hybrid unless midpoint or axial
+    w.method = pw.method == "midpoint" ? WrapMethod::Midpoint
+               : pw.method == "axial"  ? WrapMethod::Axial
+                                       : WrapMethod::Hybrid;
+    w.range_begin = pw.range_begin;
+    w.range_end = pw.range_end;
+    return w;
+  }
+
   void buildMuscles() {
     for (size_t mi = 0; mi < d_.muscles.size(); ++mi) {
       const PathForceDesc& pf = d_.muscles[mi];
@@ -436,6 +472,7 @@ class Builder {
       m.tendon_slack_length = pf.tendon_slack_length;
       for (const PathPointDesc& p : pf.points) m.path.points.push_back(makePoint(p, what));
       m.path.num_wraps = static_cast<int>(pf.wraps.size());
+      for (const PathWrapDesc& pw : pf.wraps) m.path.wraps.push_back(makeWrap(pw, what));
       try {
         validateMuscle(r_.model, m);
       } catch (const ModelError& e) {

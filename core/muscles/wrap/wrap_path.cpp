@@ -1,6 +1,7 @@
 #include "core/muscles/wrap/wrap_path.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -37,6 +38,7 @@ class PathWrapper {
     results_.assign(nw, WrapResult{});
     used_.assign(nw, false);
     E_ws_.resize(nw);
+    ground_cache_.assign(nw, {});
     for (int k = 0; k < nw; ++k) E_ws_[k] = surfacePose(path.wraps[k], E_wi);
     point_w_.resize(path.points.size());
     active_.resize(path.points.size());
@@ -55,15 +57,29 @@ class PathWrapper {
     return applyPose(E_ws_[e.wrap], e.which == 1 ? r.r1 : r.r2);
   }
 
+  // OpenSim's Point::getLocationInGround: a tangent point's ground position is cached at its
+  // first use in one evaluation and not refreshed when a later pass moves the point (the cache
+  // depends on the state's position stage only), so lengths and length changes of later passes
+  // use the first position; the wrap geometry itself always uses the current one
+  Vec3 worldCached(const Entry& e) {
+    if (e.point >= 0) return point_w_[e.point];
+    auto& c = ground_cache_[e.wrap][e.which - 1];
+    if (!c.valid) {
+      c.x = world(e);
+      c.valid = true;
+    }
+    return c.x;
+  }
+
   // OpenSim's calcLengthAfterPathComputation
-  double length() const {
+  double length() {
     double l = 0.0;
     for (size_t i = 1; i < path_entries_.size(); ++i) {
       const Entry &a = path_entries_[i - 1], &b = path_entries_[i];
       if (a.wrap >= 0 && b.wrap >= 0 && a.wrap == b.wrap)
         l += results_[b.wrap].length;  // the surface length sits on the second tangent point
       else
-        l += (world(a) - world(b)).norm();
+        l += (worldCached(a) - worldCached(b)).norm();
     }
     return l;
   }
@@ -125,8 +141,10 @@ class PathWrapper {
         break;
       }
       if (wr.code == WrapCode::Wrapped) {
-        const double change =
-            (wr.r1 - x1).norm() + wr.length + (x2 - wr.r2).norm() - (x2 - x1).norm();
+        // OpenSim's calcPathLengthChange, with its ground positions of the segment's ends
+        const Vec3 c1 = worldCached(e1), c2 = worldCached(e2);
+        const Vec3 r1_w = applyPose(E_ws_[k], wr.r1), r2_w = applyPose(E_ws_[k], wr.r2);
+        const double change = (r1_w - c1).norm() + wr.length + (c2 - r2_w).norm() - (c2 - c1).norm();
         if (change < min_change) {
           best = std::move(wr);
           best_end = pt2;
@@ -195,6 +213,11 @@ class PathWrapper {
   std::vector<WrapResult> results_;
   std::vector<bool> used_;
   std::vector<Entry> path_entries_;
+  struct CachedPoint {
+    bool valid = false;
+    Vec3 x = Vec3::Zero();
+  };
+  std::vector<std::array<CachedPoint, 2>> ground_cache_;
 };
 
 }  // namespace

@@ -12,6 +12,12 @@
 //      pass 1, if object 0 gave NoWrap and object 1 InsideRadius, their order is swapped;
 //   4. length = sum of straight segments, except between the two tangent points of one surface,
 //      where the surface length l is added (OpenSim's sphere quirk included: l may be negative).
+// OpenSim quirk, reproduced in `length`: a tangent point's ground position is cached the first
+// time it is used in one evaluation (Point::getLocationInGround) and is not refreshed when a later
+// pass moves the point, so from the second pass on the straight segments touching it, and the
+// length changes of step 2, use its first position. Without this, subject_walk_armless's med_gas
+// (two cylinders) differs from OpenSim by up to 5.6 mm; with it, by < 1e-9 m. The points in
+// WrappedPath::points are the current (geometric) positions.
 // Points are taken to the surface frame through the world: x_s = E_bs^-1 E_wb^-1 E_wc x_c.
 #include <vector>
 
