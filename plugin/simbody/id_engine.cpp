@@ -127,7 +127,12 @@ void SimbodyIdEngine::calcGeneralizedForces(double t, const VecX& q, const VecX&
   sm.matter.calcResidualForceIgnoringConstraints(sb, mobility_forces, body_forces, udot_sb, f_u);
   // muscle mass points: their share of the residual, in the same u space
   if (m.muscles) {
-    m.muscles->calcGeneralizedForces(sb, udot_sb, m.f_muscles);
+    try {
+      m.muscles->calcGeneralizedForces(sb, udot_sb, m.f_muscles);
+    } catch (const MuscleError& e) {
+      // a degenerate path at this frame: the frame cannot be solved (IdEngine contract)
+      throw osim::IdEngineError("at t = " + std::to_string(t) + ": " + e.what());
+    }
     f_u += m.f_muscles;
   }
   const VecX fu = fromSimTK(f_u);

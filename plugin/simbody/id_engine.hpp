@@ -26,7 +26,9 @@ class SimbodyIdEngine final : public osim::IdEngine {
   /// without a Simbody counterpart, or a marked joint whose mobilizer has u = qdot (not Ball/Free).
   explicit SimbodyIdEngine(const Model& model, const osim::IdEngineOptions& options = {});
   /// The same, plus the inertia and weight of the mass points of `muscles` (muscles without mass
-  /// points add nothing). Throws ModelError for a muscle that does not fit the model (validateMuscle).
+  /// points add nothing). Throws ModelError for a muscle that does not fit the model (validateMuscle);
+  /// calcGeneralizedForces throws IdEngineError naming the muscle when its path degenerates at a frame
+  /// (e.g. coincident consecutive path points).
   SimbodyIdEngine(const Model& model, std::vector<Muscle> muscles, const osim::IdEngineOptions& options = {});
   ~SimbodyIdEngine() override;
   SimbodyIdEngine(const SimbodyIdEngine&) = delete;

@@ -248,6 +248,24 @@ TEST(SimbodyIdEngineMuscles, RatesAsUMatchesCoreOnRandomTrees) {
   EXPECT_GT(marked_total, 0) << "no Ball/Free joint in the random trees: the test proves nothing";
 }
 
+// a path that degenerates (origin and insertion at the same spot: link1's end is link2's origin) is
+// a frame the engine cannot solve: IdEngineError naming the muscle, no crash
+TEST(SimbodyIdEngineMuscles, DegeneratePathIsAnEngineError) {
+  const Model m = scenes::doublePendulum();
+  Muscle mu;
+  mu.name = "collapsed";
+  mu.path.points = {makeFixedPoint(0, Vec3(0, -1, 0)), makeFixedPoint(1, Vec3::Zero())};
+  mu.mass_points = makeMassPoints({0.5}, {0.1});
+  simbody::SimbodyIdEngine engine(m, {mu});
+  VecX tau;
+  try {
+    engine.calcGeneralizedForces(0.25, Vec2(0.1, 0.2), Vec2::Zero(), Vec2::Zero(), {}, tau);
+    ADD_FAILURE() << "no error";
+  } catch (const osim::IdEngineError& e) {
+    EXPECT_NE(std::string(e.what()).find("collapsed"), std::string::npos) << e.what();
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // engines on the project's scenes and on set F
 
