@@ -56,6 +56,13 @@ int runWorkPrecision(const std::vector<std::string>& argv) {
   if (auto s = a.get("scenes")) opt.scenes = splitList(*s);
   if (auto s = a.get("integrators")) opt.integrators = splitList(*s);
   opt.gnuplot = a.has("no-plots") ? "none" : a.get("gnuplot", "");
+  // the report folder must be creatable before the runs are spent
+  std::error_code ec;
+  fs::create_directories(*dir, ec);
+  if (ec || !fs::is_directory(*dir)) {
+    std::cerr << "error: " << *dir << ": cannot create the report directory" << (ec ? ": " + ec.message() : "") << "\n";
+    return 1;
+  }
   try {
     const auto res = validation::runWorkPrecision(*dir, opt, &std::cerr);
     for (const auto& s : res.scenes) {
@@ -89,7 +96,7 @@ CommandRegistration reg(
      "usage: redmax work-precision --report DIR [--quick] [--models DIR] [--scenes LIST] [--integrators LIST]\n"
      "                             [--gnuplot PATH|none] [--no-plots]\n"
      "\n"
-     "Runs every integrator (euler, symplectic, bdf1, sdirk2 over fixed steps 1e-2..1e-4 s; rk45, cvode over\n"
+     "Runs every integrator (euler, symplectic, bdf1, sdirk2 over fixed steps 1e-2..5e-5 s; rk45, cvode over\n"
      "rtol 1e-3..1e-10, atol = 1e-2 rtol) on the scenes pendulum_straight, pendulum_via, finger and running_leg\n"
      "(osim_models/, muscle mass on their Type I/II muscles) and measures the state error at the end against rk45 at rtol 1e-12, CPU\n"
      "time, right-hand-side evaluations and energy drift per simulated second. Diverged runs are marked.\n"
