@@ -7,6 +7,7 @@
 // 1 s, so the agreement is the muscles'. Also a Type II muscle (no mass point crossing its via point)
 // and moving points (functions of q1 and q2, on link1 and on the world). CPU times of both are printed (not asserted).
 #include "plugin/simbody/particle_muscles.hpp"
+#include "plugin/simbody/particle_simulation.hpp"
 
 #include <gtest/gtest.h>
 
@@ -214,6 +215,43 @@ TEST(SimbodyParticleMuscles, DoublePendulumMovingPointsMatchCoreRk45) {
   }
   EXPECT_GT((q_core.back() - q_plain.back()).cwiseAbs().maxCoeff(), 1e-2);
   std::printf("  moving points, particles vs core rk45 over 1 s: max |dq| %.3e rad\n", worst);
+}
+
+// the driver: energies of skeleton + particles equal the core's skeleton + MuscleTerm energies at the
+// start (1e-12 relative; potential energies share the world-origin reference), the total is
+// conserved over 1 s (1e-7 relative at accuracy 1e-10), and the end state equals the core's (1e-6)
+TEST(SimbodyParticleSimulation, EnergyMatchesCoreAndIsConserved) {
+  const Model m = scenes::doublePendulum();
+  const std::vector<Muscle> muscles = pendulumMuscles();
+  State s0;
+  s0.t = 0.0;
+  s0.q = Vec2(0.7, -0.5);
+  s0.qdot = Vec2(0.4, -0.3);
+  System sys(m);
+  sys.addTerm(std::make_shared<MuscleTerm>(m, muscles));
+  DynamicsWorkspace ws(sys.model());
+  const double T_core = sys.kineticEnergy(s0, ws), V_core = sys.potentialEnergy(s0, ws);
+
+  simbody::ParticleSimulationOptions opt;
+  opt.accuracy = 1e-10;
+  opt.constraint_tolerance = 1e-11;
+  simbody::ParticleSimulation sim(m, muscles, s0, opt);
+  EXPECT_NEAR(sim.kineticEnergy(), T_core, 1e-12 * (1.0 + std::abs(T_core)));
+  EXPECT_NEAR(sim.potentialEnergy(), V_core, 1e-12 * (1.0 + std::abs(V_core)));
+  const double E0 = sim.kineticEnergy() + sim.potentialEnergy();
+  double drift = 0.0;
+  for (double t : kTimes) {
+    sim.advance(t);
+    drift = std::max(drift, std::abs(sim.kineticEnergy() + sim.potentialEnergy() - E0));
+  }
+  EXPECT_LT(drift, 1e-7 * std::abs(E0));
+  double core_s = 0.0;
+  const std::vector<VecX> q_core = coreTrajectory(m, muscles, s0, core_s);
+  EXPECT_LT((sim.state().q - q_core.back()).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_GT(sim.steps(), 0);
+  EXPECT_THROW(sim.advance(0.5), std::invalid_argument);
+  EXPECT_THROW(simbody::ParticleSimulation(m, muscles, s0, {"euler", 1e-8, 1e-10}), std::invalid_argument);
+  std::printf("  particle simulation: energy drift %.3e J of %.3f J over 1 s, %ld steps\n", drift, E0, sim.steps());
 }
 
 TEST(SimbodyParticleMuscles, RejectsConditionalPoints) {
