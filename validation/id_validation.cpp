@@ -340,6 +340,26 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
     ie.seconds = mass_run_info.seconds;
     report.addWallTime("core_mass", ie.seconds);
     addInertialEffect(ie, mass_result, core_result, sb_run.ran ? &sb_result : nullptr, report);
+    // Simbody with muscle inertia on the same model and mass points: engines agree to round-off
+    if (sb_run.ran && mass_engine.model) {
+      IdEngineRun sbm;
+      sbm.name = "simbody_mass";
+      try {
+        simbody::SimbodyIdEngine sb(*mass_engine.model, mass_engine.muscles, tool.engineOptions());
+        osim::Storage sbm_result = runEngine(tool, sb, sbm, opt.progress);
+        ie.simbody_ran = true;
+        CompareOptions co;
+        co.tolerance = {opt.engine_abs, opt.engine_rel, opt.engine_abs, opt.engine_rel};
+        co.align.grid_table = 0;
+        co.missing_columns_fail = true;
+        r.comparisons.push_back(
+            compareTables("core_mass_vs_simbody_mass", mass_result, "core_mass", sbm_result, "simbody_mass", co));
+        report.addComparison(r.comparisons.back(), "generalized force [N m or N]");
+      } catch (const std::exception& e) {
+        ie.simbody_skipped = e.what();
+        report.addCheck("simbody with muscle inertia solves every frame", false, e.what());
+      }
+    }
     mass_result.name = osim::kIdStorageName;
     writeResult(opt.report_dir, "core_mass_id.sto", mass_result);
   }
@@ -350,11 +370,16 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
     so.values = sweep_values;
     so.main_columns = opt.sweep_columns;
     so.progress = opt.progress;
+    so.simbody_check = sb_run.ran;
+    so.engine_rel = opt.engine_rel;
+    so.engine_abs = opt.engine_abs;
     r.mass_sweep = runMassSweep(tool, core_result, so, mass_factory);
     double secs = 0;
     for (const auto& p : r.mass_sweep.points) secs += p.seconds;
     report.addWallTime("mass_sweep", secs);
     addMassSweepToReport(r.mass_sweep, core_result, report);
+    if (r.mass_sweep.simbody.ran) r.comparisons.push_back(r.mass_sweep.simbody.comparison);
+    if (!r.mass_sweep.simbody.skipped.empty()) r.warnings.push_back("mass sweep: " + r.mass_sweep.simbody.skipped);
   }
 
   // the engines' own results, at full precision, beside the report

@@ -12,13 +12,16 @@
 // If the Simbody engine cannot build the model, the reason is recorded (summary.engines.simbody)
 // and validation continues with core only; that alone does not fail the run.
 //
-// Muscle mass (issue 6). Simbody has no muscle inertia: it stays the zero-mass reference, and the
-// comparisons above always use the zero-mass core. With IdValidationOptions::muscle_mass set, the
-// core is also solved with that muscle mass and its difference from the zero-mass core is
-// reported per column as the "inertial effect" (summary.inertial_effect, inertial_effect.csv, an
-// overlay, core_mass_id.sto): a measurement, never a failure. With mass_sweep values, the core is
-// solved once per value instead (validation/mass_sweep.hpp; summary.mass_sweep); only the sweep's
-// zero check (the value 0 reproduces the zero-mass result) can fail.
+// Muscle mass (issue 6). The comparisons above always use the zero-mass core and the zero-mass
+// Simbody system (OpenSim has no muscle inertia: its results are zero-mass references). With
+// IdValidationOptions::muscle_mass set, the core is also solved with that muscle mass and its
+// difference from the zero-mass core is reported per column as the "inertial effect"
+// (summary.inertial_effect, inertial_effect.csv, an overlay, core_mass_id.sto): a measurement,
+// never a failure. With mass_sweep values, the core is solved once per value instead
+// (validation/mass_sweep.hpp; summary.mass_sweep); of the sweep only its zero check (the value 0
+// reproduces the zero-mass result) can fail. In both cases, when the Simbody engine runs, Simbody
+// with muscle inertia (plugin/simbody, the same model and mass points) solves the muscle-mass
+// trial (the sweep's largest value) too: core_mass_vs_simbody_mass, engine tolerance, can fail.
 #include <limits>
 #include <string>
 #include <vector>
@@ -72,6 +75,8 @@ struct InertialEffect {
   double seconds = 0;          ///< solving every frame with mass
   std::vector<ColumnMetrics> metrics;  ///< every column, table order
   int largest = -1;            ///< the column with the largest max_rel (-1 if none)
+  bool simbody_ran = false;    ///< Simbody with muscle inertia solved it too (core_mass_vs_simbody_mass)
+  std::string simbody_skipped; ///< why not, when the zero-mass Simbody ran but this one failed
 };
 
 /// Wall time of one engine over the trial.

@@ -12,6 +12,7 @@
 #include "converter/id/core_id_engine.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/skeleton/kinematics.hpp"
+#include "plugin/simbody/id_engine.hpp"
 #include "validation/report/progress.hpp"
 
 namespace redmax::validation {
@@ -138,6 +139,8 @@ MassSweepEngineFactory makeCoreMassEngineFactory(const osim::InverseDynamicsTool
     e.muscle_mass = mm.plan.total_muscle_mass;
     for (const auto& me : mm.plan.muscles) e.muscles_with_mass += me.mass > 0.0;
     e.description = osim::describeMuscleMass(mm.plan);
+    e.model = std::make_shared<const Model>(mm.build.model);
+    e.muscles = mm.build.muscles;
     e.engine = std::make_unique<MuscleMassIdEngine>(mm.build.model, t->engineOptions(), std::move(mm.build.muscles));
     return e;
   };
@@ -303,6 +306,31 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
   std::vector<MatX> tau;
   for (double v : r.options.values) {
     MassSweepEngine e = factory(massOptionsForValue(options.base, v));
+    // Simbody with muscle inertia at the largest value: the same model and mass points
+    if (options.simbody_check && v == r.options.values.back()) {
+      r.simbody.value = v;
+      if (!e.model) {
+        r.simbody.skipped = "the engine factory gave no model";
+      } else {
+        std::unique_ptr<simbody::SimbodyIdEngine> sb;
+        try {
+          sb = std::make_unique<simbody::SimbodyIdEngine>(*e.model, e.muscles, tool.engineOptions());
+        } catch (const std::exception& ex) {
+          r.simbody.skipped = std::string("the Simbody engine cannot build this model: ") + ex.what();
+        }
+        if (sb) {
+          try {
+            r.simbody.result = tool.run(*sb);
+            r.simbody.result.name = osim::kIdStorageName;
+            r.simbody.ran = true;
+          } catch (const std::exception& ex) {
+            // an engine that fails where the core succeeds is a disagreement
+            r.simbody.failed = true;
+            r.simbody.skipped = std::string("the Simbody engine failed: ") + ex.what();
+          }
+        }
+      }
+    }
     if (!e.engine) throw std::invalid_argument("mass sweep: the engine factory made no engine");
     ProgressOptions po;
     po.stream = options.progress ? stderr : nullptr;
@@ -320,6 +348,14 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
     s.name = osim::kIdStorageName;
     tau.push_back(s.data);
     r.torques.push_back(std::move(s));
+  }
+  if (r.simbody.ran) {
+    CompareOptions co;
+    co.tolerance = {options.engine_abs, options.engine_rel, options.engine_abs, options.engine_rel};
+    co.align.grid_table = 0;
+    co.missing_columns_fail = true;
+    r.simbody.comparison = compareTables("core_mass_vs_simbody_mass", r.torques.back(), "core_mass",
+                                         r.simbody.result, "simbody_mass", co);
   }
   r.analysis = analyzeMassSweep(r.options.values, tau, zero_mass.data, options.zero_tolerance);
   for (size_t c = 0; c < r.analysis.columns.size(); ++c) r.analysis.columns[c].name = labels[c];
@@ -414,7 +450,12 @@ void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_ma
   if (!main_idx.empty())
     report.addPlot("mass_sweep_peak_change", change, "peak change and largest change against the swept muscle mass");
 
-  // the zero check: the only part of a sweep that can fail
+  // Simbody with muscle inertia at the largest value: engines agree to round-off
+  if (r.simbody.ran) report.addComparison(r.simbody.comparison, "generalized force [N m or N]");
+
+  if (r.simbody.failed) report.addCheck("mass sweep: Simbody with muscle inertia solves every frame", false, r.simbody.skipped);
+
+  // the zero check: the only sweep result that can fail
   if (an.zero_index >= 0)
     report.addCheck("mass sweep: the zero value reproduces the zero-mass result", an.zero_passed,
                     "max |tau(0) - tau_zero_mass| / peak = " + fmtG("%.3g", an.zero_max_rel) + " (tolerance " +
@@ -439,6 +480,11 @@ void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_ma
   js["muscles_with_mass"] = nm;
   js["seconds"] = secs;
   js["main_columns"] = r.main_columns;
+  JsonValue sbj = JsonValue::object();
+  sbj["ran"] = r.simbody.ran;
+  if (!r.simbody.ran) sbj["skipped"] = r.simbody.skipped.empty() ? "not requested" : r.simbody.skipped;
+  sbj["value"] = r.simbody.value;
+  js["simbody_check"] = sbj;
   JsonValue zc = JsonValue::object();
   zc["present"] = an.zero_index >= 0;
   zc["max_rel"] = num(an.zero_max_rel);

@@ -35,6 +35,7 @@
 
 #include "converter/build/muscle_mass.hpp"
 #include "converter/id/inverse_dynamics_tool.hpp"
+#include "validation/compare/metrics.hpp"
 #include "validation/report/report.hpp"
 
 namespace redmax::validation {
@@ -50,6 +51,9 @@ struct MassSweepOptions {
   double zero_tolerance = 1e-12;  ///< the zero check, relative to each column's zero-mass peak
   double r2_min = 0.999;          ///< the acceptance R^2 (reported per column, not pass/fail)
   bool progress = false;          ///< progress lines on stderr
+  /// also solve the largest value with Simbody's muscle inertia (SimbodyIdEngine with muscles)
+  bool simbody_check = false;
+  double engine_rel = 1e-9, engine_abs = 1e-10;  ///< its tolerance against the core (as core_vs_simbody)
 };
 
 /// The muscle-mass options of one sweep value: transfer_fraction = value, or density * value
@@ -76,6 +80,10 @@ struct MassSweepEngine {
   double muscle_mass = 0.0;      ///< kg carried by mass points
   int muscles_with_mass = 0;
   std::string description;       ///< osim::describeMuscleMass of the plan
+  /// the model with the mass taken from the bodies and its muscles with their mass points (for a
+  /// second engine, e.g. Simbody with muscle inertia); empty when the factory does not give them
+  std::shared_ptr<const Model> model;
+  std::vector<Muscle> muscles;
 };
 
 /// Makes the engine of one value's options for the tool's model (same coordinates, same velocity
@@ -126,12 +134,24 @@ struct MassSweepPoint {
   std::string description;
 };
 
+/// The Simbody engine with muscle inertia (plugin/simbody) at the sweep's largest value, solved on
+/// the same inputs and compared with the core at that value: an engine cross-check that can fail.
+struct MassSweepSimbodyCheck {
+  bool ran = false;
+  bool failed = false;     ///< it was built but failed on a frame (a failed check)
+  std::string skipped;     ///< why not ("" if it ran)
+  double value = 0;
+  osim::Storage result;
+  Comparison comparison;   ///< core_mass_vs_simbody_mass (when it ran)
+};
+
 struct MassSweepResult {
   MassSweepOptions options;          ///< values completed and sorted
   std::vector<MassSweepPoint> points;
   std::vector<osim::Storage> torques;  ///< per value, the tool's output table
   std::vector<std::string> main_columns;
   MassSweepAnalysis analysis;
+  MassSweepSimbodyCheck simbody;  ///< filled when MassSweepOptions::simbody_check
 };
 
 /// Run the sweep on the tool's processed inputs (the tool is not re-run: the same splines and
