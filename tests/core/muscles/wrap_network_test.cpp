@@ -255,3 +255,48 @@ TEST(WrapTraining, ParseHidden) {
 
 }  // namespace
 }  // namespace redmax
+
+// ---------------------------------------------------------------------------------------------
+// the networks committed under osim_models/networks
+
+#include <filesystem>
+
+namespace redmax {
+namespace {
+
+TEST(WrapTraining, CommittedNetworksApproximateTheExactLibrary) {
+  const std::filesystem::path dir = std::filesystem::path(REDMAX_SOURCE_DIR) / "osim_models" / "networks";
+  int checked = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".txt") continue;
+    const Mlp net = Mlp::load(entry.path().string());
+    // the file says how to reproduce it
+    ASSERT_TRUE(net.meta.count("command") && net.meta.count("seed") && net.meta.count("surface")) << entry.path();
+    EXPECT_EQ(net.meta.at("command").rfind("redmax train-wrap ", 0), 0u);
+    const WrapType type = parseWrapType(net.meta.at("surface"));
+    ASSERT_EQ(net.inputs(), wrapInputSize(type));
+    // fresh samples (all of them, also near the contact change): the network must beat the
+    // straight path p1 + alpha (p2 - p1), which is exact for every sample that does not wrap
+    // (measured: cylinder straight 0.215, 3x64 0.114, 2x64 0.149; sphere straight 0.122, 3x64 0.103;
+    // a 1x32 cylinder network, 0.216, was no better than the straight path and is not kept)
+    const WrapInputBox box = makeDefaultWrapBox(type);
+    const WrapTrainingSet test = makeWrapTrainingSet(box, makeExactWrapOracle(type), 3000, 0.0, 4242);
+    WrapTrainingSet straight = test;
+    for (Eigen::Index j = 0; j < test.X.cols(); ++j) {
+      const VecX x = test.X.col(j);
+      straight.Y.col(j) = x.segment<3>(0) + x[6] * (x.segment<3>(3) - x.segment<3>(0));
+    }
+    double se = 0.0;
+    for (Eigen::Index j = 0; j < test.X.cols(); ++j) se += (straight.Y.col(j) - test.Y.col(j)).squaredNorm();
+    const double straight_rms = std::sqrt(se / test.X.cols());
+    const double net_rms = calcWrapNetworkError(net, test).rms;
+    EXPECT_LT(net_rms, 0.9 * straight_rms) << entry.path() << ": network " << net_rms << ", straight " << straight_rms;
+    // and agrees with the error recorded in the file (other fresh samples) within 25%
+    EXPECT_NEAR(net_rms, std::stod(net.meta.at("test_rms_m")), 0.25 * net_rms) << entry.path();
+    ++checked;
+  }
+  EXPECT_GE(checked, 2);
+}
+
+}  // namespace
+}  // namespace redmax

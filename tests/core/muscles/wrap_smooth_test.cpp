@@ -30,7 +30,9 @@ TEST(WrapSmooth, EqualsExactLibraryAwayFromTheTransition) {
       if (r.code == WrapCode::InsideRadius) continue;
       const double d = calcWrapPenetration(s, p1, p2);
       // the penetration's sign is the library's decision (a quadrant cylinder may also force a wrap)
-      if (s.quadrant_sign == 0) ASSERT_EQ(d > 0.0, r.wraps()) << "d = " << d;
+      if (s.quadrant_sign == 0) {
+        ASSERT_EQ(d > 0.0, r.wraps()) << "d = " << d;
+      }
       if (d > 0.0 && d < opt.width) continue;  // inside the band
       (r.wraps() ? wrapped : straight)++;
       const Vec3 exact = calcWrappedPathPoint(s, r, p1, p2, alpha);

@@ -1,0 +1,424 @@
+// `redmax train-wrap`: train the Type III wrap network on samples of the exact wrapping library
+// [D Sec. 5.3.3.1], or (--compare) time networks, the smooth model and the exact library per mass
+// point (position + Jacobian + Jdot) against their position error.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli/args.hpp"
+#include "converter/atomic_file.hpp"
+#include "core/muscles/wrap/smooth.hpp"
+#include "core/muscles/wrap/train.hpp"
+#include "validation/report/csv.hpp"
+#include "validation/report/plot.hpp"
+
+namespace redmax::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string joinArgs(const std::vector<std::string>& argv) {
+  std::string s = "redmax train-wrap";
+  for (const auto& a : argv) s += " " + a;
+  return s;
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+void requireFolder(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir)) throw UsageError{"--report: cannot create folder '" + dir + "'"};
+}
+
+void requireParent(const std::string& file, const char* flag) {
+  const auto parent = std::filesystem::path(file).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent))
+    throw UsageError{std::string(flag) + " " + file + ": folder '" + parent.string() + "' does not exist"};
+}
+
+std::string num(double v, int prec = 4) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", prec, v);
+  return buf;
+}
+
+// ---------------------------------------------------------------------------------------------
+// training
+
+int runTrain(const Args& a, const std::vector<std::string>& argv) {
+  const WrapType type = parseWrapType(a.get("surface", "cylinder"));
+  TrainOptions opt;
+  opt.hidden = parseHidden(a.get("hidden", "6x256"));
+  const long samples = a.getInt("samples", 30000);
+  opt.epochs = static_cast<int>(a.getInt("epochs", 100));
+  opt.batch = static_cast<int>(a.getInt("batch", 256));
+  opt.learning_rate = a.getDouble("lr", 1e-4);
+  opt.seed = static_cast<unsigned long long>(a.getInt("seed", 1));
+  opt.time_limit_s = a.getDouble("time-limit", 0.0);
+  const double threshold = a.getDouble("threshold", 0.01);
+  if (samples < 10 || samples > 100000000) throw UsageError{"--samples must be between 10 and 1e8"};
+  if (opt.epochs < 1 || opt.epochs > 10000000) throw UsageError{"--epochs must be at least 1"};
+  if (opt.batch < 1) throw UsageError{"--batch must be at least 1"};
+  if (!(opt.learning_rate > 0.0 && opt.learning_rate < 1.0)) throw UsageError{"--lr must be in (0, 1)"};
+  if (!(threshold >= 0.0 && threshold < 1.0)) throw UsageError{"--threshold must be in [0, 1)"};
+  if (opt.time_limit_s < 0.0) throw UsageError{"--time-limit must be >= 0"};
+  const auto out = a.get("out");
+  if (!out) throw UsageError{"--out NET.txt is required"};
+  requireParent(*out, "--out");
+  const auto report = a.get("report");
+  if (report) requireFolder(*report);
+
+  // samples of the exact library over the stated box [D Sec. 5.3.3.1]
+  const WrapInputBox box = makeDefaultWrapBox(type);
+  const WrapOracle oracle = makeExactWrapOracle(type);
+  const auto t_data = Clock::now();
+  const WrapTrainingSet data = makeWrapTrainingSet(box, oracle, samples, threshold, opt.seed);
+  std::cerr << "train-wrap: " << wrapTypeName(type) << ", " << samples << " samples kept of " << data.drawn
+            << " drawn (" << data.invalid << " with an end inside the surface, " << data.near_contact
+            << " with 0 < l/L < " << threshold << " discarded; " << data.wrapped << " kept samples wrap), "
+            << num(secondsSince(t_data), 3) << " s\n";
+
+  // progress: a line every 2 s and at the end
+  double last_print = -1e9;
+  opt.on_epoch = [&](const TrainEpoch& e) {
+    if (e.elapsed_s - last_print < 2.0 && e.epoch != opt.epochs) return;
+    last_print = e.elapsed_s;
+    std::cerr << "train-wrap: epoch " << e.epoch << "/" << opt.epochs << ", " << e.steps << " steps, train mse "
+              << num(e.train_mse) << ", validation mse " << num(e.val_mse) << ", validation rms " << num(e.val_rms_m)
+              << " (size units), " << num(e.elapsed_s, 3) << " s\n";
+  };
+  std::vector<TrainEpoch> history;
+  Mlp net = trainWrapNetwork(data, box, opt, &history);
+
+  // error on fresh samples, all of them (also those near the contact change)
+  const WrapTrainingSet test = makeWrapTrainingSet(box, oracle, std::min(samples, 20000L), 0.0, opt.seed + 1000003);
+  const WrapErrorStats err = calcWrapNetworkError(net, test);
+  net.meta["surface"] = wrapTypeName(type);
+  net.meta["command"] = joinArgs(argv);
+  net.meta["threshold"] = num(threshold, 6);
+  net.meta["test_rms_m"] = num(err.rms, 6);
+  net.meta["test_max_m"] = num(err.max, 6);
+  net.meta["box"] = "core/muscles/wrap/train.hpp makeDefaultWrapBox (units of the surface size)";
+  net.save(*out);
+  std::cout << "trained " << net.architecture() << " (" << net.parameterCount() << " parameters) on "
+            << wrapTypeName(type) << ": " << history.size() << " epochs, " << history.back().steps << " steps, "
+            << num(history.back().elapsed_s, 3) << " s; validation mse " << num(history.back().val_mse)
+            << "; position error on " << test.X.cols() << " fresh samples: rms " << num(err.rms) << ", max "
+            << num(err.max) << " (surface size units)\nwrote " << *out << "\n";
+
+  if (report) {
+    validation::CsvTable t;
+    t.header = {"epoch", "steps", "train_mse", "val_mse", "val_rms", "elapsed_s"};
+    std::vector<double> ep, tr, va;
+    for (const auto& e : history) {
+      t.addRow({double(e.epoch), double(e.steps), e.train_mse, e.val_mse, e.val_rms_m, e.elapsed_s});
+      ep.push_back(e.epoch);
+      tr.push_back(e.train_mse);
+      va.push_back(e.val_mse);
+    }
+    const std::string dir = *report;
+    osim::writeFileAtomic(dir + "/loss.csv", validation::formatCsv(t));
+    validation::PlotFigure fig;
+    fig.title = "train-wrap " + wrapTypeName(type) + " " + net.architecture() + " seed " + std::to_string(opt.seed);
+    validation::PlotPanel p = validation::makeXYPanel("loss (normalised MSE)", "epoch", "MSE",
+                                                      {validation::makePlotLine("train", ep, tr),
+                                                       validation::makePlotLine("validation", ep, va)});
+    p.log_y = true;
+    fig.panels.push_back(p);
+    const auto gp = validation::findGnuplot();
+    if (gp.available) {
+      const auto o = validation::renderPlot(gp, validation::PlotFormat::Auto, fig, dir + "/loss");
+      if (!o.ok) std::cerr << "note: loss plot not drawn: " << o.error << "\n";
+    } else {
+      std::cerr << "note: loss plot not drawn: " << gp.why_not << "\n";
+    }
+    std::cout << "wrote " << dir << "/loss.csv and the loss plot\n";
+  }
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// speed against error
+
+struct CompareRow {
+  std::string method;
+  long parameters = 0;
+  double us_per_point = 0.0;
+  double rms = NAN, max = NAN;
+  std::string note;
+};
+
+int runCompare(const Args& a) {
+  const WrapType type = parseWrapType(a.get("surface", "cylinder"));
+  if (type != WrapType::Cylinder && type != WrapType::Sphere)
+    throw UsageError{"--compare supports cylinder and sphere (the smooth model's surfaces)"};
+  const auto report = a.get("report");
+  if (!report) throw UsageError{"--compare needs --report DIR"};
+  requireFolder(*report);
+  const long muscles = a.getInt("muscles", 200);
+  const int points = static_cast<int>(a.getInt("mass-points", 20));
+  if (muscles < 1 || points < 1) throw UsageError{"--muscles and --mass-points must be positive"};
+  const unsigned long long seed = static_cast<unsigned long long>(a.getInt("seed", 1));
+  const double width = a.getDouble("width", 0.05);
+  const WrapInputBox box = makeDefaultWrapBox(type);
+  std::vector<std::pair<std::string, Mlp>> nets;
+  for (const auto& f : splitList(a.get("nets", ""))) {
+    try {
+      nets.emplace_back(std::filesystem::path(f).stem().string(), Mlp::load(f));
+    } catch (const NetworkFormatError& e) {
+      throw UsageError{e.what()};
+    } catch (const std::runtime_error& e) {
+      throw UsageError{e.what()};
+    }
+    const Mlp& n = nets.back().second;
+    if (n.inputs() != wrapInputSize(type) || n.outputs() != 3 || (n.meta.count("surface") && n.meta.at("surface") != wrapTypeName(type)))
+      throw UsageError{f + ": not a " + wrapTypeName(type) + " wrap network"};
+  }
+  const std::string untrained = a.get("untrained", "6x256");
+  for (const auto& spec : untrained == "none" ? std::vector<std::string>{} : splitList(untrained)) {
+    // timing only: the cost of a network does not depend on its weights
+    Mlp n(wrapInputSize(type), parseHidden(spec), 3, seed);
+    n.input_min = box.lo;
+    n.input_max = box.hi;
+    nets.emplace_back(spec + " (untrained, timing only)", n);
+  }
+
+  // muscles: end points from the default box (valid ones), velocities random, 20 mass points each
+  const WrapOracle oracle = makeExactWrapOracle(type);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u01(0.0, 1.0), uv(-1.0, 1.0);
+  std::vector<VecX> inputs;  // one per muscle (alpha slot unused)
+  std::vector<Vec3> v1s, v2s;
+  while (static_cast<long>(inputs.size()) < muscles) {
+    VecX x(box.lo.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = box.lo[i] + (box.hi[i] - box.lo[i]) * u01(rng);
+    x[6] = 0.5;
+    if (!oracle(x).valid) continue;
+    inputs.push_back(x);
+    v1s.emplace_back(uv(rng), uv(rng), uv(rng));
+    v2s.emplace_back(uv(rng), uv(rng), uv(rng));
+  }
+  std::vector<double> alphas(points);
+  for (int k = 0; k < points; ++k) alphas[k] = (k + 0.5) / points;
+  const long total_points = muscles * points;
+
+  // exact positions (the reference)
+  std::vector<Vec3> exact(total_points);
+  for (long m = 0; m < muscles; ++m) {
+    const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
+    const Vec3 p1 = inputs[m].segment<3>(0), p2 = inputs[m].segment<3>(3);
+    const WrapResult r = calcWrap(s, p1, p2);
+    for (int k = 0; k < points; ++k) exact[m * points + k] = calcWrappedPathPoint(s, r, p1, p2, alphas[k]);
+  }
+  auto errors = [&](const std::vector<Vec3>& x, CompareRow& row) {
+    double se = 0.0, mx = 0.0;
+    for (long i = 0; i < total_points; ++i) {
+      const double e = (x[i] - exact[i]).norm();
+      se += e * e;
+      mx = std::max(mx, e);
+    }
+    row.rms = std::sqrt(se / total_points);
+    row.max = mx;
+  };
+  // repeat a timed loop until it has run 0.3 s; microseconds per mass point
+  auto timePerPoint = [&](const std::function<void()>& all_points) {
+    long reps = 0;
+    const auto t0 = Clock::now();
+    do {
+      all_points();
+      ++reps;
+    } while (secondsSince(t0) < 0.3);
+    return 1e6 * secondsSince(t0) / (static_cast<double>(reps) * total_points);
+  };
+  std::vector<CompareRow> rows;
+  volatile double sink = 0.0;
+
+  // exact library: position, then J and Jdot by central differences (12 + 24 more evaluations)
+  {
+    CompareRow row{"exact library + central differences", 0};
+    const double h = 1e-6;
+    auto eval = [&](const WrapSurface& s, const Vec3& p1, const Vec3& p2, double al) {
+      return calcWrappedPathPoint(s, calcWrap(s, p1, p2), p1, p2, al);
+    };
+    auto jac = [&](const WrapSurface& s, const Vec3& p1, const Vec3& p2, double al) {
+      Eigen::Matrix<double, 3, 6> J;
+      for (int i = 0; i < 6; ++i) {
+        Vec3 a1 = p1, a2 = p2, b1 = p1, b2 = p2;
+        (i < 3 ? a1 : a2)[i % 3] += h;
+        (i < 3 ? b1 : b2)[i % 3] -= h;
+        J.col(i) = (eval(s, a1, a2, al) - eval(s, b1, b2, al)) / (2 * h);
+      }
+      return J;
+    };
+    row.us_per_point = timePerPoint([&] {
+      for (long m = 0; m < muscles; ++m) {
+        const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
+        const Vec3 p1 = inputs[m].segment<3>(0), p2 = inputs[m].segment<3>(3);
+        for (int k = 0; k < points; ++k) {
+          const Vec3 x = eval(s, p1, p2, alphas[k]);
+          const auto J = jac(s, p1, p2, alphas[k]);
+          const auto Jdot = (jac(s, p1 + h * v1s[m], p2 + h * v2s[m], alphas[k]) - jac(s, p1 - h * v1s[m], p2 - h * v2s[m], alphas[k])) / (2 * h);
+          sink = sink + x[0] + J(0, 0) + Jdot(0, 0);
+        }
+      }
+    });
+    row.rms = row.max = 0.0;
+    row.note = "reference; J, Jdot jump at contact changes";
+    rows.push_back(row);
+  }
+
+  // smooth model
+  {
+    CompareRow row{"smooth model (width " + num(width, 3) + " R)", 0};
+    std::vector<Vec3> x(total_points);
+    for (long m = 0; m < muscles; ++m) {
+      const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
+      for (int k = 0; k < points; ++k)
+        x[m * points + k] = calcSmoothWrapPoint(s, inputs[m].segment<3>(0), inputs[m].segment<3>(3), alphas[k],
+                                                SmoothWrapOptions{width * s.radius});
+    }
+    errors(x, row);
+    row.us_per_point = timePerPoint([&] {
+      for (long m = 0; m < muscles; ++m) {
+        const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
+        for (int k = 0; k < points; ++k) {
+          const auto sp = calcSmoothWrapPointDerivatives(s, inputs[m].segment<3>(0), inputs[m].segment<3>(3), alphas[k],
+                                                         v1s[m], v2s[m], SmoothWrapOptions{width * s.radius});
+          sink = sink + sp.x[0] + sp.J(0, 0) + sp.Jdot(0, 0);
+        }
+      }
+    });
+    row.note = "exact J, Jdot (dual numbers)";
+    rows.push_back(row);
+  }
+
+  // networks: one batch per muscle (all its mass points), exact Jdot and the forward difference
+  for (const auto& [name, net] : nets) {
+    std::vector<MatX> X(muscles), Xdot(muscles);
+    for (long m = 0; m < muscles; ++m) {
+      X[m].resize(net.inputs(), points);
+      Xdot[m] = MatX::Zero(net.inputs(), points);
+      for (int k = 0; k < points; ++k) {
+        X[m].col(k) = inputs[m];
+        X[m](6, k) = alphas[k];
+        Xdot[m].col(k).segment<3>(0) = v1s[m];
+        Xdot[m].col(k).segment<3>(3) = v2s[m];
+      }
+    }
+    MlpWorkspace ws;
+    MatX Y, J, Jdot, Yf, Jf, Jdot_fd;
+    std::vector<Vec3> x(total_points);
+    double jd_diff = 0.0, jd_norm = 0.0;
+    long outside = 0;
+    for (long m = 0; m < muscles; ++m) {
+      net.calcJacobianDot(X[m], Xdot[m], Y, J, Jdot, ws);
+      net.calcJacobianDotFd(X[m], Xdot[m], 1e-6, Yf, Jf, Jdot_fd, ws);
+      jd_diff += (Jdot_fd - Jdot).squaredNorm();
+      jd_norm += Jdot.squaredNorm();
+      for (int k = 0; k < points; ++k) {
+        x[m * points + k] = Y.col(k);
+        if (!net.insideBox(X[m].col(k))) ++outside;
+      }
+    }
+    const bool untrained = name.find("untrained") != std::string::npos;
+    CompareRow row{"network " + name, net.parameterCount()};
+    if (!untrained) errors(x, row);
+    row.us_per_point = timePerPoint([&] {
+      for (long m = 0; m < muscles; ++m) {
+        net.calcJacobianDot(X[m], Xdot[m], Y, J, Jdot, ws);
+        sink = sink + Y(0, 0) + J(0, 0) + Jdot(0, 0);
+      }
+    });
+    const double fd_us = timePerPoint([&] {
+      for (long m = 0; m < muscles; ++m) {
+        net.calcJacobianDotFd(X[m], Xdot[m], 1e-6, Y, J, Jdot, ws);
+        sink = sink + Y(0, 0) + J(0, 0) + Jdot(0, 0);
+      }
+    });
+    row.note = "exact Jdot; Eq. 5.58 FD Jdot (eps 1e-6): " + num(fd_us, 3) + " us/point, rel. diff " +
+               num(std::sqrt(jd_diff / std::max(jd_norm, 1e-300)), 2);
+    if (outside) row.note += "; " + std::to_string(outside) + " points outside the training box";
+    rows.push_back(row);
+  }
+
+  // table, CSV, plot
+  validation::CsvTable t;
+  t.header = {"method", "parameters", "us_per_point", "rms_error", "max_error", "note"};
+  std::cout << "speed against error, " << wrapTypeName(type) << ": " << muscles << " muscles x " << points
+            << " mass points (default box, unit-size surface), position + J (3x6) + Jdot, 1 thread\n";
+  std::printf("%-48s %10s %12s %12s %12s  %s\n", "method", "params", "us/point", "rms err", "max err", "note");
+  for (const auto& r : rows) {
+    t.rows.push_back({r.method, std::to_string(r.parameters), num(r.us_per_point, 6), num(r.rms, 6), num(r.max, 6), r.note});
+    std::printf("%-48s %10ld %12.4g %12.4g %12.4g  %s\n", r.method.c_str(), r.parameters, r.us_per_point, r.rms, r.max,
+                r.note.c_str());
+  }
+  osim::writeFileAtomic(*report + "/speed_error.csv", validation::formatCsv(t));
+  std::vector<validation::PlotLine> lines;
+  for (const auto& r : rows)
+    if (std::isfinite(r.rms) && r.rms > 0.0) {
+      auto l = validation::makePlotLine(r.method, {r.us_per_point}, {r.rms}, "points");
+      l.width = 2.5;
+      lines.push_back(l);
+    }
+  validation::PlotFigure fig;
+  fig.title = "wrap models: speed against error";
+  fig.panel_width = 720;
+  fig.panel_height = 420;
+  fig.panels.push_back(validation::makeLogLogPanel(wrapTypeName(type) + ": position + J + Jdot", "microseconds per mass point",
+                                                   "RMS position error (surface size units)", lines));
+  const auto gp = validation::findGnuplot();
+  if (gp.available) {
+    const auto o = validation::renderPlot(gp, validation::PlotFormat::Auto, fig, *report + "/speed_error");
+    if (!o.ok) std::cerr << "note: plot not drawn: " << o.error << "\n";
+  }
+  std::cout << "wrote " << *report << "/speed_error.csv and the plot\n";
+  (void)sink;
+  return 0;
+}
+
+int runTrainWrap(const std::vector<std::string>& argv) {
+  Args a(argv,
+         {"surface", "hidden", "samples", "epochs", "batch", "lr", "seed", "threshold", "time-limit", "out", "report",
+          "nets", "untrained", "muscles", "mass-points", "width"},
+         {"compare"});
+  if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
+  return a.has("compare") ? runCompare(a) : runTrain(a, argv);
+}
+
+CommandRegistration reg(
+    {"train-wrap", "train the Type III wrap network, or compare wrap models (speed against error)",
+     "usage: redmax train-wrap --surface cylinder|sphere|ellipsoid|torus [--hidden 6x256] [--samples N]\n"
+     "                         [--epochs E] [--batch B] [--lr 1e-4] [--seed S] [--threshold 0.01]\n"
+     "                         [--time-limit SECONDS] --out NET.txt [--report DIR]\n"
+     "       redmax train-wrap --compare --surface cylinder|sphere [--nets A.txt,B.txt] [--untrained 6x256,...|none]\n"
+     "                         [--muscles M] [--mass-points N] [--width W] [--seed S] --report DIR\n"
+     "Training [D Sec. 5.3.3.1]: N samples (default 30000) drawn uniformly from the surface type's box\n"
+     "(core/muscles/wrap/train.hpp makeDefaultWrapBox; units of the surface size) and labelled by the exact\n"
+     "library; samples with 0 < l/L < threshold are discarded. A tanh MLP (--hidden DEPTHxWIDTH or W1-W2-...,\n"
+     "default 6x256) is trained with Adam (--lr, default 1e-4; --batch default 256) on the mean squared error\n"
+     "for E epochs (default 100) or until --time-limit. Deterministic for a seed. The network file records\n"
+     "the command, seed, losses and the error on fresh samples. --report DIR writes loss.csv and a loss plot.\n"
+     "--compare: M muscles (default 200) x N mass points (default 20) with random end points and velocities;\n"
+     "for the exact library (J, Jdot by central differences), the smooth model (band width W radii, default\n"
+     "0.05) and each network (trained ones from --nets; --untrained sizes are timed only), prints and writes\n"
+     "DIR/speed_error.csv and a plot: microseconds per mass point (position + J + Jdot) and position error.\n",
+     runTrainWrap});
+
+}  // namespace
+}  // namespace redmax::cli
