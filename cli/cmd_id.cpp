@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli/args.hpp"
+#include "cli/muscle_mass_flags.hpp"
 #include "converter/id/core_id_engine.hpp"
 #include "converter/id/inverse_dynamics_tool.hpp"
 #include "plugin/simbody/id_engine.hpp"
@@ -53,21 +54,25 @@ osim::IdToolSettings parseSettings(const Args& a) {
   if (a.has("exact") && a.has("opensim-compat"))
     throw UsageError{"--exact and --opensim-compat exclude each other"};
   s.opensim_compat = !a.has("exact");
-  const std::string mm = a.get("muscle-mass", "none");
-  if (mm != "none")
-    throw UsageError{"--muscle-mass " + mm + " is not available in `redmax id` yet (only none)"};
+  s.muscle_mass = parseMuscleMassFlags(a);
   return s;
 }
 
 int runId(const std::vector<std::string>& argv) {
   const Args a(argv,
-               {"setup", "model", "coordinates", "external-loads", "lowpass", "t0", "t1", "engine",
-                "out", "forces-to-exclude", "muscle-mass"},
+               withMuscleMassFlags({"setup", "model", "coordinates", "external-loads", "lowpass", "t0",
+                                    "t1", "engine", "out", "forces-to-exclude"}),
                {"exact", "opensim-compat", "quiet", "full-precision"});
   const osim::IdToolSettings settings = parseSettings(a);
   const std::string engine_name = a.get("engine", "core");
   if (engine_name != "core" && engine_name != "simbody")
     throw UsageError{"--engine must be core or simbody, got '" + engine_name + "'"};
+  const bool with_mass = settings.muscle_mass.source != osim::MuscleMassOptions::Source::None;
+  if (engine_name == "simbody" && with_mass) {
+    // (no Simbody engine with muscle inertia yet; a later task adds it)
+    std::cerr << "error: --engine simbody does not support muscle mass yet\n";
+    return 2;
+  }
   const bool quiet = a.has("quiet");
 
   std::unique_ptr<osim::InverseDynamicsTool> tool;
@@ -80,8 +85,9 @@ int runId(const std::vector<std::string>& argv) {
     out_path = config.output_file;
     tool = std::make_unique<osim::InverseDynamicsTool>(config);
     for (const auto& w : tool->warnings()) std::cerr << "warning: " << w << "\n";
+    if (with_mass && !quiet) std::cerr << osim::describeMuscleMass(tool->muscleMassPlan());
     if (engine_name == "core") {
-      engine = std::make_unique<osim::CoreIdEngine>(tool->model(), tool->engineOptions());
+      engine = std::make_unique<osim::CoreIdEngine>(tool->model(), tool->muscles(), tool->engineOptions());
     } else {
       try {
         engine = std::make_unique<simbody::SimbodyIdEngine>(tool->model(), tool->engineOptions());
@@ -147,16 +153,17 @@ int runId(const std::vector<std::string>& argv) {
 
 CommandRegistration reg(
     {"id", "inverse dynamics as OpenSim's InverseDynamicsTool computes it",
-     "usage: redmax id (--setup ID_SETUP.xml | --model M.osim --coordinates Q.mot)\n"
+     std::string("usage: redmax id (--setup ID_SETUP.xml | --model M.osim --coordinates Q.mot)\n"
      "                 [--external-loads LOADS.xml] [--lowpass HZ] [--t0 S] [--t1 S]\n"
      "                 [--forces-to-exclude LIST] [--engine core|simbody] [--exact]\n"
-     "                 [--full-precision] [--quiet] --out OUT.sto\n"
+     "                 [--full-precision] [--quiet] [MUSCLE-MASS OPTIONS] --out OUT.sto\n"
      "Computes the generalized forces of a motion, processing the inputs as OpenSim 4.x's\n"
      "InverseDynamicsTool does: coordinates in degrees converted for Rotational coordinates only;\n"
      "with a cutoff >= 0, padding, resampling to the smallest time step and the zero-phase\n"
      "Butterworth low-pass; quintic natural splines giving q, qdot and qddot; coordinates absent\n"
      "from the file held at their defaults; external loads interpolated (natural cubic) and applied\n"
-     "at the current poses; gravity from the model; constraints ignored; muscles excluded.\n"
+     "at the current poses; gravity from the model; constraints ignored; muscle forces excluded\n"
+     "(with muscle mass, the muscles' inertia is included; --engine core only).\n"
      "  --setup FILE         an InverseDynamicsTool setup (paths relative to it); flags override it\n"
      "  --model, --coordinates, --external-loads FILE\n"
      "  --lowpass HZ         cutoff for the coordinates (< 0: no filtering; setup default -1)\n"
@@ -175,11 +182,11 @@ CommandRegistration reg(
      "  --out FILE           output .sto (default: the setup's results_directory/output_gen_force_file)\n"
      "  --full-precision     write %.16e instead of OpenSim's %16.8lf\n"
      "  --quiet              no progress and no summary line\n"
-     "  --muscle-mass none   (only none: muscle mass in inverse dynamics is not available here yet)\n"
      "Output: 'Inverse Dynamics Generalized Forces', version=1, inDegrees=no; time, then\n"
      "<coord>_moment (Rotational) or <coord>_force columns in OpenSim's q order; written atomically.\n"
      "Prints a summary line (frames, wall time, frames per second) and, for long trials, progress on\n"
-     "stderr. Exit codes: 0 success, 1 a frame could not be solved, 2 bad input or usage.\n",
+     "stderr. Exit codes: 0 success, 1 a frame could not be solved, 2 bad input or usage.\n") +
+         muscleMassUsage(),
      runId});
 
 }  // namespace

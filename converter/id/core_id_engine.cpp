@@ -1,11 +1,13 @@
 #include "converter/id/core_id_engine.hpp"
 
+#include <algorithm>
 #include <sstream>
 #include <type_traits>
 #include <variant>
 
 #include <Eigen/Dense>
 
+#include "core/dynamics/muscle_term.hpp"
 #include "core/skeleton/kinematics.hpp"
 
 namespace redmax::osim {
@@ -110,6 +112,16 @@ CoreIdEngine::CoreIdEngine(Model model, IdEngineOptions options)
   T_.resize(marked_.size());
   system_.addTerm(loads_);
   E_wi_.resize(m.nb());
+}
+
+CoreIdEngine::CoreIdEngine(Model model, std::vector<Muscle> muscles, IdEngineOptions options)
+    : CoreIdEngine(std::move(model), std::move(options)) {
+  const bool any_mass = std::any_of(muscles.begin(), muscles.end(),
+                                    [](const Muscle& m) { return m.mass_points.size() > 0; });
+  if (!any_mass) return;
+  auto term = std::make_shared<MuscleTerm>(system_.model(), std::move(muscles));
+  muscle_mass_ = term->totalMass();
+  system_.addTerm(std::move(term));
 }
 
 void CoreIdEngine::calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,

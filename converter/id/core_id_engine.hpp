@@ -19,6 +19,7 @@
 
 #include "converter/id/id_engine.hpp"
 #include "core/dynamics/system.hpp"
+#include "core/muscles/mass_points.hpp"
 #include "core/joints/joint.hpp"
 
 namespace redmax::osim {
@@ -38,11 +39,20 @@ class CoreIdEngine final : public IdEngine {
   /// Throws IdEngineError if a marked joint has no OpenSim speed map, or the options do not
   /// match the model's joints.
   explicit CoreIdEngine(Model model, IdEngineOptions options = {});
+  /// With inertial musculotendons: a MuscleTerm over `muscles` (core/dynamics/muscle_term.hpp)
+  /// joins the System when any of them carries mass points, so tau gains the muscles' inertia,
+  /// quadratic velocity and gravity terms [D Eq. 5.7]. The term works in the core's qdot = dq/dt
+  /// convention like the rest of the system, so the rates_as_u change of variables applies
+  /// unchanged. Also throws ModelError for a muscle that does not fit the model.
+  CoreIdEngine(Model model, std::vector<Muscle> muscles, IdEngineOptions options = {});
   std::string name() const override { return "core"; }
   void calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,
                              const std::vector<IdLoadSample>& loads, VecX& tau) override;
 
   const Model& model() const { return system_.model(); }
+  const System& system() const { return system_; }
+  /// sum of the muscles' mass points (kg); 0 without muscle mass
+  double muscleMass() const { return muscle_mass_; }
   /// (qdot, qddot) in the core's own convention for the last frame solved (equal to (v, vdot)
   /// without marked joints)
   const State& lastState() const { return state_; }
@@ -58,6 +68,7 @@ class CoreIdEngine final : public IdEngine {
   State state_;
   VecX qddot_;
   std::vector<MatJ> T_;  // per marked joint (for mapping tau back)
+  double muscle_mass_ = 0.0;
 };
 
 }  // namespace redmax::osim

@@ -66,6 +66,7 @@ double degreesToRadians() {
 IdToolConfig resolveIdSettings(const IdToolSettings& s) {
   IdToolConfig c;
   c.opensim_compat = s.opensim_compat;
+  c.muscle_mass = s.muscle_mass;
   if (!s.setup_file.empty()) {
     const InverseDynamicsSetup setup = readInverseDynamicsSetup(s.setup_file);
     c.setup_file = s.setup_file;
@@ -154,7 +155,44 @@ InverseDynamicsTool::InverseDynamicsTool(IdToolConfig config) : config_(std::mov
 
   checkForces();
   prepareCoordinates();
+  applyMuscleMassOptions();
   prepareLoads();
+}
+
+// the model with muscle mass replaces the lumped one; its q order, coordinates and body indices
+// are the same (only mass properties change and the muscles are built), so the coordinate sources
+// stay valid
+void InverseDynamicsTool::applyMuscleMassOptions() {
+  muscle_mass_plan_.options = config_.muscle_mass;
+  if (config_.muscle_mass.source == MuscleMassOptions::Source::None) {
+    mass_description_ = description_;
+    return;
+  }
+  std::vector<VecX> samples;
+  VecX q, v, vdot;
+  std::vector<IdLoadSample> no_loads;
+  for (int k = 0; k < numFrames(); ++k) {
+    calcInputs(frameTime(k), q, v, vdot, no_loads);
+    samples.push_back(q);
+  }
+  BuildOptions bo;
+  bo.simbody_compat = config_.opensim_compat;
+  bo.constraints = false;
+  MuscleMassModel mm;
+  try {
+    mm = applyMuscleMass(description_, bo, config_.muscle_mass, samples);
+  } catch (const ConvertError&) {
+    throw;
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw ConvertError(config_.model_file, 0, std::string("muscle mass: ") + e.what());
+  }
+  if (mm.build.model.nr() != model().nr() || mm.build.body_index != build_->body_index)
+    throw ConvertError(config_.model_file, 0, "muscle mass: the model with muscle mass has a different tree");
+  build_ = std::make_unique<BuildResult>(std::move(mm.build));
+  muscle_mass_plan_ = std::move(mm.plan);
+  mass_description_ = std::move(mm.description);
 }
 
 // forces_to_exclude as OpenSim applies it (§7 step 7), and the forces it leaves that redmax lacks

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "converter/build/build_core_model.hpp"
+#include "converter/build/muscle_mass.hpp"
 #include "converter/external_loads.hpp"
 #include "converter/id/id_engine.hpp"
 #include "converter/id_setup.hpp"
@@ -47,6 +48,8 @@ struct IdToolSettings {
   /// group or force names). Without a setup file the default is {"Muscles"}.
   std::optional<std::vector<std::string>> forces_to_exclude;
   bool opensim_compat = true;
+  /// muscle mass (default none: OpenSim's model); copied into IdToolConfig::muscle_mass
+  MuscleMassOptions muscle_mass;
 };
 
 /// Settings after merging flags and setup: everything the tool needs.
@@ -64,6 +67,10 @@ struct IdToolConfig {
   double t1 = std::numeric_limits<double>::infinity();
   std::vector<std::string> forces_to_exclude;
   bool opensim_compat = true;
+  /// muscle mass (converter/build/muscle_mass.hpp): applied after the coordinates are processed,
+  /// so that --muscles top:K ranks over the trial's output frames; the engines then get the model
+  /// with the bodies' mass reduced (model()) and the muscles with mass points (muscles())
+  MuscleMassOptions muscle_mass;
   std::vector<std::string> warnings;  ///< from the setup file (settings 4.x ignores)
 };
 
@@ -99,7 +106,16 @@ class InverseDynamicsTool {
   const IdToolConfig& config() const { return config_; }
   const ModelDescription& description() const { return description_; }
   const BuildResult& build() const { return *build_; }
+  /// the core model the engines get: with muscle mass, the bodies' mass already reduced
   const Model& model() const { return build_->model; }
+  /// the muscles for a CoreIdEngine: with muscle mass, every built muscle (those with mass carry
+  /// their points); without, empty (the model as OpenSim's ID sees it)
+  const std::vector<Muscle>& muscles() const { return build_->muscles; }
+  /// what the muscle-mass options did (source None: every muscle lumped, no bodies changed)
+  const MuscleMassPlan& muscleMassPlan() const { return muscle_mass_plan_; }
+  /// the description the model was built from (bodies with their mass reduced); the file's own
+  /// description is description()
+  const ModelDescription& massDescription() const { return mass_description_; }
   /// the velocity convention the engines must use (rates_as_u for Ball/Free/Ellipsoid joints in
   /// OpenSim-compatible mode)
   const IdEngineOptions& engineOptions() const { return engine_options_; }
@@ -139,8 +155,11 @@ class InverseDynamicsTool {
   signal::TimeWindow window_;
   std::vector<std::string> unmodelled_forces_;
   std::vector<std::string> warnings_;
+  MuscleMassPlan muscle_mass_plan_;
+  ModelDescription mass_description_;
 
   void checkForces();
+  void applyMuscleMassOptions();
   void prepareCoordinates();
   void prepareLoads();
 };

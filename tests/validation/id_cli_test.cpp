@@ -97,7 +97,7 @@ TEST_F(IdCli, BadInputExitsWithTwoAndNamesTheFile) {
       {"id --model dp.osim --coordinates dp.mot", "no output file"},
       {"id --model dp.osim --out o.sto", "needs --setup"},
       {"id --model dp.osim --coordinates dp.mot --exact --opensim-compat --out o.sto", "exclude each other"},
-      {"id --model dp.osim --coordinates dp.mot --muscle-mass physiological --out o.sto", "--muscle-mass"},
+      {"id --model dp.osim --coordinates dp.mot --muscle-mass heavy --out o.sto", "--muscle-mass must be none"},
       {"id --setup nosetup.xml --out o.sto", "error: nosetup.xml"},
   };
   write("other.mot", "x\nversion=1\nnRows=2\nnColumns=2\ninDegrees=no\nendheader\ntime\tfoo\n0\t1\n1\t2\n");

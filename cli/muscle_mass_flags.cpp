@@ -1,0 +1,99 @@
+#include "cli/muscle_mass_flags.hpp"
+
+#include <regex>
+#include <stdexcept>
+
+namespace redmax::cli {
+
+const std::set<std::string>& muscleMassFlagNames() {
+  static const std::set<std::string> names = {
+      "muscle-mass",      "muscles",        "mass-points",   "mass-region",
+      "specific-tension", "muscle-density", "transfer-body", "transfer-fraction"};
+  return names;
+}
+
+std::set<std::string> withMuscleMassFlags(std::set<std::string> names) {
+  names.insert(muscleMassFlagNames().begin(), muscleMassFlagNames().end());
+  return names;
+}
+
+osim::MuscleMassOptions parseMuscleMassFlags(const Args& a) {
+  using Source = osim::MuscleMassOptions::Source;
+  osim::MuscleMassOptions o;
+  const std::string source = a.get("muscle-mass", "none");
+  try {
+    o.source = osim::parseMuscleMassSource(source);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError{e.what()};
+  }
+  if (o.source == Source::None) {
+    for (const std::string& f : muscleMassFlagNames())
+      if (f != "muscle-mass" && a.has(f))
+        throw UsageError{"--" + f + " needs --muscle-mass physiological or transfer"};
+    return o;
+  }
+  if (o.source != Source::Transfer)
+    for (const char* f : {"transfer-body", "transfer-fraction"})
+      if (a.has(f)) throw UsageError{std::string("--") + f + " needs --muscle-mass transfer"};
+
+  o.muscles = a.get("muscles", "all");
+  if (o.muscles.empty()) throw UsageError{"--muscles needs all, top:K or a regular expression"};
+  if (o.muscles.rfind("top:", 0) == 0) {
+    const std::string k = o.muscles.substr(4);
+    const bool digits = !k.empty() && k.size() <= 7 && k.find_first_not_of("0123456789") == std::string::npos;
+    if (!digits || std::stol(k) < 1)
+      throw UsageError{"--muscles top:K needs a whole number K >= 1, got '" + o.muscles + "'"};
+  } else if (o.muscles != "all") {
+    try {
+      std::regex re(o.muscles, std::regex::ECMAScript);
+    } catch (const std::regex_error& e) {
+      throw UsageError{"--muscles '" + o.muscles + "' is not a valid regular expression (" + e.what() + ")"};
+    }
+  }
+  const long n = a.getInt("mass-points", o.mass_points);
+  if (n < 1 || n > 100000) throw UsageError{"--mass-points must be between 1 and 100000, got " + std::to_string(n)};
+  o.mass_points = static_cast<int>(n);
+  const std::string region = a.get("mass-region", "fibre");
+  if (region == "fibre" || region == "fiber") {
+    o.region = MassPointOptions::Region::Fibre;
+  } else if (region == "whole") {
+    o.region = MassPointOptions::Region::WholePath;
+  } else {
+    throw UsageError{"--mass-region must be fibre or whole, got '" + region + "'"};
+  }
+  o.specific_tension = a.getDouble("specific-tension", o.specific_tension);
+  if (!(o.specific_tension > 0.0)) throw UsageError{"--specific-tension must be > 0 (Pa)"};
+  o.density = a.getDouble("muscle-density", o.density);
+  if (!(o.density > 0.0)) throw UsageError{"--muscle-density must be > 0 (kg/m^3)"};
+
+  if (o.source == Source::Transfer) {
+    if (!a.has("transfer-body") || a.get("transfer-body", "").empty())
+      throw UsageError{"--muscle-mass transfer needs --transfer-body BODY"};
+    o.transfer_body = a.get("transfer-body", "");
+    if (!a.has("transfer-fraction")) throw UsageError{"--muscle-mass transfer needs --transfer-fraction F"};
+    o.transfer_fraction = a.getDouble("transfer-fraction", 0.0);
+    if (!(o.transfer_fraction >= 0.0 && o.transfer_fraction < 1.0))
+      throw UsageError{"--transfer-fraction must be in [0, 1), got " + a.get("transfer-fraction", "")};
+  }
+  return o;
+}
+
+const char* muscleMassUsage() {
+  return "Muscle mass (default none: the model as OpenSim sees it, muscles lumped into the bones):\n"
+         "  --muscle-mass none|physiological|transfer\n"
+         "                       physiological: each muscle gets density * (max_isometric_force /\n"
+         "                       specific tension) * optimal_fiber_length, taken from the bodies it was\n"
+         "                       lumped into (total mass and centre of mass unchanged); transfer: a\n"
+         "                       fraction of one body's mass moves into the muscles with a path point on it\n"
+         "  --muscles all|REGEX|top:K  which muscles get mass (REGEX matches whole names; top:K the K\n"
+         "                       largest ||M_muscle|| / ||M_skeleton|| over the trial); default all\n"
+         "  --mass-points N      points per muscle (default 20)\n"
+         "  --mass-region fibre|whole  points in the fibre part of the path (default) or along all of it\n"
+         "  --specific-tension PA  default 600000 (60 N/cm^2, Rajagopal et al. 2016)\n"
+         "  --muscle-density KG_M3 default 1059.7 (Ward & Lieber 2005)\n"
+         "  --transfer-body BODY --transfer-fraction F   transfer only: F in [0, 1)\n"
+         "Muscles whose paths wrap (Type III) stay lumped. The run prints every affected body's mass\n"
+         "before and after and every muscle's mass and point count on stderr (not with --quiet).\n";
+}
+
+}  // namespace redmax::cli
