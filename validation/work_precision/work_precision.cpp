@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "converter/build/build_core_model.hpp"
+#include "converter/build/muscle_mass.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/integrators/integrator.hpp"
@@ -136,23 +137,24 @@ WorkPrecisionScene makeWorkPrecisionScene(const std::string& name, const std::st
     return s;
   }
   if (name == "running_leg") {
-    const auto b = loadModel(models_dir, "running_leg.osim");
-    // physiological mass at 60 N/cm^2 and 1059.7 kg/m^3 (the muscle-mass defaults)
-    auto physiological = [&](const std::string& muscle) {
-      const std::string path = (std::filesystem::path(models_dir) / "running_leg.osim").string();
-      for (const auto& f : osim::readOsimModel(path).muscles)
-        if (f.name == muscle) return 1059.7 * f.max_isometric_force / 0.6e6 * f.optimal_fiber_length;
-      throw std::invalid_argument("work-precision scene: running_leg has no muscle '" + muscle + "'");
-    };
+    // physiological mass (60 N/cm^2, 1059.7 kg/m^3), taken from the bones it was lumped into
+    osim::MuscleMassOptions mo;
+    mo.source = osim::MuscleMassOptions::Source::Physiological;
+    const std::string path = (std::filesystem::path(models_dir) / "running_leg.osim").string();
+    const osim::MuscleMassModel mm = osim::applyMuscleMass(osim::readOsimModel(path), {}, mo);
+    System sys = mm.build.makeSystem();
+    sys.addTerm(std::make_shared<MuscleTerm>(mm.build.model, mm.build.muscles));
+    std::string masses;
+    for (const auto& m : mm.plan.muscles)
+      if (m.points > 0) masses += (masses.empty() ? "" : ", ") + m.name + " " + fmt(m.mass, "%.3f") + " kg";
     WorkPrecisionScene s{name,
-                         "running leg (11 DoF, free pelvis) falling under gravity, soleus_r (I) and tib_ant_r (II) "
-                         "with physiological mass, gastrocnemii lumped (III)",
-                         makeSystem(b, {{"soleus_r", physiological("soleus_r")}, {"tib_ant_r", physiological("tib_ant_r")}}),
-                         State{}, 1.0, 1.0};
+                         "running leg (11 DoF, free pelvis) falling under gravity; physiological muscle mass taken "
+                         "from the bones (" + masses + "), gastrocnemii lumped (Type III)",
+                         std::move(sys), State{}, 1.0, 1.0};
     s.initial = s.system.defaultState();
-    s.initial.qdot(coordinate(b.model, "hip_flexion_r")) = 3.0;
-    s.initial.qdot(coordinate(b.model, "knee_angle_r")) = -4.0;
-    s.initial.qdot(coordinate(b.model, "ankle_angle_r")) = 2.0;
+    s.initial.qdot(coordinate(mm.build.model, "hip_flexion_r")) = 3.0;
+    s.initial.qdot(coordinate(mm.build.model, "knee_angle_r")) = -4.0;
+    s.initial.qdot(coordinate(mm.build.model, "ankle_angle_r")) = 2.0;
     return s;
   }
   throw std::invalid_argument("unknown work-precision scene '" + name + "' (expected pendulum_straight, pendulum_via, finger, running_leg)");

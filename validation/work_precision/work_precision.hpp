@@ -8,18 +8,19 @@
 // on a moving body make the energy jump, which the reference's own drift shows); runs that throw
 // SimulationError are kept and marked diverged.
 //
-// Scenes (osim_models/, through the converter; muscle mass is given to the muscles' points with
-// addMusclePointMasses and added on top of the bodies, which does not matter for an integrator
-// comparison):
+// Scenes (osim_models/, through the converter; the pendulums and the finger get the stated muscle
+// mass on their points with addMusclePointMasses, on top of the bodies, as the dissertation's
+// experiments state it; the running leg takes it from its bones):
 //   pendulum_straight  double_pendulum_straight.osim, straight_muscle 1 kg (20 points), q = (0.8, -0.4)
 //                 rad at rest (smooth and conservative: the order checks use it)
 //   pendulum_via  double_pendulum_via.osim, via_muscle 1 kg (20 points), q = (0.8, -0.4) rad at rest
 //   finger        finger.osim, FDP and FDS 0.2 kg each (the dissertation's 6.2.5), default flexed
 //                 pose, released at rest under gravity, 0.3 s (light phalanges pulled by heavy muscles
 //                 whip: over 1 s the state error of rk45 at rtol 1e-9 is still 3e-4 rad/s)
-//   running_leg   running_leg.osim under gravity, soleus_r and tib_ant_r with physiological mass
-//                 (1059.7 kg/m^3 * F_max / 0.6 MPa * l_opt), gastrocnemii lumped (Type III); the
-//                 free-floating leg falls with hip/knee/ankle velocities (3, -4, 2) rad/s
+//   running_leg   running_leg.osim under gravity with physiological muscle mass taken from the bones
+//                 (converter/build/muscle_mass.hpp: 60 N/cm^2, 1059.7 kg/m^3; soleus_r Type I,
+//                 tib_ant_r Type II; the gastrocnemii stay lumped, Type III); the free-floating leg
+//                 falls with hip/knee/ankle velocities (3, -4, 2) rad/s
 //
 // Outputs in DIR: <scene>.csv (one row per run), <scene>.png|svg (log-log error against CPU time,
 // one line per integrator), report.md (tables, the recommended integrator and setting per scene
