@@ -134,6 +134,37 @@ TEST_F(WorkPrecisionQuick, RecommendationsMeetTheirTargets) {
   }
 }
 
+TEST_F(WorkPrecisionQuick, EnergyDriftOnTheConservativePendulum) {
+  const auto& s = scene("pendulum_straight");
+  // the reference (rk45, rtol 1e-12) conserves energy; first-order methods drift about in
+  // proportion to the step, sdirk2 about with its square
+  EXPECT_LT(s.reference_energy_drift, 1e-9);
+  for (const auto& [integrator, order] : std::map<std::string, double>{{"euler", 1}, {"sdirk2", 2}}) {
+    std::map<double, double> drift;
+    for (const auto& r : s.runs)
+      if (r.integrator == integrator && r.ok) drift[r.value] = r.energy_drift;
+    ASSERT_EQ(drift.size(), 3u);
+    const double slope = std::log(drift.rbegin()->second / drift.begin()->second) /
+                         std::log(drift.rbegin()->first / drift.begin()->first);
+    EXPECT_GT(slope, 0.75 * order) << integrator;
+    EXPECT_LT(slope, 1.5 * order) << integrator;
+  }
+}
+
+TEST_F(WorkPrecisionQuick, FailedRunsAreMarkedWithWhereTheyStopped) {
+  for (const auto& name : workPrecisionSceneNames()) {
+    const CsvTable t = parseCsv(readText(dir_ / (name + ".csv")));
+    const auto& s = scene(name);
+    ASSERT_EQ(t.rows.size(), s.runs.size());
+    for (std::size_t i = 0; i < s.runs.size(); ++i) {
+      EXPECT_EQ(t.rows[i][3], s.runs[i].ok ? "ok" : "diverged") << name << " row " << i;
+      if (!s.runs[i].ok) {
+        EXPECT_NE(s.runs[i].failure.find("t = "), std::string::npos) << s.runs[i].failure;
+      }
+    }
+  }
+}
+
 TEST(WorkPrecision, UnknownNamesAreRejected) {
   WorkPrecisionOptions opt;
   opt.models_dir = std::string(REDMAX_SOURCE_DIR) + "/osim_models";
