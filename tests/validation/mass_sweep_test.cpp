@@ -8,11 +8,14 @@
 //     file, its zero value equals the plain zero-mass ID (<= 1e-12 of the peak), the torque
 //     difference is affine in the fraction (tau(F) - tau(0) = F/0.8 (tau(0.8) - tau(0)) to 1e-9
 //     of the peak, R^2 >= 1 - 1e-9), the ankle moment changes, and a physiological scale sweep
-//     has R^2 >= 0.999; the single-value inertial effect equals the sweep at the same fraction;
+//     has R^2 >= 0.999; Simbody with muscle inertia agrees with the core at 80% (1e-9 of the
+//     peak); the single-value inertial effect equals the sweep at the same fraction;
 //   - the command line: a sweep through `redmax validate` exits 0 and fills summary.json; bad
 //     sweep values exit 2;
 //   - set F (gait10dof18musc, skipped without ../shared): the same properties and a nonzero
-//     inertial effect on ankle_angle_r_moment.
+//     inertial effect on ankle_angle_r_moment; the core's muscle share at trial frames equals
+//     Lagrange's equations from central differences of the mass points' energies (1e-6), which
+//     covers set F's MovingPathPoints (Simbody's muscle inertia differs there: recorded only).
 // Measured numbers are printed with "[ measured ]"; nothing asserts a timing.
 #include <gtest/gtest.h>
 
@@ -235,6 +238,11 @@ TEST_F(MassSweep, RunningLegTibiaTransferIsAffineAndReproducesZeroMass) {
     EXPECT_LE((sw.torques[0].data.col(c) - zero.data.col(c)).cwiseAbs().maxCoeff(), 1e-12 * pk(c)) << zero.labels[c];
   EXPECT_TRUE(sw.analysis.zero_passed);
 
+  // Simbody with muscle inertia on the same model and mass points (no moving points here): round-off
+  ASSERT_TRUE(sw.simbody.ran) << sw.simbody.skipped;
+  EXPECT_TRUE(sw.simbody.comparison.passed);
+  EXPECT_TRUE(fs::exists(rep / "core_mass_vs_simbody_mass_metrics.csv"));
+
   // exactly affine in the fraction (file comment of mass_sweep.hpp), so much tighter than R^2 0.999
   const double defect = affineDefect(sw.options.values, sw.torques);
   EXPECT_LT(defect, 1e-9);
@@ -251,6 +259,7 @@ TEST_F(MassSweep, RunningLegTibiaTransferIsAffineAndReproducesZeroMass) {
   EXPECT_EQ(ms.at("mode").asString(), "transfer");
   EXPECT_EQ(ms.at("values").size(), 5u);
   EXPECT_TRUE(ms.at("zero_check").at("passed").asBool());
+  EXPECT_TRUE(s.at("simbody_mass_check").at("agrees").asBool());
   EXPECT_DOUBLE_EQ(ms.at("columns").at("ankle_angle_r_moment").at("peak_change_rel").at(4).asNumber(),
                    col.peak_change_rel[4]);
   // the muscle mass moved is 80% of the tibia's 3.161 kg at the last value
@@ -376,14 +385,15 @@ TEST_F(MassSweep, SetFTibiaTransferSweep) {
   const auto& sw = r.mass_sweep;
   // the zero-mass engines agree; Simbody with muscle inertia is recorded (its agreement with the
   // core is plugin/simbody's matter: SetFMuscleShareSatisfiesLagrangeByDifferences checks the core)
+  EXPECT_TRUE(r.passed) << "the cross-check with Simbody's muscle inertia is recorded, not counted";
   ASSERT_FALSE(r.comparisons.empty());
   EXPECT_EQ(r.comparisons[0].name, "core_vs_simbody");
   EXPECT_TRUE(r.comparisons[0].passed);
   if (sw.simbody.ran) {
     const auto& c = sw.simbody.comparison;
-    std::printf("[ measured ] set F 80%% tibia_r: core vs Simbody with muscle inertia worst %s max/peak %.3g (%s)\n",
+    std::printf("[ measured ] set F 80%% tibia_r: core vs Simbody with muscle inertia worst %s max/peak %.3g (%s; recorded, not counted)\n",
                 c.metrics[static_cast<size_t>(c.worst)].name.c_str(), c.metrics[static_cast<size_t>(c.worst)].max_rel,
-                c.passed ? "PASS" : "FAIL");
+                c.passed ? "agrees" : "DIFFERS");
   }
   EXPECT_TRUE(sw.analysis.zero_passed) << sw.analysis.zero_max_rel;
   EXPECT_LE(sw.analysis.zero_max_rel, 1e-12);
