@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cli/args.hpp"
+#include "cli/muscle_mass_flags.hpp"
 #include "validation/report/progress.hpp"
 #include "validation/simulate/simulate.hpp"
 
@@ -59,9 +60,9 @@ std::vector<std::pair<std::string, double>> parseMassList(const std::string& tex
 
 int runSimulate(const std::vector<std::string>& argv) {
   const Args a(argv,
-               {"model", "duration", "integrator", "dt", "rtol", "atol", "max-step", "initial", "initial-time",
-                "wrap", "output-dt", "out", "muscle-mass", "muscles", "mass-points", "muscle-mass-kg", "impulse"},
-               {"no-qvv", "progress", "quiet", "full-precision", "mass-whole-path"});
+               withMuscleMassFlags({"model", "duration", "integrator", "dt", "rtol", "atol", "max-step", "initial",
+                                    "initial-time", "wrap", "output-dt", "out", "muscle-mass-kg", "impulse"}),
+               {"no-qvv", "progress", "quiet", "full-precision"});
   if (!a.positionals().empty())
     throw UsageError{"simulate takes no positional arguments (got '" + a.positionals().front() + "')"};
   if (!a.has("model")) throw UsageError{"simulate needs --model M.osim"};
@@ -101,17 +102,23 @@ int runSimulate(const std::vector<std::string>& argv) {
 
   validation::SimulationModelOptions mo;
   mo.quadratic_velocity = !a.has("no-qvv");
-  const std::string mm = a.get("muscle-mass", "none");
-  // TODO(simulate): the full MUSCLE-MASS OPTIONS (cli/muscle_mass_flags.hpp) once they land
-  if (mm != "none")
-    throw UsageError{"--muscle-mass must be none here for now, got '" + mm +
-                     "' (give explicit masses with --muscle-mass-kg)"};
-  mo.muscle_mass.mass_points = static_cast<int>(a.getInt("mass-points", 20));
-  if (mo.muscle_mass.mass_points < 1 || mo.muscle_mass.mass_points > 100000)
-    throw UsageError{"--mass-points must be between 1 and 100000"};
-  mo.muscle_mass.muscles = a.get("muscles", "all");
-  if (a.has("mass-whole-path")) mo.muscle_mass.region = MassPointOptions::Region::WholePath;
-  if (auto v = a.get("muscle-mass-kg")) mo.explicit_masses = parseMassList(*v);
+  if (auto v = a.get("muscle-mass-kg")) {
+    // explicit masses take the point count and region from --mass-points / --mass-region; the
+    // flags that choose or size a mass source do not apply
+    if (a.get("muscle-mass", "none") != "none")
+      throw UsageError{"--muscle-mass-kg excludes --muscle-mass " + a.get("muscle-mass", "")};
+    for (const char* f : {"muscles", "specific-tension", "muscle-density", "transfer-body", "transfer-fraction"})
+      if (a.has(f)) throw UsageError{std::string("--") + f + " needs --muscle-mass physiological or transfer"};
+    mo.explicit_masses = parseMassList(*v);
+    const long n = a.getInt("mass-points", 20);
+    if (n < 1 || n > 100000) throw UsageError{"--mass-points must be between 1 and 100000"};
+    mo.muscle_mass.mass_points = static_cast<int>(n);
+    const std::string region = a.get("mass-region", "fibre");
+    if (region == "whole") mo.muscle_mass.region = MassPointOptions::Region::WholePath;
+    else if (region != "fibre" && region != "fiber") throw UsageError{"--mass-region must be fibre or whole"};
+  } else {
+    mo.muscle_mass = parseMuscleMassFlags(a);
+  }
   if (auto v = a.get("impulse"))
     for (const std::string& item : splitOn(*v, ';')) mo.impulses.push_back(validation::parseImpulse(item));
   const bool quiet = a.has("quiet");
@@ -213,8 +220,8 @@ CommandRegistration reg(
      "                       [--integrator euler|symplectic|bdf1|sdirk2|rk45|cvode] [--dt S]\n"
      "                       [--rtol R] [--atol A] [--max-step S] [--output-dt S]\n"
      "                       [--initial STATE.sto [--initial-time T]] [--wrap exact]\n"
-     "                       [--muscle-mass none] [--muscle-mass-kg NAME=KG,...] [--mass-points N]\n"
-     "                       [--mass-whole-path] [--no-qvv] [--impulse TARGET:FX,FY,FZ:DURATION]\n"
+     "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
+     "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
      "                       [--progress] [--quiet] [--full-precision]\n"
      "Integrates the model under gravity from its default pose (each coordinate's default_value and\n"
      "default_speed_value) with its constraints (locked, coupled and prescribed coordinates, welds).\n"
@@ -228,11 +235,9 @@ CommandRegistration reg(
      "                       coordinate, /jointset/J/C/value and /speed, or C_u; degrees if the header\n"
      "                       says inDegrees=yes; absent coordinates keep their defaults\n"
      "  --wrap exact         the only accepted value until wrapping paths (Type III) carry mass\n"
-     "  --muscle-mass none   muscles lumped into the bones, as OpenSim sees them (default)\n"
      "  --muscle-mass-kg NAME=KG,...  give these muscles KG each in mass points, ADDED to the model\n"
-     "                       (no body gives mass; e.g. the finger's 0.2 kg flexors of [D 6.2.5])\n"
-     "  --mass-points N      points per muscle (default 20); --mass-whole-path spreads them over the\n"
-     "                       whole path instead of the fibre portion\n"
+     "                       (no body gives mass; e.g. the finger's 0.2 kg flexors of [D 6.2.5]);\n"
+     "                       --mass-points and --mass-region apply; excludes --muscle-mass\n"
      "  --no-qvv             drop the muscles' quadratic velocity vector (energy experiment [D 6.2.4])\n"
      "  --impulse TARGET:FX,FY,FZ:DURATION  a force (N, ground frame) while t < DURATION (s) on a\n"
      "                       body's origin, a marker, or BODY@X,Y,Z (m, body frame); ';' separates several\n"
@@ -242,7 +247,8 @@ CommandRegistration reg(
      "kinetic_energy, potential_energy, total_energy (J; gravity potential relative to the origin).\n"
      "A NaN or divergence stops the run: exit 1, the time, coordinate and step are named, and nothing\n"
      "is written. The summary gives steps, rhs evaluations, wall time and the energy drift\n"
-     "max|E(t) - E(0)| relative to max(|E(0)|, max kinetic energy).\n",
+     "max|E(t) - E(0)| relative to max(|E(0)|, max kinetic energy).\n"
+     "\n" + std::string(muscleMassUsage()),
      runSimulate});
 
 }  // namespace

@@ -105,6 +105,18 @@ TEST_F(SimulateCli, MuscleQuadraticVelocityVectorKeepsEnergy) {
   EXPECT_GE(energyDrift(readStorage(path("noqvv.sto"))), 1e-3);
 }
 
+TEST_F(SimulateCli, PhysiologicalMuscleMassMovesMassAndKeepsEnergy) {
+  // mass taken from the bones into the straight muscle (density * F / tension * l_opt, 0.08 kg at
+  // 200 kg/m^3; the default density would leave link1 with a non-physical inertia): the run
+  // reports it and still conserves energy with tight rk45
+  const CmdResult r = run("--model " + scene("double_pendulum_straight.osim") +
+                          " --muscle-mass physiological --muscle-density 200 --duration 2 --integrator rk45 --rtol 1e-11 --atol 1e-12"
+                          " --out " + path("phys.sto"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE((r.out + r.err).find("straight_muscle"), std::string::npos) << r.out << r.err;
+  EXPECT_LE(energyDrift(readStorage(path("phys.sto"))), 1e-8);
+}
+
 TEST_F(SimulateCli, RestartFromAWrittenRowReproducesTheRun) {
   const std::string base = "--model " + scene("double_pendulum_via.osim") +
                            " --integrator euler --dt 0.001 --muscle-mass-kg via_muscle=0.5 --full-precision --quiet";
@@ -148,6 +160,9 @@ TEST_F(SimulateCli, BadInputExitsTwoWithAClearMessageAndWritesNothing) {
       {model + " --duration 1 --bogus" + out, "unknown option --bogus"},
       {model + " --duration 1 --muscle-mass-kg nobody=1" + out, "no muscle 'nobody'"},
       {model + " --duration 1 --muscle-mass-kg via_muscle=-1" + out, "KG >= 0"},
+      {model + " --duration 1 --muscle-mass-kg via_muscle=1 --muscle-mass physiological" + out, "excludes"},
+      {model + " --duration 1 --muscles via.*" + out, "--muscles needs --muscle-mass"},
+      {model + " --duration 1 --muscle-mass heavy" + out, "heavy"},
       {model + " --duration 1 --impulse link2:1,2:0.1" + out, "FX,FY,FZ"},
       {model + " --duration 1 --impulse nobody:1,2,3:0.1" + out, "'nobody' is not a moving body"},
       {model + " --duration 1 --initial " + path("missing.sto") + out, "missing.sto"},
