@@ -3,6 +3,8 @@
 //    transferred into the muscle: ID through the tool equals the closed form to 1e-12 of the peak
 //    (added inertia r^2 sum m_a alpha_a^2, gravity through sum m_a alpha_a, no quadratic term);
 //  - zero mass (transfer fraction 0) gives the none result to 1e-14 of the peak;
+//  - Euler-rate speeds (rates_as_u, a ball-jointed arm): the engine with a MuscleTerm equals the map
+//    done by hand around an independently built System + MuscleTerm (1e-12 of the peak);
 //  - the torques are affine in the mass: physiological density x s and transfer fraction s give
 //    tau(2s) - tau(0) = 2 (tau(s) - tau(0)) to 1e-9 of the change (running leg swing trial);
 //  - `redmax id` with the muscle-mass flags: summary on stderr (not with --quiet), --engine simbody
@@ -11,12 +13,16 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "converter/id/core_id_engine.hpp"
 #include "converter/id/inverse_dynamics_tool.hpp"
 #include "converter/storage.hpp"
+#include "core/dynamics/muscle_term.hpp"
+#include "core/dynamics/system.hpp"
 #include "tests/validation/pendulum_cli_fixture.hpp"
 
 namespace {
@@ -207,6 +213,102 @@ TEST_F(IdMuscleMass, TorquesAreAffineInTheMuscleMass) {
     std::printf("[ measured ] running leg tibia transfer 80%%: max |tau - tau_none| = %.3g (%.2f%% of peak), "
                 "affine defect %.2e\n", change, 100 * change / peak, defect);
   }
+}
+
+// a ball-jointed upper arm (OpenSim's Euler-angle rates read as angular velocity: rates_as_u) and
+// a pinned forearm with a straight muscle between them
+const char* kBallArm = R"(<?xml version="1.0" encoding="UTF-8" ?>
+<OpenSimDocument Version="40000">
+<Model name="ballarm"><Ground name="ground"/><gravity>0 -9.80665 0</gravity>
+<BodySet name="bodyset"><objects>
+<Body name="upper"><mass>2</mass><mass_center>0 -0.15 0</mass_center><inertia>0.02 0.005 0.02 0 0 0</inertia></Body>
+<Body name="fore"><mass>1</mass><mass_center>0 -0.12 0</mass_center><inertia>0.01 0.002 0.01 0 0 0</inertia></Body>
+</objects></BodySet>
+<JointSet name="jointset"><objects>
+<BallJoint name="shoulder"><socket_parent_frame>/ground</socket_parent_frame><socket_child_frame>/bodyset/upper</socket_child_frame>
+<coordinates><Coordinate name="b1"/><Coordinate name="b2"/><Coordinate name="b3"/></coordinates></BallJoint>
+<PinJoint name="elbow"><socket_parent_frame>elbow_p</socket_parent_frame><socket_child_frame>/bodyset/fore</socket_child_frame>
+<coordinates><Coordinate name="e"/></coordinates>
+<frames><PhysicalOffsetFrame name="elbow_p"><socket_parent>/bodyset/upper</socket_parent><translation>0 -0.3 0</translation>
+<orientation>0 0 0</orientation></PhysicalOffsetFrame></frames></PinJoint>
+</objects></JointSet>
+<ForceSet name="forceset"><objects>
+<Thelen2003Muscle name="biceps"><max_isometric_force>600</max_isometric_force>
+<optimal_fiber_length>0.12</optimal_fiber_length><tendon_slack_length>0.1</tendon_slack_length>
+<GeometryPath name="path"><PathPointSet><objects>
+<PathPoint name="o"><socket_parent_frame>/bodyset/upper</socket_parent_frame><location>0.03 -0.05 0</location></PathPoint>
+<PathPoint name="i"><socket_parent_frame>/bodyset/fore</socket_parent_frame><location>0.02 -0.05 0</location></PathPoint>
+</objects></PathPointSet></GeometryPath></Thelen2003Muscle>
+</objects></ForceSet>
+</Model></OpenSimDocument>
+)";
+
+// With rates_as_u the engine maps OpenSim's u to the core's qdot, solves with the muscle term in
+// the System, and maps the forces back: the same as doing it by hand with an independently built
+// System + MuscleTerm (1e-12 of the peak), and different from --exact (the map is active)
+TEST_F(IdMuscleMass, OpenSimSpeedMapAppliesWithMuscleMass) {
+  const std::string model = write("ballarm.osim", kBallArm);
+  std::ostringstream os;
+  os.precision(17);
+  os << "motion\nversion=1\nnRows=201\nnColumns=5\ninDegrees=yes\nendheader\ntime\tb1\tb2\tb3\te\n";
+  for (int i = 0; i <= 200; ++i) {
+    const double t = 0.005 * i, w = 2 * M_PI;
+    os << t << "\t" << 40 * std::sin(w * 0.6 * t) << "\t" << 30 * std::sin(w * 0.9 * t + 0.3) << "\t"
+       << 25 * std::sin(w * 0.5 * t + 1.0) << "\t" << 60 + 40 * std::sin(w * 1.1 * t) << "\n";
+  }
+  const std::string motion = write("ballarm.mot", os.str());
+  MuscleMassOptions mm;
+  mm.source = Source::Physiological;
+  IdToolSettings st;
+  st.model_file = model;
+  st.coordinates_file = motion;
+  st.muscle_mass = mm;
+  const InverseDynamicsTool tool(resolveIdSettings(st));
+  ASSERT_TRUE(tool.engineOptions().marked(0)) << "the ball joint takes OpenSim's u";
+  CoreIdEngine engine(tool.model(), tool.muscles(), tool.engineOptions());
+  EXPECT_GT(engine.muscleMass(), 0.05);
+  const Storage out = tool.run(engine);
+
+  // by hand: qdot = T^-1 u, qddot = T^-1 (udot - Tdot qdot), tau_u = T^-T tau_qdot on the ball block
+  System sys(tool.model());
+  sys.addTerm(std::make_shared<MuscleTerm>(tool.model(), tool.muscles()));
+  DynamicsWorkspace ws(sys.model());
+  const Joint& ball = tool.model().joints[0].joint;
+  double worst = 0, peak = 0, muscle_effect = 0;
+  System lumped(tool.model());
+  DynamicsWorkspace wl(lumped.model());
+  for (int k = 0; k < tool.numFrames(); ++k) {
+    VecX q, u, udot;
+    std::vector<IdLoadSample> loads;
+    tool.calcInputs(tool.frameTime(k), q, u, udot, loads);
+    MatJ T, Tdot;
+    const VecJ qb = q.head(3);
+    calcOpenSimSpeedMap(ball, qb, VecJ::Zero(3), T, nullptr);
+    const VecJ qdot_b = T.lu().solve(VecJ(u.head(3)));
+    calcOpenSimSpeedMap(ball, qb, qdot_b, T, &Tdot);
+    State s;
+    s.q = q;
+    s.qdot = u;
+    s.qdot.head(3) = qdot_b;
+    VecX qddot = udot;
+    qddot.head(3) = T.lu().solve(VecJ(udot.head(3) - Tdot * qdot_b));
+    VecX tau = sys.inverseDynamics(s, qddot, ws);
+    VecX tau_l = lumped.inverseDynamics(s, qddot, wl);
+    tau.head(3) = T.transpose().lu().solve(VecJ(tau.head(3)));
+    tau_l.head(3) = T.transpose().lu().solve(VecJ(tau_l.head(3)));
+    worst = std::max(worst, (out.data.row(k).transpose() - tau).cwiseAbs().maxCoeff());
+    peak = std::max(peak, tau.cwiseAbs().maxCoeff());
+    muscle_effect = std::max(muscle_effect, (tau - tau_l).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(worst, 1e-12 * peak);
+  EXPECT_GT(muscle_effect, 1e-4 * peak);
+
+  // --exact reads the same columns as qdot: a different answer, so the map above was in play
+  st.opensim_compat = false;
+  const InverseDynamicsTool exact_tool(resolveIdSettings(st));
+  CoreIdEngine exact(exact_tool.model(), exact_tool.muscles(), exact_tool.engineOptions());
+  const Storage ex = exact_tool.run(exact);
+  EXPECT_GT((ex.data - out.data).cwiseAbs().maxCoeff(), 1e-3 * peak);
 }
 
 // ---------------------------------------------------------------------------------------------
