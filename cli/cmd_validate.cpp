@@ -4,10 +4,12 @@
 // 0 every comparison passed, 1 one failed (or a frame could not be solved, or the report could
 // not be written), 2 bad input or usage.
 #include <iostream>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "cli/args.hpp"
+#include "cli/muscle_mass_flags.hpp"
 #include "validation/id_validation.hpp"
 
 namespace redmax::cli {
@@ -57,35 +59,6 @@ std::vector<std::string> splitList(const std::string& text) {
   return list;
 }
 
-// the MUSCLE-MASS OPTIONS (DESIGN.md §3); in a sweep the transfer fraction comes from the sweep
-osim::MuscleMassOptions muscleMassOptions(const Args& a, bool sweep) {
-  osim::MuscleMassOptions o;
-  o.source = osim::parseMuscleMassSource(a.get("muscle-mass", "none"));
-  o.muscles = a.get("muscles", o.muscles);
-  if (a.has("mass-points")) o.mass_points = static_cast<int>(a.getInt("mass-points", o.mass_points));
-  o.specific_tension = a.getDouble("specific-tension", o.specific_tension);
-  o.density = a.getDouble("muscle-density", o.density);
-  o.transfer_body = a.get("transfer-body", "");
-  o.transfer_fraction = a.getDouble("transfer-fraction", 0.0);
-  const bool transfer = o.source == osim::MuscleMassOptions::Source::Transfer;
-  if (o.source == osim::MuscleMassOptions::Source::None) {
-    for (const char* f : {"muscles", "mass-points", "specific-tension", "muscle-density", "transfer-body",
-                          "transfer-fraction"})
-      if (a.has(f)) throw UsageError{std::string("--") + f + " needs --muscle-mass physiological or transfer"};
-  }
-  if (transfer && o.transfer_body.empty()) throw UsageError{"--muscle-mass transfer needs --transfer-body BODY"};
-  if (transfer && !sweep && !a.has("transfer-fraction"))
-    throw UsageError{"--muscle-mass transfer needs --transfer-fraction F (or --mass-sweep F1,F2,...)"};
-  if (!transfer && (a.has("transfer-body") || a.has("transfer-fraction")))
-    throw UsageError{"--transfer-body and --transfer-fraction need --muscle-mass transfer"};
-  if (o.mass_points < 1) throw UsageError{"--mass-points must be >= 1"};
-  if (!(o.specific_tension > 0)) throw UsageError{"--specific-tension must be > 0 (Pa)"};
-  if (!(o.density > 0)) throw UsageError{"--muscle-density must be > 0 (kg/m^3)"};
-  if (transfer && !sweep && !(o.transfer_fraction >= 0 && o.transfer_fraction < 1))
-    throw UsageError{"--transfer-fraction must be in [0, 1)"};
-  return o;
-}
-
 double nonNegative(const Args& a, const std::string& name, double fallback) {
   const double x = a.getDouble(name, fallback);
   if (x < 0) throw UsageError{"--" + name + " must be >= 0"};
@@ -95,12 +68,12 @@ double nonNegative(const Args& a, const std::string& name, double fallback) {
 int runValidate(const std::vector<std::string>& argv_in) {
   validation::IdValidationOptions opt;
   const std::vector<std::string> argv = takeReferences(argv_in, opt.references);
-  const Args a(argv,
-               {"setup", "model", "coordinates", "external-loads", "lowpass", "t0", "t1", "report",
-                "forces-to-exclude", "muscle-mass", "muscles", "mass-points", "specific-tension",
-                "muscle-density", "transfer-body", "transfer-fraction", "mass-sweep", "sweep-columns",
-                "tolerance", "max-tolerance", "engine-tolerance", "interpolation", "gnuplot"},
-               {"exact", "opensim-compat", "quiet", "no-simbody", "no-plots"});
+  const std::set<std::string> value_flags =
+      withMuscleMassFlags({"setup", "model", "coordinates", "external-loads", "lowpass", "t0", "t1", "report",
+                           "forces-to-exclude", "mass-sweep", "sweep-columns", "tolerance", "max-tolerance",
+                           "engine-tolerance", "interpolation", "gnuplot"});
+  const std::set<std::string> bool_flags = {"exact", "opensim-compat", "quiet", "no-simbody", "no-plots"};
+  const Args a(argv, value_flags, bool_flags);
   if (!a.positionals().empty())
     throw UsageError{"validate takes no positional arguments (got '" + a.positionals().front() + "')"};
 
@@ -132,7 +105,14 @@ int runValidate(const std::vector<std::string>& argv_in) {
   } else if (a.has("sweep-columns")) {
     throw UsageError{"--sweep-columns needs --mass-sweep"};
   }
-  opt.muscle_mass = muscleMassOptions(a, !opt.mass_sweep.empty());
+  if (!opt.mass_sweep.empty() && a.get("muscle-mass", "") == "transfer") {
+    // the sweep gives the fractions: the shared parser still wants one, any valid value does
+    std::vector<std::string> with_fraction = argv;
+    with_fraction.push_back("--transfer-fraction=0");
+    opt.muscle_mass = parseMuscleMassFlags(Args(with_fraction, value_flags, bool_flags));
+  } else {
+    opt.muscle_mass = parseMuscleMassFlags(a);
+  }
   if (!opt.mass_sweep.empty())
     opt.mass_sweep = validation::checkMassSweepValues(opt.muscle_mass, opt.mass_sweep);
   if (auto v = a.get("sweep-columns")) opt.sweep_columns = splitList(*v);
@@ -176,6 +156,9 @@ int runValidate(const std::vector<std::string>& argv_in) {
     return 1;
   }
   if (!quiet) {
+    // what the muscle-mass step did (the largest mass of a sweep): bodies before and after, muscles
+    if (r.has_inertial_effect) std::cerr << r.inertial_effect.description;
+    if (r.has_mass_sweep && !r.mass_sweep.points.empty()) std::cerr << r.mass_sweep.points.back().description;
     for (const auto& w : r.warnings) std::cerr << "warning: " << w << "\n";
     for (const auto& e : r.files.plot_errors) std::cerr << "warning: plot: " << e << "\n";
     std::cout << validation::formatIdValidationSummary(r);
@@ -187,7 +170,7 @@ int runValidate(const std::vector<std::string>& argv_in) {
 
 CommandRegistration reg(
     {"validate", "inverse dynamics by core and Simbody, compared with each other and with references",
-     "usage: redmax validate (--setup ID_SETUP.xml | --model M.osim --coordinates Q.mot)\n"
+     std::string("usage: redmax validate (--setup ID_SETUP.xml | --model M.osim --coordinates Q.mot)\n"
      "                 [--external-loads LOADS.xml] [--lowpass HZ] [--t0 S] [--t1 S]\n"
      "                 [--forces-to-exclude LIST] [--exact]\n"
      "                 [--reference OPENSIM_ID.sto]... [--published ID.sto]...\n"
@@ -211,12 +194,12 @@ CommandRegistration reg(
      "of each engine: frames, seconds, frames per second), <cmp>_metrics.csv, <cmp>_series.csv,\n"
      "overlay and difference plots (gnuplot; skipped with a note when absent or --no-plots),\n"
      "overlay_all (every series), core_id.sto and simbody_id.sto (full precision), report.md.\n"
-     "Muscle mass (MUSCLE-MASS OPTIONS as in DESIGN.md: --muscle-mass none|physiological|transfer,\n"
-     "--muscles all|REGEX|top:K, --mass-points N, --specific-tension PA, --muscle-density KG_M3,\n"
-     "--transfer-body BODY, --transfer-fraction F). Simbody has no muscle inertia, so the comparisons\n"
-     "above always use the zero-mass core. With muscle mass the core solves the trial again and\n"
-     "the per-column difference from the zero-mass core is reported as the inertial effect\n"
-     "(inertial_effect.csv, an overlay, core_mass_id.sto, summary.inertial_effect), never a failure.\n"
+     "MUSCLE-MASS OPTIONS (below). The comparisons above always use the zero-mass core and\n"
+     "Simbody (OpenSim's results have no muscle inertia). With muscle mass the core solves the\n"
+     "trial again and the per-column difference from the zero-mass core is reported as the\n"
+     "inertial effect (inertial_effect.csv, an overlay, core_mass_id.sto, summary.inertial_effect),\n"
+     "never a failure; Simbody with muscle inertia solves it too, as a cross-check that is recorded\n"
+     "(core_mass_vs_simbody_mass_metrics.csv, summary.simbody_mass_check), not counted.\n"
      "--mass-sweep V1,V2,...  solve once per value on the same processed inputs: transfer fractions\n"
      "                       in [0, 1) with --muscle-mass transfer --transfer-body BODY (e.g.\n"
      "                       0,0.2,0.4,0.6,0.8), or scales >= 0 of the physiological mass with\n"
@@ -229,7 +212,8 @@ CommandRegistration reg(
      "                       zero-mass result to 1e-12 of each column's peak) can fail the run.\n"
      "Prints one line per engine and per comparison (worst column, PASS/FAIL).\n"
      "Exit codes: 0 every comparison passed, 1 a comparison failed (or a frame could not be solved,\n"
-     "or the report could not be written), 2 bad input or usage.\n",
+     "or the report could not be written), 2 bad input or usage.\n") +
+         muscleMassUsage(),
      runValidate});
 
 }  // namespace

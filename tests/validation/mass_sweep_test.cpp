@@ -10,8 +10,9 @@
 //     of the peak, R^2 >= 1 - 1e-9), the ankle moment changes, and a physiological scale sweep
 //     has R^2 >= 0.999; Simbody with muscle inertia agrees with the core at 80% (1e-9 of the
 //     peak); the single-value inertial effect equals the sweep at the same fraction;
-//   - the command line: a sweep through `redmax validate` exits 0 and fills summary.json; bad
-//     sweep values exit 2;
+//   - the command line: a sweep through `redmax validate` exits 0 and fills summary.json; its 80%
+//     torques equal `redmax id --muscle-mass transfer --transfer-fraction 0.8` (1e-12 of the peak);
+//     bad sweep values and flags exit 2;
 //   - set F (gait10dof18musc, skipped without ../shared): the same properties and a nonzero
 //     inertial effect on ankle_angle_r_moment; the core's muscle share at trial frames equals
 //     Lagrange's equations from central differences of the mass points' energies (1e-6), which
@@ -33,6 +34,7 @@
 #include "tests/validation/pendulum_cli_fixture.hpp"
 #include "validation/id_validation.hpp"
 #include "validation/mass_sweep.hpp"
+#include "validation/report/csv.hpp"
 #include "validation/report/json_value.hpp"
 #include "validation/report/plot.hpp"
 
@@ -345,9 +347,40 @@ TEST_F(MassSweep, CommandLineSweepAndBadValues) {
   const JsonValue s = JsonValue::parse(slurp(dir_ / "rep" / "summary.json"));
   EXPECT_EQ(s.at("mass_sweep").at("values").size(), 3u);
   EXPECT_EQ(s.at("inputs").at("muscle_mass").at("transfer_body").asString(), "tibia_r");
+  // what the muscle-mass step did is printed (bodies before and after, muscles)
+  EXPECT_NE(ok.err.find("tibia_r"), std::string::npos) << ok.err;
+
+  // `redmax id` with the same muscle mass (its own wiring: the tool's model and CoreIdEngine with a
+  // MuscleTerm) gives the sweep's 80% torques
+  const CmdResult id = run("id --model " + leg() + " --coordinates " + swing() +
+                           " --muscle-mass transfer --transfer-body tibia_r --transfer-fraction 0.8 --full-precision"
+                           " --quiet --out id80.sto");
+  ASSERT_EQ(id.code, 0) << id.err;
+  const redmax::osim::Storage id80 = redmax::osim::readStorage((dir_ / "id80.sto").string());
+  const redmax::validation::CsvTable csv = redmax::validation::parseCsv(slurp(dir_ / "rep" / "mass_sweep_tau_F0.8.csv"));
+  ASSERT_EQ(csv.rows.size(), static_cast<size_t>(id80.numRows()));
+  ASSERT_EQ(csv.header.size(), id80.labels.size() + 1);
+  const Eigen::VectorXd pk = peaks(id80.data);
+  double worst = 0;
+  for (int k = 0; k < id80.numRows(); ++k) {
+    EXPECT_NEAR(std::stod(csv.rows[static_cast<size_t>(k)][0]), id80.time[static_cast<size_t>(k)], 1e-12);
+    for (int c = 0; c < id80.data.cols(); ++c) {
+      EXPECT_EQ(csv.header[static_cast<size_t>(c) + 1], id80.labels[static_cast<size_t>(c)]);
+      worst = std::max(worst, std::abs(std::stod(csv.rows[static_cast<size_t>(k)][static_cast<size_t>(c) + 1]) -
+                                       id80.data(k, c)) / pk(c));
+    }
+  }
+  EXPECT_LT(worst, 1e-12);
+  std::printf("[ measured ] running leg 80%% tibia_r: validate sweep vs redmax id with muscle mass %.2g of the peak\n",
+              worst);
 
   const std::vector<std::pair<std::string, std::string>> cases = {
       {in + "--mass-sweep 0,0.5 --report bad", "--mass-sweep"},  // no --muscle-mass
+      {in + "--muscle-mass transfer --transfer-body tibia_r --transfer-fraction 0.5 --mass-sweep 0,0.5 --report bad",
+       "--transfer-fraction"},
+      {in + "--muscle-mass transfer --transfer-body tibia_r --report bad", "--transfer-fraction"},
+      {in + "--muscle-mass physiological --mass-sweep 0,-1 --report bad", "-1"},
+      {in + "--sweep-columns ankle_angle_r_moment --report bad", "--sweep-columns"},
       {in + "--muscle-mass transfer --transfer-body tibia_r --mass-sweep 0,1.2 --report bad", "1.2"},
       {in + "--muscle-mass transfer --transfer-body tibia_r --mass-sweep 0,abc --report bad", "abc"},
       {in + "--muscle-mass transfer --transfer-body nobody --mass-sweep 0,0.5 --report bad", "nobody"},
