@@ -13,7 +13,7 @@
 //   - the command line: a sweep through `redmax validate` exits 0 and fills summary.json; its 80%
 //     torques equal `redmax id --muscle-mass transfer --transfer-fraction 0.8` (1e-12 of the peak);
 //     bad sweep values and flags exit 2;
-//   - set F (gait10dof18musc, skipped without ../shared): the same properties and a nonzero
+//   - sets F (gait10dof18musc) and E (gait2392), skipped without ../shared: the same properties and a nonzero
 //     inertial effect on ankle_angle_r_moment; the core's muscle share at trial frames equals
 //     Lagrange's equations from central differences of the mass points' energies (1e-6), which
 //     covers set F's MovingPathPoints (Simbody's muscle inertia differs there: recorded only).
@@ -449,6 +449,39 @@ TEST_F(MassSweep, SetFTibiaTransferSweep) {
 }  // namespace
 
 namespace {
+
+// set E (gait2392: 21 muscles with a path point on tibia_r, moving points): the same properties
+TEST_F(MassSweep, SetETibiaTransferSweep) {
+  const std::string base = std::string(REDMAX_SHARED_DIR) + "/opensim/";
+  const std::string setup = base + "opensim-models/Pipelines/Gait2392_Simbody/subject01_Setup_InverseDynamics.xml";
+  const std::string model =
+      base + "opensim-models@a26e12c/Pipelines/Gait2392_Simbody/OutputReference/subject01_simbody.osim";
+  for (const auto& f : {setup, model})
+    if (!fs::exists(f)) GTEST_SKIP() << "shared OpenSim data not found: " << f << " (needs ../shared/opensim)";
+  redmax::validation::IdValidationOptions opt;
+  opt.settings.setup_file = setup;
+  opt.settings.model_file = model;
+  opt.report_dir = (dir_ / "setE").string();
+  opt.gnuplot = "none";
+  opt.muscle_mass.source = Source::Transfer;
+  opt.muscle_mass.transfer_body = "tibia_r";
+  opt.mass_sweep = kFractions;
+  const auto r = redmax::validation::runIdValidation(opt);
+  ASSERT_TRUE(r.has_mass_sweep);
+  EXPECT_TRUE(r.passed);
+  const auto& sw = r.mass_sweep;
+  EXPECT_TRUE(sw.analysis.zero_passed) << sw.analysis.zero_max_rel;
+  EXPECT_LT(affineDefect(sw.options.values, sw.torques), 1e-9);
+  EXPECT_GT(sw.analysis.r2_min_observed, 1 - 1e-9);
+  EXPECT_GT(sw.points.back().muscles_with_mass, 1);
+  const int ankle = columnOf(sw.torques[0].labels, "ankle_angle_r_moment");
+  ASSERT_GE(ankle, 0);
+  EXPECT_GT(sw.analysis.columns[static_cast<size_t>(ankle)].max_diff_rel.back(), 1e-5);
+  std::printf("[ measured ] set E, tibia_r transfer 0-80%% (%.3f kg in %d muscles): ankle max change %.3f%% of the "
+              "peak; R^2 min %.15f\n",
+              sw.points.back().muscle_mass, sw.points.back().muscles_with_mass,
+              100 * sw.analysis.columns[static_cast<size_t>(ankle)].max_diff_rel.back(), sw.analysis.r2_min_observed);
+}
 
 // the muscles' share of inverse dynamics, tau_m = tau(with mass points) - tau(skeleton alone) on
 // the same reduced model, against Lagrange's equations built by central differences of the mass
