@@ -150,10 +150,13 @@ int runSimulate(const std::vector<std::string>& argv) {
     std::printf("simulate: %s, %d coordinates, %d constraint rows, %zu muscles (%.4g kg in mass points)\n",
                 model.description.name.c_str(), core.nr(), model.system->numConstraintRows(),
                 model.muscles.size(), model.muscle_mass);
-    if (!model.mass_summary.empty()) std::printf("%s", model.mass_summary.c_str());
-    for (const auto& mu : model.description.muscles)
-      if (mu.path_type == osim::PathType::III && model.muscle_mass > 0.0)
-        std::printf("  muscle %s: lumped (Type III path: wrapping muscles carry no mass yet)\n", mu.name.c_str());
+    // where the mass went, on stderr as the other commands print it (muscle_mass_flags.hpp)
+    if (!model.mass_summary.empty()) std::fprintf(stderr, "%s", model.mass_summary.c_str());
+    if (model.added_mass > 0.0)
+      for (const auto& mu : model.description.muscles)
+        if (mu.path_type == osim::PathType::III)
+          std::fprintf(stderr, "  muscle %s: lumped (Type III path: wrapping muscles carry no mass yet)\n",
+                       mu.name.c_str());
   }
 
   // progress: always with --progress, otherwise once a run has taken more than 2 s
