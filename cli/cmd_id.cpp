@@ -68,11 +68,6 @@ int runId(const std::vector<std::string>& argv) {
   if (engine_name != "core" && engine_name != "simbody")
     throw UsageError{"--engine must be core or simbody, got '" + engine_name + "'"};
   const bool with_mass = settings.muscle_mass.source != osim::MuscleMassOptions::Source::None;
-  if (engine_name == "simbody" && with_mass) {
-    // (no Simbody engine with muscle inertia yet; a later task adds it)
-    std::cerr << "error: --engine simbody does not support muscle mass yet\n";
-    return 2;
-  }
   const bool quiet = a.has("quiet");
 
   std::unique_ptr<osim::InverseDynamicsTool> tool;
@@ -90,7 +85,8 @@ int runId(const std::vector<std::string>& argv) {
       engine = std::make_unique<osim::CoreIdEngine>(tool->model(), tool->muscles(), tool->engineOptions());
     } else {
       try {
-        engine = std::make_unique<simbody::SimbodyIdEngine>(tool->model(), tool->engineOptions());
+        // muscles with mass points: their inertia through plugin/simbody/muscle_inertia.hpp
+        engine = std::make_unique<simbody::SimbodyIdEngine>(tool->model(), tool->muscles(), tool->engineOptions());
       } catch (const simbody::SimbodyBuildError& e) {
         throw osim::ConvertError(config.model_file, 0,
                                  std::string("--engine simbody cannot build this model: ") + e.what());
@@ -163,7 +159,7 @@ CommandRegistration reg(
      "Butterworth low-pass; quintic natural splines giving q, qdot and qddot; coordinates absent\n"
      "from the file held at their defaults; external loads interpolated (natural cubic) and applied\n"
      "at the current poses; gravity from the model; constraints ignored; muscle forces excluded\n"
-     "(with muscle mass, the muscles' inertia is included; --engine core only).\n"
+     "(with muscle mass, the muscles' inertia is included, by either engine).\n"
      "  --setup FILE         an InverseDynamicsTool setup (paths relative to it); flags override it\n"
      "  --model, --coordinates, --external-loads FILE\n"
      "  --lowpass HZ         cutoff for the coordinates (< 0: no filtering; setup default -1)\n"

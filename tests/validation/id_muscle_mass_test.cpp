@@ -7,8 +7,9 @@
 //    done by hand around an independently built System + MuscleTerm (1e-12 of the peak);
 //  - the torques are affine in the mass: physiological density x s and transfer fraction s give
 //    tau(2s) - tau(0) = 2 (tau(s) - tau(0)) to 1e-9 of the change (running leg swing trial);
-//  - `redmax id` with the muscle-mass flags: summary on stderr (not with --quiet), --engine simbody
-//    refused with exit 2, bad flags exit 2 with the flag named and nothing written.
+//  - `redmax id` with the muscle-mass flags: summary on stderr (not with --quiet), bad flags exit 2
+//    with the flag named and nothing written; --engine simbody with muscle mass (plugin/simbody/
+//    muscle_inertia.hpp) equals --engine core to 1e-9 of each column's peak.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -361,12 +362,30 @@ TEST_F(IdMuscleMassCli, PrintsThePlanAndChangesTheTorques) {
   EXPECT_NE(t.err.find("not in the top 1"), std::string::npos) << t.err;
 }
 
+TEST_F(IdMuscleMassCli, SimbodyEngineWithMassEqualsCore) {
+  const std::string mass = "--muscle-mass transfer --transfer-body tibia_r --transfer-fraction 0.8 --quiet --full-precision ";
+  const CmdResult c = run(mass + "--engine core --out core.sto");
+  ASSERT_EQ(c.code, 0) << c.err;
+  const CmdResult s = run(mass + "--engine simbody --out simbody.sto");
+  ASSERT_EQ(s.code, 0) << s.err;
+  const CmdResult n = run("--quiet --full-precision --engine simbody --out none.sto");
+  ASSERT_EQ(n.code, 0) << n.err;
+  const Storage a = readStorage((dir_ / "core.sto").string()), b = readStorage((dir_ / "simbody.sto").string());
+  const Storage z = readStorage((dir_ / "none.sto").string());
+  ASSERT_EQ(a.numRows(), b.numRows());
+  ASSERT_EQ(a.data.cols(), b.data.cols());
+  for (int j = 0; j < a.data.cols(); ++j) {  // data columns (time is separate)
+    const double peak = a.data.col(j).cwiseAbs().maxCoeff();
+    EXPECT_LE((a.data.col(j) - b.data.col(j)).cwiseAbs().maxCoeff(), 1e-9 * peak) << "column " << j;
+  }
+  EXPECT_GT((b.data - z.data).cwiseAbs().maxCoeff(), 1e-6);  // the mass changed the Simbody torques
+}
+
 TEST_F(IdMuscleMassCli, BadFlagsExitTwo) {
   struct Case {
     std::string args, expect;
   };
   const std::vector<Case> cases = {
-      {"--muscle-mass physiological --engine simbody", "error: --engine simbody does not support muscle mass yet"},
       {"--muscle-mass heavy", "--muscle-mass must be none, physiological or transfer"},
       {"--muscle-mass physiological --mass-points 0", "--mass-points"},
       {"--muscle-mass physiological --mass-points two", "--mass-points expects an integer"},
