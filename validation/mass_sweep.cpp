@@ -6,12 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <Eigen/Dense>
-
 #include "converter/error.hpp"
 #include "converter/id/core_id_engine.hpp"
-#include "core/dynamics/muscle_term.hpp"
-#include "core/skeleton/kinematics.hpp"
 #include "plugin/simbody/id_engine.hpp"
 #include "validation/report/progress.hpp"
 
@@ -60,59 +56,6 @@ std::string sideOf(const std::string& body) {
   return "";
 }
 
-// The core engine with inertial muscles: the skeleton's generalized forces from CoreIdEngine (its
-// OpenSim speed conventions included) plus the mass points' share tau_m = M_m qddot - f_m
-// [D Eq. 5.6-5.7] at the core state the engine solved (lastState, lastQddot). For joints whose
-// speeds are OpenSim's u, the core's tau maps back by T^-T (core_id_engine.hpp); the map is
-// linear, so it applies to the muscle share alone.
-class MuscleMassIdEngine final : public osim::IdEngine {
- public:
-  MuscleMassIdEngine(const Model& model, const osim::IdEngineOptions& options, std::vector<Muscle> muscles)
-      : core_(model, options), term_(model, std::move(muscles)), sk_(model), options_(options) {
-    for (int j = 0; j < model.nb(); ++j)
-      if (options_.marked(j)) marked_.push_back(j);
-  }
-  std::string name() const override { return "core"; }
-
-  void calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,
-                             const std::vector<osim::IdLoadSample>& loads, VecX& tau) override {
-    core_.calcGeneralizedForces(t, q, v, vdot, loads, tau);
-    const Model& m = core_.model();
-    const State& s = core_.lastState();
-    const int nr = m.nr();
-    calcKinematics(m, s, sk_);
-    M_.setZero(nr, nr);
-    f_.setZero(nr);
-    term_.addMass(m, s, sk_, M_);
-    term_.addForce(m, s, sk_, f_);
-    VecX tau_m = M_ * core_.lastQddot() - f_;
-    for (int j : marked_) {
-      const JointSlot& slot = m.joints[j];
-      MatJ T;
-      osim::calcOpenSimSpeedMap(slot.joint, s.q.segment(slot.q_index, slot.nq), s.qdot.segment(slot.q_index, slot.nq),
-                                T, nullptr);
-      const MatJ Tt = T.transpose();
-      tau_m.segment(slot.q_index, slot.nq) =
-          Eigen::PartialPivLU<MatJ>(Tt).solve(VecJ(tau_m.segment(slot.q_index, slot.nq)));
-    }
-    tau += tau_m;
-    if (!tau.allFinite()) {
-      std::ostringstream os;
-      os << "t = " << t << ": the muscle mass points give non-finite generalized forces";
-      throw osim::IdEngineError(os.str());
-    }
-  }
-
- private:
-  osim::CoreIdEngine core_;
-  MuscleTerm term_;
-  SkeletonWorkspace sk_;
-  osim::IdEngineOptions options_;
-  std::vector<int> marked_;
-  MatX M_;
-  VecX f_;
-};
-
 }  // namespace
 
 MassSweepEngineFactory makeCoreMassEngineFactory(const osim::InverseDynamicsTool& tool) {
@@ -141,7 +84,8 @@ MassSweepEngineFactory makeCoreMassEngineFactory(const osim::InverseDynamicsTool
     e.description = osim::describeMuscleMass(mm.plan);
     e.model = std::make_shared<const Model>(mm.build.model);
     e.muscles = mm.build.muscles;
-    e.engine = std::make_unique<MuscleMassIdEngine>(mm.build.model, t->engineOptions(), std::move(mm.build.muscles));
+    // the core with the muscles' mass points as a MuscleTerm (core_id_engine.hpp)
+    e.engine = std::make_unique<osim::CoreIdEngine>(mm.build.model, std::move(mm.build.muscles), t->engineOptions());
     return e;
   };
 }
