@@ -132,6 +132,17 @@ TEST_F(SimulateCli, RestartFromAWrittenRowReproducesTheRun) {
   }
 }
 
+TEST_F(SimulateCli, ProgressGoesToStderrOnlyWhenAsked) {
+  const std::string base = "--model " + scene("double_pendulum_via.osim") + " --duration 0.5 --out " + path("p.sto");
+  CmdResult r = run(base + " --progress");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("simulate (ms simulated): 500/500"), std::string::npos) << r.err;
+  r = run(base + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(r.out, "");
+}
+
 TEST_F(SimulateCli, EveryIntegratorRuns) {
   for (const char* integ : {"euler", "symplectic", "bdf1", "sdirk2", "rk45", "cvode"}) {
     const CmdResult r = run("--model " + scene("double_pendulum_via.osim") + " --duration 0.2 --integrator " +
