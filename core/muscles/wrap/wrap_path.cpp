@@ -200,6 +200,11 @@ class PathWrapper {
     for (const Entry& e : path_entries_) out.points.push_back(WrappedPathPoint{e.point, e.wrap, e.which, world(e)});
     out.results = results_;
     out.used = used_;
+    for (size_t i = 0; i + 1 < out.points.size(); ++i) {
+      const auto &a = out.points[i], &b = out.points[i + 1];
+      out.geometric_length += (a.wrap >= 0 && a.wrap == b.wrap) ? results_[a.wrap].arcLength()
+                                                                : (b.x_w - a.x_w).norm();
+    }
     return out;
   }
 

@@ -40,6 +40,9 @@ struct WrappedPath {
   std::vector<WrapResult> results;       ///< per wrap object (frame s); NoWrap when unused
   std::vector<bool> used;                ///< per wrap object: its tangent points are in `points`
   double length = 0.0;                   ///< total path length (m), OpenSim's definition
+  /// length of the final points' straight segments and arcs (m): what calcWrappedPathPointWorld
+  /// walks; differs from `length` by OpenSim's stale positions and the sphere's sign quirk
+  double geometric_length = 0.0;
 };
 
 /// The wrapped path at configuration q with body poses E_wi (calcBodyPoses). A path without
