@@ -204,3 +204,71 @@ TEST(WrapSmooth, UnsupportedSurfacesAreRefusedWithAReason) {
 
 }  // namespace
 }  // namespace redmax
+
+// ---------------------------------------------------------------------------------------------
+// the network at a surface's scale, with the smooth model outside the training box
+
+#include "core/muscles/wrap/train.hpp"
+
+namespace redmax {
+namespace {
+
+TEST(WrapNetworkPoints, ScaledNetworkDerivativesAndFallback) {
+  const WrapSurface s = WrapSurface::makeCylinder(0.08, 8.0);  // metres, like the pendulum's
+  Mlp net(8, {10, 10}, 3, 4);
+  const WrapInputBox box = makeDefaultWrapBox(WrapType::Cylinder);
+  net.input_min = box.lo;
+  net.input_max = box.hi;
+  const std::vector<double> alphas{0.1, 0.35, 0.6, 0.9};
+  const Vec3 p1(-0.15, 0.12, 0.01), p2(0.11, -0.14, 0.05), v1(0.3, -0.2, 0.1), v2(-0.1, 0.4, 0.2);
+  MlpWorkspace ws;
+  WrapMassPoints mp;
+  calcNetworkWrapPoints(&net, s, p1, p2, v1, v2, alphas, mp, ws);
+  ASSERT_TRUE(mp.used_network);
+  // positions: the network in radii, scaled back
+  for (size_t k = 0; k < alphas.size(); ++k) {
+    VecX u(8);
+    u << p1 / 0.08, p2 / 0.08, alphas[k], 1.0;
+    MatX y;
+    net.calcOutput(u, y, ws);
+    EXPECT_LE((mp.x[k] - 0.08 * Vec3(y.col(0))).norm(), 1e-15);
+  }
+  // J and Jdot against central differences of the whole map
+  const double h = 1e-6;
+  for (size_t k = 0; k < alphas.size(); ++k) {
+    Eigen::Matrix<double, 3, 6> fd;
+    for (int i = 0; i < 6; ++i) {
+      Vec3 a1 = p1, a2 = p2, b1 = p1, b2 = p2;
+      (i < 3 ? a1 : a2)[i % 3] += h;
+      (i < 3 ? b1 : b2)[i % 3] -= h;
+      WrapMassPoints pa, pb;
+      calcNetworkWrapPoints(&net, s, a1, a2, v1, v2, alphas, pa, ws);
+      calcNetworkWrapPoints(&net, s, b1, b2, v1, v2, alphas, pb, ws);
+      fd.col(i) = (pa.x[k] - pb.x[k]) / (2 * h);
+    }
+    WrapMassPoints pp, pm;
+    calcNetworkWrapPoints(&net, s, p1 + h * v1, p2 + h * v2, v1, v2, alphas, pp, ws);
+    calcNetworkWrapPoints(&net, s, p1 - h * v1, p2 - h * v2, v1, v2, alphas, pm, ws);
+    EXPECT_TRUE(nearRel(mp.J[k], fd, 1e-7)) << k;
+    EXPECT_TRUE(nearRel(mp.Jdot[k], (pp.J[k] - pm.J[k]) / (2 * h), 1e-6)) << k;
+  }
+  // an end point outside the box (4 radii away in x): the smooth model, reported
+  const Vec3 far(0.32, 0.0, 0.0);
+  calcNetworkWrapPoints(&net, s, far, p2, v1, v2, alphas, mp, ws);
+  EXPECT_FALSE(mp.used_network);
+  for (size_t k = 0; k < alphas.size(); ++k) {
+    const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(s, far, p2, alphas[k], v1, v2);
+    EXPECT_EQ(mp.x[k], sp.x);
+    EXPECT_EQ(mp.J[k], sp.J);
+    EXPECT_EQ(mp.Jdot[k], sp.Jdot);
+  }
+  // no network at all: the smooth model
+  calcNetworkWrapPoints(nullptr, s, p1, p2, v1, v2, alphas, mp, ws);
+  EXPECT_FALSE(mp.used_network);
+  EXPECT_EQ(mp.x[2], calcSmoothWrapPoint(s, p1, p2, alphas[2]));
+  EXPECT_THROW(calcNetworkWrapPoints(&net, WrapSurface::makeTorus(0.1, 1.0), p1, p2, v1, v2, alphas, mp, ws),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace redmax
