@@ -1,7 +1,9 @@
 // `redmax flick`: the finger-flick stability study of [D Sec. 6.2.5] (validation/simulate/
 // finger_flick.hpp): the largest fingertip force the lumped and the inertial finger survive, per
 // integrator, found by bisection. Prints a markdown table; --csv writes it atomically.
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -27,7 +29,7 @@ std::vector<std::string> splitComma(const std::string& s) {
 }
 
 int runFlick(const std::vector<std::string>& argv) {
-  const Args a(argv, {"model", "integrators", "gravity", "mass", "dt", "duration", "impulse-time", "target",
+  const Args a(argv, {"model", "integrators", "gravity", "mass", "dt", "dts", "duration", "impulse-time", "target",
                       "energy-growth", "csv"},
                {});
   if (!a.positionals().empty()) throw UsageError{"flick takes no positional arguments"};
@@ -42,6 +44,17 @@ int runFlick(const std::vector<std::string>& argv) {
   const double mass = a.getDouble("mass", 0.2);
   if (!(o.dt > 0) || !(o.duration > 0) || !(o.impulse_time > 0) || !(o.energy_growth > 0) || !(mass > 0))
     throw UsageError{"--dt, --duration, --impulse-time, --energy-growth and --mass must be positive"};
+  std::vector<double> dts;
+  if (auto v = a.get("dts")) {
+    if (a.has("dt")) throw UsageError{"give --dt or --dts, not both"};
+    for (const std::string& t : splitComma(*v)) {
+      char* end = nullptr;
+      const double x = std::strtod(t.c_str(), &end);
+      if (end == t.c_str() || *end != '\0' || !(x > 0.0) || !std::isfinite(x))
+        throw UsageError{"--dts expects positive step sizes S1,S2,..., got '" + t + "'"};
+      dts.push_back(x);
+    }
+  }
   const std::vector<std::string> integrators = splitComma(a.get("integrators", "euler,symplectic"));
   for (const auto& n : integrators)
     if (n != "euler" && n != "symplectic" && n != "bdf1" && n != "sdirk2" && n != "rk45" && n != "cvode")
@@ -53,11 +66,10 @@ int runFlick(const std::vector<std::string>& argv) {
   else if (g == "both") gravity = {true, false};
   else throw UsageError{"--gravity must be on, off or both"};
 
-  const auto rows = validation::runFlickStudy(o, integrators, gravity, mass);
-  std::printf("finger flick: force on '%s' along +y for %g s, %s steps of %g s for %g s; inertial = %g kg in each of "
+  const auto rows = validation::runFlickStudy(o, integrators, gravity, mass, dts);
+  std::printf("finger flick: force on '%s' along +y for %g s, then %g s of fixed steps; inertial = %g kg in each of "
               "FDP and FDS\n%s",
-              o.target.c_str(), o.impulse_time, integrators.size() == 1 ? integrators[0].c_str() : "fixed", o.dt,
-              o.duration, mass, validation::formatFlickTable(rows).c_str());
+              o.target.c_str(), o.impulse_time, o.duration, mass, validation::formatFlickTable(rows).c_str());
   if (auto csv = a.get("csv")) osim::writeFileAtomic(*csv, validation::formatFlickCsv(rows));
   return 0;
 }
@@ -65,11 +77,12 @@ int runFlick(const std::vector<std::string>& argv) {
 CommandRegistration reg(
     {"flick", "finger-flick stability study: largest fingertip force survived, lumped vs inertial",
      "usage: redmax flick --model finger.osim [--integrators euler,symplectic] [--gravity on|off|both]\n"
-     "                    [--mass KG] [--dt S] [--duration S] [--impulse-time S] [--target MARKER]\n"
-     "                    [--energy-growth F] [--csv OUT.csv]\n"
+     "                    [--mass KG] [--dt S | --dts S1,S2,...] [--duration S] [--impulse-time S]\n"
+     "                    [--target MARKER] [--energy-growth F] [--csv OUT.csv]\n"
      "The study of the dissertation's 6.2.5: a force along +y (ground frame) on the fingertip for the\n"
      "first --impulse-time seconds (default 0.002: two 1 ms steps), then --duration s (1) of fixed steps\n"
-     "--dt (0.001). Variants: lumped (the model as is) and inertial (--mass kg, default 0.2, in each of\n"
+     "--dt (0.001; --dts gives a row set per step size, the flick keeping its duration). Variants:\n"
+     "lumped (the model as is) and inertial (--mass kg, default 0.2, in each of\n"
      "FDP and FDS, added). A run fails on a NaN/divergence or, for the artifact column, when the total\n"
      "energy rises above its value after the flick by more than F (default 0.5) times the largest\n"
      "kinetic energy seen. Forces: a doubling scan from 0.5 N to 2 kN, then bisection to 1%.\n",

@@ -67,7 +67,7 @@ TEST(FingerFlick, StudyTableHasEveryCombination) {
     EXPECT_GE(r.divergence.largest_survived, r.artifact.largest_survived) << r.variant;
   }
   const std::string table = formatFlickTable(rows);
-  EXPECT_NE(table.find("| euler | off | inertial |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| euler | 1 | off | inertial |"), std::string::npos) << table;
   const std::string csv = formatFlickCsv(rows);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
 }

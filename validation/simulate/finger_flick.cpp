@@ -74,18 +74,23 @@ FlickSearch findLargestSurvivedFlick(const FlickOptions& options, double lo, dou
 }
 
 std::vector<FlickStudyRow> runFlickStudy(const FlickOptions& base, const std::vector<std::string>& integrators,
-                                         const std::vector<bool>& gravity, double inertial_kg) {
+                                         const std::vector<bool>& gravity, double inertial_kg,
+                                         const std::vector<double>& dts) {
   std::vector<FlickStudyRow> rows;
+  const std::vector<double> steps = dts.empty() ? std::vector<double>{base.dt} : dts;
   for (bool g : gravity) {
+   for (double dt : steps) {
     for (const std::string& integ : integrators) {
       for (int inertial = 0; inertial < 2; ++inertial) {
         FlickOptions o = base;
         o.integrator = integ;
+        o.dt = dt;
         o.gravity = g;
         o.muscle_masses.clear();
         if (inertial) o.muscle_masses = {{"FDP", inertial_kg}, {"FDS", inertial_kg}};
         FlickStudyRow row;
         row.integrator = integ;
+        row.dt = dt;
         row.variant = inertial ? "inertial" : "lumped";
         row.gravity = g;
         row.artifact = findLargestSurvivedFlick(o);
@@ -94,6 +99,7 @@ std::vector<FlickStudyRow> runFlickStudy(const FlickOptions& base, const std::ve
         rows.push_back(std::move(row));
       }
     }
+   }
   }
   return rows;
 }
@@ -112,10 +118,11 @@ std::string fmt(double x) {
 
 std::string formatFlickTable(const std::vector<FlickStudyRow>& rows) {
   std::ostringstream os;
-  os << "| integrator | gravity | variant | largest force, no energy artifact (first failing) | largest force, "
-        "no divergence (first failing) |\n|---|---|---|---|---|\n";
+  os << "| integrator | dt (ms) | gravity | variant | largest force, no energy artifact (first failing) | "
+        "largest force, no divergence (first failing) |\n|---|---|---|---|---|---|\n";
   for (const auto& r : rows)
-    os << "| " << r.integrator << " | " << (r.gravity ? "on" : "off") << " | " << r.variant << " | "
+    os << "| " << r.integrator << " | " << r.dt * 1e3 << " | " << (r.gravity ? "on" : "off") << " | " << r.variant
+       << " | "
        << fmt(r.artifact.largest_survived) << " N (" << fmt(r.artifact.smallest_failed) << ") | "
        << fmt(r.divergence.largest_survived) << " N (" << fmt(r.divergence.smallest_failed) << ") |\n";
   return os.str();
@@ -124,10 +131,10 @@ std::string formatFlickTable(const std::vector<FlickStudyRow>& rows) {
 std::string formatFlickCsv(const std::vector<FlickStudyRow>& rows) {
   std::ostringstream os;
   os.precision(10);
-  os << "integrator,gravity,variant,artifact_survived_N,artifact_failed_N,divergence_survived_N,"
+  os << "integrator,dt_s,gravity,variant,artifact_survived_N,artifact_failed_N,divergence_survived_N,"
         "divergence_failed_N,artifact_runs,divergence_runs\n";
   for (const auto& r : rows)
-    os << r.integrator << "," << (r.gravity ? 1 : 0) << "," << r.variant << "," << r.artifact.largest_survived << ","
+    os << r.integrator << "," << r.dt << "," << (r.gravity ? 1 : 0) << "," << r.variant << "," << r.artifact.largest_survived << ","
        << r.artifact.smallest_failed << "," << r.divergence.largest_survived << "," << r.divergence.smallest_failed
        << "," << r.artifact.runs.size() << "," << r.divergence.runs.size() << "\n";
   return os.str();

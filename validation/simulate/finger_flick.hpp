@@ -54,16 +54,19 @@ FlickSearch findLargestSurvivedFlick(const FlickOptions& options, double lo = 0.
 /// One line of the study table: the thresholds of one integrator, variant and gravity setting.
 struct FlickStudyRow {
   std::string integrator;
+  double dt = 0.0;           ///< s
   std::string variant;       ///< "lumped" or "inertial"
   bool gravity = true;
   FlickSearch artifact;      ///< energy-growth criterion (options.energy_growth)
   FlickSearch divergence;    ///< NaN/overflow only
 };
 
-/// The study of [D 6.2.5]: for each integrator, gravity setting and variant (lumped; inertial with
-/// `inertial_kg` in each of FDP and FDS), the largest force survived under both criteria.
+/// The study of [D 6.2.5]: for each gravity setting, step size (empty: base.dt), integrator and
+/// variant (lumped; inertial with `inertial_kg` in each of FDP and FDS), the largest force survived
+/// under both criteria. The flick lasts base.impulse_time whatever the step.
 std::vector<FlickStudyRow> runFlickStudy(const FlickOptions& base, const std::vector<std::string>& integrators,
-                                         const std::vector<bool>& gravity, double inertial_kg = 0.2);
+                                         const std::vector<bool>& gravity, double inertial_kg = 0.2,
+                                         const std::vector<double>& dts = {});
 
 /// The rows as a markdown table (forces in N, the first failing force in brackets) and as CSV.
 std::string formatFlickTable(const std::vector<FlickStudyRow>& rows);
