@@ -17,6 +17,7 @@
 #include "converter/osim_reader.hpp"
 #include "converter/storage.hpp"
 #include "core/muscles/path_kinematics.hpp"
+#include "core/muscles/wrap/wrap_path.hpp"
 #include "core/skeleton/kinematics.hpp"
 
 namespace redmax::cli {
@@ -43,7 +44,7 @@ int findCoordinateColumn(const osim::Storage& s, const osim::CoordinateDesc& c) 
 }
 
 int runLengths(const std::vector<std::string>& argv) {
-  const Args a(argv, {"model", "coordinates", "wrap", "out"},
+  const Args a(argv, {"model", "coordinates", "wrap", "out", "wrap-lengths"},
                {"quiet", "full-precision", "all-paths"});
   if (!a.positionals().empty())
     throw UsageError{"lengths takes no positional arguments (got '" + a.positionals().front() + "')"};
@@ -134,12 +135,37 @@ int runLengths(const std::vector<std::string>& argv) {
   for (int k : report) out.labels.push_back(build.muscles[k].name);
   out.time = coords.time;
   out.data.resize(coords.numRows(), static_cast<int>(report.size()));
+  // optional: the surface length l of every wrap object of every reported path (0 when unused)
+  const std::string wl_path = a.get("wrap-lengths", "");
+  osim::Storage wl;
+  std::vector<std::pair<int, int>> wl_cols;  // (path, wrap)
+  if (!wl_path.empty()) {
+    wl.name = "WrapSurfaceLengths";
+    for (size_t m = 0; m < paths.size(); ++m)
+      for (size_t w = 0; w < paths[m].wraps.size(); ++w) {
+        wl.labels.push_back(out.labels[m] + "/" + paths[m].wraps[w].name);
+        wl_cols.emplace_back(static_cast<int>(m), static_cast<int>(w));
+      }
+    if (wl_cols.empty()) throw UsageError{"--wrap-lengths: no reported path has a wrap object"};
+    wl.time = coords.time;
+    wl.data.setZero(coords.numRows(), static_cast<int>(wl_cols.size()));
+  }
   std::vector<Mat4> E_wi;
   for (int row = 0; row < coords.numRows(); ++row) {
     VecX q = q0;
     for (size_t j = 0; j < column_of.size(); ++j)
       q[column_of[j].first] = coords.data(row, column_of[j].second) * scale[j];
     calcBodyPoses(model, q, E_wi);
+    for (size_t j = 0; j < wl_cols.size(); ++j) {
+      // one wrapped-path evaluation per path, at its first column
+      const int m = wl_cols[j].first;
+      if (j > 0 && wl_cols[j - 1].first == m) continue;
+      const WrappedPath wp = calcWrappedPath(model, paths[m], q, E_wi);
+      for (size_t k = j; k < wl_cols.size() && wl_cols[k].first == m; ++k) {
+        const int w = wl_cols[k].second;
+        wl.data(row, static_cast<int>(k)) = wp.used[w] ? wp.results[w].length : 0.0;
+      }
+    }
     for (size_t m = 0; m < paths.size(); ++m) {
       const double l = calcPathLength(model, paths[m], q, E_wi);
       if (!std::isfinite(l)) {
@@ -164,6 +190,10 @@ int runLengths(const std::vector<std::string>& argv) {
     }
     wo.description = "musculotendon path lengths (m), wrap " + wrap;
     osim::writeStorage(out_path, out, wo);
+    if (!wl_path.empty()) {
+      wo.description = "surface length l of each wrap object (m; 0 = not wrapping; OpenSim's value)";
+      osim::writeStorage(wl_path, wl, wo);
+    }
   } catch (const osim::ConvertError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
@@ -181,7 +211,8 @@ int runLengths(const std::vector<std::string>& argv) {
 CommandRegistration reg(
     {"lengths", "musculotendon path lengths along a motion, wrapping as OpenSim does",
      "usage: redmax lengths --model M.osim --coordinates Q.mot [--wrap exact|none]\n"
-     "                      [--all-paths] [--full-precision] [--quiet] --out LENGTHS.sto\n"
+     "                      [--wrap-lengths L.sto] [--all-paths] [--full-precision] [--quiet]\n"
+     "                      --out LENGTHS.sto\n"
      "Path length of every muscle at every row of the coordinates file, as OpenSim's\n"
      "GeometryPath computes it: active path points (conditional, moving), then each PathWrap in\n"
      "order over its range (WrapCylinder, WrapSphere, WrapEllipsoid, WrapTorus; quadrants, methods,\n"
@@ -193,6 +224,8 @@ CommandRegistration reg(
      "                       constraints are not enforced (coupled coordinates used as written)\n"
      "  --wrap exact         OpenSim-exact wrapping (default); none: straight segments, no wraps\n"
      "                       (neural and smooth are not available here yet)\n"
+     "  --wrap-lengths FILE  also write the surface length l of every wrap object of every path\n"
+     "                       (columns MUSCLE/WRAPOBJECT, 0 when that object does not wrap)\n"
      "  --all-paths          every force with a path (PathSpring, PathActuator, ...), not only muscles\n"
      "  --out FILE           output .sto: time, then one column per muscle named as the muscle (m)\n"
      "  --full-precision     write %.16e instead of OpenSim's %16.8lf\n"

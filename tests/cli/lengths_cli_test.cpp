@@ -125,6 +125,19 @@ TEST_F(LengthsCli, SubjectWalkArmlessWithFortyCylindersMatchesOpenSim) {
   std::printf("[ measured ] subject_walk_armless (40 cylinders) lengths vs OpenSim 4.4.1: max |difference| %.3g m\n",
               worst);
 
+  // the surface lengths l: one column per PathWrap (16 on these 14 muscles), cylinders >= 0, and
+  // a muscle with one wrap is as long as its straight length when l = 0
+  const CmdResult rw = run("lengths --model " + kCore + "Moco/Test/subject_walk_armless_18musc.osim --coordinates " +
+                           kCore + "Moco/Test/subject_walk_armless_coordinates.mot --quiet --out l2.sto "
+                           "--wrap-lengths w.sto");
+  ASSERT_EQ(rw.code, 0) << rw.err;
+  const Storage wl = readStorage((dir_ / "w.sto").string());
+  EXPECT_EQ(wl.numColumns(), 16);
+  EXPECT_EQ(wl.numRows(), 238);
+  EXPECT_GE(wl.data.minCoeff(), 0.0);
+  EXPECT_GT(wl.data.maxCoeff(), 1e-3);
+  EXPECT_GE(wl.findColumn("med_gas_r/Gastroc_at_condyles_r"), 0);
+
   // without the wraps the wrapping muscles are shorter, by up to centimetres: the comparison above
   // really exercises the wrap code
   const CmdResult rn = run("lengths --model " + kCore + "Moco/Test/subject_walk_armless_18musc.osim --coordinates " +
