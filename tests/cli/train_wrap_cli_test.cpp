@@ -1,0 +1,129 @@
+// `redmax train-wrap` end to end: a tiny training run writes a loadable network (with its command
+// and seed), the loss CSV, and the same weights for the same seed; --compare writes its table; bad
+// input exits 2 with a message. Timings are never asserted.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "core/muscles/wrap/network.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// the redmax executable of the same build: <build>/tests/cli_tests -> <build>/cli/redmax
+fs::path redmaxExe() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  const fs::path exe = self.parent_path().parent_path() / "cli" / "redmax";
+  return fs::exists(exe) ? exe : fs::path{};
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// the file without its wall-time line
+std::string withoutTime(const std::string& text) {
+  std::istringstream in(text);
+  std::string line, out;
+  while (std::getline(in, line))
+    if (line.rfind("meta train_seconds", 0) != 0) out += line + "\n";
+  return out;
+}
+
+struct CmdResult {
+  int code;
+  std::string out, err;
+};
+
+class TrainWrapCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to cli_tests (build target redmax)";
+    dir_ = fs::temp_directory_path() / ("redmax_train_wrap_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!dir_.empty()) fs::remove_all(dir_);
+  }
+  CmdResult run(const std::string& args) const {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = redmaxExe().string() + " " + args + " >" + out.string() + " 2>" + err.string();
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+  }
+  fs::path dir_;
+};
+
+TEST_F(TrainWrapCli, TinyTrainingWritesAReproducibleNetworkAndItsLossCurve) {
+  const std::string net = (dir_ / "net.txt").string(), rep = (dir_ / "rep").string();
+  const std::string args =
+      "train-wrap --surface cylinder --hidden 2x8 --samples 300 --epochs 3 --batch 32 --seed 2 --out " + net + " --report " + rep;
+  CmdResult r = run(args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("epoch 3/3"), std::string::npos) << r.err;
+  const redmax::Mlp m = redmax::Mlp::load(net);
+  EXPECT_EQ(m.architecture(), "2x8");
+  EXPECT_EQ(m.meta.at("seed"), "2");
+  EXPECT_EQ(m.meta.at("surface"), "cylinder");
+  EXPECT_NE(m.meta.at("command").find("--seed 2"), std::string::npos);
+  // loss.csv: header and one row per epoch
+  const std::string csv = slurp(fs::path(rep) / "loss.csv");
+  EXPECT_EQ(csv.rfind("epoch,steps,train_mse,val_mse,val_rms,elapsed_s\n", 0), 0u) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);
+  // the same command gives the same file (apart from the wall time)
+  const std::string first = slurp(net);
+  r = run(args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(withoutTime(slurp(net)), withoutTime(first));
+}
+
+TEST_F(TrainWrapCli, CompareWritesTheSpeedErrorTable) {
+  const std::string rep = (dir_ / "cmp").string();
+  const CmdResult r = run("train-wrap --compare --surface sphere --untrained 2x8 --muscles 4 --mass-points 3 --report " + rep);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = slurp(fs::path(rep) / "speed_error.csv");
+  EXPECT_EQ(csv.rfind("method,parameters,us_per_point,rms_error,max_error,note\n", 0), 0u) << csv;
+  EXPECT_NE(csv.find("exact library"), std::string::npos);
+  EXPECT_NE(csv.find("smooth model"), std::string::npos);
+  EXPECT_NE(csv.find("2x8 (untrained"), std::string::npos);
+}
+
+TEST_F(TrainWrapCli, BadInputExitsTwoWithAMessage) {
+  const std::string out = " --out " + (dir_ / "n.txt").string();
+  CmdResult r = run("train-wrap --surface cube" + out);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("unknown surface 'cube'"), std::string::npos) << r.err;
+  r = run("train-wrap --hidden 0x3" + out);
+  EXPECT_EQ(r.code, 2);
+  r = run("train-wrap --surface sphere");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--out"), std::string::npos) << r.err;
+  r = run("train-wrap --out /nonexistent_redmax_dir/n.txt");
+  EXPECT_EQ(r.code, 2);
+  r = run("train-wrap --threshold 2" + out);
+  EXPECT_EQ(r.code, 2);
+  r = run("train-wrap --compare --surface torus --report " + (dir_ / "c").string());
+  EXPECT_EQ(r.code, 2);
+  // a file that is not a network: named with its line
+  const fs::path bad = dir_ / "bad.txt";
+  std::ofstream(bad) << "redmax-mlp 1\ninputs 8\noutputs 3\nhidden 1 4\nactivation relu\n";
+  r = run("train-wrap --compare --nets " + bad.string() + " --report " + (dir_ / "c").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(bad.string() + ":5: only 'activation tanh'"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "n.txt"));
+}
+
+}  // namespace
