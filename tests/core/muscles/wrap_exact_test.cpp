@@ -190,6 +190,18 @@ TEST(WrapSphere, SurfaceLengthIsTheArcUpToOpenSimsSign) {
               negative, wrapped);
 }
 
+TEST(WrapSphere, LineThroughTheCentreStillWrapsWithTheRightLength) {
+  // OpenSim reuses the previous wrap here; we pick a fixed plane: any great circle is shortest
+  const double R = 0.03;
+  const Vec3 p1(-0.1, 0, 0), p2(0.08, 0, 0);
+  const WrapResult r = calcWrap(WrapSurface::makeSphere(R), p1, p2);
+  ASSERT_TRUE(r.wraps());
+  const double expect = std::sqrt(0.1 * 0.1 - R * R) + std::sqrt(0.08 * 0.08 - R * R) +
+                        R * (kPi - std::acos(R / 0.1) - std::acos(R / 0.08));
+  EXPECT_NEAR(calcWrappedPathLength(r, p1, p2), expect, 1e-12);
+  EXPECT_TRUE(r.r1.allFinite() && r.r2.allFinite());
+}
+
 TEST(WrapSphere, LengthGradientIsTheUnitVectorFromR2) {
   // the wrapped length is a shortest path, so dL/dp2 = (p2 - r2) / |p2 - r2| (envelope theorem)
   const WrapSurface sph = WrapSurface::makeSphere(0.03);
