@@ -392,12 +392,107 @@ int runCompare(const Args& a) {
   return 0;
 }
 
+// ---------------------------------------------------------------------------------------------
+// the threshold and architecture study [D Sec. 6.2.6, Fig. 6.8-6.11]
+
+int runStudy(const Args& a) {
+  const auto report = a.get("report");
+  if (!report) throw UsageError{"--study needs --report DIR"};
+  requireFolder(*report);
+  std::vector<double> thresholds;
+  for (const auto& t : splitList(a.get("thresholds", "0.01,0.05,0.1"))) {
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (*end != '\0' || !(v >= 0.0 && v < 1.0)) throw UsageError{"--thresholds: '" + t + "' is not in [0, 1)"};
+    thresholds.push_back(v);
+  }
+  std::vector<std::string> archs = splitList(a.get("architectures", "1x32,3x32"));
+  for (const auto& h : archs) parseHidden(h);  // validate before training
+  const long samples = a.getInt("samples", 10000);
+  if (samples < 10) throw UsageError{"--samples must be at least 10"};
+  TrainOptions opt;
+  opt.epochs = static_cast<int>(a.getInt("epochs", 60));
+  opt.batch = static_cast<int>(a.getInt("batch", 64));
+  opt.learning_rate = a.getDouble("lr", 1e-3);
+  opt.seed = static_cast<unsigned long long>(a.getInt("seed", 1));
+  if (opt.epochs < 1 || opt.batch < 1) throw UsageError{"--epochs and --batch must be positive"};
+
+  // Fig. 6.8's scene: unit cylinder, origin fixed, the insertion moves along x through the contact
+  // change (the straight line touches the cylinder at ins_x = -0.33)
+  const WrapType type = WrapType::Cylinder;
+  const WrapSurface surf = WrapSurface::makeCylinder(1.0, 1000.0);
+  const Vec3 ori(-2.0, 1.2, 0.3);
+  const double alpha = 0.5;
+  const int n = 251;
+  std::vector<double> xs(n), x_exact(n), j_exact(n);
+  auto exactPoint = [&](double x) {
+    const Vec3 ins(x, -1.3, -0.2);
+    return calcWrappedPathPoint(surf, calcWrap(surf, ori, ins), ori, ins, alpha);
+  };
+  for (int k = 0; k < n; ++k) {
+    xs[k] = -1.5 + 2.5 * k / (n - 1);
+    x_exact[k] = exactPoint(xs[k])[0];
+    const double h = 1e-7;  // one-sided near the kink would mix branches: central, tiny step
+    j_exact[k] = (exactPoint(xs[k] + h)[0] - exactPoint(xs[k] - h)[0]) / (2 * h);
+  }
+  const WrapInputBox box = makeDefaultWrapBox(type);
+  const WrapOracle oracle = makeExactWrapOracle(type);
+  validation::CsvTable t;
+  t.header = {"ins_x", "x_exact", "dxdins_exact"};
+  std::vector<std::vector<double>> cols;
+  validation::PlotFigure fig;
+  fig.title = "x_alpha (alpha 0.5) and d x_alpha / d ins_x near the contact change, by threshold and network";
+  fig.columns = 2;
+  for (double thr : thresholds) {
+    const WrapTrainingSet data = makeWrapTrainingSet(box, oracle, samples, thr, opt.seed);
+    std::vector<validation::PlotLine> lx{validation::makePlotLine("exact library", xs, x_exact)},
+        lj{validation::makePlotLine("exact library (differences)", xs, j_exact)};
+    for (const auto& arch : archs) {
+      opt.hidden = parseHidden(arch);
+      const Mlp net = trainWrapNetwork(data, box, opt);
+      MlpWorkspace ws;
+      MatX X(8, n), Y, J;
+      for (int k = 0; k < n; ++k) X.col(k) << ori, Vec3(xs[k], -1.3, -0.2), alpha, 1.0;
+      net.calcJacobian(X, Y, J, ws);
+      std::vector<double> xn(n), jn(n);
+      for (int k = 0; k < n; ++k) xn[k] = Y(0, k), jn[k] = J(0, 8 * k + 3);
+      const std::string name = arch + " thr " + num(thr, 3);
+      t.header.push_back("x_" + name);
+      t.header.push_back("dxdins_" + name);
+      cols.push_back(xn);
+      cols.push_back(jn);
+      lx.push_back(validation::makePlotLine(arch, xs, xn));
+      lj.push_back(validation::makePlotLine(arch, xs, jn));
+      std::cerr << "train-wrap --study: threshold " << thr << ", " << arch << ": validation rms "
+                << net.meta.at("final_val_rms_m") << " (size units)\n";
+    }
+    fig.panels.push_back(validation::makeXYPanel("x_alpha.x, threshold " + num(100 * thr, 3) + "%", "ins_x", "x_alpha.x", lx));
+    fig.panels.push_back(validation::makeXYPanel("d x_alpha.x / d ins_x, threshold " + num(100 * thr, 3) + "%", "ins_x",
+                                                 "Jacobian entry", lj));
+  }
+  for (int k = 0; k < n; ++k) {
+    std::vector<double> row{xs[k], x_exact[k], j_exact[k]};
+    for (const auto& c : cols) row.push_back(c[k]);
+    t.addRow(row);
+  }
+  osim::writeFileAtomic(*report + "/study.csv", validation::formatCsv(t));
+  const auto gp = validation::findGnuplot();
+  if (gp.available) {
+    const auto o = validation::renderPlot(gp, validation::PlotFormat::Auto, fig, *report + "/study");
+    if (!o.ok) std::cerr << "note: plot not drawn: " << o.error << "\n";
+  }
+  std::cout << "wrote " << *report << "/study.csv and the plot\n";
+  return 0;
+}
+
 int runTrainWrap(const std::vector<std::string>& argv) {
   Args a(argv,
          {"surface", "hidden", "samples", "epochs", "batch", "lr", "seed", "threshold", "time-limit", "out", "report",
-          "nets", "untrained", "muscles", "mass-points", "width"},
-         {"compare"});
+          "nets", "untrained", "muscles", "mass-points", "width", "thresholds", "architectures"},
+         {"compare", "study"});
   if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
+  if (a.has("compare") && a.has("study")) throw UsageError{"--compare and --study exclude each other"};
+  if (a.has("study")) return runStudy(a);
   return a.has("compare") ? runCompare(a) : runTrain(a, argv);
 }
 
@@ -408,6 +503,8 @@ CommandRegistration reg(
      "                         [--time-limit SECONDS] --out NET.txt [--report DIR]\n"
      "       redmax train-wrap --compare --surface cylinder|sphere [--nets A.txt,B.txt] [--untrained 6x256,...|none]\n"
      "                         [--muscles M] [--mass-points N] [--width W] [--seed S] --report DIR\n"
+     "       redmax train-wrap --study [--thresholds 0.01,0.05,0.1] [--architectures 1x32,3x32] [--samples N]\n"
+     "                         [--epochs E] [--batch B] [--lr R] [--seed S] --report DIR\n"
      "Training [D Sec. 5.3.3.1]: N samples (default 30000) drawn uniformly from the surface type's box\n"
      "(core/muscles/wrap/train.hpp makeDefaultWrapBox; units of the surface size) and labelled by the exact\n"
      "library; samples with 0 < l/L < threshold are discarded. A tanh MLP (--hidden DEPTHxWIDTH or W1-W2-...,\n"
@@ -417,7 +514,10 @@ CommandRegistration reg(
      "--compare: M muscles (default 200) x N mass points (default 20) with random end points and velocities;\n"
      "for the exact library (J, Jdot by central differences), the smooth model (band width W radii, default\n"
      "0.05) and each network (trained ones from --nets; --untrained sizes are timed only), prints and writes\n"
-     "DIR/speed_error.csv and a plot: microseconds per mass point (position + J + Jdot) and position error.\n",
+     "DIR/speed_error.csv and a plot: microseconds per mass point (position + J + Jdot) and position error.\n"
+     "--study [D Sec. 6.2.6]: for each threshold and architecture, trains a cylinder network (defaults: 10000\n"
+     "samples, 60 epochs, batch 64, lr 1e-3) and writes DIR/study.csv and a plot of x_alpha.x (alpha 0.5) and\n"
+     "d x_alpha.x / d ins_x against ins_x as the insertion moves through the contact change, with the exact library.\n",
      runTrainWrap});
 
 }  // namespace

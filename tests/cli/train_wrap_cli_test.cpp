@@ -101,6 +101,16 @@ TEST_F(TrainWrapCli, CompareWritesTheSpeedErrorTable) {
   EXPECT_NE(csv.find("2x8 (untrained"), std::string::npos);
 }
 
+TEST_F(TrainWrapCli, StudyWritesCurvesForEveryThresholdAndArchitecture) {
+  const std::string rep = (dir_ / "study").string();
+  const CmdResult r = run("train-wrap --study --samples 200 --epochs 2 --thresholds 0.01,0.1 --architectures 1x4 --report " + rep);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = slurp(fs::path(rep) / "study.csv");
+  EXPECT_EQ(csv.rfind("ins_x,x_exact,dxdins_exact,x_1x4 thr 0.01,dxdins_1x4 thr 0.01,x_1x4 thr 0.1,dxdins_1x4 thr 0.1\n", 0), 0u) << csv.substr(0, 200);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 252);  // header + 251 positions
+  EXPECT_EQ(run("train-wrap --study --thresholds 2 --report " + rep).code, 2);
+}
+
 TEST_F(TrainWrapCli, BadInputExitsTwoWithAMessage) {
   const std::string out = " --out " + (dir_ / "n.txt").string();
   CmdResult r = run("train-wrap --surface cube" + out);
