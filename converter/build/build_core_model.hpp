@@ -34,7 +34,8 @@
 // Muscles (section 6): every force with a path -> a core Muscle (PathPoint -> fixed point,
 // ConditionalPathPoint -> conditional point, MovingPathPoint -> moving point whose functions see
 // the coordinate clamped to its range, as OpenSim's do). Locations given in offset frames are
-// moved into the body frame. Wrap objects are counted (Type III paths stay lumped). No mass:
+// moved into the body frame. Each PathWrap becomes a core PathWrap (surface, body, pose in the
+// body, method, range) in MusclePath::wraps, which calcPathLength follows as OpenSim does. No mass:
 // addMusclePointMasses() gives muscles mass points.
 #include <memory>
 #include <string>
