@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/muscles/wrap_muscle.hpp"
+
 namespace redmax {
 
 double MassPoints::totalMass() const {
@@ -60,9 +62,12 @@ void validateMuscle(const Model& model, const Muscle& muscle) {
   if (mp.alpha.size() != mp.mass.size())
     throw ModelError(who + "mass points have " + std::to_string(mp.alpha.size()) + " alpha values but " +
                      std::to_string(mp.mass.size()) + " masses");
-  if (mp.size() > 0 && pathType(muscle.path) == PathType::III)
-    throw ModelError(who + "has wrap objects (Type III path); inertial Type III muscles are not "
-                     "supported yet, keep its mass lumped in the bodies (no mass points)");
+  if (mp.size() > 0 && pathType(muscle.path) == PathType::III) {
+    const std::string why = wrapMassPointsUnsupportedReason(muscle);
+    if (!why.empty())
+      throw ModelError(who + "has wrap objects (Type III path) and mass points, but " + why +
+                       "; keep its mass lumped in the bodies (no mass points)");
+  }
   for (int k = 0; k < mp.size(); ++k) {
     if (!(mp.alpha[k] >= 0.0 && mp.alpha[k] <= 1.0))
       throw ModelError(who + "mass point " + std::to_string(k) + ": alpha not in [0, 1]");

@@ -48,18 +48,35 @@ MassPoints makeMassPoints(double total_mass, double optimal_fiber_length, double
 /// Explicit points; throws ModelError unless sizes match, alpha in [0, 1] and masses >= 0 finite.
 MassPoints makeMassPoints(std::vector<double> alpha, std::vector<double> mass);
 
+/// How the mass points of a Type III (wrapping) muscle follow its surface
+/// (core/muscles/wrap_muscle.hpp).
+enum class WrapModel {
+  Smooth,  ///< analytic smooth model (core/muscles/wrap/smooth.hpp): C2, exact J and Jdot
+  Exact    ///< the exact library, J and Jdot by finite differences (energy jumps at contact changes)
+};
+
+/// Wrap-model choice and parameters of one muscle (used only by Type III muscles with mass points).
+struct WrapMassOptions {
+  WrapModel model = WrapModel::Smooth;
+  double width = 0.0;    ///< Smooth: transition width of the penetration (m); <= 0: 0.05 radius
+  double fd_step = 0.0;  ///< Exact: central-difference step on the end points (m); <= 0: 1e-6 size
+};
+
 /// A musculotendon: its path and, when it carries inertia, its mass points. A muscle with no mass
-/// points is lumped (massless), as OpenSim sees it; Type III paths must stay lumped for now.
+/// points is lumped (massless), as OpenSim sees it. Type III paths carry mass points only in the
+/// shape core/muscles/wrap_muscle.hpp supports (origin, one wrap surface, insertion).
 struct Muscle {
   std::string name;
   MusclePath path;
   double optimal_fiber_length = 0.0;  // m (informative here; used by makeMassPoints)
   double tendon_slack_length = 0.0;   // m
   MassPoints mass_points;             // empty = massless
+  WrapMassOptions wrap;               // Type III with mass points only
 };
 
-/// validatePath plus: Type III paths with mass points are rejected (wrapping surfaces are not yet
-/// supported for inertial muscles), alpha and masses checked. Throws ModelError naming the muscle.
+/// validatePath plus: Type III paths with mass points must have the supported shape
+/// (wrapMassPointsUnsupportedReason in core/muscles/wrap_muscle.hpp), alpha and masses checked.
+/// Throws ModelError naming the muscle.
 void validateMuscle(const Model& model, const Muscle& muscle);
 
 }  // namespace redmax

@@ -1,14 +1,21 @@
 #include "core/muscles/muscle_kinematics.hpp"
 
+#include "core/muscles/wrap_muscle.hpp"
+
 namespace redmax {
 
 void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
                           const Muscle& muscle, MuscleKinematics& mk, bool velocity) {
-  calcPathPoints(model, state, sk, muscle.path, mk, velocity);
   const MassPoints& mp = muscle.mass_points;
+  const bool wrapping = mp.size() > 0 && pathType(muscle.path) == PathType::III;
+  // Type III with mass: the wrap surface's body joins the columns (core/muscles/wrap_muscle.hpp)
+  if (wrapping) initWrapMuscleColumns(model, muscle, mk);
+  calcPathPoints(model, state, sk, muscle.path, mk, velocity);
   if (mp.size() == 0) return;
-  if (pathType(muscle.path) == PathType::III)
-    throw std::logic_error("muscle '" + muscle.name + "': Type III paths cannot carry mass points yet");
+  if (wrapping) {
+    calcWrapMassPoints(model, sk, muscle, mk);
+    return;
+  }
   calcMassPointStage(mp, mk, muscle.name);
 }
 

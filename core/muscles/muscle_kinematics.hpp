@@ -11,8 +11,10 @@ namespace redmax {
 
 /// One muscle: path stage, then Eulerian and mass-point stages when it has mass points. With
 /// `velocity` also every d/dt quantity (needs the skeleton workspace at Stage::Velocity).
-/// Throws MuscleError for a degenerate path under mass points, std::logic_error for a Type III path
-/// with mass points (validateMuscle rejects those up front).
+/// Type III paths with mass points go through calcWrapMassPoints (core/muscles/wrap_muscle.hpp).
+/// Throws MuscleError for a degenerate path under mass points (or an end point inside a wrap
+/// surface), std::logic_error for an unsupported Type III shape with mass points (validateMuscle
+/// rejects those up front).
 void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
                           const Muscle& muscle, MuscleKinematics& mk, bool velocity = true);
 
