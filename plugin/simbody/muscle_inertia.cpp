@@ -19,6 +19,10 @@ MuscleInertia::MuscleInertia(const SimbodyModel& sm, const Model& model, std::ve
     : sm_(sm), muscles_(std::move(muscles)), gravity_(gravity) {
   for (int m = 0; m < static_cast<int>(muscles_.size()); ++m) {
     validateMuscle(model, muscles_[m]);
+    // the Simbody side maps mass points from path points only (calcPathMap): no wrap surfaces yet
+    if (muscles_[m].mass_points.size() > 0 && pathType(muscles_[m].path) == PathType::III)
+      throw ModelError("muscle '" + muscles_[m].name + "': has wrap objects (Type III path) and mass points; the "
+                       "Simbody side does not move mass points over wrap surfaces yet (the core does)");
     if (muscles_[m].mass_points.size() == 0) continue;
     Entry e;
     e.muscle = m;

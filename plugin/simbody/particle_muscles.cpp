@@ -178,6 +178,10 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
     : sm_(sm), muscles_(std::move(muscles)) {
   for (const Muscle& mu : muscles_) {
     validateMuscle(model, mu);
+    // the Simbody side maps mass points from path points only (calcPathMap): no wrap surfaces yet
+    if (mu.mass_points.size() > 0 && pathType(mu.path) == PathType::III)
+      throw ModelError("muscle '" + mu.name + "': has wrap objects (Type III path) and mass points; the "
+                       "Simbody side does not move mass points over wrap surfaces yet (the core does)");
     if (mu.mass_points.size() == 0) {
       first_particle_.push_back(-1);
       continue;
