@@ -336,7 +336,18 @@ WorkPrecisionResult runWorkPrecision(const std::string& report_dir, const WorkPr
     }
     int diverged = 0;
     for (const auto& r : sr.runs) diverged += !r.ok;
-    md << "- Diverged or failed runs: " << diverged << ".\n\n" << markdownTable(sr);
+    md << "- Diverged or failed runs: " << diverged << ".\n";
+    // the symplectic rows of a non-smooth scene measure a different limit, not an inaccuracy
+    // (tests/core/integrators/variational_muscle_test.cpp)
+    bool has_symplectic = false;
+    for (const auto& r : sr.runs) has_symplectic = has_symplectic || r.integrator == "symplectic";
+    if (has_symplectic && sr.reference_energy_drift > 1e-6 * std::max(1.0, sr.energy_scale))
+      md << "- `symplectic` rows: their error against the rk45 reference need not go to zero here. Where a "
+            "mass point crosses a via point, M(q) jumps; the ODE solvers keep qdot continuous, the variational "
+            "step keeps p = M qdot continuous (v+ = M+^-1 M- v-), and it converges at order 1 to that other "
+            "solution (event-located references for both rules in "
+            "tests/core/integrators/variational_muscle_test.cpp; README, notes a researcher should know).\n";
+    md << "\n" << markdownTable(sr);
     report.addMarkdown("Scene " + name, md.str());
 
     JsonValue js = JsonValue::object();
