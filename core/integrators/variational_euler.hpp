@@ -57,6 +57,14 @@
 // linear extrapolation 2 v_k - v_k-1. Cost on the 5-link chain at 1 ms: about 5 dynamics
 // evaluations (M, f and Mdot v) per step.
 //
+// Mass matrices that jump. Where M(q) is discontinuous (a Type II mass point passing a via point:
+// J_ar changes segment, [D Eq. 5.29-5.36]) the step M(q_k) v_k+1 - h g = M(q_k-1) v_k carries p
+// across the jump, so as h -> 0 this method follows v+ = M+^-1 M- v- at each crossing, while the
+// ODE M qddot = f that the other integrators solve keeps qdot continuous. Both are consistent
+// limits of different jump rules (their kinetic-energy jumps are +-1/2 v^T (M+ - M-) v to first
+// order), so on such scenes "symplectic" converges at order 1 to another trajectory
+// (tests/core/integrators/variational_muscle_test.cpp; README, notes a researcher should know).
+//
 // Constraints: enforced at the velocity level as in "euler" [D Eq. 4.102, 4.110]: every linear
 // solve is the KKT system [A G^T; G 0] [v; lambda] = [A v_n - R(v_n); G v_k + h rhs - vel_err]
 // with G, rhs and vel_err at the start of the step (q_k, v_k); the constraint impulse enters p_k+1
