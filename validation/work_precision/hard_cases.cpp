@@ -500,7 +500,7 @@ HardCasesResult runHardCases(const std::string& models_dir, bool quick, std::ost
   say("NaN mid-run");
   for (const std::string integ : {"euler", "bdf1", "rk45", "cvode"}) {
     const NanCase c = runNanCase(integ);
-    add("nan " + integ, "force NaN from t = 0.25 s", c.stopped ? c.message.substr(0, 120) : "not stopped",
+    add("nan " + integ, "force NaN from t = 0.25 s", c.stopped ? c.message.substr(0, 240) : "not stopped",
         "stops naming time, coordinate, step", c.stopped && c.time >= 0.25 - 1e-9 && c.time < 0.3);
   }
   res.cpu_s = cpuSeconds() - c0;
@@ -514,8 +514,13 @@ void addHardCasesToReport(const HardCasesResult& r, Report& report) {
   JsonValue& js = report.section("hard_cases");
   for (const auto& row : r.rows) {
     t.addRow({row.name, row.setup, row.measured, row.bound, row.passed ? "yes" : "no"});
-    md += "| " + row.name + " | " + row.setup + " | " + row.measured + " | " + row.bound + " | " +
-          (row.passed ? "yes" : "NO") + " |\n";
+    // a '|' inside a cell (|q|, |dE|) would end the markdown cell
+    auto cell = [](std::string x) {
+      for (std::size_t p = x.find('|'); p != std::string::npos; p = x.find('|', p + 2)) x.replace(p, 1, "\\|");
+      return x;
+    };
+    md += "| " + cell(row.name) + " | " + cell(row.setup) + " | " + cell(row.measured) + " | " + cell(row.bound) +
+          " | " + (row.passed ? "yes" : "NO") + " |\n";
     JsonValue o = JsonValue::object();
     o["setup"] = JsonValue(row.setup);
     o["measured"] = JsonValue(row.measured);
