@@ -14,6 +14,7 @@
 
 #include "core/dynamics/skeleton_dynamics.hpp"
 #include "core/muscles/muscle_kinematics.hpp"
+#include "core/muscles/wrap_muscle.hpp"
 #include "core/skeleton/kinematics.hpp"
 
 namespace redmax::osim {
@@ -319,8 +320,11 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
     phys[k] = physiologicalMass(pf, options);
     if (!pf.is_muscle) {
       e.lumped_why = "not a muscle (" + pf.class_name + ")";
-    } else if (pathType(base.muscles[k].path) == redmax::PathType::III) {
+    } else if (pathType(base.muscles[k].path) == redmax::PathType::III && !options.wrap_mass) {
       e.lumped_why = "Type III path (wrapping surfaces carry no mass yet)";
+    } else if (pathType(base.muscles[k].path) == redmax::PathType::III &&
+               !redmax::wrapMassPointsUnsupportedReason(base.muscles[k]).empty()) {
+      e.lumped_why = "Type III path (" + redmax::wrapMassPointsUnsupportedReason(base.muscles[k]) + ")";
     } else if (!(phys[k] > 0.0) || !std::isfinite(phys[k])) {
       e.lumped_why = "zero physiological mass (max_isometric_force " + fmt(pf.max_isometric_force) +
                      " N, optimal_fiber_length " + fmt(pf.optimal_fiber_length) + " m)";
@@ -480,7 +484,17 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
 
   // the reduced model, its muscles with their points
   out.build = buildCoreModel(out.description, bo);
-  out.build.muscles = addMusclePointMasses(out.build.muscles, mass, mpo);
+  // Type III muscles (wrap_mass) get their points here: addMusclePointMasses keeps refusing them
+  std::vector<double> plain = mass;
+  for (int k = 0; k < nm; ++k)
+    if (pathType(out.build.muscles[k].path) == redmax::PathType::III) plain[k] = 0.0;
+  out.build.muscles = addMusclePointMasses(out.build.muscles, plain, mpo);
+  for (int k = 0; k < nm; ++k) {
+    Muscle& mu = out.build.muscles[k];
+    if (plain[k] == mass[k] || !(mass[k] > 0.0)) continue;
+    mu.mass_points = makeMassPoints(mass[k], mu.optimal_fiber_length, mu.tendon_slack_length, mpo);
+    validateMuscle(out.build.model, mu);
+  }
   for (int k = 0; k < nm; ++k) {
     MuscleMassEntry& e = out.plan.muscles[k];
     e.mass = mass[k];

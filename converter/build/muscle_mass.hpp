@@ -23,8 +23,9 @@
 //                  scale by (1 - F) and its centre of mass stays (the dissertation's tibia sweep).
 //
 // Only muscles (PathForceDesc::is_muscle) get mass. A muscle stays lumped when it is not selected,
-// when its path wraps (Type III, until wrapping surfaces carry mass) or when its physiological mass
-// is zero; the plan says which and why.
+// when its path wraps (Type III; with `wrap_mass`, only when its shape is one that
+// core/muscles/wrap_muscle.hpp cannot move mass over) or when its physiological mass is zero; the
+// plan says which and why.
 #include <string>
 #include <vector>
 
@@ -50,6 +51,10 @@ struct MuscleMassOptions {
   double density = kDefaultMuscleDensity;             ///< kg/m^3, > 0
   std::string transfer_body;                  ///< Transfer only: a body name of the model
   double transfer_fraction = 0.0;             ///< Transfer only: in [0, 1)
+  /// Type III muscles of the shape core/muscles/wrap_muscle.hpp supports (origin, one wrap surface,
+  /// insertion) take mass too (smooth wrap model). Off by default: the Simbody side cannot move
+  /// mass points over wrap surfaces yet, so engine comparisons keep them lumped.
+  bool wrap_mass = false;
 };
 
 /// "none" | "physiological" | "transfer"; throws std::invalid_argument otherwise
