@@ -61,7 +61,7 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
            "the wrap object, this path has " + std::to_string(path.points.size());
   const PathWrap& w = path.wraps[0];
   // OpenSim's 1-based range must include the only segment, points 1..2
-  const bool covers = (w.range_begin < 1 || w.range_begin <= 1) && (w.range_end < 1 || w.range_end >= 2);
+  const bool covers = w.range_begin <= 1 && (w.range_end < 1 || w.range_end >= 2);
   if (!covers)
     return "wrap object '" + w.name + "' has range " + std::to_string(w.range_begin) + " " +
            std::to_string(w.range_end) + ", which excludes the origin-insertion segment";
