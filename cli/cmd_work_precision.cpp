@@ -4,6 +4,8 @@
 // 2 bad input or usage.
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -12,6 +14,7 @@
 
 #include "cli/args.hpp"
 #include "converter/error.hpp"
+#include "converter/id/id_engine.hpp"
 #include "validation/work_precision/work_precision.hpp"
 
 namespace redmax::cli {
@@ -45,8 +48,22 @@ std::string findModelsDir(const Args& a) {
   throw UsageError{"cannot find osim_models/ (run from the repository root or pass --models DIR)"};
 }
 
+// --shared, else $REDMAX_SHARED_DIR, else ../shared beside the repository holding the models ("" if
+// none: the ID studies then fall back to the running leg and say so)
+std::string findSharedDir(const Args& a, const std::string& models_dir) {
+  if (auto d = a.get("shared")) {
+    if (!fs::is_directory(*d)) throw UsageError{"--shared " + *d + ": not a directory"};
+    return *d;
+  }
+  if (const char* env = std::getenv("REDMAX_SHARED_DIR"); env && *env && fs::is_directory(env)) return env;
+  std::error_code ec;
+  const fs::path repo = fs::absolute(models_dir, ec).parent_path();
+  if (!ec && fs::is_directory(repo.parent_path() / "shared" / "opensim")) return (repo.parent_path() / "shared").string();
+  return "";
+}
+
 int runWorkPrecision(const std::vector<std::string>& argv) {
-  Args a(argv, {"report", "models", "scenes", "integrators", "gnuplot"}, {"quick", "no-plots"});
+  Args a(argv, {"report", "models", "scenes", "integrators", "gnuplot", "studies", "shared"}, {"quick", "no-plots"});
   if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
   const auto dir = a.get("report");
   if (!dir || dir->empty()) throw UsageError{"--report DIR is required"};
@@ -56,6 +73,15 @@ int runWorkPrecision(const std::vector<std::string>& argv) {
   if (auto s = a.get("scenes")) opt.scenes = splitList(*s);
   if (auto s = a.get("integrators")) opt.integrators = splitList(*s);
   opt.gnuplot = a.has("no-plots") ? "none" : a.get("gnuplot", "");
+  if (auto s = a.get("studies")) {
+    opt.studies = splitList(*s);
+    if (opt.studies.empty()) throw UsageError{"--studies needs a list (integrators,masspoints,reduction)"};
+    const auto all = validation::workPrecisionStudyNames();
+    for (const auto& st : opt.studies)
+      if (std::find(all.begin(), all.end(), st) == all.end())
+        throw UsageError{"--studies: unknown study '" + st + "' (expected integrators, masspoints, reduction)"};
+  }
+  opt.shared_dir = findSharedDir(a, opt.models_dir);
   // the report folder must be creatable before the runs are spent
   std::error_code ec;
   fs::create_directories(*dir, ec);
@@ -79,6 +105,23 @@ int runWorkPrecision(const std::vector<std::string>& argv) {
       }
       std::cout << "\n";
     }
+    const auto& id = res.id_studies;
+    if (id.has_masspoints || id.has_reduction)
+      std::cout << "id studies on " << id.trial.name << (id.trial.note.empty() ? "" : " (" + id.trial.note + ")")
+                << ":\n";
+    if (id.has_masspoints) {
+      std::cout << "  mass points per muscle: ";
+      if (id.recommended_points < 0) std::cout << "no N reaches " << 100 * id.target << "% of the inertial effect\n";
+      for (const auto& row : id.masspoints)
+        if (row.value == id.recommended_points)
+          std::cout << "N = " << row.value << " (error " << row.error.err_effect << " of the inertial effect, "
+                    << row.cpu_per_frame_s << " s CPU per frame)\n";
+    }
+    if (id.has_reduction) {
+      std::cout << "  top-K muscles with mass:";
+      for (const auto& row : id.reduction) std::cout << " K=" << row.label << ": " << row.error.err_effect;
+      std::cout << " (error of the inertial effect)\n";
+    }
     if (res.files.plots_skipped) std::cout << "plots skipped: " << res.files.plots_note << "\n";
     std::cout << "report: " << *dir << "/report.md\n";
     return 0;
@@ -88,13 +131,16 @@ int runWorkPrecision(const std::vector<std::string>& argv) {
   } catch (const validation::ReportError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 1;
+  } catch (const osim::IdEngineError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
   }
 }
 
 CommandRegistration reg(
     {"work-precision", "error against CPU time for every integrator on the project's scenes",
      "usage: redmax work-precision --report DIR [--quick] [--models DIR] [--scenes LIST] [--integrators LIST]\n"
-     "                             [--gnuplot PATH|none] [--no-plots]\n"
+     "                             [--studies LIST] [--shared DIR] [--gnuplot PATH|none] [--no-plots]\n"
      "\n"
      "Runs every integrator (euler, symplectic, bdf1, sdirk2 over fixed steps 1e-2..5e-5 s; rk45, cvode over\n"
      "rtol 1e-3..1e-10, atol = 1e-2 rtol) on the scenes pendulum_straight, pendulum_via, finger and running_leg\n"
@@ -107,6 +153,15 @@ CommandRegistration reg(
      "  --models DIR       the osim_models folder (default: ./osim_models or the repository's)\n"
      "  --scenes LIST      comma-separated subset of pendulum_straight,pendulum_via,finger,running_leg\n"
      "  --integrators LIST comma-separated subset of euler,symplectic,bdf1,sdirk2,rk45,cvode\n"
+     "  --studies LIST     comma-separated subset of integrators,masspoints,reduction (default all).\n"
+     "                     masspoints: ID torque error against 500 mass points per muscle for N = 2..100\n"
+     "                     and CPU time per frame, with the recommended N; reduction: only the top-K\n"
+     "                     muscles by inertia contribution carry mass, K = 0, 1, 2, 5, 10, all. Trial: set F\n"
+     "                     of the shared OpenSim data with physiological muscle mass (--quick, or without\n"
+     "                     the shared data: the running leg, and the report says so). Writes\n"
+     "                     id_masspoints.csv|png, id_reduction.csv|png, id_reduction_ranking.csv\n"
+     "  --shared DIR       the shared data folder holding opensim/ (default $REDMAX_SHARED_DIR, else\n"
+     "                     ../shared beside the repository)\n"
      "\n"
      "exit codes: 0 report written, 1 a model could not be loaded or the report not written, 2 bad input.\n",
      runWorkPrecision});

@@ -108,6 +108,8 @@ std::string describeRun(const WorkPrecisionRun& run) {
 
 }  // namespace
 
+std::vector<std::string> workPrecisionStudyNames() { return {"integrators", "masspoints", "reduction"}; }
+
 std::vector<std::string> workPrecisionSceneNames() { return {"pendulum_straight", "pendulum_via", "finger", "running_leg"}; }
 
 WorkPrecisionScene makeWorkPrecisionScene(const std::string& name, const std::string& models_dir) {
@@ -213,7 +215,19 @@ WorkPrecisionRun runWorkPrecisionCase(const WorkPrecisionScene& scene, const std
 
 WorkPrecisionResult runWorkPrecision(const std::string& report_dir, const WorkPrecisionOptions& options,
                                      std::ostream* progress) {
-  const std::vector<std::string> scene_names = options.scenes.empty() ? workPrecisionSceneNames() : options.scenes;
+  for (const auto& n : options.studies) {
+    const auto all = workPrecisionStudyNames();
+    if (std::find(all.begin(), all.end(), n) == all.end())
+      throw std::invalid_argument("unknown work-precision study '" + n + "' (expected integrators, masspoints, reduction)");
+  }
+  auto wants = [&](const std::string& study) {
+    return options.studies.empty() ||
+           std::find(options.studies.begin(), options.studies.end(), study) != options.studies.end();
+  };
+  // without the integrators study no scene runs
+  const std::vector<std::string> scene_names =
+      !wants("integrators") ? std::vector<std::string>{}
+                            : options.scenes.empty() ? workPrecisionSceneNames() : options.scenes;
   const std::vector<std::string> integrators = options.integrators.empty() ? kIntegrators : options.integrators;
   for (const auto& n : integrators) workPrecisionLadder(n, options.quick);  // validates the names
   for (const auto& n : scene_names) {
@@ -224,7 +238,7 @@ WorkPrecisionResult runWorkPrecision(const std::string& report_dir, const WorkPr
   }
 
   ReportOptions ropt;
-  ropt.title = "redmax work-precision report (integrators)";
+  ropt.title = "redmax work-precision report";
   ropt.gnuplot = options.gnuplot;
   Report report(report_dir, ropt);
   report.setInput("mode", JsonValue(options.quick ? "quick" : "full"));
@@ -389,6 +403,19 @@ WorkPrecisionResult runWorkPrecision(const std::string& report_dir, const WorkPr
     js["recommended"] = std::move(rec);
     section[name] = std::move(js);
     result.scenes.push_back(std::move(sr));
+  }
+  // the inverse-dynamics studies (id_studies.hpp) on a gait trial
+  std::vector<std::string> id_studies;
+  for (const char* st : {"masspoints", "reduction"})
+    if (wants(st)) id_studies.push_back(st);
+  if (!id_studies.empty()) {
+    IdStudyOptions io;
+    io.models_dir = options.models_dir;
+    io.shared_dir = options.shared_dir;
+    io.quick = options.quick;
+    result.id_studies = runIdStudies(io, id_studies, progress);
+    report.setInput("id_studies_trial", JsonValue(result.id_studies.trial.name));
+    addIdStudiesToReport(result.id_studies, report);
   }
   result.files = report.write();
   return result;

@@ -32,6 +32,7 @@
 
 #include "core/dynamics/system.hpp"
 #include "validation/report/report.hpp"
+#include "validation/work_precision/id_studies.hpp"
 
 namespace redmax::validation {
 
@@ -43,6 +44,11 @@ struct WorkPrecisionOptions {
   std::string gnuplot;                 ///< findGnuplot hint ("" auto, "none" no plots)
   /// accuracy targets for the recommendations (max-norm state error)
   std::vector<double> targets = {1e-3, 1e-6};
+  /// "integrators", "masspoints", "reduction" (validation/work_precision/id_studies.hpp); empty = all
+  std::vector<std::string> studies;
+  /// the shared data folder (holding opensim/) for the ID studies' trial, set F; "" or absent: the
+  /// running leg stands in and the report says so
+  std::string shared_dir;
 };
 
 /// One integrator run.
@@ -84,7 +90,12 @@ struct WorkPrecisionSceneResult {
 struct WorkPrecisionResult {
   std::vector<WorkPrecisionSceneResult> scenes;
   ReportFiles files;
+  /// the ID studies (has_masspoints / has_reduction say which ran)
+  IdStudiesResult id_studies;
 };
+
+/// "integrators", "masspoints", "reduction"
+std::vector<std::string> workPrecisionStudyNames();
 
 /// "pendulum_straight", "pendulum_via", "finger", "running_leg"
 std::vector<std::string> workPrecisionSceneNames();
@@ -100,9 +111,10 @@ std::vector<double> workPrecisionLadder(const std::string& integrator, bool quic
 WorkPrecisionRun runWorkPrecisionCase(const WorkPrecisionScene& scene, const std::string& integrator, double value,
                                       double t_end, const VecX& x_ref);
 
-/// Everything: all scenes x integrators x ladder, then the report in report_dir. progress (may be
-/// null) gets one line per scene and integrator. Throws std::invalid_argument for unknown scene or
-/// integrator names, ReportError when DIR cannot be written.
+/// Everything: all scenes x integrators x ladder (study "integrators"), the ID studies
+/// ("masspoints", "reduction"), then the report in report_dir. progress (may be
+/// null) gets one line per scene and integrator. Throws std::invalid_argument for unknown scene,
+/// integrator or study names, ReportError when DIR cannot be written.
 WorkPrecisionResult runWorkPrecision(const std::string& report_dir, const WorkPrecisionOptions& options,
                                      std::ostream* progress = nullptr);
 
