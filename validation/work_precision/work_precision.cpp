@@ -1,4 +1,5 @@
 #include "validation/work_precision/work_precision.hpp"
+#include "validation/work_precision/hard_cases.hpp"
 
 #include <time.h>
 
@@ -108,7 +109,7 @@ std::string describeRun(const WorkPrecisionRun& run) {
 
 }  // namespace
 
-std::vector<std::string> workPrecisionStudyNames() { return {"integrators", "masspoints", "reduction"}; }
+std::vector<std::string> workPrecisionStudyNames() { return {"integrators", "masspoints", "reduction", "hard"}; }
 
 std::vector<std::string> workPrecisionSceneNames() { return {"pendulum_straight", "pendulum_via", "finger", "running_leg"}; }
 
@@ -417,6 +418,8 @@ WorkPrecisionResult runWorkPrecision(const std::string& report_dir, const WorkPr
     report.setInput("id_studies_trial", JsonValue(result.id_studies.trial.name));
     addIdStudiesToReport(result.id_studies, report);
   }
+  // the hard cases (hard_cases.hpp): scenes built in code, under 1 s
+  if (wants("hard")) addHardCasesToReport(runHardCases(options.models_dir, options.quick, progress), report);
   result.files = report.write();
   return result;
 }
