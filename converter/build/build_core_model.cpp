@@ -496,7 +496,62 @@ class Builder {
 
 }  // namespace
 
+namespace {
+
+// Numbers the reader accepts as OpenSim's parser does (strtod takes "nan" and "inf") but that no
+// model can use: each one is an error at its element's line, before anything is built, so that a
+// NaN never reaches a simulation.
+void checkFiniteNumbers(const ModelDescription& d) {
+  const std::string& file = d.source_file;
+  auto fail = [&](int line, const std::string& what) { throw ConvertError(file, line, what); };
+  if (!d.gravity.allFinite()) fail(0, "gravity is not finite");
+  for (const FrameDesc& f : d.frames)
+    if (!f.translation.allFinite() || !f.orientation.allFinite() || !f.X_base.allFinite())
+      fail(f.line, "frame " + quoted(f.name) + ": translation or orientation is not finite");
+  for (const JointDesc& j : d.joints) {
+    if (!j.X_PF.allFinite() || !j.X_BM.allFinite())
+      fail(j.line, j.type + " " + quoted(j.name) + ": a joint frame is not finite");
+    if (!j.radii.allFinite() || !j.winging_origin.allFinite() || !std::isfinite(j.winging_direction))
+      fail(j.line, j.type + " " + quoted(j.name) + ": radii or winging parameters are not finite");
+    for (const TransformAxisDesc& a : j.spatial_transform)
+      if (!a.axis.allFinite())
+        fail(a.line ? a.line : j.line, j.type + " " + quoted(j.name) + ": axis of " + a.name + " is not finite");
+  }
+  for (const CoordinateDesc& c : d.coordinates) {
+    if (!std::isfinite(c.default_value) || !std::isfinite(c.default_speed_value))
+      fail(c.line, "coordinate " + quoted(c.name) + ": default value or speed is not finite");
+    if (std::isnan(c.range_min) || std::isnan(c.range_max))
+      fail(c.line, "coordinate " + quoted(c.name) + ": range is NaN");
+  }
+  std::vector<bool> used(d.wrap_objects.size(), false);
+  for (const PathForceDesc& m : d.muscles) {
+    for (const PathPointDesc& p : m.points)
+      if (!p.location.allFinite() || !p.X_body_frame.allFinite() || std::isnan(p.range_min) ||
+          std::isnan(p.range_max))
+        fail(p.line ? p.line : m.line, quoted(m.name) + " path point " + quoted(p.name) + " is not finite");
+    for (const PathWrapDesc& w : m.wraps)
+      if (w.wrap_index >= 0 && w.wrap_index < static_cast<int>(used.size())) used[static_cast<size_t>(w.wrap_index)] = true;
+  }
+  for (size_t k = 0; k < d.wrap_objects.size(); ++k) {
+    const WrapObjectDesc& w = d.wrap_objects[k];
+    const std::string what = w.type + " " + quoted(w.name);
+    if (!w.X_body.allFinite() || !std::isfinite(w.radius) || !std::isfinite(w.length) ||
+        !w.dimensions.allFinite() || !std::isfinite(w.inner_radius) || !std::isfinite(w.outer_radius))
+      fail(w.line, what + ": a size or its placement is not finite");
+    if (!used[k]) continue;  // a size that no path uses cannot hurt
+    bool ok = true;
+    if (w.type == "WrapCylinder") ok = w.radius > 0.0 && w.length > 0.0;
+    else if (w.type == "WrapSphere") ok = w.radius > 0.0;
+    else if (w.type == "WrapEllipsoid") ok = (w.dimensions.array() > 0.0).all();
+    else if (w.type == "WrapTorus") ok = w.inner_radius > 0.0 && w.outer_radius > 0.0;
+    if (!ok) fail(w.line, what + ": its size must be positive");
+  }
+}
+
+}  // namespace
+
 BuildResult buildCoreModel(const ModelDescription& d, const BuildOptions& options) {
+  checkFiniteNumbers(d);
   Builder b(d, options);
   return b.build();
 }
