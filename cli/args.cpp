@@ -68,4 +68,19 @@ long Args::getInt(const std::string& name, long fallback) const {
   return x;
 }
 
+std::vector<std::string> splitList(const std::string& text, const std::string& separators) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : text) {
+    if (separators.find(c) != std::string::npos) {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
 }  // namespace redmax::cli

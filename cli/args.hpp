@@ -28,4 +28,7 @@ class Args {
   std::vector<std::string> positionals_;
 };
 
+/// The non-empty items of `text` split at any of `separators` (",": "a,,b" -> {a, b}).
+std::vector<std::string> splitList(const std::string& text, const std::string& separators = ",");
+
 }  // namespace redmax::cli

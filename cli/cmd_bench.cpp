@@ -33,14 +33,6 @@ Model makeScene(const std::string& name) {
   throw UsageError{"unknown scene '" + name + "' (expected " + kScenes + ")"};
 }
 
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 int runBench(const std::vector<std::string>& argv) {
   Args a(argv, {"scene", "repeats", "batches", "json", "integrators", "spherical", "dt", "id-setup", "id-model"}, {});

@@ -14,19 +14,6 @@
 namespace redmax::cli {
 namespace {
 
-std::vector<std::string> splitComma(const std::string& s) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : s + ",") {
-    if (c == ',') {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
-  }
-  return out;
-}
 
 int runFlick(const std::vector<std::string>& argv) {
   const Args a(argv, {"model", "integrators", "gravity", "mass", "dt", "dts", "duration", "impulse-time", "target",
@@ -47,7 +34,7 @@ int runFlick(const std::vector<std::string>& argv) {
   std::vector<double> dts;
   if (auto v = a.get("dts")) {
     if (a.has("dt")) throw UsageError{"give --dt or --dts, not both"};
-    for (const std::string& t : splitComma(*v)) {
+    for (const std::string& t : splitList(*v)) {
       char* end = nullptr;
       const double x = std::strtod(t.c_str(), &end);
       if (end == t.c_str() || *end != '\0' || !(x > 0.0) || !std::isfinite(x))
@@ -55,7 +42,7 @@ int runFlick(const std::vector<std::string>& argv) {
       dts.push_back(x);
     }
   }
-  const std::vector<std::string> integrators = splitComma(a.get("integrators", "euler,symplectic"));
+  const std::vector<std::string> integrators = splitList(a.get("integrators", "euler,symplectic"));
   for (const auto& n : integrators)
     if (n != "euler" && n != "symplectic" && n != "bdf1" && n != "sdirk2" && n != "rk45" && n != "cvode")
       throw UsageError{"--integrators: unknown integrator '" + n + "'"};

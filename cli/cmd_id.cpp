@@ -21,19 +21,6 @@
 namespace redmax::cli {
 namespace {
 
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : s + ",") {
-    if (c == ',' || c == ' ' || c == '\t') {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
-  }
-  return out;
-}
 
 osim::IdToolSettings parseSettings(const Args& a) {
   if (!a.positionals().empty())
@@ -50,7 +37,7 @@ osim::IdToolSettings parseSettings(const Args& a) {
   if (a.has("t0")) s.t0 = a.getDouble("t0", 0.0);
   if (a.has("t1")) s.t1 = a.getDouble("t1", 0.0);
   if (s.t0 && s.t1 && *s.t0 > *s.t1) throw UsageError{"--t0 is after --t1"};
-  if (auto v = a.get("forces-to-exclude")) s.forces_to_exclude = splitList(*v);
+  if (auto v = a.get("forces-to-exclude")) s.forces_to_exclude = splitList(*v, ", \t");
   if (a.has("exact") && a.has("opensim-compat"))
     throw UsageError{"--exact and --opensim-compat exclude each other"};
   s.opensim_compat = !a.has("exact");

@@ -21,24 +21,11 @@
 namespace redmax::cli {
 namespace {
 
-std::vector<std::string> splitOn(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : s + sep) {
-    if (c == sep) {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
-  }
-  return out;
-}
 
 // --muscle-mass-kg NAME=KG,NAME=KG
 std::vector<std::pair<std::string, double>> parseMassList(const std::string& text) {
   std::vector<std::pair<std::string, double>> out;
-  for (const std::string& item : splitOn(text, ',')) {
+  for (const std::string& item : splitList(text, ",")) {
     const auto eq = item.find('=');
     double kg = 0.0;
     bool ok = eq != std::string::npos && eq > 0;
@@ -120,7 +107,7 @@ int runSimulate(const std::vector<std::string>& argv) {
     mo.muscle_mass = parseMuscleMassFlags(a);
   }
   if (auto v = a.get("impulse"))
-    for (const std::string& item : splitOn(*v, ';')) mo.impulses.push_back(validation::parseImpulse(item));
+    for (const std::string& item : splitList(*v, ";")) mo.impulses.push_back(validation::parseImpulse(item));
   const bool quiet = a.has("quiet");
 
   // model and initial state: every problem here is the user's input (exit 2)

@@ -31,14 +31,6 @@ std::string joinArgs(const std::vector<std::string>& argv) {
   return s;
 }
 
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 void requireFolder(const std::string& dir) {
   std::error_code ec;

@@ -45,19 +45,6 @@ std::vector<std::string> takeReferences(const std::vector<std::string>& argv,
 }
 
 // "a,b c" -> {"a", "b", "c"}
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> list;
-  std::string cur;
-  for (char c : text + ",") {
-    if (c == ',' || c == ' ' || c == '\t') {
-      if (!cur.empty()) list.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
-  }
-  return list;
-}
 
 double nonNegative(const Args& a, const std::string& name, double fallback) {
   const double x = a.getDouble(name, fallback);
@@ -90,7 +77,7 @@ int runValidate(const std::vector<std::string>& argv_in) {
   if (a.has("t1")) s.t1 = a.getDouble("t1", 0.0);
   if (s.t0 && s.t1 && *s.t0 > *s.t1) throw UsageError{"--t0 is after --t1"};
   if (auto v = a.get("forces-to-exclude")) {
-    s.forces_to_exclude = splitList(*v);
+    s.forces_to_exclude = splitList(*v, ", \t");
   }
   if (a.has("exact") && a.has("opensim-compat"))
     throw UsageError{"--exact and --opensim-compat exclude each other"};
@@ -115,7 +102,7 @@ int runValidate(const std::vector<std::string>& argv_in) {
   }
   if (!opt.mass_sweep.empty())
     opt.mass_sweep = validation::checkMassSweepValues(opt.muscle_mass, opt.mass_sweep);
-  if (auto v = a.get("sweep-columns")) opt.sweep_columns = splitList(*v);
+  if (auto v = a.get("sweep-columns")) opt.sweep_columns = splitList(*v, ", \t");
 
   // the report and the comparisons
   opt.report_dir = a.get("report", "");
