@@ -67,11 +67,11 @@ int runWorkPrecision(const std::vector<std::string>& argv) {
   opt.gnuplot = a.has("no-plots") ? "none" : a.get("gnuplot", "");
   if (auto s = a.get("studies")) {
     opt.studies = splitList(*s);
-    if (opt.studies.empty()) throw UsageError{"--studies needs a list (integrators,masspoints,reduction)"};
+    if (opt.studies.empty()) throw UsageError{"--studies needs a list (integrators,masspoints,reduction,hard)"};
     const auto all = validation::workPrecisionStudyNames();
     for (const auto& st : opt.studies)
       if (std::find(all.begin(), all.end(), st) == all.end())
-        throw UsageError{"--studies: unknown study '" + st + "' (expected integrators, masspoints, reduction)"};
+        throw UsageError{"--studies: unknown study '" + st + "' (expected integrators, masspoints, reduction, hard)"};
   }
   opt.shared_dir = findSharedDir(a, opt.models_dir);
   // the report folder must be creatable before the runs are spent
@@ -145,7 +145,7 @@ CommandRegistration reg(
      "  --models DIR       the osim_models folder (default: ./osim_models or the repository's)\n"
      "  --scenes LIST      comma-separated subset of pendulum_straight,pendulum_via,finger,running_leg\n"
      "  --integrators LIST comma-separated subset of euler,symplectic,bdf1,sdirk2,rk45,cvode\n"
-     "  --studies LIST     comma-separated subset of integrators,masspoints,reduction (default all).\n"
+     "  --studies LIST     comma-separated subset of integrators,masspoints,reduction,hard (default all).\n"
      "                     masspoints: ID torque error against 500 mass points per muscle for N = 2..100\n"
      "                     and CPU time per frame, with the recommended N; reduction: only the top-K\n"
      "                     muscles by inertia contribution carry mass, K = 0, 1, 2, 5, 10, all. Trial: set F\n"
