@@ -9,38 +9,13 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include "tests/cli/cli_test_util.hpp"
 
 namespace {
 
+using namespace redmax::cli_test;
+
 namespace fs = std::filesystem;
-
-// the redmax executable of the same build: <build>/tests/cli_tests -> <build>/cli/redmax
-fs::path redmaxExe() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  const fs::path exe = self.parent_path().parent_path() / "cli" / "redmax";
-  return fs::exists(exe) ? exe : fs::path{};
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct CmdResult {
-  int code;
-  std::string out, err;
-};
-
-CmdResult runRedmax(const fs::path& dir, const std::string& args) {
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = redmaxExe().string() + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-}
 
 class BenchCli : public ::testing::Test {
  protected:

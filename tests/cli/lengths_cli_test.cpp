@@ -17,32 +17,15 @@
 #include <string>
 
 #include "converter/storage.hpp"
+#include "tests/cli/cli_test_util.hpp"
 
 namespace {
+
+using namespace redmax::cli_test;
 
 namespace fs = std::filesystem;
 using redmax::osim::readStorage;
 using redmax::osim::Storage;
-
-fs::path redmaxExe() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  const fs::path exe = self.parent_path().parent_path() / "cli" / "redmax";
-  return fs::exists(exe) ? exe : fs::path{};
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct CmdResult {
-  int code;
-  std::string out, err;
-};
 
 const std::string kShared = REDMAX_SHARED_DIR;
 const std::string kCore = kShared + "/opensim/opensim-core/OpenSim/";
@@ -61,11 +44,7 @@ class LengthsCli : public ::testing::Test {
   }
   bool haveShared() const { return fs::exists(kShared + "/opensim"); }
   CmdResult run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = "cd " + dir_.string() + " && " + redmaxExe().string() + " " + args + " >" +
-                            out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+    return runRedmax(dir_, args, true);
   }
 
   // max |ours - OpenSim| over all rows and the reference's columns (/forceset/NAME|length)

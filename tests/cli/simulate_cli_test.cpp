@@ -13,35 +13,17 @@
 #include <string>
 
 #include "converter/storage.hpp"
+#include "tests/cli/cli_test_util.hpp"
 
 namespace {
+
+using namespace redmax::cli_test;
 
 namespace fs = std::filesystem;
 using redmax::osim::readStorage;
 using redmax::osim::Storage;
 
-// the redmax executable of the same build: <build>/tests/cli_tests -> <build>/cli/redmax
-fs::path redmaxExe() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  const fs::path exe = self.parent_path().parent_path() / "cli" / "redmax";
-  return fs::exists(exe) ? exe : fs::path{};
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::string scene(const std::string& file) { return std::string(REDMAX_SOURCE_DIR) + "/osim_models/" + file; }
-
-struct CmdResult {
-  int code;
-  std::string out, err;
-};
 
 // max |E(t) - E(0)| / max(|E(0)|, max kinetic energy) from the written columns
 double energyDrift(const Storage& s) {
@@ -64,10 +46,7 @@ class SimulateCli : public ::testing::Test {
     if (!dir_.empty()) fs::remove_all(dir_);
   }
   CmdResult run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = redmaxExe().string() + " simulate " + args + " >" + out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+    return runRedmax(dir_, "simulate " + args);
   }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   fs::path dir_;

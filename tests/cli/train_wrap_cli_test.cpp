@@ -13,26 +13,13 @@
 #include <string>
 
 #include "core/muscles/wrap/network.hpp"
+#include "tests/cli/cli_test_util.hpp"
 
 namespace {
 
+using namespace redmax::cli_test;
+
 namespace fs = std::filesystem;
-
-// the redmax executable of the same build: <build>/tests/cli_tests -> <build>/cli/redmax
-fs::path redmaxExe() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  const fs::path exe = self.parent_path().parent_path() / "cli" / "redmax";
-  return fs::exists(exe) ? exe : fs::path{};
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // the file without its wall-time line
 std::string withoutTime(const std::string& text) {
@@ -42,11 +29,6 @@ std::string withoutTime(const std::string& text) {
     if (line.rfind("meta train_seconds", 0) != 0) out += line + "\n";
   return out;
 }
-
-struct CmdResult {
-  int code;
-  std::string out, err;
-};
 
 class TrainWrapCli : public ::testing::Test {
  protected:
@@ -59,10 +41,7 @@ class TrainWrapCli : public ::testing::Test {
     if (!dir_.empty()) fs::remove_all(dir_);
   }
   CmdResult run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = redmaxExe().string() + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+    return runRedmax(dir_, args);
   }
   fs::path dir_;
 };

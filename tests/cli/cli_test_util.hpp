@@ -1,0 +1,46 @@
+#pragma once
+// Running the `redmax` executable of the same build from the CLI tests.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace redmax::cli_test {
+
+namespace fs = std::filesystem;
+
+/// the redmax executable of the same build: <build>/tests/cli_tests -> <build>/cli/redmax ("" if absent)
+inline fs::path redmaxExe() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  const fs::path exe = self.parent_path().parent_path() / "cli" / "redmax";
+  return fs::exists(exe) ? exe : fs::path{};
+}
+
+inline std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+struct CmdResult {
+  int code;
+  std::string out, err;
+};
+
+/// `redmax ARGS` with stdout and stderr captured in files of `dir`; with in_dir the command runs
+/// with `dir` as its working directory
+inline CmdResult runRedmax(const fs::path& dir, const std::string& args, bool in_dir = false) {
+  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd = (in_dir ? "cd " + dir.string() + " && " : std::string()) + redmaxExe().string() + " " +
+                          args + " >" + out.string() + " 2>" + err.string();
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+}  // namespace redmax::cli_test
