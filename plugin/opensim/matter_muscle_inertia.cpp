@@ -1,0 +1,268 @@
+#include "plugin/opensim/matter_muscle_inertia.hpp"
+
+#include <stdexcept>
+
+#include "core/muscles/path_kinematics.hpp"
+
+namespace redmax::opensim {
+
+namespace {
+
+SimTK::Vec3 toSimTKVec3(const Vec3& v) { return SimTK::Vec3(v.x(), v.y(), v.z()); }
+Vec3 fromSimTKVec3(const SimTK::Vec3& v) { return Vec3(v[0], v[1], v[2]); }
+
+SimTK::Transform toTransform(const Mat4& E) {
+  SimTK::Mat33 R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R[r][c] = E(r, c);
+  return SimTK::Transform(SimTK::Rotation(R, true), SimTK::Vec3(E(0, 3), E(1, 3), E(2, 3)));
+}
+
+bool isMoving(const PathPoint& pt) { return pt.kind == PathPointKind::Moving && pt.coordinate >= 0; }
+
+}  // namespace
+
+MatterMuscleInertia::MatterMuscleInertia(const SimTK::SimbodyMatterSubsystem& matter, MatterMap map,
+                                         const Model& model, std::vector<Muscle> muscles, const Vec3& gravity)
+    : matter_(matter), map_(std::move(map)), muscles_(std::move(muscles)), gravity_(gravity) {
+  if (static_cast<int>(map_.mobod_of_body.size()) != model.nb() ||
+      static_cast<int>(map_.q_of_coordinate.size()) != model.nr())
+    throw std::invalid_argument("MatterMuscleInertia: the map has " + std::to_string(map_.mobod_of_body.size()) +
+                                " bodies and " + std::to_string(map_.q_of_coordinate.size()) +
+                                " coordinates, the model " + std::to_string(model.nb()) + " and " +
+                                std::to_string(model.nr()));
+  for (int m = 0; m < static_cast<int>(muscles_.size()); ++m) {
+    const Muscle& mu = muscles_[m];
+    validateMuscle(model, mu);
+    if (mu.mass_points.size() == 0) continue;
+    // every body and coordinate the path depends on must be in the foreign system
+    for (const PathPoint& pt : mu.path.points) {
+      if (pt.body >= 0 && !map_.mobod_of_body[pt.body].isValid())
+        throw std::invalid_argument("muscle '" + mu.name + "': body '" + model.bodies[pt.body].name +
+                                    "' has no mobilized body in the Simbody system");
+      if (pt.coordinate >= 0 && map_.q_of_coordinate[pt.coordinate] < 0)
+        throw std::invalid_argument("muscle '" + mu.name + "': coordinate '" + model.coordinates[pt.coordinate].name +
+                                    "' has no q in the Simbody system");
+    }
+    Entry e;
+    e.muscle = m;
+    if (pathType(mu.path) == PathType::III) {
+      const PathWrap& w = mu.path.wraps.at(0);
+      e.wrap = true;
+      e.surface_body = w.body;
+      e.X_bs = toTransform(w.E_bs);
+      if (w.body >= 0 && !map_.mobod_of_body[w.body].isValid())
+        throw std::invalid_argument("muscle '" + mu.name + "': its wrap surface's body has no mobilized body");
+    }
+    entries_.push_back(std::move(e));
+  }
+  q_core_.setZero(model.nr());
+}
+
+const SimTK::MobilizedBody& MatterMuscleInertia::mobod(int body) const {
+  return body >= 0 ? matter_.getMobilizedBody(map_.mobod_of_body[body]) : matter_.getGround();
+}
+
+double MatterMuscleInertia::totalMass() const {
+  double m = 0.0;
+  for (const Muscle& mu : muscles_) m += mu.mass_points.totalMass();
+  return m;
+}
+
+std::vector<Vec3> MatterMuscleInertia::massPointPositions() const {
+  std::vector<Vec3> out;
+  for (const Entry& e : entries_) {
+    const std::vector<Vec3>& x = e.wrap ? e.wmap.x_a : e.map.x_a;
+    out.insert(out.end(), x.begin(), x.end());
+  }
+  return out;
+}
+
+void MatterMuscleInertia::evaluate(const SimTK::State& state, bool velocity) {
+  const SimTK::Vector& q = matter_.getQ(state);
+  for (int c = 0; c < q_core_.size(); ++c)
+    q_core_[c] = map_.q_of_coordinate[c] >= 0 ? q[map_.q_of_coordinate[c]] : 0.0;
+  const SimTK::Vector* qdot = velocity ? &matter_.getQDot(state) : nullptr;
+
+  for (Entry& e : entries_) {
+    const Muscle& mu = muscles_[e.muscle];
+    const auto& points = mu.path.points;
+    // active set: conditional points by OpenSim's rule, on the state's q
+    e.active.clear();
+    for (int k = 0; k < static_cast<int>(points.size()); ++k)
+      if (isPathPointActive(points[k], q_core_)) e.active.push_back(k);
+    const int P = static_cast<int>(e.active.size());
+    e.x.resize(P);
+    e.x_b.resize(P);
+    e.dx_b.resize(P);
+    e.ddx_b.resize(P);
+    if (velocity) e.xdot.resize(P);
+    for (int i = 0; i < P; ++i) {
+      const PathPoint& pt = points[e.active[i]];
+      calcPointLocation(pt, q_core_, e.x_b[i], e.dx_b[i], e.ddx_b[i]);
+      const SimTK::MobilizedBody& B = mobod(pt.body);
+      const SimTK::Vec3 station = toSimTKVec3(e.x_b[i]);
+      e.x[i] = fromSimTKVec3(B.findStationLocationInGround(state, station));
+      if (!velocity) continue;
+      SimTK::Vec3 v = B.findStationVelocityInGround(state, station);
+      // moving point: the location's own rate through its coordinate, R x_b' qdot_c
+      if (isMoving(pt)) v += B.getBodyRotation(state) * toSimTKVec3(e.dx_b[i]) * (*qdot)[map_.q_of_coordinate[pt.coordinate]];
+      e.xdot[i] = fromSimTKVec3(v);
+    }
+    if (!e.wrap) {
+      calcPathMap(e.x, velocity ? &e.xdot : nullptr, mu.mass_points, e.map, mu.name);
+      continue;
+    }
+    if (P != 2) throw MuscleError("muscle '" + mu.name + "': a wrapping muscle needs its two end points active");
+    const SimTK::MobilizedBody& S = mobod(e.surface_body);
+    const SimTK::Transform X_GS = S.getBodyTransform(state) * e.X_bs;
+    Mat3 R;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) R(r, c) = X_GS.R()[r][c];
+    WrapSegmentVelocity v;
+    if (velocity) {
+      v.xdot1 = e.xdot[0];
+      v.xdot2 = e.xdot[1];
+      v.omega = fromSimTKVec3(S.getBodyAngularVelocity(state));
+      v.pdot = fromSimTKVec3(S.findStationVelocityInGround(state, e.X_bs.p()));
+    }
+    calcWrapPathMap(mu.path.wraps[0].surface, mu.wrap, mu.mass_points, e.x[0], e.x[1], R, fromSimTKVec3(X_GS.p()),
+                    velocity ? &v : nullptr, e.wmap, mu.name);
+  }
+}
+
+void MatterMuscleInertia::calcGeneralizedForces(const SimTK::State& state, const SimTK::Vector& udot,
+                                                SimTK::Vector& f_u) {
+  const int nu = matter_.getNumMobilities();
+  f_u.resize(nu);
+  f_u = 0.0;
+  if (entries_.empty()) return;
+  evaluate(state, true);
+
+  // one batch of stations over every muscle: JS udot and the bias JSdot u [D Eq. 5.5]
+  bodies_.clear();
+  stations_.clear();
+  bool any_moving = false;
+  for (const Entry& e : entries_) {
+    const auto& points = muscles_[e.muscle].path.points;
+    for (size_t i = 0; i < e.active.size(); ++i) {
+      const PathPoint& pt = points[e.active[i]];
+      bodies_.push_back(mobod(pt.body).getMobilizedBodyIndex());
+      stations_.push_back(toSimTKVec3(e.x_b[i]));
+      any_moving = any_moving || isMoving(pt);
+    }
+  }
+  matter_.multiplyByStationJacobian(state, bodies_, stations_, udot, JSudot_);
+  matter_.calcBiasForStationJacobian(state, bodies_, stations_, bias_);
+  forces_.resize(static_cast<int>(bodies_.size()));
+  // Type III surfaces: one frame each, spatial acceleration JF udot + JFdot u
+  frame_bodies_.clear();
+  frame_origins_.clear();
+  for (const Entry& e : entries_) {
+    if (!e.wrap) continue;
+    frame_bodies_.push_back(mobod(e.surface_body).getMobilizedBodyIndex());
+    frame_origins_.push_back(e.X_bs.p());
+  }
+  if (!frame_bodies_.empty()) {
+    matter_.multiplyByFrameJacobian(state, frame_bodies_, frame_origins_, udot, JFudot_);
+    matter_.calcBiasForFrameJacobian(state, frame_bodies_, frame_origins_, frame_bias_);
+    frame_forces_.resize(static_cast<int>(frame_bodies_.size()));
+  }
+  int frame = 0;
+  SimTK::Vector qddot, f_q;
+  if (any_moving) {
+    matter_.calcQDotDot(state, udot, qddot);
+    f_q.resize(matter_.getQ(state).size());
+    f_q = 0.0;
+  }
+  const SimTK::Vector& qdot = matter_.getQDot(state);
+
+  int row = 0;  // first station of the current muscle in the batch
+  for (Entry& e : entries_) {
+    const Muscle& mu = muscles_[e.muscle];
+    const int P = static_cast<int>(e.active.size());
+    VecX xddot(3 * P);
+    for (int i = 0; i < P; ++i) {
+      SimTK::Vec3 a = JSudot_[row + i] + bias_[row + i];
+      const PathPoint& pt = mu.path.points[e.active[i]];
+      if (isMoving(pt)) {
+        // 2 w x (R x_b' qdot_c) + R (x_b'' qdot_c^2 + x_b' qddot_c)
+        const SimTK::MobilizedBody& B = mobod(pt.body);
+        const SimTK::Rotation& R = B.getBodyRotation(state);
+        const int sq = map_.q_of_coordinate[pt.coordinate];
+        const double qd = qdot[sq], qdd = qddot[sq];
+        const SimTK::Vec3 v_rel = R * toSimTKVec3(e.dx_b[i]) * qd;
+        a += 2.0 * SimTK::cross(B.getBodyAngularVelocity(state), v_rel) +
+             R * toSimTKVec3(e.ddx_b[i] * qd * qd + e.dx_b[i] * qdd);
+      }
+      xddot.segment<3>(3 * i) = fromSimTKVec3(a);
+    }
+    // f_a = m_a (a_a - g) [D Eq. 5.6-5.7], pulled back to the path points
+    VecX a_a;
+    if (!e.wrap) {
+      a_a = calcMassPointAccelerations(e.map, xddot);
+    } else {
+      const SimTK::SpatialVec A = JFudot_[frame] + frame_bias_[frame];
+      VecX vdot(12);
+      vdot << xddot, fromSimTKVec3(A[0]), fromSimTKVec3(A[1]);
+      a_a = e.wmap.J * vdot + e.wmap.bias;
+    }
+    VecX f_a(a_a.size());
+    for (int a = 0; a < mu.mass_points.size(); ++a)
+      f_a.segment<3>(3 * a) = mu.mass_points.mass[a] * (a_a.segment<3>(3 * a) - gravity_);
+    VecX F_x;
+    if (!e.wrap) {
+      F_x = e.map.J_ax.transpose() * f_a;
+    } else {
+      // the (omega, pdot) columns: a torque and a force at the surface origin
+      const VecX F = e.wmap.J.transpose() * f_a;
+      F_x = F.head<6>();
+      frame_forces_[frame] = SimTK::SpatialVec(toSimTKVec3(F.segment<3>(6)), toSimTKVec3(F.segment<3>(9)));
+      ++frame;
+    }
+    for (int i = 0; i < P; ++i) {
+      const Vec3 F = F_x.segment<3>(3 * i);
+      forces_[row + i] = toSimTKVec3(F);
+      const PathPoint& pt = mu.path.points[e.active[i]];
+      if (isMoving(pt)) {
+        // the point's column through q_c: (R x_b')^T F, conjugate to qdot_c
+        const SimTK::MobilizedBody& B = mobod(pt.body);
+        f_q[map_.q_of_coordinate[pt.coordinate]] += ~(B.getBodyRotation(state) * toSimTKVec3(e.dx_b[i])) * toSimTKVec3(F);
+      }
+    }
+    row += P;
+  }
+  // station forces to u space: JS^T F; the q-space part through qdot = N u: N^T f_q
+  matter_.multiplyByStationJacobianTranspose(state, bodies_, stations_, forces_, f_u);
+  if (!frame_bodies_.empty()) {
+    SimTK::Vector f_frames;
+    matter_.multiplyByFrameJacobianTranspose(state, frame_bodies_, frame_origins_, frame_forces_, f_frames);
+    f_u += f_frames;
+  }
+  if (any_moving) {
+    SimTK::Vector f_extra;
+    matter_.multiplyByN(state, true, f_q, f_extra);
+    f_u += f_extra;
+  }
+}
+
+VecX MatterMuscleInertia::wrapVelocity(const SimTK::State& state, const Entry& e) const {
+  const SimTK::MobilizedBody& S = mobod(e.surface_body);
+  VecX v(12);
+  v << e.xdot[0], e.xdot[1], fromSimTKVec3(S.getBodyAngularVelocity(state)),
+      fromSimTKVec3(S.findStationVelocityInGround(state, e.X_bs.p()));
+  return v;
+}
+
+double MatterMuscleInertia::kineticEnergy(const SimTK::State& state) {
+  evaluate(state, true);
+  double T = 0.0;
+  for (const Entry& e : entries_) {
+    const MassPoints& mp = muscles_[e.muscle].mass_points;
+    const VecX xdot_a = e.wrap ? VecX(e.wmap.J * wrapVelocity(state, e)) : VecX(e.map.J_ax * stackPoints(e.xdot));
+    for (int a = 0; a < mp.size(); ++a) T += 0.5 * mp.mass[a] * xdot_a.segment<3>(3 * a).squaredNorm();
+  }
+  return T;
+}
+
+}  // namespace redmax::opensim
