@@ -84,7 +84,7 @@ std::string writeSetup(const IdSet& set, const fs::path& dir, const std::string&
     << "    <model_file>" << set.model << "</model_file>\n"
     << "    <time_range> " << set.t0 << " " << set.t1 << "</time_range>\n"
     << "    <forces_to_exclude> Muscles</forces_to_exclude>\n"
-    << "    <external_loads_file>" << (set.loads.empty() ? "Unassigned" : set.loads) << "</external_loads_file>\n"
+    << "    <external_loads_file>" << set.loads << "</external_loads_file>\n"
     << "    <coordinates_file>" << set.coordinates << "</coordinates_file>\n"
     << "    <lowpass_cutoff_frequency_for_coordinates>" << set.lowpass << "</lowpass_cutoff_frequency_for_coordinates>\n"
     << "    <output_gen_force_file>" << out << "</output_gen_force_file>\n"
