@@ -4,11 +4,15 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 
 namespace redmax {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// quadrant cylinders: the band narrows where the line's point nearest the axis is closer than
+// this many radii to the quadrant plane (see smoothPoint)
+constexpr double kQuadrantBlend = 0.25;
 
 // ---------------------------------------------------------------------------------------------
 // dual numbers: x = a + b eps with eps^2 = 0; nesting Dual<Dual<double>> gives a second
@@ -87,17 +91,22 @@ template <class T> V3<T> rotate(const V3<T>& k, const T& phi, const V3<T>& v) {
   return c * v + s * cross(k, v) + (dot(k, v) * (1.0 - c)) * k;
 }
 
+// alpha may be a constant or carry derivatives of its own (the same scalar type as the points)
+template <class T> using Alpha = std::type_identity_t<T>;
+
 // point at fraction alpha of p1 -> r1 -> arc -> r2 -> p2; the arc turns r1 about the unit axis k
-// through the origin by angle phi (with rise h along k): the library's calcWrappedPathPoint
+// through the origin by angle phi (with rise h along k): the library's calcWrappedPathPoint;
+// total_out (if given) receives the geometric length |p1 r1| + arc + |r2 p2|
 template <class T>
 V3<T> pathPoint(const V3<T>& p1, const V3<T>& p2, const V3<T>& r1, const V3<T>& r2, const V3<T>& k, const T& phi,
-                const T& h, double alpha) {
+                const T& h, const Alpha<T>& alpha, T* total_out = nullptr) {
   const T l1 = norm(r1 - p1);
   const V3<T> r1_perp = r1 - dot(r1, k) * k;
   const T rho_phi = norm(r1_perp) * phi;
   const T la = dsqrt(rho_phi * rho_phi + h * h);
   const T l2 = norm(p2 - r2);
   const T total = l1 + la + l2;
+  if (total_out) *total_out = total;
   T s = alpha * total;
   if (value(s) <= value(l1)) return p1 + (s / l1) * (r1 - p1);
   s = s - l1;
@@ -156,7 +165,8 @@ void cylinderCandidates(double R, const V3<T>& p, V3<T>& pa, V3<T>& a, V3<T>& b,
 }
 
 template <class T>
-bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double alpha, V3<T>& x) {
+bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, const Alpha<T>& alpha, V3<T>& x,
+                   T* total_out = nullptr) {
   const double R = surf.radius;
   V3<T> p11, p22, r1a, r1b, r2a, r2b, r1, r2;
   T rho1, rho2;
@@ -243,7 +253,7 @@ bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, do
   // helix about the axis
   T theta = datan2(r1[0] * r2[1] - r1[1] * r2[0], r1[0] * r2[0] + r1[1] * r2[1]);
   if (long_wrap) theta = -(2.0 * kPi - theta);  // the long way round, turning the other way
-  x = pathPoint(p1, p2, r1, r2, zAxis<T>(), theta, r2[2] - r1[2], alpha);
+  x = pathPoint(p1, p2, r1, r2, zAxis<T>(), theta, r2[2] - r1[2], alpha, total_out);
   return true;
 }
 
@@ -260,7 +270,8 @@ void sphereTangents(double R, const V3<T>& p, const V3<T>& n, V3<T>& a, V3<T>& b
 }
 
 template <class T>
-bool spherePoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double alpha, V3<T>& x) {
+bool spherePoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, const Alpha<T>& alpha, V3<T>& x,
+                 T* total_out = nullptr) {
   const double R = surf.radius;
   const V3<T> p1p2 = normalize(p1 - p2);
   V3<T> hp2 = cross(p1p2, normalize(p2));
@@ -289,67 +300,246 @@ bool spherePoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, doub
   const T angle = dacos(dot(r1n, r2n));
   const V3<T> c = cross(r1n, r2n);
   const V3<T> ax = values(c).squaredNorm() > 0.0 ? normalize(c) : n;
-  x = pathPoint(p1, p2, r1, r2, ax, angle, T(0.0), alpha);
+  x = pathPoint(p1, p2, r1, r2, ax, angle, T(0.0), alpha, total_out);
   return true;
 }
 
-// the blended point over any scalar
+// ---------------------------------------------------------------------------------------------
+// the exact library's torus (wrap_torus.cpp): the centre-circle point nearest the line anchors a
+// quadrant "+x" cylinder of the tube radius; over any scalar
+
+// OpenSim's residual along the line p + u n (the library's circleResidual) and its first and
+// (if asked) second u-derivatives
 template <class T>
-V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double alpha, double width, T* d_out,
-                  T* w_out) {
+void torusResidual(const V3<T>& p, const V3<T>& n, double r, const T& u, T& f, T& fu, T* fuu = nullptr) {
+  const T c2 = 2.0 * dot(p, n);
+  const T c3 = p[0] * n[0] + p[1] * n[1];
+  const T c4 = n[0] * n[0] + n[1] * n[1];
+  const T c5 = p[0] * p[0] + p[1] * p[1];
+  const T q = u * u * c4 + 2.0 * c3 * u + c5;
+  const T sq = dsqrt(q);
+  const T qu = 2.0 * c4 * u + 2.0 * c3;
+  f = c2 + 2.0 * u - 2.0 * r * qu / sq;
+  fu = 2.0 - 2.0 * r * (2.0 * c4 / sq - qu * qu / (2.0 * q * sq));
+  if (fuu) {
+    const T s3 = q * sq;
+    *fuu = -2.0 * r * (-3.0 * c4 * qu / s3 + 0.75 * qu * qu * qu / (s3 * q));
+  }
+}
+
+// the library's damped Newton search from u = 0 (same steps, so the same root)
+double torusSolveFromStart(const Vec3& p, const Vec3& n, double r) {
+  const V3<double> pv{p[0], p[1], p[2]}, nv{n[0], n[1], n[2]};
+  auto res = [&](double u) {
+    double f, fu;
+    torusResidual(pv, nv, r, u, f, fu);
+    return f;
+  };
+  double u = 0.0, f = res(u), bound = 0.2;
+  for (int it = 0; it < 500 && std::isfinite(f); ++it) {
+    const double h = 1e-7 * (1.0 + std::abs(u));
+    const double df = (res(u + h) - res(u - h)) / (2 * h);
+    double step = (df != 0.0 && std::isfinite(df)) ? -f / df : (f > 0 ? -bound : bound);
+    if (std::abs(step) > bound) step = step > 0 ? bound : -bound;
+    bool accepted = false;
+    for (int k = 0; k < 60; ++k) {
+      const double fn = res(u + step);
+      if (std::isfinite(fn) && std::abs(fn) < std::abs(f)) {
+        u += step;
+        f = fn;
+        accepted = true;
+        break;
+      }
+      step *= 0.5;
+    }
+    if (!accepted) break;
+    bound = std::max(bound, 2.0 * std::abs(step));
+    if (std::abs(step) < 1e-13 * (1.0 + std::abs(u)) || std::abs(f) < 1e-14) break;
+  }
+  return u;
+}
+
+// the local cylinder's frame k at the circle point c (x toward the torus centre, y = -z, z = x
+// cross y) and the end points in it; false when the library does not wrap (a quadrant excludes
+// both candidates, or a degenerate anchor)
+template <class T>
+struct TorusFrame {
+  V3<T> c, xk, yk, zk, q1, q2;
+  V3<T> toTorus(const V3<T>& q) const { return c + q[0] * xk + q[1] * yk + q[2] * zk; }
+};
+
+template <class T>
+bool torusFrame(const WrapSurface& s, const V3<T>& p1, const V3<T>& p2, TorusFrame<T>& f) {
+  const double radius = s.outer_radius;
+  const Vec3 a = values(p1), b = values(p2);
+  const Vec3 n12 = (b - a).normalized();
+  const double u1 = torusSolveFromStart(a, n12, radius), u2 = torusSolveFromStart(b, -n12, radius);
+  const Vec3 a1 = a + u1 * n12, a2 = b - u2 * n12;
+  auto dist = [&](const Vec3& x) {
+    return std::sqrt(x.squaredNorm() + radius * radius - 2.0 * radius * std::hypot(x[0], x[1]));
+  };
+  const double d1 = dist(a1), d2 = dist(a2);
+  bool first = d1 < d2;
+  if (s.quadrant_sign != 0) {
+    auto dsign = [](double v) { return v >= 0.0 ? 1 : -1; };
+    const bool ok1 = dsign(a1[s.quadrant_axis]) == s.quadrant_sign, ok2 = dsign(a2[s.quadrant_axis]) == s.quadrant_sign;
+    if (!ok1 && !ok2) return false;
+    if (ok1 != ok2) first = ok1;
+  }
+  // the chosen solution refined over T: from the converged value, each Newton step doubles the
+  // order of the correct Taylor terms, so two give exact first and second derivatives (implicit
+  // function theorem). The library's search minimises |residual|: it ends at a root, or (7% of
+  // the default box) at a stationary point of the residual with no root near, and that
+  // condition (residual' = 0) is the one differentiated then.
+  const V3<T> n = normalize(p2 - p1);
+  const V3<T> p = first ? p1 : p2;
+  const V3<T> dir = first ? n : (-1.0) * n;
+  T u(first ? u1 : u2);
+  {
+    const V3<double> pv = constant<double>(first ? a : b), nv = constant<double>(first ? n12 : Vec3(-n12));
+    double r0, ru0;
+    torusResidual(pv, nv, radius, first ? u1 : u2, r0, ru0);
+    const bool root = std::abs(r0) < 1e-8;
+    for (int k = 0; k < 2; ++k) {
+      T r, ru, ruu;
+      torusResidual(p, dir, radius, u, r, ru, &ruu);
+      u = root ? u - r / ru : u - ru / ruu;
+    }
+  }
+  const V3<T> x = p + u * dir;
+  const T m = dsqrt(x[0] * x[0] + x[1] * x[1]);
+  if (!(value(m) > 0.0) || !std::isfinite(value(m))) return false;
+  f.c = {x[0] * (radius / m), x[1] * (radius / m), T(0.0)};
+  f.xk = normalize((-1.0) * f.c);
+  f.yk = {T(0.0), T(0.0), T(-1.0)};
+  f.zk = cross(f.xk, f.yk);
+  auto toK = [&](const V3<T>& q) {
+    const V3<T> r = q - f.c;
+    return V3<T>{dot(f.xk, r), dot(f.yk, r), dot(f.zk, r)};
+  };
+  f.q1 = toK(p1);
+  f.q2 = toK(p2);
+  return true;
+}
+
+// the torus's local cylinder (the library's: radius inner_radius, length 1e4, quadrant +x)
+WrapSurface torusCylinder(const WrapSurface& s) { return WrapSurface::makeCylinder(s.inner_radius, 10000.0, 0, +1); }
+
+// the blended point over any scalar; length_out (if given) receives the blended segment length
+// L = L_straight + w (L_wrapped - L_straight), the exact wrapped length outside the band
+template <class T>
+V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, const Alpha<T>& alpha, double width, T* d_out,
+                  T* w_out, T* length_out = nullptr) {
   const V3<T> straight = p1 + alpha * (p2 - p1);
+  const T l_straight = norm(p2 - p1);
+  if (length_out) *length_out = l_straight;
+  if (surf.type == WrapType::Torus) {
+    // the smooth quadrant cylinder in the anchor's frame (lengths and blends are frame-free);
+    // where the library does not wrap at all (no anchor, an end inside the local cylinder) the
+    // straight path
+    TorusFrame<T> f;
+    const WrapSurface cyl = torusCylinder(surf);
+    const bool ok = torusFrame(surf, p1, p2, f);
+    const double ri = cyl.radius;
+    const Vec3 q1 = values(f.q1), q2 = values(f.q2);
+    if (!ok || std::hypot(q1[0], q1[1]) < ri || std::hypot(q2[0], q2[1]) < ri) {
+      if (d_out) *d_out = T(-1.0);
+      if (w_out) *w_out = T(0.0);
+      return straight;
+    }
+    return f.toTorus(smoothPoint(cyl, f.q1, f.q2, alpha, width, d_out, w_out, length_out));
+  }
   T d = penetration(surf, p1, p2);
+  T u_scale = T(1.0);
   if (surf.type == WrapType::Cylinder && surf.quadrant_sign != 0) {
-    // the library's quadrant logic: with an end on the active side it wraps exactly when the
-    // segment meets the cylinder (blended below); otherwise it may force a wrap round the
-    // active side, which has no contact change to smooth: the exact wrapped path (w = 1)
+    // the library's quadrant logic: with an end on the active side it wraps when the segment
+    // meets the cylinder, and also, with the ends on opposite sides of the quadrant plane, when
+    // the line's point nearest the axis lies on the inactive side (a wrap round the active side,
+    // continuous across d = 0 there); with neither end active it always wraps. Those wraps are
+    // the exact path (w = 1); only the contact-driven one is blended.
     const int axis = surf.quadrant_axis, sign = surf.quadrant_sign;
     auto dsign = [](double v) { return v >= 0.0 ? 1 : -1; };
-    const Vec3 a = values(p1), b = values(p2), u = b - a;
+    const Vec3 a = values(p1), b = values(p2);
     const bool s1 = dsign(a[axis]) == sign, s2 = dsign(b[axis]) == sign;
-    const double uu = u.head<2>().squaredNorm();
-    const Vec3 near12 = a + (uu > 0.0 ? -a.head<2>().dot(u.head<2>()) / uu : 0.0) * u;
-    const bool forced = (!s1 && !s2) || (value(d) <= 0.0 && dsign(a[axis]) != dsign(b[axis]) && dsign(near12[axis]) != sign);
-    if (forced) {
+    const V3<T> u = p2 - p1;
+    const T uu = u[0] * u[0] + u[1] * u[1];
+    const T tn = value(uu) > 0.0 ? -(p1[0] * u[0] + p1[1] * u[1]) / uu : T(0.0);
+    const T near_axis = p1[axis] + tn * u[axis];  // the library's near12[axis]
+    const bool opposite = dsign(a[axis]) != dsign(b[axis]);
+    const bool forced = (!s1 && !s2) || (opposite && dsign(value(near_axis)) != sign);
+    // distance of the nearest point from the quadrant plane, > 0 on the active side
+    const T foot = sign * near_axis;
+    const double kR = kQuadrantBlend * surf.radius;
+    if (forced || (value(d) > 0.0 && !(value(foot) > 0.0))) {
       if (d_out) *d_out = d;
       if (w_out) *w_out = T(1.0);
       V3<T> wrapped;
-      return cylinderPoint(surf, p1, p2, alpha, wrapped) ? wrapped : straight;
+      T l_wrapped = l_straight;
+      const bool ok = cylinderPoint(surf, p1, p2, alpha, wrapped, &l_wrapped);
+      if (ok && length_out) *length_out = l_wrapped;
+      return ok ? wrapped : straight;
     }
+    // as the nearest point nears the quadrant plane the band narrows to nothing (u = d kR /
+    // (width foot)), so the weight reaches 1 before the forced wrap takes over on the other side:
+    // continuous and smooth there, except at d = 0 on the plane itself, where the library
+    // switches between no wrap and a forced wrap
+    if (value(foot) > 0.0 && value(foot) < kR) u_scale = kR / foot;
   }
   if (d_out) *d_out = d;
   if (w_out) *w_out = T(0.0);
   // below u = 1e-6 the blend weight is < 1e-17 and the wrapped branch is not evaluated: its
   // derivatives grow like d^(-1/2) at the contact (the arc angle ~ sqrt(d)), and inf * 0 would
   // poison the dual parts
-  if (!(value(d) > 1e-6 * width)) return straight;
+  const T u = u_scale * (d / width);
+  if (!(value(u) > 1e-6)) return straight;
   V3<T> wrapped;
-  const bool ok = surf.type == WrapType::Cylinder ? cylinderPoint(surf, p1, p2, alpha, wrapped)
-                                                  : spherePoint(surf, p1, p2, alpha, wrapped);
+  T l_wrapped = l_straight;
+  const bool ok = surf.type == WrapType::Cylinder ? cylinderPoint(surf, p1, p2, alpha, wrapped, &l_wrapped)
+                                                  : spherePoint(surf, p1, p2, alpha, wrapped, &l_wrapped);
   if (!ok) return straight;  // the library's finite-length cut-off (not smoothed)
-  if (value(d) >= width) {
+  if (value(u) >= 1.0) {
     if (w_out) *w_out = T(1.0);
+    if (length_out) *length_out = l_wrapped;
     return wrapped;
   }
-  // quintic smoothstep: C2 at both ends of the band [D-independent; see the header]
-  const T u = d / width;
+  // quintic smoothstep: C2 at both ends of the band (see the header)
   const T w = u * u * u * (10.0 + u * (-15.0 + 6.0 * u));
   if (w_out) *w_out = w;
+  if (length_out) *length_out = l_straight + w * (l_wrapped - l_straight);
   return straight + w * (wrapped - straight);
 }
 
 void checkInputs(const WrapSurface& surf, const Vec3& p1, const Vec3& p2) {
   const std::string why = smoothWrapUnsupportedReason(surf);
   if (!why.empty()) throw std::invalid_argument("smooth wrap: " + why);
-  const double R = surf.radius;
-  const bool inside = surf.type == WrapType::Cylinder
-                          ? (p1.head<2>().norm() < R || p2.head<2>().norm() < R)
-                          : (p1.norm() < R || p2.norm() < R);
-  if (inside) throw std::invalid_argument("smooth wrap: an end point lies inside the surface");
   if (!p1.allFinite() || !p2.allFinite() || p1 == p2) throw std::invalid_argument("smooth wrap: degenerate end points");
+  auto inside = [&](const Vec3& p) {
+    switch (surf.type) {
+      case WrapType::Cylinder: return p.head<2>().norm() < surf.radius;
+      case WrapType::Sphere: return p.norm() < surf.radius;
+      case WrapType::Ellipsoid: return p.cwiseQuotient(surf.dimensions).squaredNorm() < 1.0;
+      case WrapType::Torus: {
+        const double rho = p.head<2>().norm() - surf.outer_radius;
+        return rho * rho + p[2] * p[2] < surf.inner_radius * surf.inner_radius;
+      }
+    }
+    return false;
+  };
+  if (inside(p1) || inside(p2)) throw std::invalid_argument("smooth wrap: an end point lies inside the surface");
 }
 
-double widthOf(const WrapSurface& surf, const SmoothWrapOptions& o) { return o.width > 0.0 ? o.width : 0.05 * surf.radius; }
+// the surface's size: the default band is 5% of it
+double sizeOf(const WrapSurface& surf) {
+  switch (surf.type) {
+    case WrapType::Cylinder:
+    case WrapType::Sphere: return surf.radius;
+    case WrapType::Ellipsoid: return surf.dimensions.minCoeff();
+    case WrapType::Torus: return surf.inner_radius;
+  }
+  return surf.radius;
+}
+
+double widthOf(const WrapSurface& surf, const SmoothWrapOptions& o) { return o.width > 0.0 ? o.width : 0.05 * sizeOf(surf); }
 
 }  // namespace
 
@@ -357,13 +547,21 @@ std::string smoothWrapUnsupportedReason(const WrapSurface& s) {
   if (!s.active) return "the surface is inactive";
   if (s.type == WrapType::Ellipsoid)
     return "ellipsoids are not supported (OpenSim's ellipsoid path is a polyline whose segment count changes, not C1)";
-  if (s.type == WrapType::Torus) return "tori are not supported (OpenSim's torus wrap is an iterative search)";
+  if (s.type == WrapType::Torus) {
+    if (!(s.inner_radius > 0.0) || !(s.outer_radius > 0.0)) return "the torus radii must be positive";
+    return "";
+  }
   if (s.type == WrapType::Sphere && s.quadrant_sign != 0) return "quadrant-constrained spheres are not supported";
   if (!(s.radius > 0.0)) return "the radius must be positive";
   return "";
 }
 
 double calcWrapPenetration(const WrapSurface& surface, const Vec3& p1, const Vec3& p2) {
+  if (surface.type == WrapType::Torus) {
+    TorusFrame<double> f;
+    if (!torusFrame(surface, constant<double>(p1), constant<double>(p2), f)) return -1.0;
+    return penetration(torusCylinder(surface), f.q1, f.q2);
+  }
   return penetration(surface, constant<double>(p1), constant<double>(p2));
 }
 
@@ -402,6 +600,54 @@ SmoothWrapPoint calcSmoothWrapPointDerivatives(const WrapSurface& surface, const
       out.penetration = d.a.a;
       out.weight = w.a.a;
     }
+  }
+  return out;
+}
+
+SmoothWrapSegmentPoint calcSmoothWrapSegmentPoint(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                                                  double alpha, const Vec3& p1dot, const Vec3& p2dot,
+                                                  double alphadot, const SmoothWrapOptions& options) {
+  checkInputs(surface, p1, p2);
+  alpha = std::clamp(alpha, 0.0, 1.0);
+  using D2 = Dual<Dual<double>>;
+  const double width = widthOf(surface, options);
+  SmoothWrapSegmentPoint out;
+  // as calcSmoothWrapPointDerivatives, with a seventh pass for alpha
+  for (int i = 0; i < 7; ++i) {
+    V3<D2> q1, q2;
+    for (int k = 0; k < 3; ++k) {
+      q1[k] = D2{Dual<double>{p1[k], p1dot[k]}, Dual<double>{i == k ? 1.0 : 0.0, 0.0}};
+      q2[k] = D2{Dual<double>{p2[k], p2dot[k]}, Dual<double>{i == k + 3 ? 1.0 : 0.0, 0.0}};
+    }
+    const D2 a{Dual<double>{alpha, alphadot}, Dual<double>{i == 6 ? 1.0 : 0.0, 0.0}};
+    const V3<D2> x = smoothPoint<D2>(surface, q1, q2, a, width, nullptr, nullptr);
+    for (int k = 0; k < 3; ++k) {
+      out.J(k, i) = x[k].b.a;
+      out.Jdot(k, i) = x[k].b.b;
+    }
+    if (i == 0)
+      for (int k = 0; k < 3; ++k) out.x[k] = x[k].a.a;
+  }
+  return out;
+}
+
+SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
+                                      const Vec3& p2dot, const SmoothWrapOptions& options) {
+  checkInputs(surface, p1, p2);
+  using D2 = Dual<Dual<double>>;
+  const double width = widthOf(surface, options);
+  SmoothWrapLength out;
+  for (int i = 0; i < 6; ++i) {
+    V3<D2> q1, q2;
+    for (int k = 0; k < 3; ++k) {
+      q1[k] = D2{Dual<double>{p1[k], p1dot[k]}, Dual<double>{i == k ? 1.0 : 0.0, 0.0}};
+      q2[k] = D2{Dual<double>{p2[k], p2dot[k]}, Dual<double>{i == k + 3 ? 1.0 : 0.0, 0.0}};
+    }
+    D2 L;
+    smoothPoint<D2>(surface, q1, q2, D2(0.0), width, nullptr, nullptr, &L);
+    out.J(0, i) = L.b.a;
+    out.Jdot(0, i) = L.b.b;
+    if (i == 0) out.length = L.a.a;
   }
   return out;
 }

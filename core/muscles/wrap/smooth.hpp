@@ -5,7 +5,8 @@
 // no training.
 //
 // Penetration. d = size - dist(straight line p1 p2, surface core): R - distance to the axis for
-// the cylinder, R - distance to the centre for the sphere. The exact library wraps exactly when
+// the cylinder, R - distance to the centre for the sphere, the tube radius - distance to the axis
+// of the torus's local cylinder (below). The exact library wraps exactly when
 // d > 0 (with both end points outside, the closest approach then lies strictly inside the
 // segment, so no other test can switch inside the blend).
 // Blend. u = clamp(d / width, 0, 1), w = 6u^5 - 15u^4 + 10u^3 (quintic smoothstep: w, w', w'' are
@@ -18,15 +19,32 @@
 // Jdot = dJ/dt along (p1dot, p2dot) are exact to round-off (forward-over-forward differentiation,
 // 6 passes: one per input direction, each also carrying the velocity direction).
 //
-// Supported: Cylinder (also with a quadrant) and Sphere without a quadrant, single wrap (OpenSim's
-// algorithms as the exact library reproduces them). A quadrant cylinder is blended as above when an
-// end point lies on the active side and the library wraps only on contact; when it forces a wrap
-// round the active side (neither end active, or ends on opposite sides with the line passing on
-// the inactive side) the model is the exact wrapped path: those switches (an end point crossing
-// the quadrant plane) are not smoothed. Not supported (smoothWrapUnsupportedReason() says why):
-// spheres with a quadrant, ellipsoids (OpenSim's result is a polyline of floor(chord / 1 mm)
-// segments whose count changes, so even the exact path is not C1) and tori (an iterative
-// closest-point search). Also not smoothed: a mass point crossing a tangent point (the path's
+// Supported: Cylinder (also with a quadrant), Sphere without a quadrant and Torus, single wrap
+// (OpenSim's algorithms as the exact library reproduces them).
+// Quadrant cylinders. The library wraps on contact (d > 0) when an end lies on the active side;
+// it also forces a wrap round the active side when neither end is active, or when the ends lie on
+// opposite sides of the quadrant plane and the line's point nearest the axis ("foot") lies on
+// the inactive side, whatever the sign of d. Forced wraps are the exact path (w = 1), so the model
+// is continuous where the library is, e.g. across d = 0 with the foot on the inactive side. The
+// contact-driven wrap is blended with a band that narrows as the foot nears the quadrant plane,
+// u = d / width * max(1, k R / foot) (k = 0.25, foot > 0 on the active side), so the weight
+// reaches 1 before the forced side begins. Not smoothed (the library itself jumps there): an end
+// point crossing the quadrant plane with neither end then active, the foot crossing the plane
+// with d < 0, and the library's candidate-table flips near the plane.
+// Tori. The library anchors a quadrant "+x" cylinder of the tube radius (length 1e4) at the point
+// of the centre circle nearest the line, found by a 1-D search from each end (the better one);
+// the model runs the same search on values, then refines the chosen solution over the dual
+// numbers by two Newton steps (implicit function theorem: exact first and second derivatives of
+// the solution); the search ends at a root of OpenSim's residual or, where the residual has no
+// root near (7% of the default box), at a stationary point of it, and that condition is the one
+// differentiated. The rest is the smooth quadrant cylinder in the anchor's frame. Equal to the
+// library outside the band to 1e-12 at roots and to 1.2e-7 of the tube size at stationary points
+// (the library's search locates those only to ~1e-9 in u; the residual is flat there). Not
+// smoothed: the switch between the two ends' solutions, and an end entering the local cylinder
+// (the library then gives no wrap).
+// Not supported (smoothWrapUnsupportedReason() says why): spheres with a quadrant and ellipsoids
+// (OpenSim's result is a polyline of floor(chord / 1 mm) segments whose count changes, so even the
+// exact path is not C1). Also not smoothed: a mass point crossing a tangent point (the path's
 // curvature changes there; OpenSim's cylinder construction is not exactly tangent, so J has a
 // small jump there too), and the cylinder's finite length (both tangent points beyond the ends:
 // the exact library stops wrapping).
@@ -39,7 +57,8 @@
 namespace redmax {
 
 struct SmoothWrapOptions {
-  /// transition width of the penetration d (m); <= 0: 0.05 times the radius
+  /// transition width of the penetration d (m); <= 0: 0.05 times the surface size (cylinder and
+  /// sphere radius, torus tube radius)
   double width = 0.0;
 };
 
@@ -67,6 +86,30 @@ Vec3 calcSmoothWrapPoint(const WrapSurface& surface, const Vec3& p1, const Vec3&
 SmoothWrapPoint calcSmoothWrapPointDerivatives(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
                                                double alpha, const Vec3& p1dot, const Vec3& p2dot,
                                                const SmoothWrapOptions& options = {});
+
+/// A smooth-model point with its arc fraction as a seventh input (frame s), for mass points whose
+/// fraction within a wrapped segment of a longer path moves (core/muscles/wrap_muscle.hpp).
+struct SmoothWrapSegmentPoint {
+  Vec3 x = Vec3::Zero();                                                   ///< position (m)
+  Eigen::Matrix<double, 3, 7> J = Eigen::Matrix<double, 3, 7>::Zero();     ///< dx / d(p1, p2, alpha)
+  Eigen::Matrix<double, 3, 7> Jdot = Eigen::Matrix<double, 3, 7>::Zero();  ///< dJ/dt along (p1dot, p2dot, alphadot)
+};
+
+/// calcSmoothWrapPointDerivatives with alpha (in [0, 1]) differentiated too, moving at alphadot.
+SmoothWrapSegmentPoint calcSmoothWrapSegmentPoint(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                                                  double alpha, const Vec3& p1dot, const Vec3& p2dot,
+                                                  double alphadot, const SmoothWrapOptions& options = {});
+
+/// The smooth model's length of the segment p1 -> p2 (frame s): L = L_straight + w (L_wrapped -
+/// L_straight) with the blend weight w of the points, so the exact library's |p1 r1| + arc + |r2 p2|
+/// outside the band and C2 across it (m); J = dL/d(p1, p2), Jdot = dJ/dt along (p1dot, p2dot).
+struct SmoothWrapLength {
+  double length = 0.0;
+  Eigen::Matrix<double, 1, 6> J = Eigen::Matrix<double, 1, 6>::Zero();
+  Eigen::Matrix<double, 1, 6> Jdot = Eigen::Matrix<double, 1, 6>::Zero();
+};
+SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
+                                      const Vec3& p2dot, const SmoothWrapOptions& options = {});
 
 /// A muscle's mass points over one surface (frame s), with J = dx/d(p1, p2) and Jdot along
 /// (p1dot, p2dot) for each; which model produced them.
