@@ -136,6 +136,17 @@ T penetration(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2) {
     if (value(t) > 0.0 && value(t) < 1.0) return d;
     return value(d) > 0.0 ? -d : d;
   }
+  if (surf.type == WrapType::Ellipsoid) {
+    // in coordinates divided by the semi-axes the ellipsoid is the unit sphere: 1 - distance of
+    // the line from the centre there, in units of the smallest semi-axis
+    const Vec3& s = surf.dimensions;
+    const V3<T> q1{p1[0] / s[0], p1[1] / s[1], p1[2] / s[2]};
+    const V3<T> uq{u[0] / s[0], u[1] / s[1], u[2] / s[2]};
+    const T t = -dot(q1, uq) / dot(uq, uq);
+    const T d = s.minCoeff() * (1.0 - norm(q1 + t * uq));
+    if (value(t) > 0.0 && value(t) < 1.0) return d;
+    return value(d) > 0.0 ? -d : d;
+  }
   // sphere: distance from the centre to the line
   const T t = -dot(p1, u) / dot(u, u);
   const V3<T> c = p1 + t * u;
@@ -305,6 +316,281 @@ bool spherePoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, cons
 }
 
 // ---------------------------------------------------------------------------------------------
+// the exact library's ellipsoid (wrap_ellipsoid.cpp), hybrid method, no quadrant, over any scalar.
+// The library's iterative pieces become exact-derivative ones: closest points on the ellipsoid
+// are found by the library's Newton iteration on values and refined over T by two Newton steps
+// (implicit function theorem); the tangent points, which the library approximates by damped
+// Gauss-Newton to a residual of 1e-4, are the closed-form intersection of the wrapping plane, the
+// polar plane of the end point and the ellipsoid; the polyline of floor(chord / 1 mm) segments is
+// replaced by its limit, the plane curve itself, with the arc length by Gauss-Legendre quadrature
+// and the point at a given arc length by Newton steps (again two over T).
+
+constexpr double kMuBlendMin = 0.7073;  // the library's constants (wrap_ellipsoid.cpp)
+constexpr double kMuBlendMax = 0.9;
+constexpr int kFanSamples = 300;
+constexpr double kSvBoundaryBlend = 0.3;
+constexpr int kArcPanels = 8;            // Gauss-Legendre panels over the arc (8 nodes each)
+
+template <class T> V3<T> cdiv(const V3<T>& v, const Vec3& a) { return {v[0] / a[0], v[1] / a[1], v[2] / a[2]}; }
+template <class T> T absT(const T& x) { return value(x) < 0.0 ? -x : x; }
+
+// the library's Newton iteration for the Lagrange parameter t of the closest point on the
+// ellipsoid (dims a, 3-D) or on the ellipse in the coordinates `axes` (2-D), on values; false
+// when it does not converge in 64 steps (the library then leaves its output untouched)
+bool closestParameter(const Vec3& a, const Vec3& q, const std::array<int, 3>& axes, int n, double& t) {
+  double inside = 0.0, amax = 0.0, qq = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const int i = axes[k];
+    inside += (q[i] / a[i]) * (q[i] / a[i]);
+    amax = std::max(amax, a[i]);
+    qq += q[i] * q[i];
+  }
+  t = inside < 1.0 ? 0.0 : amax * std::sqrt(qq);
+  for (int it = 0; it < 64; ++it) {
+    // f = prod P_i^2 - sum_i a_i^2 q_i^2 prod_{j != i} P_j^2, P_i = t + a_i^2
+    double P[3], prod = 1.0;
+    for (int k = 0; k < n; ++k) {
+      P[k] = t + a[axes[k]] * a[axes[k]];
+      prod *= P[k] * P[k];
+    }
+    double f = prod, fp = 0.0;
+    for (int k = 0; k < n; ++k) {
+      double others = 1.0, others_d = 0.0;
+      for (int j = 0; j < n; ++j) {
+        if (j == k) continue;
+        others_d = others_d * P[j] * P[j] + others * 2.0 * P[j];
+        others *= P[j] * P[j];
+      }
+      const double c = a[axes[k]] * a[axes[k]] * q[axes[k]] * q[axes[k]];
+      f -= c * others;
+      fp -= c * others_d;
+    }
+    double prod_d = 0.0;
+    {
+      double acc = 1.0;
+      for (int k = 0; k < n; ++k) {
+        prod_d = prod_d * P[k] * P[k] + acc * 2.0 * P[k];
+        acc *= P[k] * P[k];
+      }
+    }
+    fp += prod_d;
+    if (std::abs(f) < 1e-9) return true;
+    t -= f / fp;
+  }
+  return false;
+}
+
+// closest point to q on the ellipsoid (n = 3) or, in the coordinates axes[0..1], on its
+// cross-section ellipse (n = 2; the third coordinate is kept), refined over T from the library's
+// parameter: g(t) = sum (a_i q_i / (t + a_i^2))^2 - 1 = 0
+template <class T>
+bool closestOnEllipsoid(const Vec3& a, const V3<T>& q, const std::array<int, 3>& axes, int n, V3<T>& x) {
+  double t0;
+  // the library's 2-D iteration uses its last iterate when it does not converge; the 3-D one
+  // leaves its output untouched
+  if (!closestParameter(a, values(q), axes, n, t0) && n == 3) return false;
+  // g and g' at t over any scalar
+  auto newtonStep = [&](const auto& qq, const auto& t) {
+    using S = std::decay_t<decltype(t)>;
+    S g(-1.0), gp(0.0);
+    for (int k = 0; k < n; ++k) {
+      const int i = axes[k];
+      const S e = (a[i] * qq[i]) / (t + a[i] * a[i]);
+      g = g + e * e;
+      gp = gp - 2.0 * e * e / (t + a[i] * a[i]);
+    }
+    return g / gp;
+  };
+  // the library stops at |f| < 1e-9: polish on values first (the steps over T below need a
+  // converged start to give exact second derivatives)
+  const V3<double> qv = constant<double>(values(q));
+  for (int it = 0; it < 20; ++it) {
+    const double step = newtonStep(qv, t0);
+    t0 -= step;
+    if (!(std::abs(step) > 1e-15 * (1.0 + std::abs(t0)))) break;
+  }
+  T t(t0);
+  for (int step = 0; step < 2; ++step) t = t - newtonStep(q, t);
+  x = q;
+  for (int k = 0; k < n; ++k) {
+    const int i = axes[k];
+    x[i] = (a[i] * a[i]) * q[i] / (t + a[i] * a[i]);
+  }
+  return true;
+}
+
+// the tangent point from p on the ellipse cut by the plane vs.x + vs4 = 0: the plane, the polar
+// plane of p (sum x_i p_i / a_i^2 = 1, where the tangent plane at x passes through p) and the
+// ellipsoid; of the two, the one nearer c1 (where the library's search starts)
+template <class T>
+V3<T> tangentPoint(const Vec3& a, const V3<T>& p, const V3<T>& vs, const T& vs4, const Vec3& c1) {
+  const Vec3 a2 = a.cwiseProduct(a);
+  const V3<T> w = cdiv(p, a2);
+  const T g = dot(vs, w), ww = dot(w, w), vv = dot(vs, vs);
+  const T det = vv * ww - g * g;
+  const T al = (-vs4 * ww - g) / det, be = (vv + g * vs4) / det;
+  const V3<T> r0 = al * vs + be * w;
+  const V3<T> e = cross(vs, w);
+  const V3<T> r0a = cdiv(r0, a), ea = cdiv(e, a);
+  const T A = dot(ea, ea), B = 2.0 * dot(r0a, ea), C = dot(r0a, r0a) - 1.0;
+  const T sq = dsqrt(B * B - 4.0 * A * C);
+  const V3<T> xa = r0 + ((-B + sq) / (2.0 * A)) * e, xb = r0 + ((-B - sq) / (2.0 * A)) * e;
+  return (values(xa) - c1).squaredNorm() <= (values(xb) - c1).squaredNorm() ? xa : xb;
+}
+
+// the library's surface curve: rays from a0 in the plane, swept by angle phi from r1 toward r2,
+// each cut with the ellipsoid; point and speed |dP/dphi|
+template <class T>
+struct EllipsoidArc {
+  Vec3 a;
+  V3<T> a0, ar1, vsy, f2;
+  T phi0;
+  void eval(const T& phi, V3<T>* point, T* speed) const {
+    const T c = dcos(phi), s = dsin(phi);
+    const V3<T> rr = c * ar1 + s * vsy;
+    const V3<T> f1 = cdiv(rr, a);
+    const T A = dot(f1, f1), B = 2.0 * dot(f1, f2), C = dot(f2, f2) - 1.0;
+    const T mu = (-B + dsqrt(B * B - 4.0 * A * C)) / (2.0 * A);
+    if (point) *point = a0 + mu * rr;
+    if (speed) {
+      const V3<T> drr = c * vsy - s * ar1;
+      const V3<T> df1 = cdiv(drr, a);
+      const T dA = 2.0 * dot(f1, df1), dB = 2.0 * dot(df1, f2);
+      const T dmu = -(dA * mu * mu + dB * mu) / (2.0 * A * mu + B);
+      *speed = norm(dmu * rr + mu * drr);
+    }
+  }
+  // arc length from 0 to phi: composite 8-point Gauss-Legendre
+  T length(const T& phi) const {
+    static const double x[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
+                                0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
+    static const double wq[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
+                                 0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+    const T h = phi / double(kArcPanels);
+    T sum(0.0);
+    for (int k = 0; k < kArcPanels; ++k)
+      for (int j = 0; j < 8; ++j) {
+        T sp;
+        eval(h * (k + 0.5 + 0.5 * x[j]), nullptr, &sp);
+        sum = sum + wq[j] * sp;
+      }
+    return 0.5 * h * sum;
+  }
+};
+
+template <class T>
+bool ellipsoidPoint(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, const Alpha<T>& alpha, V3<T>& x,
+                    T* total_out = nullptr) {
+  // the library's scaled coordinates
+  const double factor = 3.0 / surf.dimensions.sum();
+  const Vec3 a = surf.dimensions * factor;
+  const V3<T> p1 = factor * P1, p2 = factor * P2;
+  const V3<T> p1p2 = p1 - p2;
+  // where the chord meets the ellipsoid
+  const V3<T> f1 = cdiv(p1p2, a), f2 = cdiv(p2, a);
+  const T aa = dot(f1, f1), bb = 2.0 * dot(f1, f2), cc = dot(f2, f2) - 1.0;
+  const T disc = bb * bb - 4.0 * aa * cc;
+  if (!(value(disc) > 0.0)) return false;
+  const T l1 = (-bb + dsqrt(disc)) / (2.0 * aa), l2 = (-bb - dsqrt(disc)) / (2.0 * aa);
+  const V3<T> r1c = p2 + l1 * p1p2, r2c = p2 + l2 * p1p2;
+  const V3<T> r1r2 = r2c - r1c;
+  // the plane point c1: hybrid of the axial (Frans) cross-section and the fan
+  V3<T> mu = normalize(p1p2);
+  for (int i = 0; i < 3; ++i) mu[i] = absT(mu[i]);
+  int best = 0;
+  for (int i = 1; i < 3; ++i)
+    if (value(mu[i]) > value(mu[best])) best = i;
+  T mub = mu[best];
+  const T tb = (0.0 - r1c[best]) / r1r2[best];
+  V3<T> c1{T(0.0), T(0.0), T(0.0)};
+  if (value(mub) > kMuBlendMin) {
+    // fade the axial solution out as its chord point nears the chord's ends
+    T sfade(1.0);
+    if (value(tb) < 0.0 || value(tb) > 1.0) sfade = T(0.0);
+    else if (value(tb) < kSvBoundaryBlend) sfade = tb / kSvBoundaryBlend;
+    else if (value(tb) > 1.0 - kSvBoundaryBlend) sfade = (1.0 - tb) / kSvBoundaryBlend;
+    if (value(sfade) < 1.0) mub = kMuBlendMin + sfade * (mub - kMuBlendMin);
+  }
+  if (value(mub) > kMuBlendMin) {
+    const std::array<int, 3> axes{(best + 1) % 3, (best + 2) % 3, best};
+    closestOnEllipsoid(a, r1c + tb * r1r2, axes, 2, c1);
+  }
+  if (value(mub) < kMuBlendMax) {
+    const std::array<int, 3> all{0, 1, 2};
+    V3<T> v_sum{T(0.0), T(0.0), T(0.0)}, cp = c1;
+    for (int i = 1; i < kFanSamples - 1; ++i) {
+      const V3<T> svi = r1c + (static_cast<double>(i) / kFanSamples) * r1r2;
+      closestOnEllipsoid(a, svi, all, 3, cp);  // unchanged when it fails, as in the library
+      v_sum = v_sum + normalize(cp - svi);
+    }
+    const V3<T> tc = (r1c + 0.5 * r1r2) + normalize(v_sum);
+    if (value(mub) <= kMuBlendMin) {
+      closestOnEllipsoid(a, tc, all, 3, c1);
+    } else {
+      const T tt = (mub - kMuBlendMin) / (kMuBlendMax - kMuBlendMin);
+      V3<T> t1 = tc;
+      closestOnEllipsoid(a, tc, all, 3, t1);
+      const V3<T> t2 = tt * c1 + (1.0 - tt) * t1;
+      closestOnEllipsoid(a, t2, all, 3, c1);
+    }
+  }
+  // the wrapping plane through p1, p2 and c1, and the tangent points in it
+  const V3<T> vs = normalize(cross(p1p2, p1 - c1));
+  const T vs4 = -dot(vs, c1);
+  const Vec3 c1v = values(c1);
+  const V3<T> r1 = tangentPoint(a, p1, vs, vs4, c1v), r2 = tangentPoint(a, p2, vs, vs4, c1v);
+  // the surface curve from r1 to r2 (rays from a0 where the plane meets the axis most normal to it)
+  int imax = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(value(vs[i])) > std::abs(value(vs[imax]))) imax = i;
+  EllipsoidArc<T> arc;
+  arc.a = a;
+  arc.a0 = {T(0.0), T(0.0), T(0.0)};
+  arc.a0[imax] = -vs4 / vs[imax];
+  arc.ar1 = normalize(r1 - arc.a0);
+  const V3<T> ar2 = normalize(r2 - arc.a0);
+  arc.phi0 = dacos(dot(arc.ar1, ar2));
+  arc.vsy = cross(normalize(cross(arc.ar1, ar2)), arc.ar1);
+  arc.f2 = cdiv(arc.a0, a);
+  const T la = arc.length(arc.phi0);
+  // the point at fraction alpha of p1 -> r1 -> arc -> r2 -> p2 (scaled back)
+  const T d1 = norm(r1 - p1), d2 = norm(p2 - r2);
+  const T total = d1 + la + d2;
+  if (total_out) *total_out = total / factor;
+  T s = alpha * total;
+  V3<T> xs;
+  if (value(s) <= value(d1)) {
+    xs = p1 + (s / d1) * (r1 - p1);
+  } else if (value(s - d1) <= value(la)) {
+    // the angle whose arc length is s - d1: Newton on values, then two steps over T
+    const T target = s - d1;
+    const double tv = value(target), lav = value(la), phi0v = value(arc.phi0);
+    const EllipsoidArc<double> av{a, constant<double>(values(arc.a0)), constant<double>(values(arc.ar1)),
+                                  constant<double>(values(arc.vsy)), constant<double>(values(arc.f2)), phi0v};
+    double phi = lav > 0.0 ? phi0v * tv / lav : 0.0;
+    for (int it = 0; it < 30; ++it) {
+      double sp;
+      av.eval(phi, nullptr, &sp);
+      const double step = (av.length(phi) - tv) / sp;
+      phi -= step;
+      if (std::abs(step) < 1e-15 * (1.0 + std::abs(phi))) break;
+    }
+    T phit(phi);
+    for (int k = 0; k < 2; ++k) {
+      T sp;
+      arc.eval(phit, nullptr, &sp);
+      phit = phit - (arc.length(phit) - target) / sp;
+    }
+    arc.eval(phit, &xs, nullptr);
+  } else {
+    const T f = (s - d1 - la) / d2;
+    xs = value(f) < 1.0 ? r2 + f * (p2 - r2) : p2;
+  }
+  x = (1.0 / factor) * xs;
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
 // the exact library's torus (wrap_torus.cpp): the centre-circle point nearest the line anchors a
 // quadrant "+x" cylinder of the tube radius; over any scalar
 
@@ -400,6 +686,18 @@ bool torusFrame(const WrapSurface& s, const V3<T>& p1, const V3<T>& p2, TorusFra
     double r0, ru0;
     torusResidual(pv, nv, radius, first ? u1 : u2, r0, ru0);
     const bool root = std::abs(r0) < 1e-8;
+    // polish on values first (the library stops at 1e-13 steps or when |residual| stops falling;
+    // the steps over T need a converged start for exact second derivatives)
+    double uv = first ? u1 : u2;
+    for (int k = 0; k < 20; ++k) {
+      double r, ru, ruu;
+      torusResidual(pv, nv, radius, uv, r, ru, &ruu);
+      const double step = root ? r / ru : ru / ruu;
+      if (!std::isfinite(step)) break;
+      uv -= step;
+      if (!(std::abs(step) > 1e-15 * (1.0 + std::abs(uv)))) break;
+    }
+    u = T(uv);
     for (int k = 0; k < 2; ++k) {
       T r, ru, ruu;
       torusResidual(p, dir, radius, u, r, ru, &ruu);
@@ -494,8 +792,9 @@ V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, con
   if (!(value(u) > 1e-6)) return straight;
   V3<T> wrapped;
   T l_wrapped = l_straight;
-  const bool ok = surf.type == WrapType::Cylinder ? cylinderPoint(surf, p1, p2, alpha, wrapped, &l_wrapped)
-                                                  : spherePoint(surf, p1, p2, alpha, wrapped, &l_wrapped);
+  const bool ok = surf.type == WrapType::Cylinder    ? cylinderPoint(surf, p1, p2, alpha, wrapped, &l_wrapped)
+                  : surf.type == WrapType::Ellipsoid ? ellipsoidPoint(surf, p1, p2, alpha, wrapped, &l_wrapped)
+                                                     : spherePoint(surf, p1, p2, alpha, wrapped, &l_wrapped);
   if (!ok) return straight;  // the library's finite-length cut-off (not smoothed)
   if (value(u) >= 1.0) {
     if (w_out) *w_out = T(1.0);
@@ -545,8 +844,11 @@ double widthOf(const WrapSurface& surf, const SmoothWrapOptions& o) { return o.w
 
 std::string smoothWrapUnsupportedReason(const WrapSurface& s) {
   if (!s.active) return "the surface is inactive";
-  if (s.type == WrapType::Ellipsoid)
-    return "ellipsoids are not supported (OpenSim's ellipsoid path is a polyline whose segment count changes, not C1)";
+  if (s.type == WrapType::Ellipsoid) {
+    if (!(s.dimensions.minCoeff() > 0.0)) return "the ellipsoid's semi-axes must be positive";
+    if (s.quadrant_sign != 0) return "quadrant-constrained ellipsoids are not supported";
+    return "";
+  }
   if (s.type == WrapType::Torus) {
     if (!(s.inner_radius > 0.0) || !(s.outer_radius > 0.0)) return "the torus radii must be positive";
     return "";

@@ -19,8 +19,8 @@
 // Jdot = dJ/dt along (p1dot, p2dot) are exact to round-off (forward-over-forward differentiation,
 // 6 passes: one per input direction, each also carrying the velocity direction).
 //
-// Supported: Cylinder (also with a quadrant), Sphere without a quadrant and Torus, single wrap
-// (OpenSim's algorithms as the exact library reproduces them).
+// Supported: Cylinder (also with a quadrant), Sphere and Ellipsoid without a quadrant, and Torus,
+// single wrap (OpenSim's algorithms as the exact library reproduces them).
 // Quadrant cylinders. The library wraps on contact (d > 0) when an end lies on the active side;
 // it also forces a wrap round the active side when neither end is active, or when the ends lie on
 // opposite sides of the quadrant plane and the line's point nearest the axis ("foot") lies on
@@ -42,12 +42,31 @@
 // (the library's search locates those only to ~1e-9 in u; the residual is flat there). Not
 // smoothed: the switch between the two ends' solutions, and an end entering the local cylinder
 // (the library then gives no wrap).
-// Not supported (smoothWrapUnsupportedReason() says why): spheres with a quadrant and ellipsoids
-// (OpenSim's result is a polyline of floor(chord / 1 mm) segments whose count changes, so even the
-// exact path is not C1). Also not smoothed: a mass point crossing a tangent point (the path's
-// curvature changes there; OpenSim's cylinder construction is not exactly tangent, so J has a
-// small jump there too), and the cylinder's finite length (both tangent points beyond the ends:
-// the exact library stops wrapping).
+// Ellipsoids (hybrid method, the library's default; no quadrant). In the library's scaled
+// coordinates: the chord's crossing points, the plane point c1 (axial cross-section closest point,
+// fan of 298 closest points, their linear blends and fades by the chord direction), the plane
+// through p1, p2 and c1, the tangent points in it, the surface curve between them. Each closest
+// point is the library's Newton iteration on values, polished, then refined over the dual numbers
+// by two Newton steps (implicit function theorem). The tangent points, which the library finds by
+// damped Gauss-Newton to a residual of 1e-4, are here the closed-form intersection of the plane,
+// the end point's polar plane and the ellipsoid (the root nearer c1). The library's polyline of
+// floor(chord / 1 mm) segments (at most 499) is replaced by its limit, the plane curve itself
+// (rays from the library's point a0), with its arc length by 8 x 8-point Gauss-Legendre and the
+// point at a given arc length by Newton steps (polished on values, two over T). Positions equal
+// the library's outside the band to the library's own accuracy: on the default box, |smooth -
+// exact| / smallest semi-axis has median 5.7e-6, 99th percentile 9.6e-5, max 3.3e-3; path lengths
+// median 1.6e-7, 99th percentile 6.8e-6. J and Jdot are exact derivatives of this model. Not
+// smoothed (the library's own kinks and jumps, J jumps there): the hybrid method's linear blend
+// in the chord direction (mu in [0.7073, 0.9]) and its fade near the chord's ends, a fan sample
+// switching between roots of the closest-point equation (interior points), and the library's
+// "same direction seen from the centre" cut-off.
+// Penetration of an ellipsoid: 1 - the line's distance from the centre in coordinates divided by
+// the semi-axes, times the smallest semi-axis (> 0 exactly when the library wraps).
+// Not supported (smoothWrapUnsupportedReason() says why): spheres and ellipsoids with a quadrant.
+// Also not smoothed: a mass point crossing a tangent point (the path's curvature changes there;
+// OpenSim's cylinder construction is not exactly tangent, so J has a small jump there too), and
+// the cylinder's finite length (both tangent points beyond the ends: the exact library stops
+// wrapping).
 #include <string>
 #include <vector>
 
@@ -58,7 +77,7 @@ namespace redmax {
 
 struct SmoothWrapOptions {
   /// transition width of the penetration d (m); <= 0: 0.05 times the surface size (cylinder and
-  /// sphere radius, torus tube radius)
+  /// sphere radius, torus tube radius, smallest ellipsoid semi-axis)
   double width = 0.0;
 };
 

@@ -1,0 +1,168 @@
+// The smooth model on ellipsoids: the exact library's hybrid construction with its iterative
+// pieces made differentiable (closest points refined by Newton steps over dual numbers, tangent
+// points in closed form, the polyline replaced by its limit curve); equal to the library outside
+// the band to the library's own accuracy, J and Jdot against central differences, C1/C2 across
+// the band.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "core/muscles/wrap/smooth.hpp"
+
+namespace redmax {
+namespace {
+
+bool nearRel(const MatX& a, const MatX& b, double tol) { return (a - b).norm() <= tol * (1.0 + b.norm()); }
+
+bool insideEllipsoid(const WrapSurface& s, const Vec3& p, double margin) {
+  return p.cwiseQuotient(s.dimensions).norm() < 1.0 + margin;
+}
+
+TEST(WrapSmoothEllipsoid, EqualsExactLibraryAwayFromTheTransition) {
+  // the default training box: semi-axes in [0.5, 1.5], end points in [-3, 3]^3
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-3.0, 3.0), ua(0.0, 1.0), ud(0.5, 1.5);
+  std::vector<double> errs;
+  int straight = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const WrapSurface s = WrapSurface::makeEllipsoid(Vec3(ud(rng), ud(rng), ud(rng)));
+    const Vec3 p1(u(rng), u(rng), u(rng)), p2(u(rng), u(rng), u(rng));
+    const double alpha = ua(rng);
+    if (insideEllipsoid(s, p1, 0.0) || insideEllipsoid(s, p2, 0.0)) continue;
+    const WrapResult r = calcWrap(s, p1, p2);
+    const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(s, p1, p2, alpha, Vec3::Zero(), Vec3::Zero());
+    if (sp.weight != 0.0 && sp.weight != 1.0) continue;  // inside the band
+    ASSERT_EQ(sp.weight == 1.0, r.wraps()) << "d " << sp.penetration;
+    const Vec3 exact = calcWrappedPathPoint(s, r, p1, p2, alpha);
+    EXPECT_LE((calcSmoothWrapPoint(s, p1, p2, alpha) - sp.x).norm(), 1e-12);
+    if (!r.wraps()) {
+      ++straight;
+      EXPECT_LE((sp.x - exact).norm(), 1e-14);
+      continue;
+    }
+    // the library's path and length against the model's, relative to the smallest semi-axis
+    errs.push_back((sp.x - exact).norm() / s.dimensions.minCoeff());
+  }
+  ASSERT_GT(errs.size(), 300u);
+  EXPECT_GT(straight, 1000);
+  std::sort(errs.begin(), errs.end());
+  const double median = errs[errs.size() / 2], p99 = errs[errs.size() * 99 / 100], worst = errs.back();
+  std::printf("ellipsoid: %zu wrapped samples, |smooth - exact| / min semi-axis: median %.1e, 99%% %.1e, max %.1e\n",
+              errs.size(), median, p99, worst);
+  // the library's tangent points stop at a residual of 1e-4 and its arc is a polyline (measured:
+  // median 5.7e-6, 99th percentile 9.6e-5, max 1.5e-3)
+  EXPECT_LT(median, 2e-5);
+  EXPECT_LT(p99, 3e-4);
+  EXPECT_LT(worst, 5e-3);
+}
+
+TEST(WrapSmoothEllipsoid, JacobianAndJdotMatchCentralDifferences) {
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(-3.0, 3.0), ua(0.05, 0.95), uv(-1.0, 1.0), ud(0.5, 1.5);
+  int in_band = 0, wrapped = 0, tested = 0;
+  for (int k = 0; k < 3000 && tested < 120; ++k) {
+    const WrapSurface s = WrapSurface::makeEllipsoid(Vec3(ud(rng), ud(rng), ud(rng)));
+    const SmoothWrapOptions opt{0.3 * s.dimensions.minCoeff()};  // a wide band so that many samples land inside it
+    const Vec3 p1(u(rng), u(rng), u(rng)), p2(u(rng), u(rng), u(rng));
+    const Vec3 v1(uv(rng), uv(rng), uv(rng)), v2(uv(rng), uv(rng), uv(rng));
+    const double alpha = ua(rng);
+    // end points off the surface (the tangent construction's derivatives grow without bound as an
+    // end point nears it)
+    if (insideEllipsoid(s, p1, 0.2) || insideEllipsoid(s, p2, 0.2)) continue;
+    const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(s, p1, p2, alpha, v1, v2, opt);
+    if (sp.weight == 0.0) continue;
+    const double h = 1e-6;
+    Eigen::Matrix<double, 3, 6> fd;
+    for (int i = 0; i < 6; ++i) {
+      Vec3 a1 = p1, a2 = p2, b1 = p1, b2 = p2;
+      (i < 3 ? a1 : a2)[i % 3] += h;
+      (i < 3 ? b1 : b2)[i % 3] -= h;
+      fd.col(i) = (calcSmoothWrapPoint(s, a1, a2, alpha, opt) - calcSmoothWrapPoint(s, b1, b2, alpha, opt)) / (2 * h);
+    }
+    const auto Jp = calcSmoothWrapPointDerivatives(s, p1 + h * v1, p2 + h * v2, alpha, v1, v2, opt).J;
+    const auto Jm = calcSmoothWrapPointDerivatives(s, p1 - h * v1, p2 - h * v2, alpha, v1, v2, opt).J;
+    const Eigen::Matrix<double, 3, 6> fd_dot = (Jp - Jm) / (2 * h);
+    // skip the stencil whose differences have not converged to the tolerance (FD(2h) - FD(h) is 3
+    // times their h^2 error): one that straddles a piece boundary of the library's construction
+    // (a mass point crossing a tangent point, the hybrid method's linear blends and fades, a fan
+    // sample switching roots)
+    const auto Jp2 = calcSmoothWrapPointDerivatives(s, p1 + 2 * h * v1, p2 + 2 * h * v2, alpha, v1, v2, opt).J;
+    const auto Jm2 = calcSmoothWrapPointDerivatives(s, p1 - 2 * h * v1, p2 - 2 * h * v2, alpha, v1, v2, opt).J;
+    if (!nearRel((Jp2 - Jm2) / (4 * h), fd_dot, 3e-7)) continue;
+    ++tested;
+    if (sp.weight > 0.0 && sp.weight < 1.0) ++in_band;
+    if (sp.weight == 1.0) ++wrapped;
+    EXPECT_TRUE(nearRel(sp.J, fd, 1e-6)) << "w " << sp.weight << "\n" << sp.J << "\n" << fd;
+    EXPECT_TRUE(nearRel(sp.Jdot, fd_dot, 1e-6)) << "w " << sp.weight << "\n" << sp.Jdot << "\n" << fd_dot;
+  }
+  EXPECT_GE(tested, 100);
+  EXPECT_GE(in_band, 10);
+  EXPECT_GE(wrapped, 30);
+}
+
+// the insertion moves so that the line approaches the ellipsoid and wraps on it; the first and
+// second derivatives along the sweep are continuous at both edges of the band, where the exact
+// library's derivative jumps
+TEST(WrapSmoothEllipsoid, C2AcrossBothEdgesOfTheBand) {
+  const WrapSurface s = WrapSurface::makeEllipsoid(Vec3(0.8, 1.2, 0.6));
+  const double width = 0.03, alpha = 0.3;
+  const Vec3 p1(-2.5, 1.6, 0.3), p2_0(2.0, 1.7, -0.2), dir(0.0, -1.6, 0.1);
+  auto p2 = [&](double t) { return Vec3(p2_0 + t * dir); };
+  auto pen = [&](double t) { return calcWrapPenetration(s, p1, p2(t)); };
+  ASSERT_LT(pen(0.0), 0.0);
+  ASSERT_GT(pen(1.0), width);
+  auto where = [&](double target) {
+    double lo = 0.0, hi = 1.0;
+    for (int k = 0; k < 200; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (pen(mid) < target ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  };
+  auto derivs = [&](double t, Vec3& x1, Vec3& x2) {
+    const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(s, p1, p2(t), alpha, Vec3::Zero(), dir, SmoothWrapOptions{width});
+    x1 = sp.J.rightCols<3>() * dir;
+    x2 = sp.Jdot.rightCols<3>() * dir;
+  };
+  for (double edge : {0.0, width}) {
+    const double t0 = where(edge);
+    double gap1[2], gap2[2], x2 = 0.0;
+    for (int k = 0; k < 2; ++k) {
+      const double e = k == 0 ? 1e-6 : 1e-7;
+      Vec3 a1, a2, b1, b2;
+      derivs(t0 - e, a1, a2);
+      derivs(t0 + e, b1, b2);
+      ASSERT_TRUE(a1.allFinite() && a2.allFinite() && b1.allFinite() && b2.allFinite());
+      gap1[k] = (a1 - b1).norm();
+      gap2[k] = (a2 - b2).norm();
+      x2 = std::max(a2.norm(), b2.norm());
+    }
+    EXPECT_LT(gap1[1], 1e-6) << "edge " << edge;
+    EXPECT_LT(gap2[1], 1e-2 * (1.0 + x2)) << "edge " << edge;
+    EXPECT_LE(gap1[1], 0.15 * gap1[0] + 1e-15);
+    EXPECT_LE(gap2[1], 0.15 * gap2[0] + 1e-12);
+  }
+  const double t0 = where(0.0), h = 1e-6;
+  auto exact = [&](double t) { return calcWrappedPathPoint(s, calcWrap(s, p1, p2(t)), p1, p2(t), alpha); };
+  const Vec3 left = (exact(t0 - 1e-7) - exact(t0 - 1e-7 - h)) / h;
+  const Vec3 right = (exact(t0 + 1e-7 + h) - exact(t0 + 1e-7)) / h;
+  EXPECT_GT((left - right).norm(), 1e-2);
+}
+
+TEST(WrapSmoothEllipsoid, ArcLengthQuadratureConverged) {
+  // the model's wrapped length against the library's polyline of up to 499 segments: they agree
+  // to the polyline's own error, far below the position tolerance above
+  const WrapSurface s = WrapSurface::makeEllipsoid(Vec3(0.05, 0.03, 0.02));  // muscle-sized, metres
+  const Vec3 p1(-0.08, 0.01, 0.004), p2(0.07, -0.005, 0.006);
+  const WrapResult r = calcWrap(s, p1, p2);
+  ASSERT_TRUE(r.wraps());
+  const SmoothWrapLength L = calcSmoothWrapLength(s, p1, p2, Vec3::Zero(), Vec3::Zero());
+  EXPECT_NEAR(L.length, calcWrappedPathLength(r, p1, p2), 1e-6);
+  EXPECT_EQ(smoothWrapUnsupportedReason(s), "");
+  EXPECT_NE(smoothWrapUnsupportedReason(WrapSurface::makeEllipsoid(Vec3(1, 2, 3), 0, 1)), "");
+  EXPECT_THROW(calcSmoothWrapPoint(s, Vec3(0.01, 0, 0), p2, 0.5), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace redmax
