@@ -460,31 +460,79 @@ struct EllipsoidArc {
       *speed = norm(dmu * rr + mu * drr);
     }
   }
-  // arc length from 0 to phi: composite 8-point Gauss-Legendre
-  T length(const T& phi) const {
+  // arc length from phi_a to phi_b: 8-point Gauss-Legendre
+  T panelLength(const T& phi_a, const T& phi_b) const {
     static const double x[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
                                 0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
     static const double wq[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
                                  0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
-    const T h = phi / double(kArcPanels);
+    const T half = 0.5 * (phi_b - phi_a), mid = 0.5 * (phi_a + phi_b);
     T sum(0.0);
-    for (int k = 0; k < kArcPanels; ++k)
-      for (int j = 0; j < 8; ++j) {
-        T sp;
-        eval(h * (k + 0.5 + 0.5 * x[j]), nullptr, &sp);
-        sum = sum + wq[j] * sp;
-      }
-    return 0.5 * h * sum;
+    for (int j = 0; j < 8; ++j) {
+      T sp;
+      eval(mid + x[j] * half, nullptr, &sp);
+      sum = sum + wq[j] * sp;
+    }
+    return half * sum;
   }
 };
 
+// bitwise equality of scalars with all their dual parts (cache keys)
+inline bool sameScalar(double x, double y) { return x == y || (x != x && y != y); }
+template <class T> bool sameScalar(const Dual<T>& x, const Dual<T>& y) { return sameScalar(x.a, y.a) && sameScalar(x.b, y.b); }
+template <class T> bool sameVec(const V3<T>& u, const V3<T>& v) {
+  return sameScalar(u[0], v[0]) && sameScalar(u[1], v[1]) && sameScalar(u[2], v[2]);
+}
+
+// the last few alpha-independent constructions per thread, keyed by the surface's size and the
+// end points with all their dual parts: a muscle's mass points (same end points, several alphas)
+// and the derivative passes of one point share them. Correctness does not depend on a hit.
+template <class S, class T>
+struct SetupCache {
+  struct Entry {
+    bool used = false;
+    Vec3 size = Vec3::Zero();
+    V3<T> p1{}, p2{};
+    bool ok = false;
+    S setup{};
+  };
+  std::array<Entry, 8> entries;
+  int next = 0;
+  template <class F>
+  const Entry& get(const Vec3& size, const V3<T>& p1, const V3<T>& p2, const F& make) {
+    for (const Entry& e : entries)
+      if (e.used && e.size == size && sameVec(e.p1, p1) && sameVec(e.p2, p2)) return e;
+    Entry& e = entries[next];
+    next = (next + 1) % static_cast<int>(entries.size());
+    e.used = true;
+    e.size = size;
+    e.p1 = p1;
+    e.p2 = p2;
+    e.ok = make(e.setup);
+    return e;
+  }
+};
+
+// everything of the ellipsoid path that does not depend on alpha, in the library's scaled
+// coordinates
 template <class T>
-bool ellipsoidPoint(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, const Alpha<T>& alpha, V3<T>& x,
-                    T* total_out = nullptr) {
+struct EllipsoidWrap {
+  double factor = 1.0;
+  V3<T> p1{}, p2{}, r1{}, r2{};
+  EllipsoidArc<T> arc{};
+  std::array<T, kArcPanels + 1> cum{};  // arc length at the panel boundaries phi0 k / kArcPanels
+  T la{}, d1{}, d2{}, total{};
+};
+
+template <class T>
+bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, EllipsoidWrap<T>& ew) {
   // the library's scaled coordinates
   const double factor = 3.0 / surf.dimensions.sum();
   const Vec3 a = surf.dimensions * factor;
+  ew.factor = factor;
   const V3<T> p1 = factor * P1, p2 = factor * P2;
+  ew.p1 = p1;
+  ew.p2 = p2;
   const V3<T> p1p2 = p1 - p2;
   // where the chord meets the ellipsoid
   const V3<T> f1 = cdiv(p1p2, a), f2 = cdiv(p2, a);
@@ -552,41 +600,66 @@ bool ellipsoidPoint(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, c
   arc.phi0 = dacos(dot(arc.ar1, ar2));
   arc.vsy = cross(normalize(cross(arc.ar1, ar2)), arc.ar1);
   arc.f2 = cdiv(arc.a0, a);
-  const T la = arc.length(arc.phi0);
+  // arc length at the panel boundaries (composite 8-point Gauss-Legendre)
+  ew.cum[0] = T(0.0);
+  for (int k = 0; k < kArcPanels; ++k)
+    ew.cum[k + 1] = ew.cum[k] + arc.panelLength(arc.phi0 * (double(k) / kArcPanels), arc.phi0 * (double(k + 1) / kArcPanels));
+  ew.arc = arc;
+  ew.r1 = r1;
+  ew.r2 = r2;
+  ew.la = ew.cum[kArcPanels];
+  ew.d1 = norm(r1 - p1);
+  ew.d2 = norm(p2 - r2);
+  ew.total = ew.d1 + ew.la + ew.d2;
+  return true;
+}
+
+template <class T>
+bool ellipsoidPoint(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, const Alpha<T>& alpha, V3<T>& x,
+                    T* total_out = nullptr) {
+  static thread_local SetupCache<EllipsoidWrap<T>, T> cache;
+  const auto& entry = cache.get(surf.dimensions, P1, P2, [&](EllipsoidWrap<T>& ew) { return ellipsoidSetup(surf, P1, P2, ew); });
+  if (!entry.ok) return false;
+  const EllipsoidWrap<T>& ew = entry.setup;
+  const EllipsoidArc<T>& arc = ew.arc;
   // the point at fraction alpha of p1 -> r1 -> arc -> r2 -> p2 (scaled back)
-  const T d1 = norm(r1 - p1), d2 = norm(p2 - r2);
-  const T total = d1 + la + d2;
-  if (total_out) *total_out = total / factor;
-  T s = alpha * total;
+  if (total_out) *total_out = ew.total / ew.factor;
+  const T s = alpha * ew.total;
   V3<T> xs;
-  if (value(s) <= value(d1)) {
-    xs = p1 + (s / d1) * (r1 - p1);
-  } else if (value(s - d1) <= value(la)) {
-    // the angle whose arc length is s - d1: Newton on values, then two steps over T
-    const T target = s - d1;
-    const double tv = value(target), lav = value(la), phi0v = value(arc.phi0);
-    const EllipsoidArc<double> av{a, constant<double>(values(arc.a0)), constant<double>(values(arc.ar1)),
-                                  constant<double>(values(arc.vsy)), constant<double>(values(arc.f2)), phi0v};
-    double phi = lav > 0.0 ? phi0v * tv / lav : 0.0;
+  if (value(s) <= value(ew.d1)) {
+    xs = ew.p1 + (s / ew.d1) * (ew.r1 - ew.p1);
+  } else if (value(s - ew.d1) <= value(ew.la)) {
+    // the angle whose arc length is s - d1: the panel on values, Newton within it on values, then
+    // two Newton steps over T
+    const T target = s - ew.d1;
+    const double tv = value(target);
+    int k = 0;
+    while (k + 1 < kArcPanels && value(ew.cum[k + 1]) < tv) ++k;
+    const EllipsoidArc<double> av{arc.a, constant<double>(values(arc.a0)), constant<double>(values(arc.ar1)),
+                                  constant<double>(values(arc.vsy)), constant<double>(values(arc.f2)), value(arc.phi0)};
+    const double h = value(arc.phi0) / kArcPanels, lo = h * k, cum_k = value(ew.cum[k]);
+    const double seg = value(ew.cum[k + 1]) - cum_k;
+    double phi = lo + (seg > 0.0 ? h * (tv - cum_k) / seg : 0.0);
     for (int it = 0; it < 30; ++it) {
       double sp;
       av.eval(phi, nullptr, &sp);
-      const double step = (av.length(phi) - tv) / sp;
+      const double step = (cum_k + av.panelLength(lo, phi) - tv) / sp;
       phi -= step;
-      if (std::abs(step) < 1e-15 * (1.0 + std::abs(phi))) break;
+      if (!(std::abs(step) > 1e-15 * (1.0 + std::abs(phi)))) break;
     }
     T phit(phi);
-    for (int k = 0; k < 2; ++k) {
+    const T lot = arc.phi0 * (double(k) / kArcPanels);
+    for (int step = 0; step < 2; ++step) {
       T sp;
       arc.eval(phit, nullptr, &sp);
-      phit = phit - (arc.length(phit) - target) / sp;
+      phit = phit - (ew.cum[k] + arc.panelLength(lot, phit) - target) / sp;
     }
     arc.eval(phit, &xs, nullptr);
   } else {
-    const T f = (s - d1 - la) / d2;
-    xs = value(f) < 1.0 ? r2 + f * (p2 - r2) : p2;
+    const T f = (s - ew.d1 - ew.la) / ew.d2;
+    xs = value(f) < 1.0 ? ew.r2 + f * (ew.p2 - ew.r2) : ew.p2;
   }
-  x = (1.0 / factor) * xs;
+  x = (1.0 / ew.factor) * xs;
   return true;
 }
 
