@@ -63,7 +63,11 @@ int runTrain(const Args& a, const std::vector<std::string>& argv) {
   opt.learning_rate = a.getDouble("lr", 1e-4);
   opt.seed = static_cast<unsigned long long>(a.getInt("seed", 1));
   opt.time_limit_s = a.getDouble("time-limit", 0.0);
+  opt.threads = static_cast<int>(a.getInt("threads", 1));
+  opt.shards = static_cast<int>(a.getInt("shards", opt.threads));
   const double threshold = a.getDouble("threshold", 0.01);
+  if (opt.threads < 1 || opt.threads > 256) throw UsageError{"--threads must be between 1 and 256"};
+  if (opt.shards < 1 || opt.shards > 4096) throw UsageError{"--shards must be between 1 and 4096"};
   if (samples < 10 || samples > 100000000) throw UsageError{"--samples must be between 10 and 1e8"};
   if (opt.epochs < 1 || opt.epochs > 10000000) throw UsageError{"--epochs must be at least 1"};
   if (opt.batch < 1) throw UsageError{"--batch must be at least 1"};
@@ -80,7 +84,7 @@ int runTrain(const Args& a, const std::vector<std::string>& argv) {
   const WrapInputBox box = makeDefaultWrapBox(type);
   const WrapOracle oracle = makeExactWrapOracle(type);
   const auto t_data = Clock::now();
-  const WrapTrainingSet data = makeWrapTrainingSet(box, oracle, samples, threshold, opt.seed);
+  const WrapTrainingSet data = makeWrapTrainingSet(box, oracle, samples, threshold, opt.seed, opt.threads);
   std::cerr << "train-wrap: " << wrapTypeName(type) << ", " << samples << " samples kept of " << data.drawn
             << " drawn (" << data.invalid << " with an end inside the surface, " << data.near_contact
             << " with 0 < l/L < " << threshold << " discarded; " << data.wrapped << " kept samples wrap), "
@@ -99,7 +103,7 @@ int runTrain(const Args& a, const std::vector<std::string>& argv) {
   Mlp net = trainWrapNetwork(data, box, opt, &history);
 
   // error on fresh samples, all of them (also those near the contact change)
-  const WrapTrainingSet test = makeWrapTrainingSet(box, oracle, std::min(samples, 20000L), 0.0, opt.seed + 1000003);
+  const WrapTrainingSet test = makeWrapTrainingSet(box, oracle, std::min(samples, 20000L), 0.0, opt.seed + 1000003, opt.threads);
   const WrapErrorStats err = calcWrapNetworkError(net, test);
   net.meta["surface"] = wrapTypeName(type);
   net.meta["command"] = joinArgs(argv);
@@ -480,7 +484,7 @@ int runStudy(const Args& a) {
 int runTrainWrap(const std::vector<std::string>& argv) {
   Args a(argv,
          {"surface", "hidden", "samples", "epochs", "batch", "lr", "seed", "threshold", "time-limit", "out", "report",
-          "nets", "untrained", "muscles", "mass-points", "width", "thresholds", "architectures"},
+          "threads", "shards", "nets", "untrained", "muscles", "mass-points", "width", "thresholds", "architectures"},
          {"compare", "study"});
   if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
   if (a.has("compare") && a.has("study")) throw UsageError{"--compare and --study exclude each other"};
@@ -492,7 +496,7 @@ CommandRegistration reg(
     {"train-wrap", "train the Type III wrap network, or compare wrap models (speed against error)",
      "usage: redmax train-wrap --surface cylinder|sphere|ellipsoid|torus [--hidden 6x256] [--samples N]\n"
      "                         [--epochs E] [--batch B] [--lr 1e-4] [--seed S] [--threshold 0.01]\n"
-     "                         [--time-limit SECONDS] --out NET.txt [--report DIR]\n"
+     "                         [--time-limit SECONDS] [--threads T [--shards S]] --out NET.txt [--report DIR]\n"
      "       redmax train-wrap --compare --surface cylinder|sphere [--nets A.txt,B.txt] [--untrained 6x256,...|none]\n"
      "                         [--muscles M] [--mass-points N] [--width W] [--seed S] --report DIR\n"
      "       redmax train-wrap --study [--thresholds 0.01,0.05,0.1] [--architectures 1x32,3x32] [--samples N]\n"
@@ -503,6 +507,8 @@ CommandRegistration reg(
      "default 6x256) is trained with Adam (--lr, default 1e-4; --batch default 256) on the mean squared error\n"
      "for E epochs (default 100) or until --time-limit. Deterministic for a seed. The network file records\n"
      "the command, seed, losses and the error on fresh samples. --report DIR writes loss.csv and a loss plot.\n"
+     "--threads T labels samples and computes gradients on T threads; every mini-batch is cut into S shards\n"
+     "(default T) summed in order, so the network depends on S and the seed, not on T (S = 1: serial).\n"
      "--compare: M muscles (default 200) x N mass points (default 20) with random end points and velocities;\n"
      "for the exact library (J, Jdot by central differences), the smooth model (band width W radii, default\n"
      "0.05) and each network (trained ones from --nets; --untrained sizes are timed only), prints and writes\n"

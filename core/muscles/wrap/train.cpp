@@ -1,10 +1,13 @@
 #include "core/muscles/wrap/train.hpp"
 
+#include <barrier>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 namespace redmax {
 namespace {
@@ -35,6 +38,16 @@ void adamStep(MatX& param, const MatX& grad, AdamSlot& s, const TrainOptions& o,
   s.m = o.beta1 * s.m + (1.0 - o.beta1) * grad;
   s.v = o.beta2 * s.v + (1.0 - o.beta2) * grad.cwiseAbs2();
   param.array() -= o.learning_rate * (s.m.array() / c1) / ((s.v.array() / c2).sqrt() + o.adam_eps);
+}
+
+// f(t) for t = 0..T-1, on T - 1 new threads and this one
+void runParallel(int T, const std::function<void(int)>& f) {
+  if (T <= 1) return f(0);
+  std::vector<std::thread> pool;
+  pool.reserve(static_cast<size_t>(T - 1));
+  for (int t = 1; t < T; ++t) pool.emplace_back(f, t);
+  f(0);
+  for (auto& th : pool) th.join();
 }
 
 }  // namespace
@@ -159,7 +172,7 @@ std::vector<int> parseHidden(const std::string& spec) {
 }
 
 WrapTrainingSet makeWrapTrainingSet(const WrapInputBox& box, const WrapOracle& oracle, long n, double threshold,
-                                    unsigned long long seed) {
+                                    unsigned long long seed, int threads) {
   const int n_in = static_cast<int>(box.lo.size());
   if (n < 1 || box.hi.size() != n_in) throw std::invalid_argument("makeWrapTrainingSet: bad box or sample count");
   std::mt19937_64 rng(seed);
@@ -167,24 +180,36 @@ WrapTrainingSet makeWrapTrainingSet(const WrapInputBox& box, const WrapOracle& o
   set.X.resize(n_in, n);
   set.Y.resize(3, n);
   long kept = 0;
-  VecX x(n_in);
+  // blocks of inputs drawn in sequence, labelled (in parallel), then examined in order: the set is
+  // the one a serial loop would keep, whatever the thread count
+  const int T = std::max(1, threads);
+  const long block = T > 1 ? 1024L * T : 1;
+  MatX Xb(n_in, block);
+  std::vector<WrapSample> Sb(static_cast<size_t>(block));
   while (kept < n && set.drawn < 50 * n) {
-    for (int i = 0; i < n_in; ++i) x[i] = box.lo[i] + (box.hi[i] - box.lo[i]) * uniform01(rng);
-    ++set.drawn;
-    const WrapSample s = oracle(x);
-    if (!s.valid || !s.x.allFinite()) {
-      ++set.invalid;
-      continue;
+    const long m = std::min(block, 50 * n - set.drawn);
+    for (long j = 0; j < m; ++j)
+      for (int i = 0; i < n_in; ++i) Xb(i, j) = box.lo[i] + (box.hi[i] - box.lo[i]) * uniform01(rng);
+    runParallel(T, [&](int t) {
+      for (long j = t; j < m; j += T) Sb[static_cast<size_t>(j)] = oracle(Xb.col(j));
+    });
+    for (long j = 0; j < m && kept < n; ++j) {
+      const WrapSample& s = Sb[static_cast<size_t>(j)];
+      ++set.drawn;
+      if (!s.valid || !s.x.allFinite()) {
+        ++set.invalid;
+        continue;
+      }
+      // [D Sec. 5.3.3.1]: keep straight paths (l = 0) and clearly wrapped ones
+      if (s.l > 0.0 && s.l < threshold * s.L) {
+        ++set.near_contact;
+        continue;
+      }
+      if (s.l > 0.0) ++set.wrapped;
+      set.X.col(kept) = Xb.col(j);
+      set.Y.col(kept) = s.x;
+      ++kept;
     }
-    // [D Sec. 5.3.3.1]: keep straight paths (l = 0) and clearly wrapped ones
-    if (s.l > 0.0 && s.l < threshold * s.L) {
-      ++set.near_contact;
-      continue;
-    }
-    if (s.l > 0.0) ++set.wrapped;
-    set.X.col(kept) = x;
-    set.Y.col(kept) = s.x;
-    ++kept;
   }
   if (kept < n)
     throw std::runtime_error("only " + std::to_string(kept) + " of " + std::to_string(n) + " samples usable after " +
@@ -242,12 +267,9 @@ Mlp trainWrapNetwork(const WrapTrainingSet& data, const WrapInputBox& box, const
     sW[l] = {MatX::Zero(net.weights(l).rows(), net.weights(l).cols()), MatX::Zero(net.weights(l).rows(), net.weights(l).cols())};
     sb[l] = {MatX::Zero(net.biases(l).size(), 1), MatX::Zero(net.biases(l).size(), 1)};
   }
-  std::vector<MatX> H(L - 1);
-  std::vector<MatX> gW(L), gb(L);
-  MatX U, T, V, dV, dH, dZ;
 
   // forward in normalised units; H keeps the hidden activations for the backward pass
-  auto forward = [&](const MatX& Uin, MatX& Vout) {
+  auto forward = [&](const MatX& Uin, std::vector<MatX>& H, MatX& Vout) {
     for (int l = 0; l < L - 1; ++l) {
       const MatX& prev = l == 0 ? Uin : H[l - 1];
       H[l].noalias() = net.weights(l) * prev;
@@ -257,13 +279,14 @@ Mlp trainWrapNetwork(const WrapTrainingSet& data, const WrapInputBox& box, const
     Vout.noalias() = net.weights(L - 1) * H[L - 2];
     Vout.colwise() += net.biases(L - 1);
   };
+  std::vector<MatX> Hval(L - 1);
   auto validation = [&](double& mse, double& rms_m) {
     double se = 0.0, se_m = 0.0;
     const long chunk = 4096;
     MatX Vv;
     for (long c0 = 0; c0 < n_val; c0 += chunk) {
       const long c = std::min(chunk, n_val - c0);
-      forward(Uval.middleCols(c0, c), Vv);
+      forward(Uval.middleCols(c0, c), Hval, Vv);
       const MatX D = Vv - Tval.middleCols(c0, c);
       se += D.squaredNorm();
       se_m += (D.array().colwise() * net.output_scale.array()).matrix().squaredNorm();
@@ -272,6 +295,20 @@ Mlp trainWrapNetwork(const WrapTrainingSet& data, const WrapInputBox& box, const
     rms_m = std::sqrt(se_m / static_cast<double>(n_val));
   };
 
+  // Data parallelism: every mini-batch is cut into S shards (fixed), each shard's gradient is
+  // computed on its own workspace, and the shards are summed in shard order, so the weights depend
+  // on S but not on the thread count T. S = 1 is the plain serial algorithm.
+  const int T = std::max(1, opt.threads);
+  const int S = opt.shards > 0 ? opt.shards : T;
+  struct Shard {
+    std::vector<MatX> H, gW, gb;
+    MatX U, T, V, dV, dH, dZ;
+    double loss = 0.0;
+  };
+  std::vector<Shard> shard(static_cast<size_t>(S));
+  for (auto& sh : shard) sh.H.resize(L - 1), sh.gW.resize(L), sh.gb.resize(L);
+  std::vector<MatX> gW(L), gb(L);
+
   std::vector<long> perm(n_tr);
   for (long i = 0; i < n_tr; ++i) perm[i] = i;
   long steps = 0;
@@ -279,41 +316,64 @@ Mlp trainWrapNetwork(const WrapTrainingSet& data, const WrapInputBox& box, const
   for (int epoch = 1; epoch <= opt.epochs; ++epoch) {
     shuffle(perm, rng);
     double loss_sum = 0.0;
-    long batches = 0;
-    for (long b0 = 0; b0 < n_tr; b0 += opt.batch) {
-      const long B = std::min<long>(opt.batch, n_tr - b0);
-      U.resize(n_in, B);
-      T.resize(n_out, B);
-      for (long j = 0; j < B; ++j) U.col(j) = Utr.col(perm[b0 + j]), T.col(j) = Ttr.col(perm[b0 + j]);
-      forward(U, V);
-      // mean squared error and its gradient, backpropagated layer by layer
-      dV = V - T;
-      loss_sum += dV.squaredNorm() / (static_cast<double>(B) * n_out);
-      dV *= 2.0 / (static_cast<double>(B) * n_out);
-      gW[L - 1].noalias() = dV * H[L - 2].transpose();
-      gb[L - 1] = dV.rowwise().sum();
-      dH.noalias() = net.weights(L - 1).transpose() * dV;
+    const long n_batches = (n_tr + opt.batch - 1) / opt.batch;
+    const long steps0 = steps;
+
+    // gradient of the mean squared error over batch columns [b0, b0 + B), shard k's slice
+    auto shardGradient = [&](int k, long b0, long B) {
+      Shard& sh = shard[static_cast<size_t>(k)];
+      const long c0 = B * k / S, c1 = B * (k + 1) / S, C = c1 - c0;
+      sh.loss = 0.0;
+      if (C == 0) {
+        for (int l = 0; l < L; ++l) sh.gW[l].setZero(net.weights(l).rows(), net.weights(l).cols()), sh.gb[l].setZero(net.biases(l).size(), 1);
+        return;
+      }
+      sh.U.resize(n_in, C);
+      sh.T.resize(n_out, C);
+      for (long j = 0; j < C; ++j) sh.U.col(j) = Utr.col(perm[b0 + c0 + j]), sh.T.col(j) = Ttr.col(perm[b0 + c0 + j]);
+      forward(sh.U, sh.H, sh.V);
+      sh.dV = sh.V - sh.T;
+      sh.loss = sh.dV.squaredNorm() / (static_cast<double>(B) * n_out);
+      sh.dV *= 2.0 / (static_cast<double>(B) * n_out);
+      sh.gW[L - 1].noalias() = sh.dV * sh.H[L - 2].transpose();
+      sh.gb[L - 1] = sh.dV.rowwise().sum();
+      sh.dH.noalias() = net.weights(L - 1).transpose() * sh.dV;
       for (int l = L - 2; l >= 0; --l) {
-        dZ = dH.array() * (1.0 - H[l].array().square());
-        const MatX& prev = l == 0 ? U : H[l - 1];
-        gW[l].noalias() = dZ * prev.transpose();
-        gb[l] = dZ.rowwise().sum();
-        if (l > 0) dH.noalias() = net.weights(l).transpose() * dZ;
+        sh.dZ = sh.dH.array() * (1.0 - sh.H[l].array().square());
+        const MatX& prev = l == 0 ? sh.U : sh.H[l - 1];
+        sh.gW[l].noalias() = sh.dZ * prev.transpose();
+        sh.gb[l] = sh.dZ.rowwise().sum();
+        if (l > 0) sh.dH.noalias() = net.weights(l).transpose() * sh.dZ;
       }
-      ++steps;
-      const double c1 = 1.0 - std::pow(opt.beta1, static_cast<double>(steps));
-      const double c2 = 1.0 - std::pow(opt.beta2, static_cast<double>(steps));
-      for (int l = 0; l < L; ++l) {
-        adamStep(net.weights(l), gW[l], sW[l], opt, c1, c2);
-        MatX bias = net.biases(l);
-        adamStep(bias, gb[l], sb[l], opt, c1, c2);
-        net.biases(l) = bias;
+    };
+    // sum of the shards in order, then Adam, for one layer
+    auto layerUpdate = [&](int l, long step) {
+      gW[l] = shard[0].gW[l];
+      gb[l] = shard[0].gb[l];
+      for (int k = 1; k < S; ++k) gW[l] += shard[static_cast<size_t>(k)].gW[l], gb[l] += shard[static_cast<size_t>(k)].gb[l];
+      const double c1 = 1.0 - std::pow(opt.beta1, static_cast<double>(step));
+      const double c2 = 1.0 - std::pow(opt.beta2, static_cast<double>(step));
+      adamStep(net.weights(l), gW[l], sW[l], opt, c1, c2);
+      MatX bias = net.biases(l);
+      adamStep(bias, gb[l], sb[l], opt, c1, c2);
+      net.biases(l) = bias;
+    };
+    std::barrier<> sync(T);
+    runParallel(T, [&](int t) {
+      for (long bi = 0; bi < n_batches; ++bi) {
+        const long b0 = bi * opt.batch, B = std::min<long>(opt.batch, n_tr - b0);
+        for (int k = t; k < S; k += T) shardGradient(k, b0, B);
+        sync.arrive_and_wait();
+        for (int l = t; l < L; l += T) layerUpdate(l, steps0 + bi + 1);
+        if (t == 0)
+          for (int k = 0; k < S; ++k) loss_sum += shard[static_cast<size_t>(k)].loss;
+        sync.arrive_and_wait();
       }
-      ++batches;
-    }
+    });
+    steps = steps0 + n_batches;
     last.epoch = epoch;
     last.steps = steps;
-    last.train_mse = loss_sum / std::max(1L, batches);
+    last.train_mse = loss_sum / std::max(1L, n_batches);
     validation(last.val_mse, last.val_rms_m);
     last.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!std::isfinite(last.train_mse)) throw std::runtime_error("training diverged at epoch " + std::to_string(epoch) + " (loss not finite)");
@@ -326,7 +386,8 @@ Mlp trainWrapNetwork(const WrapTrainingSet& data, const WrapInputBox& box, const
   net.meta["architecture"] = net.architecture();
   net.meta["samples"] = std::to_string(n) + " (train " + std::to_string(n_tr) + ", validation " + std::to_string(n_val) + ")";
   net.meta["epochs"] = std::to_string(last.epoch);
-  net.meta["adam"] = "lr " + fmt(opt.learning_rate) + " batch " + std::to_string(opt.batch) + " steps " + std::to_string(steps);
+  net.meta["adam"] = "lr " + fmt(opt.learning_rate) + " batch " + std::to_string(opt.batch) + " steps " + std::to_string(steps) +
+                     (S > 1 ? " shards " + std::to_string(S) : std::string());
   net.meta["final_train_mse"] = fmt(last.train_mse);
   net.meta["final_val_mse"] = fmt(last.val_mse);
   net.meta["final_val_rms_m"] = fmt(last.val_rms_m);

@@ -7,8 +7,9 @@
 //
 // Determinism: one seeded generator (std::mt19937_64, top 53 bits -> double) draws the samples,
 // the validation split, the initial weights and every epoch's shuffle; reductions run in a fixed
-// order on one thread (Eigen without OpenMP), so a seed reproduces a network bit for bit on the
-// same build and machine.
+// order (Eigen without OpenMP), so a seed reproduces a network bit for bit on the same build and
+// machine. Parallel training splits every mini-batch into a fixed number of shards whose gradients
+// are summed in shard order: the result depends on the shard count, never on the thread count.
 #include <functional>
 #include <string>
 #include <vector>
@@ -69,9 +70,11 @@ struct WrapTrainingSet {
 };
 
 /// Draw samples until n are kept (or 50 n drawn). threshold: discard 0 < l/L < threshold
-/// [D Sec. 5.3.3.1]. Throws std::runtime_error if fewer than n could be kept.
+/// [D Sec. 5.3.3.1]. Throws std::runtime_error if fewer than n could be kept. With threads > 1 the
+/// oracle runs on blocks of inputs in parallel (it must be thread-safe; the exact oracle is); the
+/// inputs are still drawn in sequence and kept in order, so the set does not depend on threads.
 WrapTrainingSet makeWrapTrainingSet(const WrapInputBox& box, const WrapOracle& oracle, long n, double threshold,
-                                    unsigned long long seed);
+                                    unsigned long long seed, int threads = 1);
 
 /// One line of the loss curve.
 struct TrainEpoch {
@@ -92,6 +95,8 @@ struct TrainOptions {
   double validation_fraction = 0.1;
   unsigned long long seed = 1;
   double time_limit_s = 0.0;  ///< > 0: stop after the epoch that passes it
+  int threads = 1;  ///< worker threads (harness-level parallelism; the core stays single-threaded)
+  int shards = 0;   ///< gradient shards per mini-batch (<= 0: = threads); 1 = the serial algorithm
   std::function<void(const TrainEpoch&)> on_epoch;  ///< progress (called after every epoch)
 };
 

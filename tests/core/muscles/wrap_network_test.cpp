@@ -245,6 +245,52 @@ TEST(WrapTraining, TinyNetworkLearnsAndIsDeterministic) {
   EXPECT_FALSE(trainWrapNetwork(set, box, other).identical(net));
 }
 
+TEST(WrapTraining, ParallelLabellingKeepsTheSerialSet) {
+  const WrapInputBox box = makeDefaultWrapBox(WrapType::Sphere);
+  const WrapOracle oracle = makeExactWrapOracle(WrapType::Sphere);
+  const WrapTrainingSet a = makeWrapTrainingSet(box, oracle, 3000, 0.05, 11, 1);
+  const WrapTrainingSet b = makeWrapTrainingSet(box, oracle, 3000, 0.05, 11, 3);
+  EXPECT_EQ(a.X, b.X);
+  EXPECT_EQ(a.Y, b.Y);
+  EXPECT_EQ(a.drawn, b.drawn);
+  EXPECT_EQ(a.invalid, b.invalid);
+  EXPECT_EQ(a.near_contact, b.near_contact);
+  EXPECT_EQ(a.wrapped, b.wrapped);
+}
+
+TEST(WrapTraining, ShardedGradientsAreTheSerialOnesAndThreadCountFree) {
+  const WrapInputBox box = makeDefaultWrapBox(WrapType::Cylinder);
+  const WrapTrainingSet set = makeWrapTrainingSet(box, makeExactWrapOracle(WrapType::Cylinder), 800, 0.01, 5);
+  TrainOptions opt;
+  opt.hidden = parseHidden("2x16");
+  opt.learning_rate = 1e-3;
+  opt.seed = 3;
+  // one Adam step over the whole training part: the sharded gradient sums to the serial one, so
+  // the weights agree to rounding (Adam's first step is lr * g / (|g| + eps) elementwise)
+  opt.epochs = 1;
+  opt.batch = 1000;
+  opt.threads = 1;
+  opt.shards = 1;
+  const Mlp serial = trainWrapNetwork(set, box, opt);
+  opt.shards = 5;
+  const Mlp sharded = trainWrapNetwork(set, box, opt);
+  for (int l = 0; l < serial.layers(); ++l) {
+    EXPECT_LT((serial.weights(l) - sharded.weights(l)).cwiseAbs().maxCoeff(), 1e-12) << "layer " << l;
+    EXPECT_LT((serial.biases(l) - sharded.biases(l)).cwiseAbs().maxCoeff(), 1e-12) << "layer " << l;
+  }
+  // many steps with 4 shards: 1 and 3 threads give the same network bit for bit
+  opt.epochs = 4;
+  opt.batch = 32;
+  opt.shards = 4;
+  opt.threads = 1;
+  const Mlp t1 = trainWrapNetwork(set, box, opt);
+  opt.threads = 3;
+  Mlp t3 = trainWrapNetwork(set, box, opt);
+  t3.meta = t1.meta;  // wall time differs
+  EXPECT_TRUE(t3.identical(t1));
+  EXPECT_NE(t1.meta.at("adam").find("shards 4"), std::string::npos);
+}
+
 TEST(WrapTraining, ParseHidden) {
   EXPECT_EQ(parseHidden("6x256"), std::vector<int>(6, 256));
   EXPECT_EQ(parseHidden("64-32"), (std::vector<int>{64, 32}));
