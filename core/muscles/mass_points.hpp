@@ -17,12 +17,16 @@
 //     potential energy of a uniform line density; no point sits on an attachment, where its mass
 //     would only add to a bone.
 //   - Region::WholePath spreads the points over alpha in [0, 1] in the same way.
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/muscles/path.hpp"
 
 namespace redmax {
+
+class Mlp;                  // core/muscles/wrap/network.hpp
+class WrapFallbackMonitor;  // core/muscles/wrap/network_model.hpp
 
 /// Where the points of a muscle sit along the path.
 struct MassPointOptions {
@@ -52,7 +56,9 @@ MassPoints makeMassPoints(std::vector<double> alpha, std::vector<double> mass);
 /// (core/muscles/wrap_muscle.hpp).
 enum class WrapModel {
   Smooth,  ///< analytic smooth model (core/muscles/wrap/smooth.hpp): C2, exact J and Jdot
-  Exact    ///< the exact library, J and Jdot by finite differences (energy jumps at contact changes)
+  Exact,   ///< the exact library, J and Jdot by finite differences (energy jumps at contact changes)
+  Neural   ///< a trained network (core/muscles/wrap/network_model.hpp): C-infinity, exact J and Jdot;
+           ///< falls back to Smooth outside its training box (CLI word `neural`)
 };
 
 /// Wrap-model choice and parameters of one muscle (used only by Type III muscles with mass points).
@@ -60,6 +66,13 @@ struct WrapMassOptions {
   WrapModel model = WrapModel::Smooth;
   double width = 0.0;    ///< Smooth: transition width of the penetration (m); <= 0: 0.05 radius
   double fd_step = 0.0;  ///< Exact: central-difference step on the end points (m); <= 0: 1e-6 size
+  /// Neural: the network (loadWrapNetwork); also the fallback's transition width is `width`
+  std::shared_ptr<const Mlp> network;
+  bool network_fd_jdot = false;   ///< Neural: Jdot by the forward difference [D Eq. 5.58], not exactly
+  double network_fd_eps = 0.0;    ///< Neural: its time step (s); <= 0: 1e-6
+  /// Neural: counts evaluations and fallbacks per muscle and passes the first fallback of each to
+  /// its sink (the core does not print); null: fallbacks are silent
+  std::shared_ptr<WrapFallbackMonitor> monitor;
 };
 
 /// A musculotendon: its path and, when it carries inertia, its mass points. A muscle with no mass

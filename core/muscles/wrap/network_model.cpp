@@ -1,0 +1,320 @@
+#include "core/muscles/wrap/network_model.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/muscles/mass_points.hpp"
+#include "core/muscles/path.hpp"
+#include "core/muscles/wrap/train.hpp"
+
+namespace redmax {
+
+namespace {
+
+thread_local NetworkWrapEval last_eval;  // lastNetworkWrapEval()
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+// Where a quadrant changes OpenSim's cylinder path from the unconstrained one (which the networks
+// learnt): a forced wrap round the active side (neither end active, or the ends on opposite sides
+// of the quadrant plane with the line's point nearest the axis, the "foot", on the inactive side),
+// or a contact (d > 0) whose foot lies on the inactive side, which the library also wraps round the
+// active side. The same split as the smooth model's (smooth.cpp smoothPoint), on plain doubles.
+bool quadrantChangesPath(const WrapSurface& s, const Vec3& a, const Vec3& b) {
+  if (s.type != WrapType::Cylinder || s.quadrant_sign == 0 || s.quadrant_axis < 0) return false;
+  const int axis = s.quadrant_axis, sign = s.quadrant_sign;
+  auto dsign = [](double v) { return v >= 0.0 ? 1 : -1; };
+  const Vec3 u = b - a;
+  const bool s1 = dsign(a[axis]) == sign, s2 = dsign(b[axis]) == sign;
+  const double uu = u.head<2>().squaredNorm();
+  const double near_axis = a[axis] + (uu > 0.0 ? -a.head<2>().dot(u.head<2>()) / uu : 0.0) * u[axis];
+  const bool forced = (!s1 && !s2) || (dsign(a[axis]) != dsign(b[axis]) && dsign(near_axis) != sign);
+  return forced || (calcWrapPenetration(s, a, b) > 0.0 && !(sign * near_axis > 0.0));
+}
+
+void checkEndPoints(const WrapSurface& s, const Vec3& p1, const Vec3& p2) {
+  if (!p1.allFinite() || !p2.allFinite() || p1 == p2)
+    throw std::invalid_argument("network wrap: degenerate end points");
+  const double R = s.radius;
+  const bool inside = s.type == WrapType::Cylinder ? (p1.head<2>().norm() < R || p2.head<2>().norm() < R)
+                                                   : (p1.norm() < R || p2.norm() < R);
+  if (inside) throw std::invalid_argument("network wrap: an end point lies inside the surface");
+}
+
+}  // namespace
+
+std::string toString(NetworkWrapFallback why) {
+  switch (why) {
+    case NetworkWrapFallback::None: return "network";
+    case NetworkWrapFallback::NoNetwork: return "no network";
+    case NetworkWrapFallback::SurfaceType: return "network trained for another surface type";
+    case NetworkWrapFallback::Quadrant: return "the quadrant makes the path wrap round the active side";
+    case NetworkWrapFallback::FiniteLength: return "end point beyond the cylinder's length";
+    case NetworkWrapFallback::OutsideBox: return "outside the training box";
+  }
+  return "?";
+}
+
+std::string NetworkWrapEval::describe(const Mlp* net) const {
+  if (fallback != NetworkWrapFallback::OutsideBox || !net || input < 0 || input >= net->inputs()) return toString(fallback);
+  const std::string name =
+      input < static_cast<int>(net->input_names.size()) ? net->input_names[input] : "#" + std::to_string(input);
+  std::string s = "input " + name + " = " + num(value) + " (size units) outside the training box [" +
+                  num(net->input_min[input]) + ", " + num(net->input_max[input]) + "]";
+  if (point >= 0) s += " at mass point " + std::to_string(point);
+  return s;
+}
+
+std::string networkWrapUnsupportedReason(const Mlp& net) {
+  if (net.inputs() != 8 || net.outputs() != 3)
+    return "a wrap network maps 8 inputs (origin, insertion, alpha, radius) to 3 outputs, this one maps " +
+           std::to_string(net.inputs()) + " to " + std::to_string(net.outputs());
+  if (net.input_min.size() != 8 || net.input_max.size() != 8) return "the network stores no training box";
+  return "";
+}
+
+std::string neuralWrapUnsupportedReason(const Mlp* net, const WrapSurface& surface) {
+  if (!net) return "no wrap network was given (WrapMassOptions::network)";
+  std::string why = networkWrapUnsupportedReason(*net);
+  if (!why.empty()) return why;
+  // the fallback must exist for every configuration
+  why = smoothWrapUnsupportedReason(surface);
+  if (!why.empty()) return why + " (the network model falls back to the smooth model)";
+  return "";
+}
+
+NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                                     const Vec3& p1dot, const Vec3& p2dot, const std::vector<double>& alphas,
+                                     bool with_jdot, WrapMassPoints& out, NetworkWrapWorkspace& ws,
+                                     const NetworkWrapOptions& options, const std::vector<double>& alphadots,
+                                     std::vector<Vec3>* x_alpha, std::vector<Vec3>* x_alphadot) {
+  last_eval = NetworkWrapEval{};
+  const std::string why = smoothWrapUnsupportedReason(surface);
+  if (!why.empty()) throw std::invalid_argument("network wrap: " + why);
+  if (net) {
+    const std::string bad = networkWrapUnsupportedReason(*net);
+    if (!bad.empty()) throw std::invalid_argument("network wrap: " + bad);
+  }
+  checkEndPoints(surface, p1, p2);
+  const int n = static_cast<int>(alphas.size());
+  if (!alphadots.empty() && static_cast<int>(alphadots.size()) != n)
+    throw std::invalid_argument("network wrap: alphadots must be empty or one per fraction");
+  auto alphadot = [&](int k) { return with_jdot && !alphadots.empty() ? alphadots[k] : 0.0; };
+  out.x.resize(n);
+  out.J.resize(n);
+  out.Jdot.resize(n);
+  if (x_alpha) x_alpha->resize(n);
+  if (x_alphadot) x_alphadot->resize(n);
+
+  // which model: checked on every call [D Sec. 6.2.7]
+  NetworkWrapEval ev;
+  if (!net) {
+    ev.fallback = NetworkWrapFallback::NoNetwork;
+  } else if (auto it = net->meta.find("surface"); it != net->meta.end() && it->second != wrapTypeName(surface.type)) {
+    ev.fallback = NetworkWrapFallback::SurfaceType;
+  } else if (surface.type != WrapType::Cylinder && surface.type != WrapType::Sphere) {
+    ev.fallback = NetworkWrapFallback::SurfaceType;  // networks take one radius: cylinders and spheres
+  } else if (quadrantChangesPath(surface, p1, p2)) {
+    ev.fallback = NetworkWrapFallback::Quadrant;
+  } else if (surface.type == WrapType::Cylinder &&
+             (std::abs(p1.z()) > 0.5 * surface.length || std::abs(p2.z()) > 0.5 * surface.length)) {
+    ev.fallback = NetworkWrapFallback::FiniteLength;
+  } else {
+    // scaled inputs (size units, radius 1) and the box test on each of them
+    const double c = 1.0 / surface.radius;
+    ws.X.resize(8, n);
+    for (int k = 0; k < n; ++k) ws.X.col(k) << c * p1, c * p2, alphas[k], 1.0;
+    for (int k = 0; k < n && ev.usedNetwork(); ++k)
+      for (int i = 0; i < 8; ++i) {
+        const double v = ws.X(i, k);
+        if (!(v >= net->input_min[i] && v <= net->input_max[i])) {
+          ev = {NetworkWrapFallback::OutsideBox, i, v, k};
+          break;
+        }
+      }
+  }
+  last_eval = ev;
+
+  if (ev.usedNetwork()) {
+    const double R = surface.radius, c = 1.0 / R;
+    if (with_jdot) {
+      ws.Xdot.resize(8, n);
+      for (int k = 0; k < n; ++k) ws.Xdot.col(k) << c * p1dot, c * p2dot, alphadot(k), 0.0;
+      if (options.fd_jdot)
+        net->calcJacobianDotFd(ws.X, ws.Xdot, options.fd_eps > 0.0 ? options.fd_eps : 1e-6, ws.Y, ws.J, ws.Jdot, ws.mlp);
+      else
+        net->calcJacobianDot(ws.X, ws.Xdot, ws.Y, ws.J, ws.Jdot, ws.mlp);
+    } else {
+      net->calcJacobian(ws.X, ws.Y, ws.J, ws.mlp);
+    }
+    for (int k = 0; k < n; ++k) {
+      // w = R y(u): Jw = dy/du, Jwdot = its derivative along the scaled velocity; alpha is not
+      // scaled, so dw/dalpha = R dy/dalpha (header)
+      out.x[k] = R * ws.Y.col(k);
+      out.J[k] = ws.J.block<3, 6>(0, 8 * k);
+      if (with_jdot) out.Jdot[k] = ws.Jdot.block<3, 6>(0, 8 * k);
+      else out.Jdot[k].setZero();
+      if (x_alpha) (*x_alpha)[k] = R * ws.J.col(8 * k + 6);
+      if (x_alphadot) (*x_alphadot)[k] = with_jdot ? Vec3(R * ws.Jdot.col(8 * k + 6)) : Vec3::Zero();
+    }
+    out.used_network = true;
+    return ev;
+  }
+
+  out.used_network = false;
+  const Vec3 v1 = with_jdot ? p1dot : Vec3::Zero(), v2 = with_jdot ? p2dot : Vec3::Zero();
+  bool moving_alpha = false;
+  for (int k = 0; k < n; ++k) moving_alpha = moving_alpha || alphadot(k) != 0.0;
+  for (int k = 0; k < n; ++k) {
+    if (x_alpha || x_alphadot || moving_alpha) {
+      // the fraction as a seventh input of the smooth model
+      const SmoothWrapSegmentPoint sp =
+          calcSmoothWrapSegmentPoint(surface, p1, p2, alphas[k], v1, v2, alphadot(k), options.fallback);
+      out.x[k] = sp.x;
+      out.J[k] = sp.J.leftCols<6>();
+      out.Jdot[k] = sp.Jdot.leftCols<6>();
+      if (x_alpha) (*x_alpha)[k] = sp.J.col(6);
+      if (x_alphadot) (*x_alphadot)[k] = sp.Jdot.col(6);
+    } else {
+      const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(surface, p1, p2, alphas[k], v1, v2, options.fallback);
+      out.x[k] = sp.x;
+      out.J[k] = sp.J;
+      out.Jdot[k] = sp.Jdot;
+    }
+  }
+  return ev;
+}
+
+const NetworkWrapEval& lastNetworkWrapEval() { return last_eval; }
+
+// ---------------------------------------------------------------------------------------------
+
+WrapFallbackMonitor::WrapFallbackMonitor(Sink sink) : sink_(std::move(sink)) {}
+
+void WrapFallbackMonitor::record(const std::string& muscle, const std::string& wrap, const NetworkWrapEval& e,
+                                 const Mlp* net) {
+  std::string message;
+  Sink sink;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Counts& c = counts_[muscle];
+    ++c.evaluations;
+    if (e.usedNetwork()) return;
+    if (++c.fallbacks > 1) return;
+    c.first = e.describe(net);
+    message = "muscle '" + muscle + "', wrap object '" + wrap +
+              "': the network wrap model fell back to the smooth model (" + c.first +
+              "); further fallbacks of this muscle are counted in the run summary";
+    sink = sink_;
+  }
+  if (sink) sink(message);  // outside the lock: the sink may take its time
+}
+
+void WrapFallbackMonitor::setSink(Sink sink) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  sink_ = std::move(sink);
+}
+
+std::map<std::string, WrapFallbackMonitor::Counts> WrapFallbackMonitor::counts() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return counts_;
+}
+
+long WrapFallbackMonitor::fallbacks(const std::string& muscle) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = counts_.find(muscle);
+  return it == counts_.end() ? 0 : it->second.fallbacks;
+}
+
+long WrapFallbackMonitor::evaluations(const std::string& muscle) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = counts_.find(muscle);
+  return it == counts_.end() ? 0 : it->second.evaluations;
+}
+
+long WrapFallbackMonitor::totalFallbacks() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  long t = 0;
+  for (const auto& [name, c] : counts_) t += c.fallbacks;
+  return t;
+}
+
+std::string WrapFallbackMonitor::summary() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::ostringstream os;
+  for (const auto& [name, c] : counts_) {
+    os << "  " << name << ": " << c.fallbacks << " of " << c.evaluations
+       << " evaluations fell back to the smooth model";
+    if (c.fallbacks > 0) os << " (first: " << c.first << ")";
+    os << "\n";
+  }
+  return os.str();
+}
+
+void WrapFallbackMonitor::reset() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  counts_.clear();
+}
+
+// ---------------------------------------------------------------------------------------------
+
+NetworkWrapEval calcNeuralWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
+                                          const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
+                                          const std::vector<double>& alphas, const std::vector<double>& alphadots,
+                                          bool velocity, WrapMassPoints& out, std::vector<Vec3>* x_alpha,
+                                          std::vector<Vec3>* x_alphadot) {
+  thread_local NetworkWrapWorkspace ws;
+  NetworkWrapOptions o;
+  o.fd_jdot = options.network_fd_jdot;
+  o.fd_eps = options.network_fd_eps > 0.0 ? options.network_fd_eps : 1e-6;
+  o.fallback.width = options.width;
+  return calcNetworkWrapModel(options.network.get(), surface, p1, p2, p1dot, p2dot, alphas, velocity, out, ws, o,
+                              alphadots, x_alpha, x_alphadot);
+}
+
+void recordNeuralWrapEval(const Muscle& muscle, const PathWrap& w) {
+  if (muscle.wrap.model != WrapModel::Neural || !muscle.wrap.monitor) return;
+  muscle.wrap.monitor->record(muscle.name, w.name, lastNetworkWrapEval(), muscle.wrap.network.get());
+}
+
+std::shared_ptr<const Mlp> loadWrapNetwork(const std::string& path) {
+  auto net = std::make_shared<Mlp>(Mlp::load(path));
+  const std::string why = networkWrapUnsupportedReason(*net);
+  if (!why.empty()) throw std::runtime_error(path + ": not a wrap network: " + why);
+  return net;
+}
+
+std::string defaultWrapNetworkPath(const std::string& source_dir, WrapType type) {
+  if (type != WrapType::Cylinder && type != WrapType::Sphere) return "";
+  const std::filesystem::path p =
+      std::filesystem::path(source_dir) / "osim_models" / "networks" / (wrapTypeName(type) + "_3x64.txt");
+  std::error_code ec;
+  return std::filesystem::is_regular_file(p, ec) ? p.string() : "";
+}
+
+double calcNetworkWrapPathLength(const Mlp* net, const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                                 int segments, NetworkWrapWorkspace& ws, NetworkWrapEval* eval,
+                                 const NetworkWrapOptions& options) {
+  if (segments < 1) throw std::invalid_argument("network wrap length: segments must be >= 1");
+  std::vector<double> alphas(segments + 1);
+  for (int k = 0; k <= segments; ++k) alphas[k] = static_cast<double>(k) / segments;
+  WrapMassPoints pts;
+  const NetworkWrapEval ev =
+      calcNetworkWrapModel(net, surface, p1, p2, Vec3::Zero(), Vec3::Zero(), alphas, false, pts, ws, options);
+  if (eval) *eval = ev;
+  // the ends are the attachments themselves (the network's alpha = 0, 1 outputs only approximate them)
+  pts.x.front() = p1;
+  pts.x.back() = p2;
+  double L = 0.0;
+  for (int k = 0; k < segments; ++k) L += (pts.x[k + 1] - pts.x[k]).norm();
+  return L;
+}
+
+}  // namespace redmax
