@@ -13,7 +13,7 @@ void calcMuscleKinematics(const Model& model, const State& state, const Skeleton
   calcPathPoints(model, state, sk, muscle.path, mk, velocity);
   if (mp.size() == 0) return;
   if (wrapping) {
-    calcWrapMassPoints(model, sk, muscle, mk);
+    calcWrapMassPoints(model, state, sk, muscle, mk);
     return;
   }
   calcMassPointStage(mp, mk, muscle.name);

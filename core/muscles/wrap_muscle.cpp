@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "core/muscles/path_kinematics.hpp"
+#include "core/muscles/via_point.hpp"
+#include "core/muscles/wrap/wrap_path.hpp"
+#include "core/skeleton/kinematics.hpp"
 #include "core/spatial/se3.hpp"
 
 namespace redmax {
@@ -46,6 +50,131 @@ void exactPoints(const WrapSurface& surface, const Vec3& a, const Vec3& b, const
   for (size_t k = 0; k < alphas.size(); ++k) xs[k] = calcWrappedPathPoint(surface, r, a, b, alphas[k]);
 }
 
+// OpenSim's 1-based range of a PathWrap as 0-based first and last point indices (< 1: the ends)
+void wrapRange(const PathWrap& w, int np, int& lo, int& hi) {
+  lo = w.range_begin < 1 ? 0 : w.range_begin - 1;
+  hi = w.range_end < 1 ? np - 1 : std::min(w.range_end - 1, np - 1);
+}
+
+// the candidate segments [first, last) of wrap w over the active points (OpenSim's applyWrapObjects:
+// from the first active point at/after the range's begin to the last one at/before its end)
+bool wrapSegments(const PathWrap& w, const MuscleKinematics& mk, int np, int& first, int& last) {
+  int lo = 0, hi = 0;
+  wrapRange(w, np, lo, hi);
+  const int P = static_cast<int>(mk.active.size());
+  first = -1;
+  last = -1;
+  for (int i = 0; i < P; ++i) {
+    if (first < 0 && mk.active[i] >= lo) first = i;
+    if (mk.active[i] <= hi) last = i;
+  }
+  return first >= 0 && last > first;
+}
+
+// pose and motion of one wrap surface frame, Jacobians in mk's compact columns [D Eq. 5.39-5.41]
+struct SurfaceMotion {
+  Mat3 R = Mat3::Identity();
+  Vec3 p = Vec3::Zero();
+  MatX J_om, J_p, Jdot_om, Jdot_p;
+  Vec3 omega = Vec3::Zero(), pdot = Vec3::Zero();
+};
+
+void calcSurfaceMotion(const Model& model, const SkeletonWorkspace& sk, const PathWrap& w, const MuscleKinematics& mk,
+                       bool vel, SurfaceMotion& sm) {
+  const int k = static_cast<int>(mk.cols.size());
+  const int b = w.body;
+  const Mat4 E_ws = b >= 0 ? Mat4(sk.E_wi[b] * w.E_bs) : w.E_bs;
+  sm.R = E_ws.topLeftCorner<3, 3>();
+  sm.p = E_ws.topRightCorner<3, 1>();
+  sm.J_om.setZero(3, k);
+  sm.J_p.setZero(3, k);
+  sm.Jdot_om.setZero(3, k);
+  sm.Jdot_p.setZero(3, k);
+  sm.omega.setZero();
+  sm.pdot.setZero();
+  if (b < 0) return;
+  const Vec3 x_bs = w.E_bs.topRightCorner<3, 1>();
+  const Mat3 R_wb = sk.E_wi[b].topLeftCorner<3, 3>();
+  const Mat3x6 G = R_wb * Gamma(x_bs);  // surface origin's point Jacobian block [D Eq. 5.9]
+  MatX J_mb;
+  gatherBodyRows(model, sk.J_mr, b, mk, J_mb);
+  sm.J_om.noalias() = R_wb * J_mb.topRows<3>();
+  sm.J_p.noalias() = G * J_mb;
+  if (!vel) return;
+  const Vec6& phi = sk.phi[b];
+  const Vec3 omega_b = phi.head<3>();
+  sm.omega = R_wb * omega_b;
+  sm.pdot = G * phi;
+  MatX Jdot_mb;
+  gatherBodyRows(model, sk.Jdot_mr, b, mk, Jdot_mb);
+  // d/dt R_wb = R_wb [omega_b]; x_bs is fixed in the body [D Eq. 5.11]
+  sm.Jdot_om.noalias() = R_wb * (skew(omega_b) * J_mb.topRows<3>() + Jdot_mb.topRows<3>());
+  sm.Jdot_p.noalias() = R_wb * (skew(omega_b) * Gamma(x_bs) * J_mb + Gamma(x_bs) * Jdot_mb);
+}
+
+// the ends (active points i, i + 1) of a segment in a surface frame, A_j = dp_j/dq and d/dt
+struct SegmentEnds {
+  Vec3 p1 = Vec3::Zero(), p2 = Vec3::Zero(), p1dot = Vec3::Zero(), p2dot = Vec3::Zero();
+  MatX A1, A2, A1dot, A2dot;
+};
+
+void calcSegmentEnds(const SurfaceMotion& sm, const MuscleKinematics& mk, int i, bool vel, SegmentEnds& e) {
+  const Mat3& R = sm.R;
+  const Vec3 r1 = mk.x_w[i] - sm.p, r2 = mk.x_w[i + 1] - sm.p;
+  e.p1 = R.transpose() * r1;
+  e.p2 = R.transpose() * r2;
+  const MatX B1 = mk.J_xr.middleRows<3>(3 * i) - sm.J_p + skew(r1) * sm.J_om;  // R A_1
+  const MatX B2 = mk.J_xr.middleRows<3>(3 * (i + 1)) - sm.J_p + skew(r2) * sm.J_om;
+  e.A1.noalias() = R.transpose() * B1;
+  e.A2.noalias() = R.transpose() * B2;
+  e.p1dot.setZero();
+  e.p2dot.setZero();
+  if (!vel) return;
+  const Vec3 r1dot = mk.xdot_w[i] - sm.pdot, r2dot = mk.xdot_w[i + 1] - sm.pdot;
+  e.p1dot = R.transpose() * (r1dot - sm.omega.cross(r1));
+  e.p2dot = R.transpose() * (r2dot - sm.omega.cross(r2));
+  const Mat3 W = skew(sm.omega);
+  e.A1dot.noalias() = R.transpose() * (-W * B1 + mk.Jdot_xr.middleRows<3>(3 * i) - sm.Jdot_p + skew(r1dot) * sm.J_om +
+                                       skew(r1) * sm.Jdot_om);
+  e.A2dot.noalias() = R.transpose() * (-W * B2 + mk.Jdot_xr.middleRows<3>(3 * (i + 1)) - sm.Jdot_p +
+                                       skew(r2dot) * sm.J_om + skew(r2) * sm.Jdot_om);
+}
+
+// active segment and fraction of its length holding the point at alpha of the wrapped path
+void locateOnWrappedPath(const WrappedPath& wp, double alpha, int& segment, double& beta) {
+  const size_t n = wp.points.size();
+  std::vector<double> piece(n > 0 ? n - 1 : 0);
+  double total = 0.0;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    const auto &a = wp.points[i], &b = wp.points[i + 1];
+    piece[i] = (a.wrap >= 0 && a.wrap == b.wrap) ? wp.results[a.wrap].arcLength() : (b.x_w - a.x_w).norm();
+    total += piece[i];
+  }
+  const double target = std::clamp(alpha, 0.0, 1.0) * total;
+  segment = -1;
+  double seg_start = 0.0, acc = 0.0, seg_len = 0.0;
+  int found = -1;
+  double found_start = 0.0;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    if (wp.points[i].point >= 0) {
+      // a path point opens the next active segment
+      if (found >= 0 && segment == found) break;
+      ++segment;
+      seg_start = acc;
+      seg_len = 0.0;
+    }
+    seg_len += piece[i];
+    if (found < 0 && (target <= acc + piece[i] || i + 2 == n)) {
+      found = segment;
+      found_start = seg_start;
+    }
+    acc += piece[i];
+  }
+  if (found < 0) found = std::max(segment, 0);
+  segment = found;
+  beta = seg_len > 0.0 ? std::clamp((target - found_start) / seg_len, 0.0, 1.0) : 0.0;
+}
+
 }  // namespace
 
 std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
@@ -53,22 +182,37 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
   if (path.wraps.empty())
     return "the path only counts its wrap objects (num_wraps = " + std::to_string(path.num_wraps) +
            ") without describing them";
-  if (path.wraps.size() != 1 || (path.num_wraps != 0 && path.num_wraps != 1))
-    return "inertial Type III muscles support one wrap object per path, this one has " +
-           std::to_string(std::max<int>(static_cast<int>(path.wraps.size()), path.num_wraps));
-  if (path.points.size() != 2)
-    return "inertial Type III muscles support exactly two path points (origin and insertion) around "
-           "the wrap object, this path has " + std::to_string(path.points.size());
-  const PathWrap& w = path.wraps[0];
-  // OpenSim's 1-based range must include the only segment, points 1..2
-  const bool covers = w.range_begin <= 1 && (w.range_end < 1 || w.range_end >= 2);
-  if (!covers)
-    return "wrap object '" + w.name + "' has range " + std::to_string(w.range_begin) + " " +
-           std::to_string(w.range_end) + ", which excludes the origin-insertion segment";
-  if (!w.surface.active) return "wrap object '" + w.name + "' is inactive";
-  if (muscle.wrap.model == WrapModel::Smooth) {
+  const int np = static_cast<int>(path.points.size());
+  for (const PathWrap& w : path.wraps) {
+    int lo = 0, hi = 0;
+    wrapRange(w, np, lo, hi);
+    if (hi <= lo)
+      return "wrap object '" + w.name + "' has range " + std::to_string(w.range_begin) + " " +
+             std::to_string(w.range_end) + ", which excludes " +
+             (np == 2 ? std::string("the origin-insertion segment") : std::string("every segment of the path"));
+  }
+  if (muscle.wrap.model == WrapModel::Exact) return "";  // the whole OpenSim path, any surfaces
+  for (size_t k = 0; k < path.wraps.size(); ++k) {
+    const PathWrap& w = path.wraps[k];
+    if (!w.surface.active) continue;  // never wraps
     const std::string why = smoothWrapUnsupportedReason(w.surface);
     if (!why.empty()) return "the smooth wrap model cannot take wrap object '" + w.name + "': " + why;
+    // two ranges sharing two points can land on one segment: OpenSim then applies both in turn
+    // (and iterates), which the smooth model does not compose
+    int lo = 0, hi = 0;
+    wrapRange(w, np, lo, hi);
+    for (size_t j = 0; j < k; ++j) {
+      const PathWrap& v = path.wraps[j];
+      if (!v.surface.active) continue;
+      int lo2 = 0, hi2 = 0;
+      wrapRange(v, np, lo2, hi2);
+      if (std::min(hi, hi2) > std::max(lo, lo2))
+        return "the smooth wrap model takes one wrap object per segment, but wrap objects '" + v.name + "' and '" +
+               w.name + "' can both act on the segment between path points " + std::to_string(std::max(lo, lo2) + 1) +
+               " and " + std::to_string(std::min(hi, hi2) + 1) +
+               " (OpenSim applies them in turn and iterates; the smooth model does not compose surfaces): use the "
+               "exact model";
+    }
   }
   return "";
 }
@@ -139,111 +283,379 @@ void calcExactWrapPointsFd(const WrapSurface& surface, const Vec3& p1, const Vec
   }
 }
 
+void calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                         const Vec3& p1dot, const Vec3& p2dot, const std::vector<double>& alphas,
+                         const std::vector<double>& alphadots, bool with_alpha, bool velocity, WrapModelPoints& out) {
+  const int n = static_cast<int>(alphas.size());
+  const Vec3 v1 = velocity ? p1dot : Vec3::Zero(), v2 = velocity ? p2dot : Vec3::Zero();
+  auto alphadot = [&](int a) { return velocity && !alphadots.empty() ? alphadots[a] : 0.0; };
+  bool moving_alpha = false;
+  for (int a = 0; a < n; ++a) moving_alpha = moving_alpha || alphadot(a) != 0.0;
+  out.used_network = false;
+  out.x.resize(n);
+  out.J.resize(n);
+  out.Jdot.resize(n);
+  out.x_alpha.assign(with_alpha ? n : 0, Vec3::Zero());
+  out.x_alphadot.assign(with_alpha ? n : 0, Vec3::Zero());
+  switch (options.model) {
+    case WrapModel::Smooth: {
+      SmoothWrapOptions so;
+      so.width = options.width;
+      for (int a = 0; a < n; ++a) {
+        if (with_alpha || moving_alpha) {
+          // the fraction is a seventh input: its rate enters Jdot
+          const SmoothWrapSegmentPoint sp = calcSmoothWrapSegmentPoint(surface, p1, p2, alphas[a], v1, v2, alphadot(a), so);
+          out.x[a] = sp.x;
+          out.J[a] = sp.J.leftCols<6>();
+          out.Jdot[a] = sp.Jdot.leftCols<6>();
+          if (with_alpha) {
+            out.x_alpha[a] = sp.J.col(6);
+            out.x_alphadot[a] = sp.Jdot.col(6);
+          }
+        } else {
+          const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(surface, p1, p2, alphas[a], v1, v2, so);
+          out.x[a] = sp.x;
+          out.J[a] = sp.J;
+          out.Jdot[a] = sp.Jdot;
+        }
+      }
+      return;
+    }
+    case WrapModel::Exact:
+      if (with_alpha || moving_alpha)
+        throw std::logic_error("calcWrapModelPoints: the exact model has no derivative along the fraction");
+      calcExactWrapPointsFd(surface, p1, p2, v1, v2, alphas, out, options.fd_step, velocity);
+      return;
+  }
+  throw std::logic_error("calcWrapModelPoints: unknown wrap model");
+}
+
+SmoothWrapLength calcWrapModelLength(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
+                                     const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot) {
+  SmoothWrapOptions so;
+  so.width = options.width;
+  return calcSmoothWrapLength(surface, p1, p2, p1dot, p2dot, so);
+}
+
+namespace {
+
+bool coversBody(const Model& model, const MuscleKinematics& mk, int b) {
+  if (b < 0) return true;
+  if (static_cast<int>(mk.col_of.size()) != model.nr()) return false;
+  for (int j : model.ancestors(b))
+    if (model.joints[j].nq > 0 && mk.col_of[model.joints[j].q_index] < 0) return false;
+  return true;
+}
+
+void sizeMassPointOutputs(int N, int k, MuscleKinematics& mk) {
+  mk.x_a.resize(N);
+  mk.segment.assign(N, 0);
+  mk.beta.assign(N, 0.0);
+  if (mk.J_ar.rows() != 3 * N || mk.J_ar.cols() != k) mk.J_ar.resize(3 * N, k);
+  if (mk.velocity && (mk.Jdot_ar.rows() != 3 * N || mk.Jdot_ar.cols() != k)) mk.Jdot_ar.resize(3 * N, k);
+}
+
+// the segment construction of the header (smooth model; exact model with one segment and one wrap)
+void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, const Muscle& muscle,
+                               MuscleKinematics& mk) {
+  const MassPoints& mp = muscle.mass_points;
+  const MusclePath& path = muscle.path;
+  const int N = mp.size();
+  const int k = static_cast<int>(mk.cols.size());
+  const int P = static_cast<int>(mk.x_w.size());
+  const int nseg = P - 1;
+  const int np = static_cast<int>(path.points.size());
+  const int nw = static_cast<int>(path.wraps.size());
+  const bool vel = mk.velocity;
+  if (P < 2) throw std::logic_error("calcWrapMassPoints: needs the path stage");
+  const std::string who = "muscle '" + muscle.name + "'";
+
+  // which wrap acts on which segment (header): the candidate penetrating most
+  std::vector<int> seg_wrap(nseg, -1);
+  std::vector<SurfaceMotion> sm(nw);
+  std::vector<char> have_sm(nw, 0);
+  auto motion = [&](int w) -> const SurfaceMotion& {
+    if (!have_sm[w]) {
+      calcSurfaceMotion(model, sk, path.wraps[w], mk, vel, sm[w]);
+      have_sm[w] = 1;
+    }
+    return sm[w];
+  };
+  for (int w = 0; w < nw; ++w) {
+    const PathWrap& pw = path.wraps[w];
+    if (!pw.surface.active) continue;
+    int first = 0, last = 0;
+    if (!wrapSegments(pw, mk, np, first, last)) continue;
+    int best = -1;
+    double best_d = -std::numeric_limits<double>::infinity();
+    for (int i = first; i < last; ++i) {
+      if (seg_wrap[i] >= 0) continue;
+      if (last - first == 1) {
+        best = i;
+        break;
+      }
+      const SurfaceMotion& m = motion(w);
+      const Vec3 p1 = m.R.transpose() * (mk.x_w[i] - m.p), p2 = m.R.transpose() * (mk.x_w[i + 1] - m.p);
+      const double d = calcWrapPenetration(pw.surface, p1, p2);
+      if (d > best_d) {
+        best_d = d;
+        best = i;
+      }
+    }
+    if (best >= 0) seg_wrap[best] = w;
+  }
+  std::vector<SegmentEnds> ends(nseg);
+  for (int i = 0; i < nseg; ++i)
+    if (seg_wrap[i] >= 0) {
+      const int w = seg_wrap[i];
+      if (!coversBody(model, mk, path.wraps[w].body))
+        throw std::logic_error("calcWrapMassPoints: mk's columns do not cover the wrap body (initWrapMuscleColumns)");
+      calcSegmentEnds(motion(w), mk, i, vel, ends[i]);
+    }
+
+  // Eulerian coordinates s_i = S_i / sum L over the segment lengths (header); one segment: (0, 1)
+  mk.s.setZero(P);
+  mk.s[P - 1] = 1.0;
+  mk.J_sr.setZero(P, k);
+  mk.sdot.setZero(P);
+  if (vel) mk.Jdot_sr.setZero(P, k);
+  if (nseg > 1) {
+    VecX L(nseg), Ld = VecX::Zero(nseg);
+    MatX J_L(nseg, k), Jdot_L = MatX::Zero(nseg, k);
+    for (int i = 0; i < nseg; ++i) {
+      if (seg_wrap[i] < 0) {
+        // straight: l = |dx|, dl/dq = dxbar^T (J_{i+1} - J_i) [D Eq. 5.18-5.19, 5.27-5.28]
+        const Vec3& u = mk.dxbar[i];
+        const auto dJ = mk.J_xr.middleRows<3>(3 * (i + 1)) - mk.J_xr.middleRows<3>(3 * i);
+        L[i] = mk.l[i];
+        J_L.row(i).noalias() = u.transpose() * dJ;
+        if (vel && L[i] > 0.0) {
+          const Vec3 dv = mk.xdot_w[i + 1] - mk.xdot_w[i];
+          const Vec3 ud = (Mat3::Identity() - u * u.transpose()) * dv / L[i];
+          Ld[i] = u.dot(dv);
+          Jdot_L.row(i).noalias() = ud.transpose() * dJ;
+          Jdot_L.row(i).noalias() +=
+              u.transpose() * (mk.Jdot_xr.middleRows<3>(3 * (i + 1)) - mk.Jdot_xr.middleRows<3>(3 * i));
+        }
+      } else {
+        const int w = seg_wrap[i];
+        const SegmentEnds& e = ends[i];
+        SmoothWrapLength sl;
+        try {
+          sl = calcWrapModelLength(muscle.wrap, path.wraps[w].surface, e.p1, e.p2, e.p1dot, e.p2dot);
+        } catch (const std::invalid_argument& ex) {
+          throw MuscleError(who + ", wrap object '" + path.wraps[w].name + "': " + ex.what());
+        }
+        L[i] = sl.length;
+        J_L.row(i).noalias() = sl.J.leftCols<3>() * e.A1 + sl.J.rightCols<3>() * e.A2;
+        if (vel) {
+          Ld[i] = sl.J.leftCols<3>().dot(e.p1dot) + sl.J.rightCols<3>().dot(e.p2dot);
+          Jdot_L.row(i).noalias() = sl.Jdot.leftCols<3>() * e.A1 + sl.Jdot.rightCols<3>() * e.A2 +
+                                    sl.J.leftCols<3>() * e.A1dot + sl.J.rightCols<3>() * e.A2dot;
+        }
+      }
+    }
+    const double Lam = L.sum();
+    for (int i = 0; i < nseg; ++i)
+      if (!(L[i] > 1e-12 * (1.0 + Lam)))
+        throw MuscleError(who + ": path segment " + std::to_string(i) + " (between active points " +
+                          std::to_string(mk.active[i]) + " and " + std::to_string(mk.active[i + 1]) +
+                          ") has zero length here; mass points need distinct consecutive path points");
+    const Eigen::RowVectorXd J_Lam = J_L.colwise().sum();
+    const double Lamdot = Ld.sum();
+    const Eigen::RowVectorXd Jdot_Lam = Jdot_L.colwise().sum();
+    double S = 0.0, Sdot = 0.0;
+    Eigen::RowVectorXd J_S = Eigen::RowVectorXd::Zero(k), Jdot_S = Eigen::RowVectorXd::Zero(k);
+    for (int i = 1; i < P - 1; ++i) {
+      S += L[i - 1];
+      J_S += J_L.row(i - 1);
+      // s_i Lam = S_i, differentiated once and twice (header)
+      mk.s[i] = S / Lam;
+      mk.J_sr.row(i) = (J_S - mk.s[i] * J_Lam) / Lam;
+      if (!vel) continue;
+      Sdot += Ld[i - 1];
+      Jdot_S += Jdot_L.row(i - 1);
+      mk.sdot[i] = (Sdot - mk.s[i] * Lamdot) / Lam;
+      mk.Jdot_sr.row(i) = (Jdot_S - mk.s[i] * Jdot_Lam - mk.sdot[i] * J_Lam - Lamdot * mk.J_sr.row(i)) / Lam;
+    }
+  }
+
+  // mass points: segment, beta and betadot [D Eq. 5.29, 5.31]
+  sizeMassPointOutputs(N, k, mk);
+  std::vector<double> betadot(N, 0.0);
+  for (int a = 0; a < N; ++a) {
+    const double s_a = mp.alpha[a];
+    int i = 0;
+    while (i < P - 2 && mk.s[i + 1] <= s_a) ++i;
+    const double ds = mk.s[i + 1] - mk.s[i];
+    mk.segment[a] = i;
+    mk.beta[a] = (s_a - mk.s[i]) / ds;
+    if (vel) betadot[a] = -((1.0 - mk.beta[a]) * mk.sdot[i] + mk.beta[a] * mk.sdot[i + 1]) / ds;
+  }
+
+  // straight segments: Type II's EOL construction (via_point.hpp) with these s
+  MatX J_zr(8, k), Jdot_zr(8, k);
+  for (int a = 0; a < N; ++a) {
+    const int i = mk.segment[a];
+    if (seg_wrap[i] >= 0) continue;
+    const double beta = mk.beta[a];
+    const double ds = mk.s[i + 1] - mk.s[i];
+    const Vec3 F = (mk.x_w[i + 1] - mk.x_w[i]) / ds;  // [D Eq. 5.33]
+    mk.x_a[a] = (1.0 - beta) * mk.x_w[i] + beta * mk.x_w[i + 1];  // [D Eq. 5.30]
+    J_zr.topRows<3>() = mk.J_xr.middleRows<3>(3 * i);
+    J_zr.middleRows<3>(3) = mk.J_xr.middleRows<3>(3 * (i + 1));
+    J_zr.row(6) = mk.J_sr.row(i);
+    J_zr.row(7) = mk.J_sr.row(i + 1);
+    const Eigen::Matrix<double, 3, 8> J_az = calcJ_az(beta, F);  // [D Eq. 5.34, 5.36]
+    mk.J_ar.middleRows<3>(3 * a).noalias() = J_az * J_zr;
+    if (!vel) continue;
+    const Vec3 Fdot = (mk.xdot_w[i + 1] - mk.xdot_w[i] - F * (mk.sdot[i + 1] - mk.sdot[i])) / ds;
+    Jdot_zr.topRows<3>() = mk.Jdot_xr.middleRows<3>(3 * i);
+    Jdot_zr.middleRows<3>(3) = mk.Jdot_xr.middleRows<3>(3 * (i + 1));
+    Jdot_zr.row(6) = mk.Jdot_sr.row(i);
+    Jdot_zr.row(7) = mk.Jdot_sr.row(i + 1);
+    mk.Jdot_ar.middleRows<3>(3 * a).noalias() = calcJdot_az(beta, betadot[a], F, Fdot) * J_zr;
+    mk.Jdot_ar.middleRows<3>(3 * a).noalias() += J_az * Jdot_zr;
+  }
+
+  // wrapped segments: one batch per segment through the dispatch, then the chain rule (header)
+  const bool moving_beta = nseg > 1;
+  std::vector<int> idx;
+  std::vector<double> betas, betadots;
+  WrapModelPoints wp;
+  for (int i = 0; i < nseg; ++i) {
+    const int w = seg_wrap[i];
+    if (w < 0) continue;
+    idx.clear();
+    betas.clear();
+    betadots.clear();
+    for (int a = 0; a < N; ++a)
+      if (mk.segment[a] == i) {
+        idx.push_back(a);
+        betas.push_back(mk.beta[a]);
+        betadots.push_back(betadot[a]);
+      }
+    if (idx.empty()) continue;
+    const PathWrap& pw = path.wraps[w];
+    const SurfaceMotion& m = motion(w);
+    const SegmentEnds& e = ends[i];
+    try {
+      calcWrapModelPoints(muscle.wrap, pw.surface, e.p1, e.p2, e.p1dot, e.p2dot, betas, betadots, moving_beta, vel, wp);
+    } catch (const std::invalid_argument& ex) {
+      throw MuscleError(who + ", wrap object '" + pw.name + "': " + ex.what());
+    }
+    const Mat3& R = m.R;
+    const double ds = mk.s[i + 1] - mk.s[i];
+    for (size_t j = 0; j < idx.size(); ++j) {
+      const int a = idx[j];
+      const double beta = betas[j];
+      const Vec3 Rw = R * wp.x[j];
+      mk.x_a[a] = Rw + m.p;
+      const Mat3 Jw1 = wp.J[j].leftCols<3>(), Jw2 = wp.J[j].rightCols<3>();
+      MatX JwA = Jw1 * e.A1 + Jw2 * e.A2;  // dw/dq in the surface frame
+      Eigen::RowVectorXd J_b;
+      if (moving_beta) {
+        // beta (ds) = alpha - s_i
+        J_b = -((1.0 - beta) * mk.J_sr.row(i) + beta * mk.J_sr.row(i + 1)) / ds;
+        JwA.noalias() += wp.x_alpha[j] * J_b;
+      }
+      mk.J_ar.middleRows(3 * a, 3).noalias() = R * JwA - skew(Rw) * m.J_om + m.J_p;
+      if (!vel) continue;
+      Vec3 wdot = Jw1 * e.p1dot + Jw2 * e.p2dot;
+      const Mat3 Jw1dot = wp.Jdot[j].leftCols<3>(), Jw2dot = wp.Jdot[j].rightCols<3>();
+      MatX inner = Jw1dot * e.A1 + Jw2dot * e.A2 + Jw1 * e.A1dot + Jw2 * e.A2dot;
+      if (moving_beta) {
+        const double bd = betadots[j];
+        const double dsdot = mk.sdot[i + 1] - mk.sdot[i];
+        const Eigen::RowVectorXd Jdot_b = -((1.0 - beta) * mk.Jdot_sr.row(i) + beta * mk.Jdot_sr.row(i + 1) + dsdot * J_b +
+                                 bd * (mk.J_sr.row(i + 1) - mk.J_sr.row(i))) / ds;
+        wdot += wp.x_alpha[j] * bd;
+        inner.noalias() += wp.x_alphadot[j] * J_b + wp.x_alpha[j] * Jdot_b;
+      }
+      const Vec3 Rwdot = m.omega.cross(Rw) + R * wdot;
+      mk.Jdot_ar.middleRows(3 * a, 3).noalias() =
+          skew(m.omega) * R * JwA + R * inner - skew(Rwdot) * m.J_om - skew(Rw) * m.Jdot_om + m.Jdot_p;
+    }
+  }
+}
+
+// the exact model on any path: OpenSim's whole wrapped path, J and Jdot by differences in q (header)
+void calcExactPathMassPointsFd(const Model& model, const State& state, const Muscle& muscle, MuscleKinematics& mk) {
+  const MassPoints& mp = muscle.mass_points;
+  const int N = mp.size();
+  const int k = static_cast<int>(mk.cols.size());
+  const bool vel = mk.velocity;
+  sizeMassPointOutputs(N, k, mk);
+  std::vector<Mat4> E_wi;
+  auto eval = [&](const VecX& q, std::vector<Vec3>& xs, bool locate) {
+    calcBodyPoses(model, q, E_wi);
+    const WrappedPath wp = calcWrappedPath(model, muscle.path, q, E_wi);
+    xs.resize(N);
+    for (int a = 0; a < N; ++a) {
+      xs[a] = calcWrappedPathPointWorld(muscle.path, wp, E_wi, mp.alpha[a]);
+      if (locate) locateOnWrappedPath(wp, mp.alpha[a], mk.segment[a], mk.beta[a]);
+    }
+  };
+  eval(state.q, mk.x_a, true);
+  // steps in q (rad or m): central differences for J, a wider mixed stencil for Jdot (its error
+  // is divided by the product of two steps, see calcExactWrapPointsFd)
+  const double h = 1e-6, s = 2e-4;
+  std::vector<Vec3> xp, xm, xpp, xpm, xmp, xmm;
+  VecX q = state.q;
+  for (int j = 0; j < k; ++j) {
+    const int c = mk.cols[j];
+    q[c] = state.q[c] + h;
+    eval(q, xp, false);
+    q[c] = state.q[c] - h;
+    eval(q, xm, false);
+    q[c] = state.q[c];
+    for (int a = 0; a < N; ++a) mk.J_ar.block<3, 1>(3 * a, j) = (xp[a] - xm[a]) / (2.0 * h);
+  }
+  if (!vel) return;
+  mk.Jdot_ar.setZero();
+  VecX v = VecX::Zero(state.q.size());
+  for (int j = 0; j < k; ++j) v[mk.cols[j]] = state.qdot[mk.cols[j]];
+  const double speed = v.norm();
+  if (!(speed > 0.0)) return;
+  const double tau = s / speed;
+  for (int j = 0; j < k; ++j) {
+    const int c = mk.cols[j];
+    VecX e = VecX::Zero(state.q.size());
+    e[c] = s;
+    eval(state.q + e + tau * v, xpp, false);
+    eval(state.q + e - tau * v, xpm, false);
+    eval(state.q - e + tau * v, xmp, false);
+    eval(state.q - e - tau * v, xmm, false);
+    for (int a = 0; a < N; ++a)
+      mk.Jdot_ar.block<3, 1>(3 * a, j) = (xpp[a] - xpm[a] - xmp[a] + xmm[a]) / (4.0 * s * tau);
+  }
+}
+
+// origin -> one surface -> insertion: the exact model's end-point differences (the dissertation's)
+bool isSingleSegmentShape(const Muscle& muscle) {
+  return muscle.path.points.size() == 2 && muscle.path.wraps.size() == 1;
+}
+
+}  // namespace
+
+void calcWrapMassPoints(const Model& model, const State& state, const SkeletonWorkspace& sk, const Muscle& muscle,
+                        MuscleKinematics& mk) {
+  const std::string why = wrapMassPointsUnsupportedReason(muscle);
+  if (!why.empty()) throw std::logic_error("muscle '" + muscle.name + "': " + why);
+  if (muscle.wrap.model == WrapModel::Exact && !isSingleSegmentShape(muscle)) {
+    calcExactPathMassPointsFd(model, state, muscle, mk);
+    return;
+  }
+  calcSegmentWrapMassPoints(model, sk, muscle, mk);
+}
+
 void calcWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, const Muscle& muscle, MuscleKinematics& mk) {
   const std::string why = wrapMassPointsUnsupportedReason(muscle);
   if (!why.empty()) throw std::logic_error("muscle '" + muscle.name + "': " + why);
-  if (mk.x_w.size() != 2) throw std::logic_error("calcWrapMassPoints: needs the path stage of a two-point path");
-  const MassPoints& mp = muscle.mass_points;
-  const PathWrap& w = muscle.path.wraps[0];
-  const int N = mp.size();
-  const int k = static_cast<int>(mk.cols.size());
-  const int b = w.body;
-  const bool vel = mk.velocity;
-  if (b >= 0 && (static_cast<int>(mk.col_of.size()) != model.nr() || [&] {
-        for (int j : model.ancestors(b))
-          if (model.joints[j].nq > 0 && mk.col_of[model.joints[j].q_index] < 0) return true;
-        return false;
-      }()))
-    throw std::logic_error("calcWrapMassPoints: mk's columns do not cover the wrap body (initWrapMuscleColumns)");
-
-  // surface pose E_ws = E_wb E_bs and the body's motion [D Eq. 5.39-5.41]
-  const Mat4 E_ws = b >= 0 ? Mat4(sk.E_wi[b] * w.E_bs) : w.E_bs;
-  const Mat3 R = E_ws.topLeftCorner<3, 3>();
-  const Vec3 p = E_ws.topRightCorner<3, 1>();
-  const Vec3 x_bs = w.E_bs.topRightCorner<3, 1>();
-  MatX J_om = MatX::Zero(3, k), J_p = MatX::Zero(3, k), Jdot_om = MatX::Zero(3, k), Jdot_p = MatX::Zero(3, k);
-  Vec3 omega = Vec3::Zero(), pdot = Vec3::Zero();
-  if (b >= 0) {
-    const Mat3 R_wb = sk.E_wi[b].topLeftCorner<3, 3>();
-    const Mat3x6 G = R_wb * Gamma(x_bs);  // surface origin's point Jacobian block [D Eq. 5.9]
-    MatX J_mb;
-    gatherBodyRows(model, sk.J_mr, b, mk, J_mb);
-    J_om.noalias() = R_wb * J_mb.topRows<3>();
-    J_p.noalias() = G * J_mb;
-    if (vel) {
-      const Vec6& phi = sk.phi[b];
-      const Vec3 omega_b = phi.head<3>();
-      omega = R_wb * omega_b;
-      pdot = G * phi;
-      MatX Jdot_mb;
-      gatherBodyRows(model, sk.Jdot_mr, b, mk, Jdot_mb);
-      // d/dt R_wb = R_wb [omega_b]; x_bs is fixed in the body [D Eq. 5.11]
-      Jdot_om.noalias() = R_wb * (skew(omega_b) * J_mb.topRows<3>() + Jdot_mb.topRows<3>());
-      Jdot_p.noalias() = R_wb * (skew(omega_b) * Gamma(x_bs) * J_mb + Gamma(x_bs) * Jdot_mb);
-    }
-  }
-
-  // end points in the surface frame and their Jacobians A_i = dp_i/dq
-  const Vec3 r1 = mk.x_w[0] - p, r2 = mk.x_w[1] - p;
-  const Vec3 p1 = R.transpose() * r1, p2 = R.transpose() * r2;
-  const auto J_x1 = mk.J_xr.topRows<3>();
-  const auto J_x2 = mk.J_xr.middleRows<3>(3);
-  const MatX B1 = J_x1 - J_p + skew(r1) * J_om;  // R A_1
-  const MatX B2 = J_x2 - J_p + skew(r2) * J_om;
-  const MatX A1 = R.transpose() * B1, A2 = R.transpose() * B2;
-  Vec3 p1dot = Vec3::Zero(), p2dot = Vec3::Zero();
-  MatX A1dot, A2dot;
-  if (vel) {
-    const Vec3 r1dot = mk.xdot_w[0] - pdot, r2dot = mk.xdot_w[1] - pdot;
-    p1dot = R.transpose() * (r1dot - omega.cross(r1));
-    p2dot = R.transpose() * (r2dot - omega.cross(r2));
-    const Mat3 W = skew(omega);
-    A1dot = R.transpose() * (-W * B1 + mk.Jdot_xr.topRows<3>() - Jdot_p + skew(r1dot) * J_om + skew(r1) * Jdot_om);
-    A2dot = R.transpose() * (-W * B2 + mk.Jdot_xr.middleRows<3>(3) - Jdot_p + skew(r2dot) * J_om + skew(r2) * Jdot_om);
-  }
-
-  // the wrap model's points in the surface frame [D Eq. 5.38, 5.44]
-  WrapMassPoints wp;
-  try {
-    if (muscle.wrap.model == WrapModel::Smooth) {
-      SmoothWrapOptions so;
-      so.width = muscle.wrap.width;
-      wp.x.resize(N);
-      wp.J.resize(N);
-      wp.Jdot.resize(N);
-      for (int a = 0; a < N; ++a) {
-        const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(w.surface, p1, p2, mp.alpha[a], p1dot, p2dot, so);
-        wp.x[a] = sp.x;
-        wp.J[a] = sp.J;
-        wp.Jdot[a] = sp.Jdot;
-      }
-    } else {
-      calcExactWrapPointsFd(w.surface, p1, p2, p1dot, p2dot, mp.alpha, wp, muscle.wrap.fd_step, vel);
-    }
-  } catch (const std::invalid_argument& e) {
-    throw MuscleError("muscle '" + muscle.name + "', wrap object '" + w.name + "': " + e.what());
-  }
-
-  // chain rule to the reduced coordinates [D Eq. 5.45-5.57]
-  mk.x_a.resize(N);
-  mk.segment.assign(N, 0);
-  mk.beta.resize(N);
-  if (mk.J_ar.rows() != 3 * N || mk.J_ar.cols() != k) mk.J_ar.resize(3 * N, k);
-  if (vel && (mk.Jdot_ar.rows() != 3 * N || mk.Jdot_ar.cols() != k)) mk.Jdot_ar.resize(3 * N, k);
-  for (int a = 0; a < N; ++a) {
-    mk.beta[a] = mp.alpha[a];
-    const Vec3 Rw = R * wp.x[a];
-    mk.x_a[a] = Rw + p;
-    const Mat3 Jw1 = wp.J[a].leftCols<3>(), Jw2 = wp.J[a].rightCols<3>();
-    const MatX JwA = Jw1 * A1 + Jw2 * A2;  // dw/dq in the surface frame
-    mk.J_ar.middleRows(3 * a, 3).noalias() = R * JwA - skew(Rw) * J_om + J_p;
-    if (!vel) continue;
-    const Vec3 Rwdot = omega.cross(Rw) + R * (Jw1 * p1dot + Jw2 * p2dot);
-    const Mat3 Jw1dot = wp.Jdot[a].leftCols<3>(), Jw2dot = wp.Jdot[a].rightCols<3>();
-    mk.Jdot_ar.middleRows(3 * a, 3).noalias() =
-        skew(omega) * R * JwA + R * (Jw1dot * A1 + Jw2dot * A2 + Jw1 * A1dot + Jw2 * A2dot) -
-        skew(Rwdot) * J_om - skew(Rw) * Jdot_om + Jdot_p;
-  }
+  if (muscle.wrap.model == WrapModel::Exact && !isSingleSegmentShape(muscle))
+    throw std::logic_error("calcWrapMassPoints: muscle '" + muscle.name +
+                           "': the exact model on this path needs the state (the overload taking it)");
+  calcSegmentWrapMassPoints(model, sk, muscle, mk);
 }
 
 }  // namespace redmax

@@ -1,34 +1,62 @@
 #pragma once
-// Type III mass points: a muscle whose path wraps over one surface [D Sec. 5.3.3, Eq. 5.38-5.57].
+// Type III mass points: a muscle whose path wraps over surfaces [D Sec. 5.3.3, Eq. 5.38-5.57].
 //
-// Supported shape: origin -> (one wrap surface, on any body or the world) -> insertion, i.e. two
-// path points (fixed or moving) and one PathWrap whose range covers their segment.
-// wrapMassPointsUnsupportedReason() says why another shape is refused (validateMuscle throws it).
+// Supported shapes (wrapMassPointsUnsupportedReason() says why another is refused; validateMuscle
+// throws it): any path points (fixed, conditional, moving) and any wrap objects, with
+//   Smooth  at most one wrap object per segment: no two wrap ranges may share a segment (OpenSim
+//           applies wraps on one segment in turn and iterates; composing two smooth surfaces is
+//           not done), and every active surface a cylinder or a sphere the smooth model takes;
+//   Exact   anything the exact library takes (several wraps on one segment included).
 //
-// Chain rule. The surface frame s moves rigidly with its body b: E_ws = E_wb E_bs (R = R_ws,
-// p = p_ws). The end points in s are p1 = R^T (x_1 - p), p2 = R^T (x_2 - p) [D Eq. 5.39-5.41],
-// the wrap model gives w(p1, p2, alpha) in s with Jw = (Jw1, Jw2) = dw/d(p1, p2) [D Eq. 5.38,
-// 5.44], and the mass point is x_a = R w + p. With omega the body's angular velocity (world),
-// J_om = R_wb J_mr(b, omega rows) and J_p = R_wb Gamma(x_bs) J_mr(b) the surface origin's point
-// Jacobian (x_bs = E_bs's translation) [D Eq. 5.8-5.9]:
+// Segments. The active path points split the path into segments (i, i+1). A wrap object acts on
+// one segment within its range: Smooth picks the candidate segment whose straight line penetrates
+// the surface most (OpenSim tries every segment of the range and keeps a mandatory wrap or the
+// smallest length change; the two agree whenever one segment meets the surface, and the choice
+// only switches where the penetrations are equal, which is continuous while both are <= 0).
+// Segment lengths L_i: straight |x_{i+1} - x_i|, or the wrap model's length of the wrapped segment
+// (smooth: exact wrapped length outside the band, blended inside). Mass points keep their arc
+// fraction alpha of the whole length: s_i = (L_0 + ... + L_{i-1}) / sum L (Eulerian coordinates of
+// the path points, as Type II's equal strain gives over a polyline, core/muscles/via_point.hpp);
+// a point with s_i <= alpha < s_{i+1} sits at beta = (alpha - s_i) / (s_{i+1} - s_i) of its
+// segment [D Eq. 5.29]. J_s, Jdot_s follow from differentiating s_i = S_i / sum L.
+//   straight segment  x_a = (1 - beta) x_i + beta x_{i+1}, J_ar = J_az J_zr with via_point's
+//                     calcJ_az / calcJdot_az [D Eq. 5.30-5.36] (EOL sliding across via points);
+//   wrapped segment   x_a = R w(p1, p2, beta) + p over its surface (below), beta moving with
+//                     J_beta = -((1 - beta) J_s_i + beta J_s_{i+1}) / Delta s.
+//
+// Chain rule through a surface. The surface frame s moves rigidly with its body b: E_ws = E_wb
+// E_bs (R = R_ws, p = p_ws). The segment's ends in s are p1 = R^T (x_i - p), p2 = R^T (x_{i+1} - p)
+// [D Eq. 5.39-5.41], the wrap model gives w(p1, p2, beta) in s with Jw = (Jw1, Jw2) = dw/d(p1, p2)
+// and w_b = dw/dbeta [D Eq. 5.38, 5.44], and the mass point is x_a = R w + p. With omega the body's
+// angular velocity (world), J_om = R_wb J_mr(b, omega rows) and J_p = R_wb Gamma(x_bs) J_mr(b) the
+// surface origin's point Jacobian (x_bs = E_bs's translation) [D Eq. 5.8-5.9]:
 //   A_i   = dp_i/dq = R^T (J_xi - J_p + [x_i - p] J_om)                          (i = 1, 2)
-//   J_ar  = R (Jw1 A_1 + Jw2 A_2) - [R w] J_om + J_p           J_ori, J_ins, J_base [D Eq. 5.45-5.50]
-//   Jdot_ar = [omega] R Jw A + R (Jwdot A + Jw Adot) - [d(R w)/dt] J_om - [R w] Jdot_om + Jdot_p
+//   J_ar  = R (Jw1 A_1 + Jw2 A_2 + w_b J_beta) - [R w] J_om + J_p   J_ori, J_ins, J_base [D Eq. 5.45-5.50]
+//   Jdot_ar = [omega] R Jw' + R (Jwdot A + Jw Adot + w_bdot J_beta + w_b Jdot_beta) - [d(R w)/dt] J_om
+//             - [R w] Jdot_om + Jdot_p,     Jw' = Jw A + w_b J_beta
 //   Adot_i = R^T (-[omega] (J_xi - J_p + [r_i] J_om) + Jdot_xi - Jdot_p + [rdot_i] J_om + [r_i] Jdot_om)
-// with r_i = x_i - p, d(R w)/dt = omega x R w + R Jw (p1dot, p2dot), Jwdot = dJw/dt along
-// (p1dot, p2dot) = A qdot [D Eq. 5.51-5.57]. A world surface has J_om = J_p = 0.
+// with r_i = x_i - p, d(R w)/dt = omega x R w + R (Jw (p1dot, p2dot) + w_b betadot), and Jwdot,
+// w_bdot the time derivatives along (p1dot, p2dot, betadot) [D Eq. 5.51-5.57]. A world surface has
+// J_om = J_p = 0. With two path points and one wrap (origin -> surface -> insertion) beta = alpha
+// and J_beta = 0: the dissertation's case.
 //
 // Wrap models (Muscle::wrap):
 //   Smooth (default)  core/muscles/wrap/smooth.hpp: exact wrapped path away from the contact
 //                     change, C2 blend across it; J and Jdot exact (dual numbers). The mass matrix
 //                     is continuous, so the energy is conserved to integrator error.
-//   Exact             the exact library (core/muscles/wrap/wrap_surface.hpp), J by central finite
-//                     differences on the end points and Jdot by central differences of that J
-//                     along (p1dot, p2dot) (the dissertation's route, [D Eq. 5.58]). Positions are
-//                     continuous at a contact change but J jumps there, so the kinetic energy
-//                     jumps: the dissertation's motivation for a smooth model.
-// Columns: a wrap surface on a body that moves neither end point adds its body's coordinates to
-// the muscle's compact columns (initWrapMuscleColumns; calcMuscleKinematics calls it).
+//   Exact             the exact library (core/muscles/wrap/wrap_surface.hpp). Origin -> one
+//                     surface -> insertion: J by central differences on the end points and Jdot by
+//                     central differences of that J along (p1dot, p2dot) (the dissertation's route,
+//                     [D Eq. 5.58]). Any other shape: the whole path as OpenSim computes it
+//                     (core/muscles/wrap/wrap_path.hpp: the segment each wrap lands on, several
+//                     wraps on one segment, OpenSim's passes) with x_a at alpha of its geometric
+//                     length, J by central differences in q and Jdot by mixed central differences
+//                     along qdot. Positions are continuous at a contact change but J jumps there,
+//                     so the kinetic energy jumps: the dissertation's motivation for a smooth model.
+// Dispatch: calcWrapModelPoints() is the one place where a surface-frame wrap model is chosen
+// (p1, p2, fractions -> w, Jw, Jwdot); a new model (e.g. a network) hooks in there.
+// Columns: a wrap surface on a body that moves no path point adds its body's coordinates to the
+// muscle's compact columns (initWrapMuscleColumns; calcMuscleKinematics calls it).
 #include <string>
 #include <vector>
 
@@ -39,8 +67,8 @@
 
 namespace redmax {
 
-/// "" when `muscle`'s path has the supported Type III shape for mass points (header) and its
-/// surface fits muscle.wrap.model, else a sentence saying why not.
+/// "" when `muscle`'s path is a supported Type III shape for mass points (header) under
+/// muscle.wrap.model, else a sentence saying why not.
 std::string wrapMassPointsUnsupportedReason(const Muscle& muscle);
 
 /// Make mk's compact columns cover every coordinate that moves the path's points or its wrap
@@ -48,15 +76,43 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle);
 void initWrapMuscleColumns(const Model& model, const Muscle& muscle, MuscleKinematics& mk);
 
 /// Mass points of a supported Type III muscle after calcPathPoints (mk.x_w, J_xr; with
-/// mk.velocity also xdot_w, Jdot_xr): x_a (world), J_ar and (with mk.velocity) Jdot_ar in mk's
-/// compact columns; segment = 0 and beta = alpha. Needs the columns of initWrapMuscleColumns and
-/// the skeleton workspace of the same state. Throws MuscleError (naming the muscle) when an end
-/// point lies inside the surface or the ends coincide, std::logic_error for an unsupported shape.
+/// mk.velocity also xdot_w, Jdot_xr) for the same state: x_a (world), J_ar and (with mk.velocity)
+/// Jdot_ar in mk's compact columns; segment (between active points segment, segment + 1) and beta
+/// (fraction of that segment's length). Needs the columns of initWrapMuscleColumns and the
+/// skeleton workspace of `state`. Throws MuscleError (naming the muscle) when an end point lies
+/// inside a surface, ends coincide or a segment has zero length, std::logic_error for an
+/// unsupported shape.
+void calcWrapMassPoints(const Model& model, const State& state, const SkeletonWorkspace& sk, const Muscle& muscle,
+                        MuscleKinematics& mk);
+/// The same without the state: enough for the smooth model and for origin -> surface -> insertion;
+/// the exact model on other shapes needs q (std::logic_error).
 void calcWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, const Muscle& muscle,
                         MuscleKinematics& mk);
 
+/// A wrap model's points over one surface (frame s): WrapMassPoints (x, J = dx/d(p1, p2) 3x6, Jdot
+/// = dJ/dt along (p1dot, p2dot, alphadot)) plus, when asked for, the derivative along the fraction.
+struct WrapModelPoints : WrapMassPoints {
+  std::vector<Vec3> x_alpha;     ///< dx/dalpha (m)
+  std::vector<Vec3> x_alphadot;  ///< d/dt dx/dalpha along (p1dot, p2dot, alphadot)
+};
+
+/// THE wrap-model dispatch point: mass points at fractions `alphas` of the wrapped segment p1 -> p2
+/// (frame s) by options.model, moving with (p1dot, p2dot) and fraction rates `alphadots` (empty:
+/// all zero). `with_alpha` also fills x_alpha and x_alphadot (the exact model cannot: it has no
+/// alpha derivative; std::logic_error). Without `velocity` Jdot is zero. Throws
+/// std::invalid_argument for an end point inside the surface or an unsupported surface.
+void calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                         const Vec3& p1dot, const Vec3& p2dot, const std::vector<double>& alphas,
+                         const std::vector<double>& alphadots, bool with_alpha, bool velocity, WrapModelPoints& out);
+
+/// The wrap model's length of the wrapped segment p1 -> p2 (frame s) with dL/d(p1, p2) and its time
+/// derivative (the smooth model's; every model that distributes points over several segments uses
+/// it: the Exact model on such paths goes through the whole OpenSim path instead).
+SmoothWrapLength calcWrapModelLength(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
+                                     const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot);
+
 /// The exact library's points at fractions alphas over one surface (frame s), with J = dx/d(p1, p2)
-/// by central differences of step h (m; <= 0: 1e-6 times the surface size) and, when
+/// by central differences of step h (m; <= 0: 1e-5 times the surface size) and, when
 /// `with_jdot`, Jdot by central differences of J along (p1dot, p2dot) (else zero). calcWrap runs
 /// once per stencil point for all alphas (1 + 12 + 24 calls with Jdot).
 void calcExactWrapPointsFd(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
