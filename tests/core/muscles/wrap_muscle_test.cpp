@@ -226,8 +226,8 @@ TEST(WrapMuscle, ValidationNamesTheUnsupportedShape) {
   two_wraps.wrap.model = WrapModel::Exact;  // the exact model composes them as OpenSim does
   EXPECT_NO_THROW(validateMuscle(m, two_wraps));
   Muscle ellipsoid = pendulumWrapMuscle(WrapModel::Smooth);
-  ellipsoid.path.wraps[0].surface = WrapSurface::makeEllipsoid(Vec3(0.08, 0.1, 0.2));
-  expectThrow(ellipsoid, "ellipsoids are not supported");
+  ellipsoid.path.wraps[0].surface = WrapSurface::makeEllipsoid(Vec3(0.08, 0.1, 0.2), 0, -1);
+  expectThrow(ellipsoid, "quadrant-constrained ellipsoids are not supported");
   Muscle counted = pendulumWrapMuscle(WrapModel::Smooth);
   counted.path.wraps.clear();
   expectThrow(counted, "only counts its wrap objects");
