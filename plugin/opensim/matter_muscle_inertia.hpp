@@ -15,11 +15,16 @@
 //
 // Frames: path points are stations in the core bodies' frames, which are the OpenSim bodies'
 // frames (DESIGN.md §2), so a core body maps to the mobilized body of the OpenSim body of the same
-// name. Only TUs compiled against OpenSim's Simbody include this header (plugin/opensim).
+// name.
+//
+// Simbody comes through plugin/simbody/simbody_include.hpp, whose C++20 fix for index comparisons is
+// needed by Debian's Simbody 3.7 and harmless with OpenSim's newer one (its member operator== is the
+// better match), so the same source compiles against both: in libredmax_opensim against OpenSim's
+// Simbody, and in tests/opensim_matter against Debian's, where it is checked against MuscleInertia.
 #include <string>
 #include <vector>
 
-#include <Simbody.h>
+#include "plugin/simbody/simbody_include.hpp"
 
 #include "core/muscles/mass_points.hpp"
 #include "core/muscles/path_map.hpp"
