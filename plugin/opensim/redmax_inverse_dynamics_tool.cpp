@@ -209,16 +209,21 @@ bool RedmaxInverseDynamicsTool::run() {
       osim::BuildOptions bo;
       bo.simbody_compat = true;
       bo.constraints = false;
-      // top:K ranks over the output frames: q of each frame in the core's order (= OpenSim's)
+      // top:K ranks over the output frames: q of each frame in the core's q order
       std::vector<VecX> samples;
-      for (double t : times) {
-        VecX q(static_cast<Eigen::Index>(description.coordinates.size()));
-        for (size_t k = 0; k < description.coordinates.size(); ++k) {
-          const std::string& name = description.coordinates[k].name;
-          q[static_cast<Eigen::Index>(k)] = splines.contains(name) ? evaluateFunction(splines.get(name), 0, t)
-                                                                   : description.coordinates[k].default_value;
+      if (options.muscles.rfind("top:", 0) == 0) {
+        osim::BuildOptions order_options = bo;
+        order_options.muscles = false;
+        const osim::BuildResult order = osim::buildCoreModel(description, order_options);
+        for (double t : times) {
+          VecX q(order.model.nr());
+          for (int k = 0; k < order.model.nr(); ++k) {
+            const std::string& name = order.model.coordinates[k].name;
+            q[k] = splines.contains(name) ? evaluateFunction(splines.get(name), 0, t)
+                                          : order.model.coordinates[k].default_value;
+          }
+          samples.push_back(q);
         }
-        samples.push_back(q);
       }
       mass = std::make_unique<osim::MuscleMassModel>(osim::applyMuscleMass(description, bo, options, samples));
     } catch (const osim::ConvertError& e) {
