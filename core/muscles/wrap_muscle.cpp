@@ -7,6 +7,7 @@
 
 #include "core/muscles/path_kinematics.hpp"
 #include "core/muscles/via_point.hpp"
+#include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap/wrap_path.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "core/spatial/se3.hpp"
@@ -192,6 +193,11 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
              (np == 2 ? std::string("the origin-insertion segment") : std::string("every segment of the path"));
   }
   if (muscle.wrap.model == WrapModel::Exact) return "";  // the whole OpenSim path, any surfaces
+  if (muscle.wrap.model == WrapModel::Neural)  // a usable network; the smooth model's checks below apply too (fallback)
+    for (const PathWrap& w : path.wraps) {
+      const std::string why = w.surface.active ? neuralWrapUnsupportedReason(muscle.wrap.network.get(), w.surface) : "";
+      if (!why.empty()) return "the neural wrap model cannot take wrap object '" + w.name + "': " + why;
+    }
   for (size_t k = 0; k < path.wraps.size(); ++k) {
     const PathWrap& w = path.wraps[k];
     if (!w.surface.active) continue;  // never wraps
@@ -321,6 +327,10 @@ void calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surf
       }
       return;
     }
+    case WrapModel::Neural:  // the network, or the smooth model outside its training box (wrap/network_model.hpp)
+      calcNeuralWrapModelPoints(options, surface, p1, p2, v1, v2, alphas, alphadots, velocity, out,
+                                with_alpha ? &out.x_alpha : nullptr, with_alpha ? &out.x_alphadot : nullptr);
+      return;
     case WrapModel::Exact:
       if (with_alpha || moving_alpha)
         throw std::logic_error("calcWrapModelPoints: the exact model has no derivative along the fraction");
@@ -541,6 +551,7 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
     const SegmentEnds& e = ends[i];
     try {
       calcWrapModelPoints(muscle.wrap, pw.surface, e.p1, e.p2, e.p1dot, e.p2dot, betas, betadots, moving_beta, vel, wp);
+      recordNeuralWrapEval(muscle, pw);  // Neural: count fallbacks, warn once (wrap/network_model.hpp)
     } catch (const std::invalid_argument& ex) {
       throw MuscleError(who + ", wrap object '" + pw.name + "': " + ex.what());
     }
