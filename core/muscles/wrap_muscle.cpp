@@ -608,9 +608,11 @@ void calcExactPathMassPointsFd(const Model& model, const State& state, const Mus
     }
   };
   eval(state.q, mk.x_a, true);
-  // steps in q (rad or m): central differences for J, a wider mixed stencil for Jdot (its error
-  // is divided by the product of two steps, see calcExactWrapPointsFd)
-  const double h = 1e-6, s = 2e-4;
+  // steps in q (rad or m): central differences for J, a wider mixed stencil for Jdot (its round-off
+  // is divided by the product of two steps: ~1e-16 |x| |qdot| / s^2, 1e-6 here). Not wider: with
+  // several wraps OpenSim's tangency iterations and passes make the path only piecewise smooth at
+  // a fine scale, and a 2e-4 stencil straddled such kinks on Rajagopal's gastrocnemii (O(1) errors)
+  const double h = 1e-6, s = 1e-5;
   std::vector<Vec3> xp, xm, xpp, xpm, xmp, xmm;
   VecX q = state.q;
   for (int j = 0; j < k; ++j) {

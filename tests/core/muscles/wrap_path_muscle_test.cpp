@@ -163,6 +163,76 @@ TEST(WrapPathMuscle, ViaPointAndWrapJacobiansMatchCentralDifferences) {
   EXPECT_GE(in_band, 1);
 }
 
+// the knee muscle with a conditional point on the thigh (active for knee angle q2 in [-0.5, 0.25])
+// and the via point moving with the knee, x_b = (-0.11 + 0.02 q2^2, -0.7 + 0.03 q2, 0)
+Muscle kneeMovingMuscle(WrapModel model) {
+  Muscle mu = kneeMuscle(model);
+  mu.path.points[1] = makeMovingPoint(0, 1,
+                                      {std::make_shared<PolynomialFunction>(std::vector<double>{0.02, 0.0, -0.11}),
+                                       std::make_shared<PolynomialFunction>(std::vector<double>{0.03, -0.7}), nullptr},
+                                      Vec3::Zero(), "moving_via");
+  mu.path.points.insert(mu.path.points.begin() + 1,
+                        makeConditionalPoint(0, Vec3(-0.105, -0.5, 0.01), 1, -0.5, 0.25, "conditional"));
+  return mu;
+}
+
+TEST(WrapPathMuscle, ConditionalAndMovingPointsWithWrapJacobiansMatchCentralDifferences) {
+  const Model m = scenes::doublePendulum();
+  const Muscle mu = kneeMovingMuscle(WrapModel::Smooth);
+  validateMuscle(m, mu);
+  const double width = 0.05 * kKneeRadius;
+  std::mt19937 rng(19);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int count[3] = {0, 0, 0}, active = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    State s;
+    s.q = Vec2(u(rng), 0.2 + 0.5 * u(rng));
+    s.qdot = Vec2(2 * u(rng), 2 * u(rng));
+    if (std::abs(s.q[1] - 0.25) < 1e-3) continue;  // the conditional point switches there
+    const bool cond = s.q[1] <= 0.25 + kConditionalTolerance;
+    const int c = classify(segmentPenetration(m, mu, s, 0, cond ? 2 : 1), width);
+    if (c < 0) continue;
+    ++count[c];
+    active += cond;
+    checkAgainstFd(m, mu, s, 1e-6, std::string(c == 0 ? "straight" : c == 1 ? "band" : "wrapped") +
+                                       (cond ? ", conditional active" : ""));
+  }
+  std::printf("[ measured ] knee-like with conditional + moving points: %d straight, %d band, %d wrapped; conditional "
+              "point active in %d\n",
+              count[0], count[1], count[2], active);
+  EXPECT_GE(count[0], 5);
+  EXPECT_GE(count[2], 5);
+  EXPECT_GE(active, 5);
+}
+
+TEST(WrapPathMuscle, WithoutContactEqualsTheTypeIIConstruction) {
+  // while the straight line misses the surface the wrap model is the straight segment, so the
+  // segment construction must reproduce via_point.hpp's EOL (its own J_sx = -L^-1 DeltaS DeltaXbar)
+  const Model m = scenes::doublePendulum();
+  for (const Muscle& mu : {kneeMuscle(WrapModel::Smooth), kneeMovingMuscle(WrapModel::Smooth)}) {
+    Muscle plain = mu;
+    plain.path.wraps.clear();
+    plain.path.num_wraps = 0;
+    std::mt19937 rng(43);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    int n = 0;
+    for (int trial = 0; trial < 60; ++trial) {
+      State s;
+      s.q = Vec2(u(rng), 0.2 + 0.5 * u(rng));
+      s.qdot = Vec2(2 * u(rng), 2 * u(rng));
+      const MuscleKinematics mk0 = test::evalMuscle(m, plain, s);
+      const int P = static_cast<int>(mk0.x_w.size());
+      if (!(segmentPenetration(m, mu, s, 0, P - 2) < 0.0)) continue;
+      ++n;
+      const MuscleKinematics mk = test::evalMuscle(m, mu, s);
+      for (int a = 0; a < mu.mass_points.size(); ++a) EXPECT_LT((mk.x_a[a] - mk0.x_a[a]).norm(), 1e-14);
+      EXPECT_TRUE(nearRel(mk.J_ar, mk0.J_ar, 1e-12)) << (mk.J_ar - mk0.J_ar).norm();
+      EXPECT_TRUE(nearRel(mk.Jdot_ar, mk0.Jdot_ar, 1e-12)) << (mk.Jdot_ar - mk0.Jdot_ar).norm();
+    }
+    EXPECT_GE(n, 10) << mu.path.points.size();
+  }
+}
+
 TEST(WrapPathMuscle, TwoWrapsOnDifferentSegmentsJacobiansMatchCentralDifferences) {
   const Model m = scenes::revoluteChain(3);
   const Muscle mu = chainTwoWrapMuscle(WrapModel::Smooth);
