@@ -1,6 +1,6 @@
 // Type III mass points on the real models' wrapping muscles (core/muscles/wrap_muscle.hpp): every
-// muscle with wrap objects of subject_walk_armless_18musc, Rajagopal2016 (../shared/opensim) and the
-// running leg (osim_models/) is counted as supported before (origin -> one wrap -> insertion only)
+// muscle with wrap objects of subject_walk_armless_18musc, Rajagopal2016 (../shared/opensim), the
+// running leg and the knee-like double_pendulum_wrap_via (osim_models/) is counted as supported before (origin -> one wrap -> insertion only)
 // and now (smooth model / exact model), then given mass points (smooth where it takes the path, the
 // exact model otherwise) and its J_ar, Jdot_ar checked against central differences near the default
 // pose (a seeded offset of up to 0.1) with a random qdot (seeded). gait10dof18musc has no wrap objects (its gastrocnemius goes
@@ -125,6 +125,15 @@ TEST(WrapPathModels, RunningLegWrappingMusclesGetMassPoints) {
   EXPECT_GT(t.wrapping, 0);
   EXPECT_EQ(t.exact, t.wrapping);
   EXPECT_GE(t.smooth, t.before);
+}
+
+TEST(WrapPathModels, KneeLikeSceneViaPointAndWrapGetsMassPoints) {
+  const Tally t = checkModel(std::string(REDMAX_SOURCE_DIR) + "/osim_models/double_pendulum_wrap_via.osim",
+                             "double_pendulum_wrap_via");
+  EXPECT_EQ(t.wrapping, 1);
+  EXPECT_EQ(t.before, 0);
+  EXPECT_EQ(t.smooth, 1);
+  EXPECT_EQ(t.exact, 1);
 }
 
 TEST(WrapPathModels, SubjectWalkArmlessEveryWrappingMuscleGetsMassPoints) {
