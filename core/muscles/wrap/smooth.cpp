@@ -383,41 +383,62 @@ bool closestParameter(const Vec3& a, const Vec3& q, const std::array<int, 3>& ax
 // closest point to q on the ellipsoid (n = 3) or, in the coordinates axes[0..1], on its
 // cross-section ellipse (n = 2; the third coordinate is kept), refined over T from the library's
 // parameter: g(t) = sum (a_i q_i / (t + a_i^2))^2 - 1 = 0
-template <class T>
-bool closestOnEllipsoid(const Vec3& a, const V3<T>& q, const std::array<int, 3>& axes, int n, V3<T>& x) {
-  double t0;
-  // the library's 2-D iteration uses its last iterate when it does not converge; the 3-D one
-  // leaves its output untouched
-  if (!closestParameter(a, values(q), axes, n, t0) && n == 3) return false;
-  // g and g' at t over any scalar
-  auto newtonStep = [&](const auto& qq, const auto& t) {
-    using S = std::decay_t<decltype(t)>;
-    S g(-1.0), gp(0.0);
-    for (int k = 0; k < n; ++k) {
-      const int i = axes[k];
-      const S e = (a[i] * qq[i]) / (t + a[i] * a[i]);
-      g = g + e * e;
-      gp = gp - 2.0 * e * e / (t + a[i] * a[i]);
-    }
-    return g / gp;
-  };
-  // the library stops at |f| < 1e-9: polish on values first (the steps over T below need a
-  // converged start to give exact second derivatives)
-  const V3<double> qv = constant<double>(values(q));
+// Newton step g / g' of g(t) = sum (a_i q_i / (t + a_i^2))^2 - 1 over any scalar
+template <class S, class Q>
+S closestNewtonStep(const Vec3& a, const Q& q, const std::array<int, 3>& axes, int n, const S& t) {
+  S g(-1.0), gp(0.0);
+  for (int k = 0; k < n; ++k) {
+    const int i = axes[k];
+    const S e = (a[i] * q[i]) / (t + a[i] * a[i]);
+    g = g + e * e;
+    gp = gp - 2.0 * e * e / (t + a[i] * a[i]);
+  }
+  return g / gp;
+}
+
+// the library's parameter, polished on values (the library stops at |f| < 1e-9; the steps over
+// T need a converged start to give exact second derivatives); false where the library's 3-D
+// iteration fails (it then leaves its output untouched; its 2-D one uses the last iterate)
+bool closestParameterPolished(const Vec3& a, const Vec3& q, const std::array<int, 3>& axes, int n, double& t0) {
+  if (!closestParameter(a, q, axes, n, t0) && n == 3) return false;
+  const V3<double> qv = constant<double>(q);
   for (int it = 0; it < 20; ++it) {
-    const double step = newtonStep(qv, t0);
+    const double step = closestNewtonStep(a, qv, axes, n, t0);
     t0 -= step;
     if (!(std::abs(step) > 1e-15 * (1.0 + std::abs(t0)))) break;
   }
+  return true;
+}
+
+// the closest point from a converged parameter: two Newton steps over T
+template <class T>
+V3<T> closestFromParameter(const Vec3& a, const V3<T>& q, const std::array<int, 3>& axes, int n, double t0) {
   T t(t0);
-  for (int step = 0; step < 2; ++step) t = t - newtonStep(q, t);
-  x = q;
+  for (int step = 0; step < 2; ++step) t = t - closestNewtonStep(a, q, axes, n, t);
+  V3<T> x = q;
   for (int k = 0; k < n; ++k) {
     const int i = axes[k];
     x[i] = (a[i] * a[i]) * q[i] / (t + a[i] * a[i]);
   }
+  return x;
+}
+
+template <class T>
+bool closestOnEllipsoid(const Vec3& a, const V3<T>& q, const std::array<int, 3>& axes, int n, V3<T>& x) {
+  double t0;
+  if (!closestParameterPolished(a, values(q), axes, n, t0)) return false;
+  x = closestFromParameter(a, q, axes, n, t0);
   return true;
 }
+
+// the fan's parameters on values, per thread for the last chord: the derivative passes of a
+// point share them
+struct FanParameters {
+  bool used = false;
+  Vec3 a = Vec3::Zero(), r1c = Vec3::Zero(), r1r2 = Vec3::Zero();
+  std::array<double, kFanSamples> t{};
+  std::array<char, kFanSamples> ok{};
+};
 
 // the tangent point from p on the ellipse cut by the plane vs.x + vs4 = 0: the plane, the polar
 // plane of p (sum x_i p_i / a_i^2 = 1, where the tangent plane at x passes through p) and the
@@ -565,10 +586,20 @@ bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, E
   }
   if (value(mub) < kMuBlendMax) {
     const std::array<int, 3> all{0, 1, 2};
+    static thread_local FanParameters fan;
+    const Vec3 r1cv = values(r1c), r1r2v = values(r1r2);
+    if (!fan.used || fan.a != a || fan.r1c != r1cv || fan.r1r2 != r1r2v) {
+      fan.used = true;
+      fan.a = a;
+      fan.r1c = r1cv;
+      fan.r1r2 = r1r2v;
+      for (int i = 1; i < kFanSamples - 1; ++i)
+        fan.ok[i] = closestParameterPolished(a, values(r1c + (static_cast<double>(i) / kFanSamples) * r1r2), all, 3, fan.t[i]);
+    }
     V3<T> v_sum{T(0.0), T(0.0), T(0.0)}, cp = c1;
     for (int i = 1; i < kFanSamples - 1; ++i) {
       const V3<T> svi = r1c + (static_cast<double>(i) / kFanSamples) * r1r2;
-      closestOnEllipsoid(a, svi, all, 3, cp);  // unchanged when it fails, as in the library
+      if (fan.ok[i]) cp = closestFromParameter(a, svi, all, 3, fan.t[i]);  // else unchanged, as in the library
       v_sum = v_sum + normalize(cp - svi);
     }
     const V3<T> tc = (r1c + 0.5 * r1r2) + normalize(v_sum);
