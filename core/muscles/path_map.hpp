@@ -43,4 +43,43 @@ VecX calcMassPointAccelerations(const PathMap& pm, const VecX& xddot);
 /// Stack P points into a 3P vector (x_0; x_1; ...).
 VecX stackPoints(const std::vector<Vec3>& x);
 
+// ---- Type III: one wrapping segment ----------------------------------------------------------
+// The mass points of a segment x1 -> (surface s) -> x2 as a function of its end points and of the
+// surface's pose (R = R_ws, p = p_ws, world), for engines that move the surface themselves (a
+// Simbody frame). With r_i = x_i - p, the end points in s are p_i = R^T r_i, the wrap model gives
+// w(p1, p2, alpha) and Jw = (Jw1, Jw2) in s [D Eq. 5.38, 5.44], and x_a = R w + p [D Eq. 5.39-5.41].
+// The inputs' velocities are v = (xdot1, xdot2, omega, pdot) (12, world; omega the surface's
+// angular velocity, pdot its origin's velocity). With B_i = R Jw_i R^T:
+//   xdot_a  = J v,   J = (B_1, B_2, -[R w] + B_1 [r_1] + B_2 [r_2], I - B_1 - B_2)        (3 x 12)
+//   xddot_a = J vdot + b,  vdot = (xddot1, xddot2, alpha, pddot),
+//   b = w x (w x R w) + 2 w x (R Jw pdot_s) + R Jwdot pdot_s + R Jw pddot_s|_(vdot = 0)
+// with pdot_s = (p1dot, p2dot), p_idot = R^T (rdot_i - w x r_i), pddot_i|_(vdot = 0) =
+// -R^T (w x (rdot_i - w x r_i) + w x rdot_i), rdot_i = xdot_i - pdot, w = omega
+// [D Eq. 5.51-5.57, written in world velocities instead of the reduced coordinates]. The wrap
+// model is the core's (Muscle::wrap, core/muscles/wrap_muscle.hpp): smooth (exact J, Jwdot) or the
+// exact library with finite differences.
+
+/// Velocities of a wrapping segment's inputs (world; m/s, rad/s).
+struct WrapSegmentVelocity {
+  Vec3 xdot1 = Vec3::Zero(), xdot2 = Vec3::Zero();  ///< end points
+  Vec3 omega = Vec3::Zero();                        ///< surface angular velocity
+  Vec3 pdot = Vec3::Zero();                         ///< surface origin velocity
+};
+
+/// Output of calcWrapPathMap for one muscle (N mass points).
+struct WrapPathMap {
+  std::vector<Vec3> x_a;  ///< mass point positions, world                                    (N)
+  MatX J;                 ///< d xdot_a / d v, columns (xdot1, xdot2, omega, pdot)       (3N x 12)
+  VecX bias;              ///< b = xddot_a at vdot = 0 (valid with velocity)                  (3N)
+  bool velocity = false;  ///< true when bias is valid
+};
+
+/// Mass points `mp` of the segment x1 -> surface -> x2 (world) for the surface at pose (R, p)
+/// (world) with wrap model `wrap`; with `v` also the bias. Throws MuscleError naming
+/// `muscle_name` (and the surface) for an end point inside the surface or coinciding ends,
+/// std::invalid_argument for an empty `mp`.
+void calcWrapPathMap(const WrapSurface& surface, const WrapMassOptions& wrap, const MassPoints& mp, const Vec3& x1,
+                     const Vec3& x2, const Mat3& R, const Vec3& p, const WrapSegmentVelocity* v, WrapPathMap& out,
+                     const std::string& muscle_name = "");
+
 }  // namespace redmax

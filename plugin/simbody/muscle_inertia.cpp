@@ -11,6 +11,19 @@ Vec3 fromSimTKVec3(const SimTK::Vec3& v) { return Vec3(v[0], v[1], v[2]); }
 
 }  // namespace
 
+std::string simbodyWrapShapeUnsupportedReason(const Muscle& mu) {
+  if (mu.mass_points.size() == 0 || pathType(mu.path) != PathType::III) return "";
+  const MusclePath& path = mu.path;
+  if (path.wraps.size() != 1 || path.points.size() != 2)
+    return "muscle '" + mu.name + "': the Simbody side carries Type III mass points only for origin -> one wrap "
+           "surface -> insertion (this path has " + std::to_string(path.points.size()) + " points and " +
+           std::to_string(path.wraps.size()) + " wrap objects); use the core";
+  for (const PathPoint& p : path.points)
+    if (p.kind == PathPointKind::Conditional)
+      return "muscle '" + mu.name + "': conditional end point '" + p.name + "' on a wrapping path with mass points";
+  return "";
+}
+
 MuscleInertia::MuscleInertia(const SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles)
     : MuscleInertia(sm, model, std::move(muscles), model.gravity) {}
 
@@ -19,13 +32,18 @@ MuscleInertia::MuscleInertia(const SimbodyModel& sm, const Model& model, std::ve
     : sm_(sm), muscles_(std::move(muscles)), gravity_(gravity) {
   for (int m = 0; m < static_cast<int>(muscles_.size()); ++m) {
     validateMuscle(model, muscles_[m]);
-    // the Simbody side maps mass points from path points only (calcPathMap): no wrap surfaces yet
-    if (muscles_[m].mass_points.size() > 0 && pathType(muscles_[m].path) == PathType::III)
-      throw ModelError("muscle '" + muscles_[m].name + "': has wrap objects (Type III path) and mass points; the "
-                       "Simbody side does not move mass points over wrap surfaces yet (the core does)");
     if (muscles_[m].mass_points.size() == 0) continue;
+    const std::string why = simbodyWrapShapeUnsupportedReason(muscles_[m]);
+    if (!why.empty()) throw ModelError(why);
     Entry e;
     e.muscle = m;
+    // Type III: validateMuscle accepted the supported shape (one wrap surface, two points)
+    if (pathType(muscles_[m].path) == PathType::III) {
+      const PathWrap& w = muscles_[m].path.wraps.at(0);
+      e.wrap = true;
+      e.surface_body = w.body;
+      e.X_bs = toTransform(w.E_bs);
+    }
     entries_.push_back(std::move(e));
   }
   // core coordinate -> Simbody q (Euler angles: the same numbers, possibly another order)
@@ -73,7 +91,26 @@ void MuscleInertia::evaluate(const SimTK::State& state, bool velocity) {
         v += B.getBodyRotation(state) * toSimTKVec3(e.dx_b[i]) * (*qdot)[simbody_q_of_[pt.coordinate]];
       e.xdot[i] = fromSimTKVec3(v);
     }
-    calcPathMap(e.x, velocity ? &e.xdot : nullptr, mu.mass_points, e.map, mu.name);
+    if (!e.wrap) {
+      calcPathMap(e.x, velocity ? &e.xdot : nullptr, mu.mass_points, e.map, mu.name);
+      continue;
+    }
+    // the surface frame S on its body: pose, angular velocity and origin velocity (Ground)
+    if (P != 2) throw MuscleError("muscle '" + mu.name + "': a wrapping muscle needs its two end points active");
+    const SimTK::MobilizedBody& S = e.surface_body >= 0 ? sm_.mobods[e.surface_body] : sm_.matter.getGround();
+    const SimTK::Transform X_GS = S.getBodyTransform(state) * e.X_bs;
+    Mat3 R;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) R(r, c) = X_GS.R()[r][c];
+    WrapSegmentVelocity v;
+    if (velocity) {
+      v.xdot1 = e.xdot[0];
+      v.xdot2 = e.xdot[1];
+      v.omega = fromSimTKVec3(S.getBodyAngularVelocity(state));
+      v.pdot = fromSimTKVec3(S.findStationVelocityInGround(state, e.X_bs.p()));
+    }
+    calcWrapPathMap(mu.path.wraps[0].surface, mu.wrap, mu.mass_points, e.x[0], e.x[1], R, fromSimTKVec3(X_GS.p()),
+                    velocity ? &v : nullptr, e.wmap, mu.name);
   }
 }
 
@@ -102,6 +139,21 @@ void MuscleInertia::calcGeneralizedForces(const SimTK::State& state, const SimTK
   sm_.matter.multiplyByStationJacobian(state, bodies_, stations_, udot, JSudot_);
   sm_.matter.calcBiasForStationJacobian(state, bodies_, stations_, bias_);
   forces_.resize(static_cast<int>(bodies_.size()));
+  // Type III surfaces: one frame each, spatial acceleration JF udot + JFdot u = (alpha, pddot)
+  frame_bodies_.clear();
+  frame_origins_.clear();
+  for (const Entry& e : entries_) {
+    if (!e.wrap) continue;
+    const SimTK::MobilizedBody& S = e.surface_body >= 0 ? sm_.mobods[e.surface_body] : sm_.matter.getGround();
+    frame_bodies_.push_back(S.getMobilizedBodyIndex());
+    frame_origins_.push_back(e.X_bs.p());
+  }
+  if (!frame_bodies_.empty()) {
+    sm_.matter.multiplyByFrameJacobian(state, frame_bodies_, frame_origins_, udot, JFudot_);
+    sm_.matter.calcBiasForFrameJacobian(state, frame_bodies_, frame_origins_, frame_bias_);
+    frame_forces_.resize(static_cast<int>(frame_bodies_.size()));
+  }
+  int frame = 0;  // the current Type III entry's frame
   SimTK::Vector qddot, f_q;
   if (any_moving) {
     sm_.matter.calcQDotDot(state, udot, qddot);
@@ -131,11 +183,29 @@ void MuscleInertia::calcGeneralizedForces(const SimTK::State& state, const SimTK
       xddot.segment<3>(3 * i) = fromSimTKVec3(a);
     }
     // f_a = m_a (a_a - g) [D Eq. 5.6-5.7], pulled back to the path points by J_ax^T
-    const VecX a_a = calcMassPointAccelerations(e.map, xddot);
+    VecX a_a;
+    if (!e.wrap) {
+      a_a = calcMassPointAccelerations(e.map, xddot);
+    } else {
+      // vdot = (xddot1, xddot2, alpha, pddot); a_a = J vdot + b (path_map.hpp)
+      const SimTK::SpatialVec A = JFudot_[frame] + frame_bias_[frame];
+      VecX vdot(12);
+      vdot << xddot, fromSimTKVec3(A[0]), fromSimTKVec3(A[1]);
+      a_a = e.wmap.J * vdot + e.wmap.bias;
+    }
     VecX f_a(a_a.size());
     for (int a = 0; a < mu.mass_points.size(); ++a)
       f_a.segment<3>(3 * a) = mu.mass_points.mass[a] * (a_a.segment<3>(3 * a) - gravity_);
-    const VecX F_x = e.map.J_ax.transpose() * f_a;
+    VecX F_x;
+    if (!e.wrap) {
+      F_x = e.map.J_ax.transpose() * f_a;
+    } else {
+      // the (omega, pdot) columns give a torque and a force at the surface origin
+      const VecX F = e.wmap.J.transpose() * f_a;
+      F_x = F.head<6>();
+      frame_forces_[frame] = SimTK::SpatialVec(toSimTKVec3(F.segment<3>(6)), toSimTKVec3(F.segment<3>(9)));
+      ++frame;
+    }
     for (int i = 0; i < P; ++i) {
       const Vec3 F = F_x.segment<3>(3 * i);
       forces_[row + i] = toSimTKVec3(F);
@@ -150,6 +220,11 @@ void MuscleInertia::calcGeneralizedForces(const SimTK::State& state, const SimTK
   }
   // station forces to u space: JS^T F; the q-space part through qdot = N u: N^T f_q
   sm_.matter.multiplyByStationJacobianTranspose(state, bodies_, stations_, forces_, f_u);
+  if (!frame_bodies_.empty()) {
+    SimTK::Vector f_frames;
+    sm_.matter.multiplyByFrameJacobianTranspose(state, frame_bodies_, frame_origins_, frame_forces_, f_frames);
+    f_u += f_frames;
+  }
   if (any_moving) {
     SimTK::Vector f_extra;
     sm_.matter.multiplyByN(state, true, f_q, f_extra);
@@ -163,12 +238,20 @@ VecX MuscleInertia::calcGeneralizedForces(const SimTK::State& state, const VecX&
   return fromSimTK(f_u);
 }
 
+VecX MuscleInertia::wrapVelocity(const SimTK::State& state, const Entry& e) const {
+  const SimTK::MobilizedBody& S = e.surface_body >= 0 ? sm_.mobods[e.surface_body] : sm_.matter.getGround();
+  VecX v(12);
+  v << e.xdot[0], e.xdot[1], fromSimTKVec3(S.getBodyAngularVelocity(state)),
+      fromSimTKVec3(S.findStationVelocityInGround(state, e.X_bs.p()));
+  return v;
+}
+
 double MuscleInertia::kineticEnergy(const SimTK::State& state) {
   evaluate(state, true);
   double T = 0.0;
   for (const Entry& e : entries_) {
     const MassPoints& mp = muscles_[e.muscle].mass_points;
-    const VecX xdot_a = e.map.J_ax * stackPoints(e.xdot);
+    const VecX xdot_a = e.wrap ? VecX(e.wmap.J * wrapVelocity(state, e)) : VecX(e.map.J_ax * stackPoints(e.xdot));
     for (int a = 0; a < mp.size(); ++a) T += 0.5 * mp.mass[a] * xdot_a.segment<3>(3 * a).squaredNorm();
   }
   return T;
@@ -179,7 +262,8 @@ double MuscleInertia::potentialEnergy(const SimTK::State& state) {
   double V = 0.0;
   for (const Entry& e : entries_) {
     const MassPoints& mp = muscles_[e.muscle].mass_points;
-    for (int a = 0; a < mp.size(); ++a) V -= mp.mass[a] * gravity_.dot(e.map.x_a[a]);
+    const std::vector<Vec3>& x_a = e.wrap ? e.wmap.x_a : e.map.x_a;
+    for (int a = 0; a < mp.size(); ++a) V -= mp.mass[a] * gravity_.dot(x_a[a]);
   }
   return V;
 }

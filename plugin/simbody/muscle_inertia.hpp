@@ -16,6 +16,13 @@
 // x_b' qddot_c), and a generalized force (R x_b')^T F on qdot_c, mapped to u by N^T (qdot = N u).
 // Points on the world (body -1) are stations on Ground.
 //
+// Type III (origin, one wrap surface, insertion; core/muscles/wrap_muscle.hpp's shape): the
+// surface frame s is a frame on its body (X_GS = X_GB E_bs), whose spatial velocity (omega, pdot)
+// and acceleration come from Simbody's frame Jacobian and its bias; the path map is
+// calcWrapPathMap (core/muscles/path_map.hpp: the core's wrap model), v = (xdot1, xdot2, omega,
+// pdot), a_a = J vdot + b, and the (omega, pdot) part of J^T f_a is a spatial force (torque, force
+// at the surface origin) that JF^T takes to u [D Eq. 5.45-5.57].
+//
 // Only TUs that need Simbody include this header (plugin/simbody/simbody_include.hpp).
 #include <string>
 #include <vector>
@@ -26,6 +33,11 @@
 #include "core/muscles/path_map.hpp"
 
 namespace redmax::simbody {
+
+/// "" when a muscle with mass points can be carried by the Simbody side, else why not: Type III
+/// only as origin -> one wrap surface -> insertion with fixed or moving ends (the path map of
+/// calcWrapPathMap); other wrapping shapes the core may take are refused.
+std::string simbodyWrapShapeUnsupportedReason(const Muscle& muscle);
 
 /// Muscle mass points of a Simbody system. Keeps references to `sm` (it must outlive this object);
 /// copies the model's muscles. Muscles without mass points are skipped.
@@ -47,7 +59,10 @@ class MuscleInertia {
   double potentialEnergy(const SimTK::State& state);
 
   /// mass point positions (world) of muscle m (index into muscles()) after the last evaluation
-  const std::vector<Vec3>& massPointPositions(int m) const { return entries_.at(m).map.x_a; }
+  const std::vector<Vec3>& massPointPositions(int m) const {
+    const Entry& e = entries_.at(m);
+    return e.wrap ? e.wmap.x_a : e.map.x_a;
+  }
   const std::vector<Muscle>& muscles() const { return muscles_; }
   /// sum of all mass-point masses (kg)
   double totalMass() const;
@@ -56,12 +71,19 @@ class MuscleInertia {
   struct Entry {
     int muscle = 0;                        // index into muscles_
     PathMap map;
+    // Type III: the surface (path.wraps[0]) on body `surface_body` (-1: Ground) at E_bs
+    bool wrap = false;
+    WrapPathMap wmap;
+    int surface_body = -1;
+    SimTK::Transform X_bs;
     // per active point, refreshed by evaluate()
     std::vector<int> active;               // indices into path.points
     std::vector<Vec3> x, xdot, x_b, dx_b, ddx_b;
   };
   // active points, positions and velocities (and the path maps) of every entry
   void evaluate(const SimTK::State& state, bool velocity);
+  // v = (xdot1, xdot2, omega, pdot) of a Type III entry after evaluate(state, true)
+  VecX wrapVelocity(const SimTK::State& state, const Entry& e) const;
 
   const SimbodyModel& sm_;
   std::vector<Muscle> muscles_;
@@ -73,6 +95,9 @@ class MuscleInertia {
   SimTK::Array_<SimTK::MobilizedBodyIndex> bodies_;
   SimTK::Array_<SimTK::Vec3> stations_;
   SimTK::Vector_<SimTK::Vec3> JSudot_, bias_, forces_;
+  SimTK::Array_<SimTK::MobilizedBodyIndex> frame_bodies_;  // one frame per Type III entry
+  SimTK::Array_<SimTK::Vec3> frame_origins_;
+  SimTK::Vector_<SimTK::SpatialVec> JFudot_, frame_bias_, frame_forces_;
 };
 
 }  // namespace redmax::simbody

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <map>
+#include <memory>
 
 #include <Eigen/LU>
 
 #include "core/muscles/path_kinematics.hpp"
 #include "core/muscles/path_map.hpp"
+#include "plugin/simbody/muscle_inertia.hpp"
 
 namespace redmax::simbody {
 
@@ -24,12 +26,13 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
  public:
   // point_bodies: per path point; coord_mobods: per path point, the mobilizer of a moving point's
   // coordinate (or null) and the coordinate's index within it
+  // surface_body: a Type III muscle's wrap surface body (Ground for a world surface), else null
   PathConstraint(SimTK::SimbodyMatterSubsystem& matter, const Muscle& mu,
                  const std::vector<SimTK::MobilizedBody>& point_bodies,
                  const std::vector<const SimTK::MobilizedBody*>& coord_mobods, const std::vector<int>& coord_in_mobod,
-                 const std::vector<SimTK::MobilizedBody>& particles)
+                 const std::vector<SimTK::MobilizedBody>& particles, const SimTK::MobilizedBody* surface_body)
       : Implementation(matter, 3 * mu.mass_points.size(), 0, 0),
-        points_(mu.path.points), mp_(mu.mass_points), name_(mu.name) {
+        points_(mu.path.points), mp_(mu.mass_points), name_(mu.name), wrap_opt_(mu.wrap) {
     // a body (mobilizer) carrying several points (coordinates) is constrained once
     std::map<int, SimTK::ConstrainedBodyIndex> cb_of;
     std::map<int, SimTK::ConstrainedMobilizerIndex> cm_of;
@@ -48,6 +51,16 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       cm_[i] = jt->second;
       mq_[i] = SimTK::MobilizerQIndex(coord_in_mobod[i]);
     }
+    if (surface_body) {
+      const PathWrap& w = mu.path.wraps.at(0);
+      wrap_ = true;
+      surface_ = w.surface;
+      X_bs_ = toTransform(w.E_bs);
+      const int b = surface_body->getMobilizedBodyIndex();
+      auto it = cb_of.find(b);
+      if (it == cb_of.end()) it = cb_of.emplace(b, addConstrainedBody(*surface_body)).first;
+      surface_cb_ = it->second;
+    }
     for (const SimTK::MobilizedBody& p : particles) particle_cb_.push_back(addConstrainedBody(p));
     x_.resize(P);
     xdot_.resize(P);
@@ -65,10 +78,10 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       locate(i, moving(i) ? getOneQ(s, cq, cm_[i], mq_[i]) : 0.0);
       x_[i] = fromSimTKVec3(findStationLocation(X_AB, point_cb_[i], toSimTKVec3(x_b_[i])));
     }
-    calcPathMap(x_, nullptr, mp_, map_, name_);
+    const std::vector<Vec3>& x_a = mapPositions(wrap_ ? X_AB[surface_cb_] : SimTK::Transform());
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& p = X_AB[particle_cb_[a]].p();
-      for (int k = 0; k < 3; ++k) perr[3 * a + k] = p[k] - map_.x_a[a][k];
+      for (int k = 0; k < 3; ++k) perr[3 * a + k] = p[k] - x_a[a][k];
     }
   }
 
@@ -84,9 +97,18 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
         v += getBodyRotationFromState(s, point_cb_[i]) * toSimTKVec3(dx_b_[i]) * getOneQDot(s, cqdot, cm_[i], mq_[i]);
       xdot_[i] = fromSimTKVec3(v);
     }
-    calcPathMap(x_, nullptr, mp_, map_, name_);
-    // xdot_a = J_ax xdot [D Eq. 5.4]
-    const VecX xdot_a = map_.J_ax * stackPoints(xdot_);
+    // xdot_a = J_ax xdot [D Eq. 5.4]; Type III: J (xdot, omega, pdot) (path_map.hpp)
+    VecX xdot_a;
+    if (!wrap_) {
+      calcPathMap(x_, nullptr, mp_, map_, name_);
+      xdot_a = map_.J_ax * stackPoints(xdot_);
+    } else {
+      mapPositions(getBodyTransformFromState(s, surface_cb_));
+      VecX v(12);
+      v << stackPoints(xdot_), fromSimTKVec3(getBodyAngularVelocity(V_AB, surface_cb_)),
+          fromSimTKVec3(findStationVelocity(s, V_AB, surface_cb_, X_bs_.p()));
+      xdot_a = wmap_.J * v;
+    }
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& v = V_AB[particle_cb_[a]][1];
       for (int k = 0; k < 3; ++k) pverr[3 * a + k] = v[k] - xdot_a[3 * a + k];
@@ -115,9 +137,25 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       xdot_[i] = fromSimTKVec3(v);
       xddot.segment<3>(3 * static_cast<int>(i)) = fromSimTKVec3(acc);
     }
-    calcPathMap(x_, &xdot_, mp_, map_, name_);
-    // a_a = J_ax xddot + Jdot_ax xdot [D Eq. 5.5]
-    const VecX a_a = calcMassPointAccelerations(map_, xddot);
+    // a_a = J_ax xddot + Jdot_ax xdot [D Eq. 5.5]; Type III: J vdot + b (path_map.hpp)
+    VecX a_a;
+    if (!wrap_) {
+      calcPathMap(x_, &xdot_, mp_, map_, name_);
+      a_a = calcMassPointAccelerations(map_, xddot);
+    } else {
+      WrapSegmentVelocity v;
+      v.xdot1 = xdot_[0];
+      v.xdot2 = xdot_[1];
+      v.omega = fromSimTKVec3(getBodyAngularVelocityFromState(s, surface_cb_));
+      v.pdot = fromSimTKVec3(findStationVelocityFromState(s, surface_cb_, X_bs_.p()));
+      const SimTK::Transform X_AS = getBodyTransformFromState(s, surface_cb_) * X_bs_;
+      calcWrapPathMap(surface_, wrap_opt_, mp_, x_[0], x_[1], toMat3(X_AS.R()), fromSimTKVec3(X_AS.p()), &v, wmap_,
+                      name_);
+      VecX vdot(12);
+      vdot << xddot, fromSimTKVec3(getBodyAngularAcceleration(A_AB, surface_cb_)),
+          fromSimTKVec3(findStationAcceleration(s, A_AB, surface_cb_, X_bs_.p()));
+      a_a = wmap_.J * vdot + wmap_.bias;
+    }
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& acc = A_AB[particle_cb_[a]][1];
       for (int k = 0; k < 3; ++k) paerr[3 * a + k] = acc[k] - a_a[3 * a + k];
@@ -131,13 +169,23 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       locate(i, moving(i) ? getOneQFromState(s, cm_[i], mq_[i]) : 0.0);
       x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], toSimTKVec3(x_b_[i])));
     }
-    calcPathMap(x_, nullptr, mp_, map_, name_);
-    // G^T lambda with G = (I on the particles, -J_ax on the path points)
+    // G^T lambda with G = (I on the particles, -J_ax on the path points); Type III: -J on
+    // (xdot, omega, pdot), the last six a torque and a force at the surface origin
     VecX l(3 * mp_.size());
     for (int r = 0; r < l.size(); ++r) l[r] = lambda[r];
     for (int a = 0; a < mp_.size(); ++a)
       addInStationForce(s, particle_cb_[a], SimTK::Vec3(0), toSimTKVec3(l.segment<3>(3 * a)), bodyForcesInA);
-    const VecX F = -(map_.J_ax.transpose() * l);
+    VecX F;
+    if (!wrap_) {
+      calcPathMap(x_, nullptr, mp_, map_, name_);
+      F = -(map_.J_ax.transpose() * l);
+    } else {
+      mapPositions(getBodyTransformFromState(s, surface_cb_));
+      const VecX G = -(wmap_.J.transpose() * l);
+      F = G.head<6>();
+      addInBodyTorque(s, surface_cb_, toSimTKVec3(G.segment<3>(6)), bodyForcesInA);
+      addInStationForce(s, surface_cb_, X_bs_.p(), toSimTKVec3(G.segment<3>(9)), bodyForcesInA);
+    }
     for (size_t i = 0; i < x_.size(); ++i) {
       const SimTK::Vec3 Fi = toSimTKVec3(F.segment<3>(3 * static_cast<int>(i)));
       addInStationForce(s, point_cb_[i], toSimTKVec3(x_b_[i]), Fi, bodyForcesInA);
@@ -149,6 +197,23 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
 
  private:
   bool moving(size_t i) const { return cm_[i].isValid(); }
+  static Mat3 toMat3(const SimTK::Rotation& R) {
+    Mat3 out;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) out(r, c) = R[r][c];
+    return out;
+  }
+  // mass point positions from x_ (and, Type III, the surface body's pose X_AB in the ancestor)
+  const std::vector<Vec3>& mapPositions(const SimTK::Transform& X_AB_surface) const {
+    if (!wrap_) {
+      calcPathMap(x_, nullptr, mp_, map_, name_);
+      return map_.x_a;
+    }
+    const SimTK::Transform X_AS = X_AB_surface * X_bs_;
+    calcWrapPathMap(surface_, wrap_opt_, mp_, x_[0], x_[1], toMat3(X_AS.R()), fromSimTKVec3(X_AS.p()), nullptr, wmap_,
+                    name_);
+    return wmap_.x_a;
+  }
   // x_b and its derivatives along the coordinate, for the coordinate's value q_c (moving points)
   void locate(size_t i, double q_c) const {
     const PathPoint& p = points_[i];
@@ -170,6 +235,13 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   mutable std::vector<Vec3> x_, xdot_, x_b_, dx_b_, ddx_b_;
   mutable VecX q_;  // scratch core q holding only the coordinate being evaluated
   mutable PathMap map_;
+  // Type III: the wrap surface, its pose on its body and the constrained body carrying it
+  WrapMassOptions wrap_opt_;
+  bool wrap_ = false;
+  WrapSurface surface_;
+  SimTK::Transform X_bs_;
+  SimTK::ConstrainedBodyIndex surface_cb_;
+  mutable WrapPathMap wmap_;
 };
 
 }  // namespace
@@ -178,14 +250,12 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
     : sm_(sm), muscles_(std::move(muscles)) {
   for (const Muscle& mu : muscles_) {
     validateMuscle(model, mu);
-    // the Simbody side maps mass points from path points only (calcPathMap): no wrap surfaces yet
-    if (mu.mass_points.size() > 0 && pathType(mu.path) == PathType::III)
-      throw ModelError("muscle '" + mu.name + "': has wrap objects (Type III path) and mass points; the "
-                       "Simbody side does not move mass points over wrap surfaces yet (the core does)");
     if (mu.mass_points.size() == 0) {
       first_particle_.push_back(-1);
       continue;
     }
+    const std::string why = simbodyWrapShapeUnsupportedReason(mu);
+    if (!why.empty()) throw SimbodyBuildError(why);
     for (const PathPoint& p : mu.path.points)
       if (p.kind == PathPointKind::Conditional)
         throw SimbodyBuildError("muscle '" + mu.name + "': point '" + p.name +
@@ -221,7 +291,15 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
       coord_mobods.push_back(mob);
       coord_in_mobod.push_back(k_in);
     }
-    SimTK::Constraint::Custom(new PathConstraint(sm.matter, mu, point_bodies, coord_mobods, coord_in_mobod, mine));
+    // Type III (validateMuscle accepted the supported shape): the surface's body is constrained too
+    std::unique_ptr<SimTK::MobilizedBody> surface_body;
+    if (pathType(mu.path) == PathType::III) {
+      const int b = mu.path.wraps.at(0).body;
+      surface_body = std::make_unique<SimTK::MobilizedBody>(b >= 0 ? sm.mobods[b]
+                                                                   : SimTK::MobilizedBody(sm.matter.updGround()));
+    }
+    SimTK::Constraint::Custom(
+        new PathConstraint(sm.matter, mu, point_bodies, coord_mobods, coord_in_mobod, mine, surface_body.get()));
   }
   // the topology changed: a new default state, Euler angles on as makeSimbodyModel sets them
   try {
@@ -248,6 +326,7 @@ void ParticleMuscles::placeParticles(SimTK::State& sb) const {
       qdot[mm.q_index + k] = qdot_sb[mm.simbody_q + k];
     }
   PathMap map;
+  WrapPathMap wmap;
   for (size_t m = 0; m < muscles_.size(); ++m) {
     if (first_particle_[m] < 0) continue;
     const Muscle& mu = muscles_[m];
@@ -263,10 +342,33 @@ void ParticleMuscles::placeParticles(SimTK::State& sb) const {
         v += B.getBodyRotation(sb) * toSimTKVec3(dx_b) * qdot[p.coordinate];
       xdot.push_back(fromSimTKVec3(v));
     }
-    calcPathMap(x, &xdot, mu.mass_points, map, mu.name);
-    const VecX xdot_a = map.J_ax * stackPoints(xdot);
+    VecX xdot_a;
+    const std::vector<Vec3>* x_a = &map.x_a;
+    if (pathType(mu.path) != PathType::III) {
+      calcPathMap(x, &xdot, mu.mass_points, map, mu.name);
+      xdot_a = map.J_ax * stackPoints(xdot);
+    } else {
+      // Type III: the surface frame's pose and motion (path_map.hpp's calcWrapPathMap)
+      const PathWrap& w = mu.path.wraps.at(0);
+      const SimTK::MobilizedBody& S = w.body >= 0 ? sm_.mobods[w.body] : sm_.matter.getGround();
+      const SimTK::Transform X_bs = toTransform(w.E_bs);
+      const SimTK::Transform X_GS = S.getBodyTransform(sb) * X_bs;
+      Mat3 R;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) R(r, c) = X_GS.R()[r][c];
+      WrapSegmentVelocity v;
+      v.xdot1 = xdot[0];
+      v.xdot2 = xdot[1];
+      v.omega = fromSimTKVec3(S.getBodyAngularVelocity(sb));
+      v.pdot = fromSimTKVec3(S.findStationVelocityInGround(sb, X_bs.p()));
+      calcWrapPathMap(w.surface, mu.wrap, mu.mass_points, x[0], x[1], R, fromSimTKVec3(X_GS.p()), &v, wmap, mu.name);
+      VecX vv(12);
+      vv << xdot[0], xdot[1], v.omega, v.pdot;
+      xdot_a = wmap.J * vv;
+      x_a = &wmap.x_a;
+    }
     for (int a = 0; a < mu.mass_points.size(); ++a) {
-      x_p[first_particle_[m] + a] = toSimTKVec3(map.x_a[a]);
+      x_p[first_particle_[m] + a] = toSimTKVec3((*x_a)[a]);
       v_p[first_particle_[m] + a] = toSimTKVec3(xdot_a.segment<3>(3 * a));
     }
   }

@@ -23,9 +23,10 @@ ParticleSimulation::ParticleSimulation(const Model& model, std::vector<Muscle> m
   Impl& m = *impl_;
   if (!(options.accuracy > 0.0) || !(options.constraint_tolerance > 0.0))
     throw std::invalid_argument("particle simulation: accuracy and constraint tolerance must be positive");
-  if (options.integrator != "merson" && options.integrator != "feldberg")
+  if (options.integrator != "merson" && options.integrator != "feldberg" && options.integrator != "cpodes")
     throw std::invalid_argument("particle simulation: unknown integrator '" + options.integrator +
-                                "' (merson or feldberg)");
+                                "' (merson, feldberg or cpodes)");
+  if (!(options.max_step >= 0.0)) throw std::invalid_argument("particle simulation: negative maximum step");
   m.model = model;
   m.sm = makeSimbodyModel(model);
   m.particles = std::make_unique<ParticleMuscles>(*m.sm, model, std::move(muscles));
@@ -34,9 +35,12 @@ ParticleSimulation::ParticleSimulation(const Model& model, std::vector<Muscle> m
   m.particles->placeParticles(st);
   if (options.integrator == "merson")
     m.integ = std::make_unique<SimTK::RungeKuttaMersonIntegrator>(m.sm->system);
-  else
+  else if (options.integrator == "feldberg")
     m.integ = std::make_unique<SimTK::RungeKuttaFeldbergIntegrator>(m.sm->system);
+  else
+    m.integ = std::make_unique<SimTK::CPodesIntegrator>(m.sm->system, SimTK::CPodes::BDF, SimTK::CPodes::Newton);
   m.integ->setAccuracy(options.accuracy);
+  if (options.max_step > 0.0) m.integ->setMaximumStepSize(options.max_step);
   m.integ->setConstraintTolerance(options.constraint_tolerance);
   m.stepper = std::make_unique<SimTK::TimeStepper>(m.sm->system, *m.integ);
   m.stepper->initialize(st);
@@ -81,5 +85,15 @@ double ParticleSimulation::potentialEnergy() const {
 }
 
 long ParticleSimulation::steps() const { return impl_->integ->getNumStepsTaken(); }
+
+ParticleSimulationCounts ParticleSimulation::counts() const {
+  const SimTK::Integrator& in = *impl_->integ;
+  ParticleSimulationCounts c;
+  c.steps = in.getNumStepsTaken();
+  c.realizations = in.getNumRealizations();
+  c.failed_steps = in.getNumErrorTestFailures() + in.getNumConvergenceTestFailures();
+  c.projections = in.getNumProjections();
+  return c;
+}
 
 }  // namespace redmax::simbody

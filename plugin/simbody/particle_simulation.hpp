@@ -15,9 +15,20 @@
 namespace redmax::simbody {
 
 struct ParticleSimulationOptions {
-  std::string integrator = "merson";  ///< "merson" (RungeKuttaMerson 4(5)) or "feldberg" (RungeKuttaFeldberg 4(5))
+  /// "merson" (RungeKuttaMerson 4(5)), "feldberg" (RungeKuttaFeldberg 4(5)) or "cpodes"
+  /// (CPodesIntegrator: BDF with Newton iterations, Simbody's bundled CVODE descendant)
+  std::string integrator = "merson";
   double accuracy = 1e-8;             ///< Simbody's relative accuracy
   double constraint_tolerance = 1e-10;  ///< path constraints (m, m/s)
+  double max_step = 0.0;              ///< s; > 0 caps the step size (Integrator::setMaximumStepSize)
+};
+
+/// Simbody's integrator counters (Integrator::getNum*), summed over the run.
+struct ParticleSimulationCounts {
+  long steps = 0;            ///< accepted steps
+  long realizations = 0;     ///< realizations to Stage::Acceleration (one per right-hand side)
+  long failed_steps = 0;     ///< error-test and convergence failures
+  long projections = 0;      ///< constraint projections
 };
 
 /// One run from an initial core state. The header is Simbody-free (pimpl).
@@ -41,6 +52,8 @@ class ParticleSimulation {
   double potentialEnergy() const;
   /// accepted integrator steps so far
   long steps() const;
+  /// all of Simbody's counters so far
+  ParticleSimulationCounts counts() const;
 
  private:
   struct Impl;

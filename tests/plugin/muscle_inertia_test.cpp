@@ -3,9 +3,11 @@
 // Simbody's station Jacobians and biases, the core side from J_mr; both share only the path maps.
 //   - component: T^T f_u (Simbody, mapped to core velocities) == M_muscle qddot - f_muscle (core),
 //     and the mass points' kinetic and potential energies, on random trees (Gimbal, Ball, Free
-//     mobilizers) with Type I, Type II (1-5 via points), moving and conditional points;
+//     mobilizers) with Type I, Type II (1-5 via points), moving and conditional points, and Type III
+//     (one cylinder or sphere on the origin's body, a third body or the world; fixed or moving ends);
 //   - engine: SimbodyIdEngine(model, muscles) == core System + MuscleTerm inverse dynamics on the
-//     project's scenes (double pendulums with a Type I and a Type II muscle, finger, running leg) and
+//     project's scenes (double pendulums with a Type I, II and III muscle, finger, running leg with its
+//     wrapping gastrocnemii) and
 //     on set F (gait10dof18musc) with 20% and 80% of tibia_r's mass moved into its muscles.
 // Agreement: max |a - b| <= 1e-9 max |b| (relative to the peak of the reference column) at random
 // states. Each case also checks that the muscles change the torques by more than 1e-4 of the peak,
@@ -31,6 +33,7 @@
 #include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/system.hpp"
 #include "core/muscles/path_kinematics.hpp"
+#include "core/spatial/se3.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "plugin/simbody/id_engine.hpp"
 #include "validation/scenes/scenes.hpp"
@@ -184,6 +187,106 @@ TEST(SimbodyMuscleInertia, MatchesCoreMuscleTermOnRandomTrees) {
   EXPECT_GE(checked, 40);
 }
 
+// Type III: origin -> one surface -> insertion. The surface (radius 0.03 m) is centred within
+// 0.015 m of the ends' midpoint at the state (so the path wraps), randomly oriented, on the
+// origin's body (variant 0), a body that moves neither end (1), the world (2), or with a moving
+// insertion (3); smooth wrap model.
+Muscle randomWrapMuscle(const Model& m, int variant, std::mt19937& rng, const State& s, bool sphere) {
+  Muscle mu;
+  mu.name = "wrap" + std::to_string(variant);
+  const int b1 = randomBody(m, rng, true);
+  int b2 = randomBody(m, rng, false);
+  mu.path.points.push_back(makeFixedPoint(b1, randomVec(rng, 0.3)));
+  if (variant == 3) {
+    auto cubic = std::make_shared<PolynomialFunction>(std::vector<double>{0.05, -0.1, 0.2, 0.1});
+    auto line = std::make_shared<LinearFunction>(0.3, 0.2);
+    mu.path.points.push_back(makeMovingPoint(b2, static_cast<int>(rng() % m.nr()), {cubic, nullptr, line}, Vec3(0, 0.1, 0)));
+  } else {
+    mu.path.points.push_back(makeFixedPoint(b2, randomVec(rng, 0.3)));
+  }
+  int bs = b1;
+  if (variant == 1) bs = randomBody(m, rng, false);
+  if (variant == 2) bs = -1;
+  // the ends at this state (world), the surface centred between them
+  SkeletonWorkspace sk(m);
+  calcKinematics(m, s, sk);
+  auto world = [&](const PathPoint& p) {
+    Vec3 x_b, dx, ddx;
+    calcPointLocation(p, s.q, x_b, dx, ddx);
+    return p.body < 0 ? x_b : Vec3((sk.E_wi[p.body] * x_b.homogeneous()).head<3>());
+  };
+  const Vec3 mid = 0.5 * (world(mu.path.points[0]) + world(mu.path.points[1]));
+  Mat4 E_ws = Mat4::Identity();
+  E_ws.topLeftCorner<3, 3>() = expSO3(randomVec(rng, 2.0));
+  // off the line by up to half the radius: a line through the axis or centre would leave the side
+  // of the wrap to round-off
+  E_ws.topRightCorner<3, 1>() = mid + randomVec(rng, 0.015 / std::sqrt(3.0));
+  PathWrap w;
+  w.name = sphere ? "ball" : "drum";
+  w.surface = sphere ? WrapSurface::makeSphere(0.03) : WrapSurface::makeCylinder(0.03, 2.0);
+  w.body = bs;
+  w.E_bs = bs >= 0 ? Mat4(sk.E_wi[bs].inverse() * E_ws) : E_ws;
+  mu.path.wraps = {w};
+  mu.path.num_wraps = 1;
+  MassPointOptions opt;
+  opt.count = 6;
+  mu.mass_points = makeMassPoints(0.7, 0.5, 0.3, opt);
+  mu.optimal_fiber_length = 0.5;
+  mu.tendon_slack_length = 0.3;
+  return mu;
+}
+
+TEST(SimbodyMuscleInertia, TypeIIIMatchesCoreMuscleTermOnRandomTrees) {
+  using scenes::TreeJoints;
+  using simbody::SphericalAs;
+  struct Case {
+    Model model;
+    SphericalAs spherical;
+  };
+  const std::vector<Case> cases{{scenes::randomTree(6, 11, TreeJoints::SimbodyComparable), SphericalAs::Gimbal},
+                                {scenes::randomTree(8, 29, TreeJoints::SimbodyComparable), SphericalAs::Ball},
+                                {scenes::doublePendulum(), SphericalAs::Gimbal}};
+  std::mt19937 rng(77);
+  int checked = 0;
+  for (size_t ci = 0; ci < cases.size(); ++ci) {
+    const Model& m = cases[ci].model;
+    simbody::SimbodyBuildOptions opt;
+    opt.spherical = cases[ci].spherical;
+    const auto sm = simbody::makeSimbodyModel(m, opt);
+    for (int variant = 0; variant <= 3; ++variant) {
+      for (int trial = 0; trial < 4; ++trial) {
+        SCOPED_TRACE("case " + std::to_string(ci) + " variant " + std::to_string(variant) + " trial " +
+                     std::to_string(trial));
+        const State s = randomState(m.nr(), rng);
+        // a wrapping muscle next to a Type II one, so the batches span both kinds
+        std::vector<Muscle> muscles{randomWrapMuscle(m, variant, rng, s, trial % 2 == 1), randomMuscle(m, 1, rng, s)};
+        for (Muscle& mu : muscles) validateMuscle(m, mu);
+        const MuscleTerm term(m, muscles);
+        simbody::MuscleInertia mi(*sm, m, muscles);
+        const VecX qddot = VecX::NullaryExpr(m.nr(), [&] { return randomVec(rng, 3.0)[0]; });
+        VecX core;
+        try {
+          core = coreMuscleTau(m, term, s, qddot);
+        } catch (const MuscleError&) {
+          continue;  // an end point inside the surface or two coinciding points at this state
+        }
+        const VecX sb = simbodyMuscleTau(*sm, mi, m, s, qddot);
+        EXPECT_TRUE(closeToPeak(sb, core, kTol));
+        SkeletonWorkspace sk(m);
+        calcKinematics(m, s, sk);
+        SimTK::State st = sm->default_state;
+        simbody::setSimbodyState(*sm, m, s, st);
+        sm->system.realize(st, SimTK::Stage::Velocity);
+        const double T_core = term.kineticEnergy(m, s, sk), V_core = term.potentialEnergy(m, s, sk);
+        EXPECT_NEAR(mi.kineticEnergy(st), T_core, kTol * (1.0 + std::abs(T_core)));
+        EXPECT_NEAR(mi.potentialEnergy(st), V_core, kTol * (1.0 + std::abs(V_core)));
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GE(checked, 30);
+}
+
 TEST(SimbodyMuscleInertia, MasslessMusclesAddNothingAndBadMusclesThrow) {
   const Model m = scenes::doublePendulum();
   const auto sm = simbody::makeSimbodyModel(m);
@@ -305,13 +408,17 @@ int compareEngines(const osim::ModelDescription& d, const Model& model, const st
   return compared;
 }
 
-// every muscle that can carry mass gets `mass` kg over 10 points; Type III stays lumped
+// every muscle gets `mass` kg over 10 points (Type III directly: addMusclePointMasses refuses them)
 std::vector<Muscle> withMass(const std::vector<Muscle>& muscles, double mass) {
   std::vector<double> masses;
   for (const Muscle& mu : muscles) masses.push_back(pathType(mu.path) == PathType::III ? 0.0 : mass);
   MassPointOptions opt;
   opt.count = 10;
-  return osim::addMusclePointMasses(muscles, masses, opt);
+  std::vector<Muscle> out = osim::addMusclePointMasses(muscles, masses, opt);
+  for (Muscle& mu : out)
+    if (pathType(mu.path) == PathType::III)
+      mu.mass_points = makeMassPoints(mass, mu.optimal_fiber_length, mu.tendon_slack_length, opt);
+  return out;
 }
 
 TEST(SimbodyIdEngineMuscles, MatchesCoreOnProjectScenes) {
@@ -320,7 +427,8 @@ TEST(SimbodyIdEngineMuscles, MatchesCoreOnProjectScenes) {
     double mass;
   };
   for (const Scene& sc : {Scene{"double_pendulum_straight.osim", 0.5}, Scene{"double_pendulum_via.osim", 0.5},
-                          Scene{"finger.osim", 0.2}, Scene{"running_leg.osim", 0.4}}) {
+                          Scene{"double_pendulum_wrap.osim", 0.5}, Scene{"finger.osim", 0.2},
+                          Scene{"running_leg.osim", 0.4}}) {
     SCOPED_TRACE(sc.file);
     const osim::ModelDescription d = osim::readOsimModel(scenePath(sc.file));
     osim::BuildOptions bo;
