@@ -7,6 +7,7 @@
 // through a conditional via point instead), so it is not here.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
 #include <random>
 #include <string>
@@ -39,7 +40,21 @@ struct Tally {
   int wrapping = 0, before = 0, smooth = 0, exact = 0, checked = 0;
   double worst_J[2] = {0.0, 0.0}, worst_Jdot[2] = {0.0, 0.0};  // smooth, exact
   double worst_path = 0.0;  // smooth points against the exact library's whole path (m)
+  double us[2] = {0.0, 0.0};  // summed CPU time of one muscle evaluation with velocity (us)
+  int timed[2] = {0, 0};
 };
+
+// mean CPU time of calcMuscleKinematics (positions, J_ar, Jdot_ar) for one muscle: reported only
+double timeMuscle(const Model& m, const Muscle& mu, const State& s) {
+  SkeletonWorkspace sk(m);
+  calcKinematics(m, s, sk);
+  MuscleWorkspace ws(m, {mu});
+  const int reps = 50;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int r = 0; r < reps; ++r) calcMuscleKinematics(m, s, sk, mu, ws.muscles[0], true);
+  const auto t1 = std::chrono::steady_clock::now();
+  return std::chrono::duration<double, std::micro>(t1 - t0).count() / reps;
+}
 
 // J_ar and Jdot_ar of `mu` at s against central differences (relative errors into tally)
 void checkMuscle(const Model& m, const Muscle& mu, const State& s, double tol_J, double tol_Jdot, Tally& t) {
@@ -60,6 +75,8 @@ void checkMuscle(const Model& m, const Muscle& mu, const State& s, double tol_J,
   const double eJ = (mk.J_ar - J_fd).norm() / (1.0 + J_fd.norm());
   const double eJd = (mk.Jdot_ar - Jdot_fd).norm() / (1.0 + Jdot_fd.norm());
   const int e = mu.wrap.model == WrapModel::Exact;
+  t.us[e] += timeMuscle(m, mu, s);
+  ++t.timed[e];
   t.worst_J[e] = std::max(t.worst_J[e], eJ);
   t.worst_Jdot[e] = std::max(t.worst_Jdot[e], eJd);
   if (!e) {
@@ -117,6 +134,9 @@ Tally checkModel(const std::string& file, const char* label) {
               "exact whole path: max %.1e m\n",
               label, t.wrapping, t.before, t.smooth, t.exact, t.checked, t.worst_J[0], t.worst_Jdot[0], t.worst_J[1],
               t.worst_Jdot[1], t.worst_path);
+  std::printf("[ measured ] %s: one muscle's 10 mass points with J_ar, Jdot_ar: smooth %.0f us, exact %.0f us (mean, "
+              "shared machine)\n",
+              label, t.timed[0] ? t.us[0] / t.timed[0] : 0.0, t.timed[1] ? t.us[1] / t.timed[1] : 0.0);
   return t;
 }
 
