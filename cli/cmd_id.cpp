@@ -50,10 +50,13 @@ int runId(const std::vector<std::string>& argv) {
                withMuscleMassFlags({"setup", "model", "coordinates", "external-loads", "lowpass", "t0",
                                     "t1", "engine", "out", "forces-to-exclude"}),
                {"exact", "opensim-compat", "quiet", "full-precision"});
-  const osim::IdToolSettings settings = parseSettings(a);
+  osim::IdToolSettings settings = parseSettings(a);
   const std::string engine_name = a.get("engine", "core");
   if (engine_name != "core" && engine_name != "simbody")
     throw UsageError{"--engine must be core or simbody, got '" + engine_name + "'"};
+  // Simbody cannot move mass points over wrap surfaces yet: wrapping muscles stay lumped there
+  // unless --wrap is given (then the engine refuses them by name)
+  if (engine_name == "simbody" && !a.has("wrap")) settings.muscle_mass.wrap_mass = false;
   const bool with_mass = settings.muscle_mass.source != osim::MuscleMassOptions::Source::None;
   const bool quiet = a.has("quiet");
 

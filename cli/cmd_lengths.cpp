@@ -54,7 +54,8 @@ int runLengths(const std::vector<std::string>& argv) {
                     out_path = *a.get("out");
   const std::string wrap = a.get("wrap", "exact");
   if (wrap == "neural" || wrap == "smooth")
-    throw UsageError{"--wrap " + wrap + " is not available in `redmax lengths` yet (exact or none)"};
+    throw UsageError{"--wrap " + wrap + " chooses how mass points move over wrap surfaces (simulate, id and "
+                     "validate with muscle mass); lengths are OpenSim's: --wrap exact (default) or none"};
   if (wrap != "exact" && wrap != "none")
     throw UsageError{"--wrap must be exact, neural, smooth or none, got '" + wrap + "'"};
   const bool quiet = a.has("quiet");

@@ -15,6 +15,7 @@
 
 #include "cli/args.hpp"
 #include "cli/muscle_mass_flags.hpp"
+#include "core/muscles/wrap/network_model.hpp"
 #include "validation/report/progress.hpp"
 #include "validation/simulate/simulate.hpp"
 
@@ -79,13 +80,11 @@ int runSimulate(const std::vector<std::string>& argv) {
       throw UsageError{"--integrator must be euler, symplectic, bdf1, sdirk2, rk45 or cvode, got '" +
                        so.integrator + "'"};
   }
-  const std::string wrap = a.get("wrap", "exact");
-  if (wrap != "exact" && wrap != "neural" && wrap != "smooth")
-    throw UsageError{"--wrap must be exact, neural or smooth, got '" + wrap + "'"};
-  if (wrap != "exact")
-    throw UsageError{"--wrap " + wrap +
-                     " is not available: wrapping muscles (Type III) stay lumped until the wrapping "
-                     "paths land; only --wrap exact is accepted"};
+  // --wrap and friends (muscle_mass_flags.hpp) choose how wrapping muscles with mass move; with no
+  // mass at all they would do nothing
+  if (hasWrapFlags(a) && !a.has("muscle-mass-kg") && a.get("muscle-mass", "none") == "none")
+    throw UsageError{std::string("--") + (a.has("wrap") ? "wrap" : a.has("wrap-width") ? "wrap-width" : "wrap-network") +
+                     " needs muscle mass (--muscle-mass physiological|transfer or --muscle-mass-kg)"};
 
   validation::SimulationModelOptions mo;
   mo.quadratic_velocity = !a.has("no-qvv");
@@ -97,6 +96,7 @@ int runSimulate(const std::vector<std::string>& argv) {
     for (const char* f : {"muscles", "specific-tension", "muscle-density", "transfer-body", "transfer-fraction"})
       if (a.has(f)) throw UsageError{std::string("--") + f + " needs --muscle-mass physiological or transfer"};
     mo.explicit_masses = parseMassList(*v);
+    parseWrapFlags(a, mo.muscle_mass);
     const long n = a.getInt("mass-points", 20);
     if (n < 1 || n > 100000) throw UsageError{"--mass-points must be between 1 and 100000"};
     mo.muscle_mass.mass_points = static_cast<int>(n);
@@ -140,10 +140,9 @@ int runSimulate(const std::vector<std::string>& argv) {
     // where the mass went, on stderr as the other commands print it (muscle_mass_flags.hpp)
     if (!model.mass_summary.empty()) std::fprintf(stderr, "%s", model.mass_summary.c_str());
     if (model.added_mass > 0.0)
-      for (const auto& mu : model.description.muscles)
-        if (mu.path_type == osim::PathType::III)
-          std::fprintf(stderr, "  muscle %s: lumped (Type III path: wrapping muscles carry no mass yet)\n",
-                       mu.name.c_str());
+      for (const Muscle& mu : model.muscles)
+        if (pathType(mu.path) == PathType::III && mu.mass_points.size() == 0)
+          std::fprintf(stderr, "  muscle %s: lumped (Type III path, no mass given)\n", mu.name.c_str());
   }
 
   // progress: always with --progress, otherwise once a run has taken more than 2 s
@@ -201,6 +200,11 @@ int runSimulate(const std::vector<std::string>& argv) {
                 res.wall_s, res.energy_initial, res.energy_final, res.energy_drift_rel, res.energy_drift_abs,
                 out_path.c_str());
   }
+  // --wrap neural: how often the smooth model stood in for the network (muscle_mass_flags.hpp)
+  if (const auto& monitor = mo.muscle_mass.wrap.monitor; monitor && !quiet) {
+    const std::string counts = monitor->summary();
+    if (!counts.empty()) std::fprintf(stderr, "wrap network fallbacks:\n%s", counts.c_str());
+  }
   return 0;
 }
 
@@ -209,7 +213,7 @@ CommandRegistration reg(
      "usage: redmax simulate --model M.osim --duration S --out STATES.sto\n"
      "                       [--integrator euler|symplectic|bdf1|sdirk2|rk45|cvode] [--dt S]\n"
      "                       [--rtol R] [--atol A] [--max-step S] [--output-dt S]\n"
-     "                       [--initial STATE.sto [--initial-time T]] [--wrap exact]\n"
+     "                       [--initial STATE.sto [--initial-time T]]\n"
      "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
      "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
      "                       [--progress] [--quiet] [--full-precision]\n"
@@ -224,10 +228,9 @@ CommandRegistration reg(
      "                       --initial-time T picks another and starts there); columns named by\n"
      "                       coordinate, /jointset/J/C/value and /speed, or C_u; degrees if the header\n"
      "                       says inDegrees=yes; absent coordinates keep their defaults\n"
-     "  --wrap exact         the only accepted value until wrapping paths (Type III) carry mass\n"
      "  --muscle-mass-kg NAME=KG,...  give these muscles KG each in mass points, ADDED to the model\n"
      "                       (no body gives mass; e.g. the finger's 0.2 kg flexors of [D 6.2.5]);\n"
-     "                       --mass-points and --mass-region apply; excludes --muscle-mass\n"
+     "                       --mass-points, --mass-region and --wrap apply; excludes --muscle-mass\n"
      "  --no-qvv             drop the muscles' quadratic velocity vector (energy experiment [D 6.2.4])\n"
      "  --impulse TARGET:FX,FY,FZ:DURATION  a force (N, ground frame) while t < DURATION (s) on a\n"
      "                       body's origin, a marker, or BODY@X,Y,Z (m, body frame); ';' separates several\n"

@@ -1,20 +1,66 @@
 #include "cli/muscle_mass_flags.hpp"
 
+#include <cmath>
+#include <iostream>
+#include <memory>
 #include <regex>
 #include <stdexcept>
+
+#include "core/muscles/wrap/network_model.hpp"
 
 namespace redmax::cli {
 
 const std::set<std::string>& muscleMassFlagNames() {
   static const std::set<std::string> names = {
       "muscle-mass",      "muscles",        "mass-points",   "mass-region",
-      "specific-tension", "muscle-density", "transfer-body", "transfer-fraction"};
+      "specific-tension", "muscle-density", "transfer-body", "transfer-fraction",
+      "wrap",             "wrap-width",     "wrap-network"};
   return names;
 }
 
 std::set<std::string> withMuscleMassFlags(std::set<std::string> names) {
   names.insert(muscleMassFlagNames().begin(), muscleMassFlagNames().end());
   return names;
+}
+
+bool hasWrapFlags(const Args& a) { return a.has("wrap") || a.has("wrap-width") || a.has("wrap-network"); }
+
+void parseWrapFlags(const Args& a, osim::MuscleMassOptions& o) {
+  // smooth by default: the mass matrix stays continuous at contact changes, so energy is conserved
+  // to integrator error; exact (finite-difference J) jumps there [D Sec. 5.3.3, 6.2.4]
+  const std::string model = a.get("wrap", "smooth");
+  o.wrap = WrapMassOptions{};
+  o.wrap_mass = model != "lumped";
+  if (model == "smooth") {
+    o.wrap.model = WrapModel::Smooth;
+  } else if (model == "exact") {
+    o.wrap.model = WrapModel::Exact;
+  } else if (model == "neural") {
+    o.wrap.model = WrapModel::Neural;
+    if (!a.has("wrap-network") || a.get("wrap-network", "").empty())
+      throw UsageError{"--wrap neural needs --wrap-network FILE (a network of `redmax train-wrap`, e.g. "
+                       "osim_models/networks/cylinder_3x64.txt)"};
+    const std::string file = a.get("wrap-network", "");
+    try {
+      o.wrap.network = loadWrapNetwork(file);
+    } catch (const std::exception& e) {
+      throw UsageError{std::string("--wrap-network: ") + e.what()};
+    }
+    // outside the training box the smooth model takes over: warn once per muscle, count them all
+    o.wrap.monitor = std::make_shared<WrapFallbackMonitor>(
+        [](const std::string& message) { std::cerr << "warning: " << message << "\n"; });
+  } else if (model != "lumped") {
+    throw UsageError{"--wrap must be smooth, exact, neural or lumped, got '" + model + "'"};
+  }
+  if (a.has("wrap-width")) {
+    if (model != "smooth" && model != "neural")
+      throw UsageError{"--wrap-width needs --wrap smooth or neural (the smooth model's transition width; neural "
+                       "falls back to it)"};
+    o.wrap.width = a.getDouble("wrap-width", 0.0);
+    if (!(o.wrap.width > 0.0) || !std::isfinite(o.wrap.width))
+      throw UsageError{"--wrap-width must be a positive number of metres, got '" + a.get("wrap-width", "") + "'"};
+  }
+  if (a.has("wrap-network") && model != "neural") throw UsageError{"--wrap-network needs --wrap neural"};
 }
 
 osim::MuscleMassOptions parseMuscleMassFlags(const Args& a) {
@@ -32,6 +78,7 @@ osim::MuscleMassOptions parseMuscleMassFlags(const Args& a) {
         throw UsageError{"--" + f + " needs --muscle-mass physiological or transfer"};
     return o;
   }
+  parseWrapFlags(a, o);
   if (o.source != Source::Transfer)
     for (const char* f : {"transfer-body", "transfer-fraction"})
       if (a.has(f)) throw UsageError{std::string("--") + f + " needs --muscle-mass transfer"};
@@ -92,8 +139,23 @@ const char* muscleMassUsage() {
          "  --specific-tension PA  default 600000 (60 N/cm^2, Rajagopal et al. 2016)\n"
          "  --muscle-density KG_M3 default 1059.7 (Ward & Lieber 2005)\n"
          "  --transfer-body BODY --transfer-fraction F   transfer only: F in [0, 1)\n"
-         "Muscles whose paths wrap (Type III) stay lumped. The run prints every affected body's mass\n"
-         "before and after and every muscle's mass and point count on stderr (not with --quiet).\n";
+         "  --wrap smooth|exact|neural|lumped  wrapping (Type III) muscles: smooth (default) gives them\n"
+         "                       mass over the analytic smooth wrap model (C2 across contact changes,\n"
+         "                       energy-consistent); exact over OpenSim's wrapping with finite-difference\n"
+         "                       Jacobians (energy jumps at contact changes); neural over a trained network;\n"
+         "                       lumped keeps them massless. Supported shape: origin, one cylinder or\n"
+         "                       sphere (smooth) or any surface (exact), insertion; other wrapping muscles\n"
+         "                       stay lumped and the summary says why. `redmax id --engine simbody` keeps\n"
+         "                       them lumped unless --wrap is given (Simbody's muscle inertia has no wrap\n"
+         "                       surfaces yet)\n"
+         "  --wrap-width W       smooth (and neural's fallback): transition width in metres (default 0.05\n"
+         "                       of the radius)\n"
+         "  --wrap-network FILE  neural (required): a network of `redmax train-wrap` (e.g.\n"
+         "                       osim_models/networks/cylinder_3x64.txt); surfaces it was not trained for\n"
+         "                       and inputs outside its training box use the smooth model, with a warning\n"
+         "                       once per muscle and the count in the summary\n"
+         "The run prints every affected body's mass before and after and every muscle's mass and point\n"
+         "count on stderr (not with --quiet).\n";
 }
 
 }  // namespace redmax::cli

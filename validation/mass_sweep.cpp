@@ -82,6 +82,7 @@ MassSweepEngineFactory makeCoreMassEngineFactory(const osim::InverseDynamicsTool
     e.muscle_mass = mm.plan.total_muscle_mass;
     for (const auto& me : mm.plan.muscles) e.muscles_with_mass += me.mass > 0.0;
     e.description = osim::describeMuscleMass(mm.plan);
+    e.wrap = osim::countWrapMass(mm.plan);
     e.model = std::make_shared<const Model>(mm.build.model);
     e.muscles = mm.build.muscles;
     // the core with the muscles' mass points as a MuscleTerm (core_id_engine.hpp)
@@ -288,6 +289,7 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
     p.muscle_mass = e.muscle_mass;
     p.muscles_with_mass = e.muscles_with_mass;
     p.description = e.description;
+    p.wrap = e.wrap;
     r.points.push_back(p);
     s.name = osim::kIdStorageName;
     tau.push_back(s.data);
@@ -422,6 +424,24 @@ void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_ma
   js["muscles_with_mass"] = nm;
   js["seconds"] = secs;
   js["main_columns"] = r.main_columns;
+  // wrapping muscles at the largest value: how many carry mass, and why the others stay lumped
+  if (!r.points.empty()) {
+    const osim::WrapMassCount& wc = r.points.back().wrap;
+    JsonValue wj = JsonValue::object();
+    wj["wrap_mass"] = base.wrap_mass;
+    wj["wrap_model"] = osim::toString(base.wrap.model);
+    wj["wrapping_muscles"] = wc.wrapping;
+    wj["with_mass"] = wc.with_mass;
+    JsonValue lumped = JsonValue::array();
+    for (const auto& [name, why] : wc.lumped) {
+      JsonValue l = JsonValue::object();
+      l["muscle"] = name;
+      l["why"] = why;
+      lumped.push(l);
+    }
+    wj["lumped"] = lumped;
+    js["wrapping"] = wj;
+  }
   JsonValue sbj = JsonValue::object();
   sbj["ran"] = r.simbody.ran;
   if (!r.simbody.ran) sbj["skipped"] = r.simbody.skipped.empty() ? "not requested" : r.simbody.skipped;
@@ -478,6 +498,10 @@ void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_ma
              "keep their path fractions, so R^2 differs from 1 only by round-off (lowest R^2 "
           << fmtG("%.15g", an.r2_min_observed) << ", largest nonlinearity " << fmtG("%.2g", an.nonlinearity_max)
           << " of the peak).\n";
+  if (!r.points.empty() && r.points.back().wrap.wrapping > 0)
+    md_text << "\nWrapping muscles (wrap mass " << (base.wrap_mass ? "on, model " : "off, model ")
+            << osim::toString(base.wrap.model) << "), at " << valueLabel(base, values[last]) << ":\n\n```\n"
+            << formatWrapMassCount(r.points.back().wrap) << "```\n";
   report.addMarkdown("Muscle-mass sweep", md_text.str());
   if (!r.points.empty() && !r.points.back().description.empty())
     report.addMarkdown("Muscle mass at " + valueLabel(base, values[last]), "```\n" + r.points.back().description + "```\n");
@@ -530,6 +554,26 @@ std::string formatSimbodyMassCheck(const Comparison& c) {
   return os.str();
 }
 
+std::string formatWrapMassCount(const osim::WrapMassCount& c) {
+  if (c.wrapping == 0) return "";
+  std::ostringstream os;
+  os << "wrapping (Type III): " << c.with_mass << " of " << c.wrapping << " carry mass\n";
+  // one line per reason, in order of first appearance
+  std::vector<std::pair<std::string, std::vector<std::string>>> by_why;
+  for (const auto& [name, why] : c.lumped) {
+    auto it = std::find_if(by_why.begin(), by_why.end(), [&](const auto& g) { return g.first == why; });
+    if (it == by_why.end()) by_why.push_back({why, {name}});
+    else it->second.push_back(name);
+  }
+  for (const auto& [why, names] : by_why) {
+    os << "  lumped " << names.size() << ": " << why << " (";
+    for (size_t j = 0; j < names.size() && j < 6; ++j) os << (j ? ", " : "") << names[j];
+    if (names.size() > 6) os << ", ...";
+    os << ")\n";
+  }
+  return os.str();
+}
+
 std::string formatMassSweepSummary(const MassSweepResult& r) {
   const osim::MuscleMassOptions& base = r.options.base;
   std::ostringstream os;
@@ -545,6 +589,10 @@ std::string formatMassSweepSummary(const MassSweepResult& r) {
            << " (" << fmtG("%+.2f%%", 100 * col.peak_change_rel[last]) << "), max change "
            << fmtG("%.2f%%", 100 * col.max_diff_rel[last]) << " of the peak, R^2 "
            << (col.has_effect ? fmtG("%.12f", col.r2) : std::string("n/a (no effect)")) << "\n";
+  if (!r.points.empty()) {
+    std::istringstream wl(formatWrapMassCount(r.points.back().wrap));
+    for (std::string line; std::getline(wl, line);) os << "  " << line << "\n";
+  }
   if (r.simbody.ran) os << "  " << formatSimbodyMassCheck(r.simbody.comparison);
   else if (!r.simbody.skipped.empty()) os << "  simbody with muscle inertia: " << r.simbody.skipped << "\n";
   os << "  zero check: max |diff| / peak " << fmtG("%.3g", r.analysis.zero_max_rel) << " -> "

@@ -80,6 +80,7 @@ struct MassSweepEngine {
   double muscle_mass = 0.0;      ///< kg carried by mass points
   int muscles_with_mass = 0;
   std::string description;       ///< osim::describeMuscleMass of the plan
+  osim::WrapMassCount wrap;      ///< wrapping (Type III) muscles: how many carry mass, why the others do not
   /// the model with the mass taken from the bodies and its muscles with their mass points (for a
   /// second engine, e.g. Simbody with muscle inertia); empty when the factory does not give them
   std::shared_ptr<const Model> model;
@@ -132,6 +133,7 @@ struct MassSweepPoint {
   int muscles_with_mass = 0;
   double seconds = 0;      ///< solving every frame
   std::string description;
+  osim::WrapMassCount wrap;  ///< from the engine (MassSweepEngine::wrap)
 };
 
 /// The Simbody engine with muscle inertia (plugin/simbody) at the sweep's largest value, solved on
@@ -179,6 +181,11 @@ void addSimbodyMassCheck(const Comparison& c, const osim::Storage& core_mass, co
 
 /// One line for a recorded cross-check: "<name>: worst COL max/peak X -> agrees | DIFFERS (recorded, not counted)".
 std::string formatSimbodyMassCheck(const Comparison& c);
+
+/// The wrapping muscles at the sweep's largest value in one line per reason: "wrapping (Type III):
+/// W of N carry mass" then "  lumped K: REASON (names...)" (names up to 6 per reason). Empty when
+/// the model has no wrapping muscle.
+std::string formatWrapMassCount(const osim::WrapMassCount& c);
 
 /// The lines `redmax validate` prints: per value the muscle mass; per main column the peak change
 /// at the largest value and R^2; the zero check.

@@ -290,7 +290,12 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
   const Model& model = base.model;
   const int nm = static_cast<int>(base.muscles.size());
   out.plan.muscles.resize(nm);
-  for (int k = 0; k < nm; ++k) out.plan.muscles[k].name = base.muscles[k].name;
+  for (int k = 0; k < nm; ++k) {
+    out.plan.muscles[k].name = base.muscles[k].name;
+    out.plan.muscles[k].wraps = pathType(base.muscles[k].path) == redmax::PathType::III;
+    // the wrap model decides which surfaces a Type III muscle may carry mass over
+    if (out.plan.muscles[k].wraps) base.muscles[k].wrap = options.wrap;
+  }
 
   if (options.source == Source::None) {
     for (auto& e : out.plan.muscles) e.lumped_why = "--muscle-mass none";
@@ -321,7 +326,7 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
     if (!pf.is_muscle) {
       e.lumped_why = "not a muscle (" + pf.class_name + ")";
     } else if (pathType(base.muscles[k].path) == redmax::PathType::III && !options.wrap_mass) {
-      e.lumped_why = "Type III path (wrapping surfaces carry no mass yet)";
+      e.lumped_why = "Type III path (wrap mass off: --wrap lumped)";
     } else if (pathType(base.muscles[k].path) == redmax::PathType::III &&
                !redmax::wrapMassPointsUnsupportedReason(base.muscles[k]).empty()) {
       e.lumped_why = "Type III path (" + redmax::wrapMassPointsUnsupportedReason(base.muscles[k]) + ")";
@@ -491,6 +496,7 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
   out.build.muscles = addMusclePointMasses(out.build.muscles, plain, mpo);
   for (int k = 0; k < nm; ++k) {
     Muscle& mu = out.build.muscles[k];
+    if (pathType(mu.path) == redmax::PathType::III) mu.wrap = options.wrap;
     if (plain[k] == mass[k] || !(mass[k] > 0.0)) continue;
     mu.mass_points = makeMassPoints(mass[k], mu.optimal_fiber_length, mu.tendon_slack_length, mpo);
     validateMuscle(out.build.model, mu);
@@ -507,6 +513,26 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
     out.plan.total_muscle_mass += mass[k];
   }
   return out;
+}
+
+WrapMassCount countWrapMass(const MuscleMassPlan& plan) {
+  WrapMassCount c;
+  for (const auto& e : plan.muscles) {
+    if (!e.wraps) continue;
+    ++c.wrapping;
+    if (e.mass > 0.0) ++c.with_mass;
+    else c.lumped.push_back({e.name, e.lumped_why});
+  }
+  return c;
+}
+
+const char* toString(WrapModel model) {
+  switch (model) {
+    case WrapModel::Smooth: return "smooth";
+    case WrapModel::Exact: return "exact";
+    case WrapModel::Neural: return "neural";
+  }
+  return "?";
 }
 
 std::string describeMuscleMass(const MuscleMassPlan& plan) {
@@ -527,6 +553,19 @@ std::string describeMuscleMass(const MuscleMassPlan& plan) {
   for (const auto& e : plan.muscles) with += e.mass > 0.0;
   os << "  " << with << " of " << plan.muscles.size() << " path forces carry "
      << fmt(plan.total_muscle_mass) << " kg\n";
+  const WrapMassCount wc = countWrapMass(plan);
+  if (wc.wrapping > 0) {
+    os << "  wrapping (Type III): " << wc.with_mass << " of " << wc.wrapping << " carry mass";
+    if (o.wrap_mass) {
+      os << " (wrap model " << toString(o.wrap.model);
+      if (o.wrap.model != WrapModel::Exact)
+        os << ", width " << (o.wrap.width > 0.0 ? fmt(o.wrap.width) + " m" : std::string("0.05 radius"));
+      os << ")";
+    } else {
+      os << " (wrap mass off)";
+    }
+    os << "\n";
+  }
   if (!plan.bodies.empty()) {
     os << "  bodies (mass before -> after, kg; centre of mass after, m):\n";
     for (const auto& b : plan.bodies)

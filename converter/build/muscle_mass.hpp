@@ -55,6 +55,9 @@ struct MuscleMassOptions {
   /// insertion) take mass too (smooth wrap model). Off by default: the Simbody side cannot move
   /// mass points over wrap surfaces yet, so engine comparisons keep them lumped.
   bool wrap_mass = false;
+  /// wrap model of every Type III muscle that takes mass (copied to Muscle::wrap before the
+  /// shape check, so the model decides which surfaces are supported); used only with wrap_mass
+  WrapMassOptions wrap;
 };
 
 /// "none" | "physiological" | "transfer"; throws std::invalid_argument otherwise
@@ -70,6 +73,7 @@ struct MuscleMassEntry {
   double mass = 0.0;        ///< kg given to its mass points (0 = lumped)
   int points = 0;           ///< mass points (0 = lumped)
   std::string lumped_why;   ///< "" when it carries mass, else e.g. "not selected", "Type III path"
+  bool wraps = false;       ///< its path has wrap objects (Type III)
 };
 
 /// a body whose mass changed; inertia about its own centre of mass, body axes
@@ -108,6 +112,18 @@ struct MuscleMassModel {
 MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& build_options,
                                 const MuscleMassOptions& options,
                                 const std::vector<VecX>& samples = {});
+
+/// The wrapping (Type III) muscles of a plan: how many there are, how many carry mass, and the
+/// others with the reason each stays lumped (MuscleMassEntry::lumped_why), in plan order.
+struct WrapMassCount {
+  int wrapping = 0;
+  int with_mass = 0;
+  std::vector<std::pair<std::string, std::string>> lumped;  ///< (muscle, why)
+};
+WrapMassCount countWrapMass(const MuscleMassPlan& plan);
+
+/// "smooth" | "exact" | "neural"; for summaries
+const char* toString(WrapModel model);
 
 /// Multi-line human-readable summary: each affected body's mass before and after, each muscle's
 /// mass and point count, the lumped muscles and why, and the top:K ranking.

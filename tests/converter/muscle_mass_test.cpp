@@ -192,7 +192,7 @@ TEST(MuscleMass, PhysiologicalConservesMassAndComOnScenes) {
       // the only muscle wraps: nothing moves
       const MuscleMassModel r = applyMuscleMass(d, idBuild(), o);
       EXPECT_EQ(r.plan.total_muscle_mass, 0.0);
-      EXPECT_EQ(r.plan.muscles[0].lumped_why, "Type III path (wrapping surfaces carry no mass yet)");
+      EXPECT_EQ(r.plan.muscles[0].lumped_why, "Type III path (wrap mass off: --wrap lumped)");
       continue;
     }
     expectConserved(d, o, entry.path().filename().string());

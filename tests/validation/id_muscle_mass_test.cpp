@@ -336,10 +336,10 @@ TEST_F(IdMuscleMassCli, PrintsThePlanAndChangesTheTorques) {
   const CmdResult none = run("--full-precision --out none.sto");
   ASSERT_EQ(none.code, 0) << none.err;
   EXPECT_EQ(none.err.find("muscle mass"), std::string::npos) << none.err;
-  const CmdResult r = run("--muscle-mass physiological --mass-points 10 --full-precision --out phys.sto");
+  const CmdResult r = run("--muscle-mass physiological --mass-points 10 --wrap lumped --full-precision --out phys.sto");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const std::string want : {"muscle mass: physiological", "tibia_r: ", "soleus_r: ", "10 points",
-                                 "med_gas_r: Type III path (wrapping surfaces carry no mass yet)"})
+                                 "med_gas_r: Type III path (wrap mass off: --wrap lumped)"})
     EXPECT_NE(r.err.find(want), std::string::npos) << want << "\n" << r.err;
   const Storage a = readStorage((dir_ / "none.sto").string()), b = readStorage((dir_ / "phys.sto").string());
   ASSERT_EQ(a.numRows(), b.numRows());

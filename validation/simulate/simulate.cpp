@@ -160,12 +160,33 @@ SimulationModel makeSimulationModel(const osim::ModelDescription& d, const Simul
     MassPointOptions mp;
     mp.count = options.muscle_mass.mass_points;
     mp.region = options.muscle_mass.region;
-    m.muscles = osim::addMusclePointMasses(m.muscles, masses, mp);
+    // wrapping (Type III) muscles take their points here when wrap mass is on (addMusclePointMasses
+    // refuses them); validateMuscle names the reason when the shape is not supported
+    std::vector<double> plain = masses;
+    for (size_t k = 0; k < m.muscles.size(); ++k) {
+      if (pathType(m.muscles[k].path) != PathType::III || !(masses[k] > 0.0)) continue;
+      if (!options.muscle_mass.wrap_mass)
+        throw std::invalid_argument("--muscle-mass-kg: muscle '" + m.muscles[k].name +
+                                    "' wraps (Type III) and wrap mass is off (--wrap lumped)");
+      plain[k] = 0.0;
+    }
+    m.muscles = osim::addMusclePointMasses(m.muscles, plain, mp);
+    for (size_t k = 0; k < m.muscles.size(); ++k) {
+      if (plain[k] == masses[k]) continue;
+      Muscle& mu = m.muscles[k];
+      mu.wrap = options.muscle_mass.wrap;
+      mu.mass_points = makeMassPoints(masses[k], mu.optimal_fiber_length, mu.tendon_slack_length, mp);
+      validateMuscle(m.build.model, mu);
+    }
     std::ostringstream os;
     for (size_t k = 0; k < m.muscles.size(); ++k) {
       if (masses[k] <= 0.0) continue;
       os << "  muscle " << m.muscles[k].name << ": " << masses[k] << " kg on " << m.muscles[k].mass_points.size()
-         << " points (added; no body gives mass)\n";
+         << " points (added; no body gives mass)"
+         << (pathType(m.muscles[k].path) == PathType::III
+                 ? std::string(", wrapping, wrap model ") + osim::toString(m.muscles[k].wrap.model)
+                 : std::string())
+         << "\n";
       m.added_mass += masses[k];
     }
     m.mass_summary = os.str();
