@@ -349,6 +349,16 @@ SmoothWrapLength calcWrapModelLength(const WrapMassOptions& options, const WrapS
 
 namespace {
 
+// true when the wrap model refuses the segment p1 -> p2 (frame s): an end inside the surface
+bool endInsideSurface(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1, const Vec3& p2) {
+  try {
+    calcWrapModelLength(options, surface, p1, p2, Vec3::Zero(), Vec3::Zero());
+    return false;
+  } catch (const std::invalid_argument&) {
+    return true;
+  }
+}
+
 bool coversBody(const Model& model, const MuscleKinematics& mk, int b) {
   if (b < 0) return true;
   if (static_cast<int>(mk.col_of.size()) != model.nr()) return false;
@@ -381,6 +391,7 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
   const std::string who = "muscle '" + muscle.name + "'";
 
   // which wrap acts on which segment (header): the candidate penetrating most
+  const bool single_shape = path.points.size() == 2 && path.wraps.size() == 1;
   std::vector<int> seg_wrap(nseg, -1);
   std::vector<SurfaceMotion> sm(nw);
   std::vector<char> have_sm(nw, 0);
@@ -400,12 +411,20 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
     double best_d = -std::numeric_limits<double>::infinity();
     for (int i = first; i < last; ++i) {
       if (seg_wrap[i] >= 0) continue;
-      if (last - first == 1) {
+      if (single_shape) {
         best = i;
         break;
       }
       const SurfaceMotion& m = motion(w);
       const Vec3 p1 = m.R.transpose() * (mk.x_w[i] - m.p), p2 = m.R.transpose() * (mk.x_w[i + 1] - m.p);
+      // OpenSim gives a segment with an end inside the surface no wrap (InsideRadius), and so do
+      // we on general paths (the positions jump there as OpenSim's do); on origin -> surface ->
+      // insertion it stays a MuscleError (the dissertation's shape, where nothing else can wrap)
+      if (endInsideSurface(muscle.wrap, pw.surface, p1, p2)) continue;
+      if (last - first == 1) {
+        best = i;
+        break;
+      }
       const double d = calcWrapPenetration(pw.surface, p1, p2);
       if (d > best_d) {
         best_d = d;

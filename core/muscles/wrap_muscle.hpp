@@ -12,7 +12,9 @@
 // one segment within its range: Smooth picks the candidate segment whose straight line penetrates
 // the surface most (OpenSim tries every segment of the range and keeps a mandatory wrap or the
 // smallest length change; the two agree whenever one segment meets the surface, and the choice
-// only switches where the penetrations are equal, which is continuous while both are <= 0).
+// only switches where the penetrations are equal, which is continuous while both are <= 0). A
+// segment with an end inside the surface takes no wrap (OpenSim's InsideRadius; the points jump
+// there as OpenSim's path does), except on origin -> surface -> insertion, where it is an error.
 // Segment lengths L_i: straight |x_{i+1} - x_i|, or the wrap model's length of the wrapped segment
 // (smooth: exact wrapped length outside the band, blended inside). Mass points keep their arc
 // fraction alpha of the whole length: s_i = (L_0 + ... + L_{i-1}) / sum L (Eulerian coordinates of
@@ -80,8 +82,8 @@ void initWrapMuscleColumns(const Model& model, const Muscle& muscle, MuscleKinem
 /// Jdot_ar in mk's compact columns; segment (between active points segment, segment + 1) and beta
 /// (fraction of that segment's length). Needs the columns of initWrapMuscleColumns and the
 /// skeleton workspace of `state`. Throws MuscleError (naming the muscle) when an end point lies
-/// inside a surface, ends coincide or a segment has zero length, std::logic_error for an
-/// unsupported shape.
+/// inside the surface of origin -> surface -> insertion, ends coincide or a segment has zero
+/// length, std::logic_error for an unsupported shape.
 void calcWrapMassPoints(const Model& model, const State& state, const SkeletonWorkspace& sk, const Muscle& muscle,
                         MuscleKinematics& mk);
 /// The same without the state: enough for the smooth model and for origin -> surface -> insertion;

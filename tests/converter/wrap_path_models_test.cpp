@@ -174,5 +174,57 @@ TEST(WrapPathModels, Rajagopal2016EveryWrappingMuscleGetsMassPoints) {
   EXPECT_GT(t.smooth, t.before);
 }
 
+TEST(WrapPathModels, SmoothMusclesAtRandomPosesStayOnOpenSimsPath) {
+  // 100 poses per muscle, default +- 0.6 in every coordinate (seeded): no evaluation error (a
+  // segment with an end inside a surface takes no wrap, as in OpenSim), and the smooth points stay
+  // on OpenSim's whole path except in the transition band (bounded by the band width) and where two
+  // segments of one range meet the surface (smooth: deepest; OpenSim: first mandatory or shortest)
+  REDMAX_REQUIRE_SHARED();
+  for (const char* rel : {"/opensim/opensim-core/OpenSim/Moco/Test/subject_walk_armless_18musc.osim",
+                          "/opensim/opensim-models/Models/Rajagopal/Rajagopal2016.osim"}) {
+    const ModelDescription d = readOsimModel(std::string(REDMAX_SHARED_DIR) + rel);
+    BuildOptions bo;
+    bo.constraints = false;
+    const BuildResult r = buildCoreModel(d, bo);
+    const Model& m = r.model;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    int total = 0, errors = 0, on = 0, band = 0, far = 0;
+    double worst = 0.0;
+    for (const Muscle& base : r.muscles) {
+      if (pathType(base.path) != redmax::PathType::III) continue;
+      Muscle mu = base;
+      mu.mass_points = makeMassPoints(1.0, 0.0, 0.0, {10, MassPointOptions::Region::WholePath});
+      if (!wrapMassPointsUnsupportedReason(mu).empty()) continue;
+      for (int t = 0; t < 100; ++t) {
+        State s;
+        s.q = m.defaultQ() + 0.6 * VecX::NullaryExpr(m.nr(), [&] { return u(rng); });
+        s.qdot = VecX::Zero(m.nr());
+        ++total;
+        try {
+          const MuscleKinematics mk = redmax::test::evalMuscle(m, mu, s, false);
+          std::vector<Mat4> E_wi;
+          calcBodyPoses(m, s.q, E_wi);
+          const WrappedPath wp = calcWrappedPath(m, mu.path, s.q, E_wi);
+          double dev = 0.0;
+          for (int a = 0; a < mu.mass_points.size(); ++a)
+            dev = std::max(dev, (mk.x_a[a] - calcWrappedPathPointWorld(mu.path, wp, E_wi, mu.mass_points.alpha[a])).norm());
+          worst = std::max(worst, dev);
+          (dev < 1e-9 ? on : dev < 1e-3 ? band : far)++;
+        } catch (const std::exception& e) {
+          ++errors;
+          ADD_FAILURE() << mu.name << ": " << e.what();
+        }
+      }
+    }
+    std::printf("[ measured ] %s: %d smooth muscle-poses, %d on OpenSim's path (< 1e-9 m), %d within 1 mm, %d farther "
+                "(max %.1e m), %d errors\n",
+                rel, total, on, band, far, worst, errors);
+    EXPECT_EQ(errors, 0);
+    EXPECT_GT(on, 0.8 * total);
+    EXPECT_LE(far, 0.01 * total);
+  }
+}
+
 }  // namespace
 }  // namespace redmax::osim
