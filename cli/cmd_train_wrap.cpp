@@ -1,12 +1,14 @@
 // `redmax train-wrap`: train the Type III wrap network on samples of the exact wrapping library
 // [D Sec. 5.3.3.1], or (--compare) time networks, the smooth model and the exact library per mass
 // point (position + Jacobian + Jdot) against their position error.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <memory>
 #include <random>
 #include <sstream>
 #include <string>
@@ -14,10 +16,12 @@
 
 #include "cli/args.hpp"
 #include "converter/atomic_file.hpp"
+#include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap/smooth.hpp"
 #include "core/muscles/wrap/train.hpp"
 #include "validation/report/csv.hpp"
 #include "validation/report/plot.hpp"
+#include "validation/scenes/wrap_pendulums.hpp"
 
 namespace redmax::cli {
 namespace {
@@ -347,8 +351,39 @@ int runCompare(const Args& a) {
         sink = sink + Y(0, 0) + J(0, 0) + Jdot(0, 0);
       }
     });
+    // the same network as a run-time wrap model (network_model.hpp: scaling by the radius, the box
+    // test on every input, the smooth model where it fails)
+    const bool as_model = networkWrapUnsupportedReason(net).empty() && (type == WrapType::Cylinder || type == WrapType::Sphere);
+    std::vector<WrapSurface> surfs;
+    for (long m = 0; m < muscles && as_model; ++m) surfs.push_back(makeWrapSurfaceFromInput(type, inputs[m]));
+    NetworkWrapWorkspace nws;
+    WrapMassPoints wmp;
+    std::vector<long> on_net;  // muscles whose scaled inputs stay in the box (timed: the network's cost)
+    for (long m = 0; m < muscles && as_model; ++m)
+      if (calcNetworkWrapModel(&net, surfs[m], inputs[m].segment<3>(0), inputs[m].segment<3>(3), v1s[m], v2s[m], alphas,
+                               true, wmp, nws)
+              .usedNetwork())
+        on_net.push_back(m);
+    double model_us = NAN;
+    if (!on_net.empty()) {
+      long reps = 0;
+      const auto t0 = Clock::now();
+      do {
+        for (long m : on_net) {
+          calcNetworkWrapModel(&net, surfs[m], inputs[m].segment<3>(0), inputs[m].segment<3>(3), v1s[m], v2s[m], alphas,
+                               true, wmp, nws);
+          sink = sink + wmp.x[0][0] + wmp.J[0](0, 0) + wmp.Jdot[0](0, 0);
+        }
+        ++reps;
+      } while (secondsSince(t0) < 0.3);
+      model_us = 1e6 * secondsSince(t0) / (static_cast<double>(reps) * on_net.size() * points);
+    }
+    const long fell_back = muscles - static_cast<long>(on_net.size());
     row.note = "exact Jdot; Eq. 5.58 FD Jdot (eps 1e-6): " + num(fd_us, 3) + " us/point, rel. diff " +
                num(std::sqrt(jd_diff / std::max(jd_norm, 1e-300)), 2);
+    if (as_model)
+      row.note += "; as a wrap model (scaling, box test, " + std::to_string(fell_back) + " of " + std::to_string(muscles) +
+                  " muscles leave the box at radius 0.5-1.5, timed on the others): " + num(model_us, 3) + " us/point";
     if (outside) row.note += "; " + std::to_string(outside) + " points outside the training box";
     rows.push_back(row);
   }
@@ -481,13 +516,79 @@ int runStudy(const Args& a) {
   return 0;
 }
 
+// ---------------------------------------------------------------------------------------------
+// a group of wrapping double pendulums on one network (issue 7, Results)
+
+int runPendulums(const Args& a) {
+  const std::string file = *a.get("pendulums");
+  std::shared_ptr<const Mlp> net;
+  try {
+    net = loadWrapNetwork(file);
+  } catch (const std::runtime_error& e) {  // NetworkFormatError included
+    throw UsageError{e.what()};
+  }
+  if (net->meta.count("surface") && net->meta.at("surface") != "cylinder")
+    throw UsageError{"--pendulums " + file + ": the pendulums wrap a cylinder, this network is for a " +
+                     net->meta.at("surface")};
+  const long count = a.getInt("count", 8);
+  const double duration = a.getDouble("duration", 2.0);
+  const double tol = a.getDouble("tol", 1e-12);
+  const unsigned seed = static_cast<unsigned>(a.getInt("seed", 1));
+  if (count < 1 || count > 1000) throw UsageError{"--count must be between 1 and 1000"};
+  if (!(duration > 0.0 && duration <= 1000.0)) throw UsageError{"--duration must be in (0, 1000] s"};
+  if (!(tol > 0.0 && tol < 1.0)) throw UsageError{"--tol must be in (0, 1)"};
+  const auto report = a.get("report");
+  if (report) requireFolder(*report);
+  WrapMassOptions wrap;
+  wrap.model = WrapModel::Neural;
+  wrap.network = net;
+  wrap.network_fd_jdot = a.has("fd-jdot");
+  const auto specs = scenes::makeWrapPendulumGroup(static_cast<int>(count), seed);
+  std::vector<scenes::WrapPendulumRun> runs;
+  for (size_t i = 0; i < specs.size(); ++i) {
+    runs.push_back(scenes::runWrapPendulum(specs[i], wrap, duration, tol));
+    std::cerr << "train-wrap --pendulums: " << i + 1 << "/" << specs.size() << " done, drift "
+              << num(runs.back().max_drift, 3) << " J, " << num(runs.back().wall_s, 3) << " s\n";
+  }
+  double worst = 0.0;
+  long fallbacks = 0, evaluations = 0;
+  for (const auto& r : runs) {
+    worst = std::max(worst, r.max_drift);
+    fallbacks += r.fallbacks;
+    evaluations += r.evaluations;
+  }
+  std::cout << count << " wrapping double pendulums (seed " << seed << ") on " << file << " (" << net->architecture()
+            << "), " << num(duration, 4) << " s rk45 rtol = atol = " << num(tol, 2) << ", Jdot "
+            << (wrap.network_fd_jdot ? "by forward differences [D Eq. 5.58]" : "exact") << ":\n"
+            << scenes::formatWrapPendulumTable(runs) << "largest energy drift " << num(worst, 3) << " J; " << fallbacks
+            << " of " << evaluations << " wrap evaluations fell back to the smooth model\n";
+  if (report) {
+    validation::CsvTable t;
+    t.header = {"pendulum", "origin_x", "origin_y", "insertion_x", "insertion_y", "radius", "tilt", "q2_0", "E0",
+                "max_drift", "max_10ms_change", "contact_changes", "steps", "evaluations", "fallbacks", "wall_s"};
+    for (size_t i = 0; i < runs.size(); ++i) {
+      const auto& r = runs[i];
+      const auto& s = r.spec;
+      t.addRow({double(i), s.origin.x(), s.origin.y(), s.insertion.x(), s.insertion.y(), s.radius, s.tilt, s.q2, r.E0,
+                r.max_drift, r.max_step_change, double(r.contact_changes), double(r.steps), double(r.evaluations),
+                double(r.fallbacks), r.wall_s});
+    }
+    osim::writeFileAtomic(*report + "/pendulums.csv", validation::formatCsv(t));
+    std::cout << "wrote " << *report << "/pendulums.csv\n";
+  }
+  return 0;
+}
+
 int runTrainWrap(const std::vector<std::string>& argv) {
   Args a(argv,
          {"surface", "hidden", "samples", "epochs", "batch", "lr", "seed", "threshold", "time-limit", "out", "report",
-          "threads", "shards", "nets", "untrained", "muscles", "mass-points", "width", "thresholds", "architectures"},
-         {"compare", "study"});
+          "threads", "shards", "nets", "untrained", "muscles", "mass-points", "width", "thresholds", "architectures",
+          "pendulums", "count", "duration", "tol"},
+         {"compare", "study", "fd-jdot"});
   if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
-  if (a.has("compare") && a.has("study")) throw UsageError{"--compare and --study exclude each other"};
+  if (a.has("compare") + a.has("study") + a.has("pendulums") > 1)
+    throw UsageError{"--compare, --study and --pendulums exclude each other"};
+  if (a.has("pendulums")) return runPendulums(a);
   if (a.has("study")) return runStudy(a);
   return a.has("compare") ? runCompare(a) : runTrain(a, argv);
 }
@@ -501,6 +602,8 @@ CommandRegistration reg(
      "                         [--muscles M] [--mass-points N] [--width W] [--seed S] --report DIR\n"
      "       redmax train-wrap --study [--thresholds 0.01,0.05,0.1] [--architectures 1x32,3x32] [--samples N]\n"
      "                         [--epochs E] [--batch B] [--lr R] [--seed S] --report DIR\n"
+     "       redmax train-wrap --pendulums NET.txt [--count 8] [--duration 2] [--tol 1e-12] [--seed S] [--fd-jdot]\n"
+     "                         [--report DIR]\n"
      "Training [D Sec. 5.3.3.1]: N samples (default 30000) drawn uniformly from the surface type's box\n"
      "(core/muscles/wrap/train.hpp makeDefaultWrapBox; units of the surface size) and labelled by the exact\n"
      "library; samples with 0 < l/L < threshold are discarded. A tanh MLP (--hidden DEPTHxWIDTH or W1-W2-...,\n"
@@ -515,7 +618,12 @@ CommandRegistration reg(
      "DIR/speed_error.csv and a plot: microseconds per mass point (position + J + Jdot) and position error.\n"
      "--study [D Sec. 6.2.6]: for each threshold and architecture, trains a cylinder network (defaults: 10000\n"
      "samples, 60 epochs, batch 64, lr 1e-3) and writes DIR/study.csv and a plot of x_alpha.x (alpha 0.5) and\n"
-     "d x_alpha.x / d ins_x against ins_x as the insertion moves through the contact change, with the exact library.\n",
+     "d x_alpha.x / d ins_x against ins_x as the insertion moves through the contact change, with the exact library.\n"
+     "--pendulums NET.txt: a group of wrapping double pendulums (validation/scenes/wrap_pendulums.hpp; origin,\n"
+     "insertion, radius and surface tilt drawn with the seed) all on one cylinder network (WrapModel::Neural),\n"
+     "gravity only, rk45 at --tol for --duration s; prints each one's energy drift, contact changes, steps and\n"
+     "smooth-model fallbacks (--fd-jdot: Jdot by the forward difference [D Eq. 5.58]); --report DIR writes\n"
+     "DIR/pendulums.csv.\n",
      runTrainWrap});
 
 }  // namespace
