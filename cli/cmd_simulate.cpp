@@ -4,6 +4,7 @@
 // 1 the run diverged (nothing written), 2 bad input or usage.
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -15,6 +16,7 @@
 
 #include "cli/args.hpp"
 #include "cli/muscle_mass_flags.hpp"
+#include "cli/simulate_simbody.hpp"
 #include "core/muscles/wrap/network_model.hpp"
 #include "validation/report/progress.hpp"
 #include "validation/simulate/simulate.hpp"
@@ -49,7 +51,7 @@ std::vector<std::pair<std::string, double>> parseMassList(const std::string& tex
 int runSimulate(const std::vector<std::string>& argv) {
   const Args a(argv,
                withMuscleMassFlags({"model", "duration", "integrator", "dt", "rtol", "atol", "max-step", "initial",
-                                    "initial-time", "wrap", "output-dt", "out", "muscle-mass-kg", "impulse"}),
+                                    "initial-time", "wrap", "output-dt", "out", "muscle-mass-kg", "impulse", "engine"}),
                {"no-qvv", "progress", "quiet", "full-precision"});
   if (!a.positionals().empty())
     throw UsageError{"simulate takes no positional arguments (got '" + a.positionals().front() + "')"};
@@ -57,6 +59,8 @@ int runSimulate(const std::vector<std::string>& argv) {
   if (!a.has("duration")) throw UsageError{"simulate needs --duration S"};
   if (!a.has("out")) throw UsageError{"simulate needs --out STATES.sto"};
   const std::string model_path = *a.get("model"), out_path = *a.get("out");
+  const std::string engine = a.get("engine", "core");
+  if (engine != "core" && engine != "simbody") throw UsageError{"--engine must be core or simbody, got '" + engine + "'"};
 
   validation::SimulateOptions so;
   so.duration = a.getDouble("duration", 0.0);
@@ -161,7 +165,30 @@ int runSimulate(const std::vector<std::string>& argv) {
     progress->set(std::lround((t - initial.t) * 1000.0));
   };
 
-  const validation::SimulationResult res = validation::simulate(model, initial, so);
+  // the engine: the core, or Simbody with one particle per mass point (cli/simulate_simbody.hpp)
+  if (engine == "simbody") {
+    const std::string why = simbodyEngineUnsupportedReason(model, so, mo.quadratic_velocity);
+    if (!why.empty()) throw UsageError{why};
+  }
+  const std::clock_t cpu_start = std::clock();
+  validation::SimulationResult res;
+  if (engine == "simbody") {
+    try {
+      res = simulateSimbody(model, initial, so);
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "error: " << model_path << ": --engine simbody: " << e.what() << "\n";
+      return 2;
+    } catch (const ModelError& e) {
+      std::cerr << "error: " << model_path << ": --engine simbody: " << e.what() << "\n";
+      return 2;
+    } catch (const std::runtime_error& e) {  // simbody::SimbodyBuildError: a model Simbody cannot take
+      std::cerr << "error: " << model_path << ": --engine simbody cannot build this model: " << e.what() << "\n";
+      return 2;
+    }
+  } else {
+    res = validation::simulate(model, initial, so);
+  }
+  const double cpu_s = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   if (progress) progress->finish();
   if (res.failed) {
     std::cerr << "error: " << model_path << ": simulation failed: " << res.failure << "\n"
@@ -180,7 +207,7 @@ int runSimulate(const std::vector<std::string>& argv) {
       wo.decimals = 16;
     }
     std::ostringstream desc;
-    desc << "redmax simulate: model " << model_path << ", integrator " << so.integrator;
+    desc << "redmax simulate: model " << model_path << ", engine " << engine << ", integrator " << so.integrator;
     if (so.integrator == "rk45" || so.integrator == "cvode")
       desc << " (rtol " << io.rtol << ", atol " << io.atol << ")";
     else
@@ -194,10 +221,10 @@ int runSimulate(const std::vector<std::string>& argv) {
     return 2;
   }
   if (!quiet) {
-    std::printf("simulate: %g s with %s: %ld steps, %ld rhs evaluations, %ld failed steps, %.3f s wall; "
-                "energy %.10g -> %.10g J, drift %.3e relative (%.3e J) -> %s\n",
-                so.duration, so.integrator.c_str(), res.stats.steps, res.stats.rhs_evals, res.stats.failed_steps,
-                res.wall_s, res.energy_initial, res.energy_final, res.energy_drift_rel, res.energy_drift_abs,
+    std::printf("simulate: %g s with %s (engine %s): %ld steps, %ld rhs evaluations, %ld failed steps, %.3f s wall, "
+                "%.3f s CPU; energy %.10g -> %.10g J, drift %.3e relative (%.3e J) -> %s\n",
+                so.duration, so.integrator.c_str(), engine.c_str(), res.stats.steps, res.stats.rhs_evals,
+                res.stats.failed_steps, res.wall_s, cpu_s, res.energy_initial, res.energy_final, res.energy_drift_rel, res.energy_drift_abs,
                 out_path.c_str());
   }
   // --wrap neural: how often the smooth model stood in for the network (muscle_mass_flags.hpp)
@@ -216,7 +243,7 @@ CommandRegistration reg(
      "                       [--initial STATE.sto [--initial-time T]]\n"
      "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
      "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
-     "                       [--progress] [--quiet] [--full-precision]\n"
+     "                       [--engine core|simbody] [--progress] [--quiet] [--full-precision]\n"
      "Integrates the model under gravity from its default pose (each coordinate's default_value and\n"
      "default_speed_value) with its constraints (locked, coupled and prescribed coordinates, welds).\n"
      "  --integrator NAME    euler (semi-implicit, fixed step), symplectic (variational Euler), bdf1\n"
@@ -234,6 +261,11 @@ CommandRegistration reg(
      "  --no-qvv             drop the muscles' quadratic velocity vector (energy experiment [D 6.2.4])\n"
      "  --impulse TARGET:FX,FY,FZ:DURATION  a force (N, ground frame) while t < DURATION (s) on a\n"
      "                       body's origin, a marker, or BODY@X,Y,Z (m, body frame); ';' separates several\n"
+     "  --engine core|simbody  the REDMAX core (default) or Simbody: the skeleton rebuilt as a Simbody\n"
+     "                       system, each muscle mass point a particle held on its path (a Constraint::Custom\n"
+     "                       per muscle); --integrator rk45 (RungeKuttaMerson) or cvode (CPodes), --rtol is\n"
+     "                       Simbody's accuracy, --atol its constraint tolerance; no core constraints,\n"
+     "                       --impulse or --no-qvv; same output columns (Simbody's energies)\n"
      "  --progress           progress on stderr (otherwise shown once a run takes over 2 s)\n"
      "  --full-precision     write %.16e instead of %16.8lf (restarts from the file are then exact)\n"
      "Output: time, /jointset/<joint>/<coord>/value and .../speed for every coordinate (radians, SI),\n"
