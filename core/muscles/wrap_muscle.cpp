@@ -625,6 +625,19 @@ void calcExactPathMassPointsFd(const Model& model, const State& state, const Mus
       xs[a] = calcWrappedPathPointWorld(muscle.path, wp, E_wi, mp.alpha[a]);
       if (locate) locateOnWrappedPath(wp, mp.alpha[a], mk.segment[a], mk.beta[a]);
     }
+    if (!locate) return;
+    // s: arc fractions of the active points along the wrapped path (no J_sr, sdot on this route)
+    std::vector<double> s_pts;
+    double acc = 0.0;
+    for (size_t i = 0; i < wp.points.size(); ++i) {
+      if (i > 0) {
+        const auto &a = wp.points[i - 1], &b = wp.points[i];
+        acc += (a.wrap >= 0 && a.wrap == b.wrap) ? wp.results[a.wrap].arcLength() : (b.x_w - a.x_w).norm();
+      }
+      if (wp.points[i].point >= 0) s_pts.push_back(acc);
+    }
+    mk.s.resize(static_cast<int>(s_pts.size()));
+    for (size_t i = 0; i < s_pts.size(); ++i) mk.s[i] = acc > 0.0 ? s_pts[i] / acc : 0.0;
   };
   eval(state.q, mk.x_a, true);
   // steps in q (rad or m): central differences for J, a wider mixed stencil for Jdot (its round-off

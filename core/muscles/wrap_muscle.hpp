@@ -80,7 +80,8 @@ void initWrapMuscleColumns(const Model& model, const Muscle& muscle, MuscleKinem
 /// Mass points of a supported Type III muscle after calcPathPoints (mk.x_w, J_xr; with
 /// mk.velocity also xdot_w, Jdot_xr) for the same state: x_a (world), J_ar and (with mk.velocity)
 /// Jdot_ar in mk's compact columns; segment (between active points segment, segment + 1) and beta
-/// (fraction of that segment's length). Needs the columns of initWrapMuscleColumns and the
+/// (fraction of that segment's length), and the Eulerian coordinates s of the active points (arc
+/// fractions; the segment construction also fills J_sr, sdot, Jdot_sr). Needs the columns of initWrapMuscleColumns and the
 /// skeleton workspace of `state`. Throws MuscleError (naming the muscle) when an end point lies
 /// inside the surface of origin -> surface -> insertion, ends coincide or a segment has zero
 /// length, std::logic_error for an unsupported shape.

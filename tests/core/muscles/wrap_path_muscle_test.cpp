@@ -462,6 +462,14 @@ TEST(WrapPathMuscle, KneeEnergySmoothConservedToIntegratorError) {
   EXPECT_GE(a.contact_changes, 2);
   EXPECT_GT(a.T_max, 1e-2);
   EXPECT_LT(a.drift, 1e-8);
+  // the exact model on the same points (OpenSim's whole path, J by differences in q): J jumps at the
+  // contact changes, so the energy does (the dissertation's motivation for a smooth model)
+  mu.wrap.model = WrapModel::Exact;
+  const KneeEnergy e = runKnee(mu);
+  std::printf("[ measured ] the same with the exact model: max drift %.2e J over %d contact changes, %ld steps\n",
+              e.drift, e.contact_changes, e.steps);
+  EXPECT_GE(e.contact_changes, 2);
+  EXPECT_GT(e.drift, 100.0 * a.drift);
   // (b) the fibre region (20 points) spans the via point: points slide past its corner, where J_ar
   // jumps as in any Type II path (path.hpp), so the energy jumps there whatever the wrap model
   const KneeEnergy b = runKnee(kneeMuscle(WrapModel::Smooth));
