@@ -14,6 +14,7 @@
 
 #include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap_muscle.hpp"
+#include "core/spatial/se3.hpp"
 #include "tests/core/muscles/muscle_test_util.hpp"
 #include "validation/scenes/scenes.hpp"
 #include "validation/scenes/wrap_pendulums.hpp"
@@ -260,6 +261,42 @@ TEST(NetworkWrapModel, MuscleJacobiansOnAMovingSurfaceMatchCentralDifferences) {
       checkMuscleAgainstFd(m, mu, s, 1e-6);
     }
   }
+  EXPECT_GT(monitor->evaluations("wrap_muscle"), 0);
+  EXPECT_EQ(monitor->fallbacks("wrap_muscle"), 0) << monitor->summary();
+}
+
+// a path with a via point before the wrapped segment: mass points over the whole path slide onto and
+// along the wrapped segment, so the network's alpha derivative enters J and Jdot
+TEST(NetworkWrapModel, SlidingPointsOnAViaPointPathMatchCentralDifferences) {
+  const auto net = committedNet("cylinder_3x64.txt");
+  auto monitor = std::make_shared<WrapFallbackMonitor>();
+  const Model m = scenes::doublePendulum();
+  Muscle mu = scenes::makeWrapPendulumMuscle(scenes::WrapPendulumSpec{}, neural(net, monitor));
+  mu.path.points = {makeFixedPoint(0, Vec3(-0.1, -0.5, 0), "origin"), makeFixedPoint(0, Vec3(-0.1, -0.8, 0), "via"),
+                    makeFixedPoint(1, Vec3(-0.1, -0.2, 0), "insertion")};
+  mu.path.wraps[0].range_begin = 2;  // via -> insertion
+  mu.path.wraps[0].range_end = 3;
+  MassPointOptions mpo;
+  mpo.region = MassPointOptions::Region::WholePath;
+  mu.mass_points = makeMassPoints(1.0, 0.5, 0.3, mpo);
+  validateMuscle(m, mu);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int wrapped = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    State s;
+    s.q = Vec2(u(rng), 0.25 + 0.2 * u(rng));
+    s.qdot = Vec2(2 * u(rng), 2 * u(rng));
+    // does the via -> insertion segment touch the cylinder here?
+    const MuscleKinematics mk = test::evalMuscle(m, mu, s);
+    SkeletonWorkspace sk(m);
+    calcKinematics(m, s, sk);
+    const Mat4 E_sw = inverseE(Mat4(sk.E_wi[0] * mu.path.wraps[0].E_bs));
+    wrapped += calcWrapPenetration(mu.path.wraps[0].surface, transformPoint(E_sw, mk.x_w[1]),
+                                   transformPoint(E_sw, mk.x_w[2])) > 0.0;
+    checkMuscleAgainstFd(m, mu, s, 1e-6);
+  }
+  EXPECT_GE(wrapped, 3);
   EXPECT_GT(monitor->evaluations("wrap_muscle"), 0);
   EXPECT_EQ(monitor->fallbacks("wrap_muscle"), 0) << monitor->summary();
 }
