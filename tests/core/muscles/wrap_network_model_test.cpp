@@ -122,6 +122,19 @@ TEST(NetworkWrapModel, JacobiansMatchCentralDifferencesSphere) {
   checkModelAgainstFd(*net, WrapSurface::makeSphere(0.03), 2.8, 5);
 }
 
+TEST(NetworkWrapModel, LoadingAndDefaultNetworks) {
+  const std::string src = REDMAX_SOURCE_DIR;
+  const std::string cyl = defaultWrapNetworkPath(src, WrapType::Cylinder);
+  EXPECT_NE(cyl.find("osim_models/networks/cylinder_3x64.txt"), std::string::npos) << cyl;
+  EXPECT_NE(defaultWrapNetworkPath(src, WrapType::Sphere).find("sphere_3x64.txt"), std::string::npos);
+  EXPECT_EQ(defaultWrapNetworkPath(src, WrapType::Torus), "");
+  EXPECT_EQ(defaultWrapNetworkPath("/nonexistent", WrapType::Cylinder), "");
+  const auto net = loadWrapNetwork(cyl);
+  EXPECT_EQ(net->meta.at("surface"), "cylinder");
+  EXPECT_THROW(loadWrapNetwork(src + "/osim_models/networks/README.md"), std::runtime_error);  // not a network
+  EXPECT_THROW(loadWrapNetwork("/nonexistent/net.txt"), std::runtime_error);
+}
+
 // ---------------------------------------------------------------------------------------------
 // fallback: the smooth model's result exactly, the reason reported
 
