@@ -61,7 +61,8 @@ class WorkPrecisionQuick : public ::testing::Test {
 };
 
 TEST_F(WorkPrecisionQuick, WritesEveryFile) {
-  ASSERT_EQ(result_->scenes.size(), 4u);
+  ASSERT_EQ(result_->scenes.size(), workPrecisionSceneNames().size());
+  EXPECT_EQ(result_->scenes.size(), 5u);
   for (const auto& name : workPrecisionSceneNames()) {
     const fs::path csv = dir_ / (name + ".csv");
     ASSERT_TRUE(fs::is_regular_file(csv)) << csv;
@@ -76,6 +77,15 @@ TEST_F(WorkPrecisionQuick, WritesEveryFile) {
   const std::string md = readText(dir_ / "report.md");
   EXPECT_NE(md.find("Recommended for error <= 0.001"), std::string::npos);
   EXPECT_NE(md.find("Scene running_leg"), std::string::npos);
+  EXPECT_NE(md.find("Scene pendulum_wrap"), std::string::npos);
+  // the cross-scene summary comes before the scenes
+  EXPECT_LT(md.find("Recommended defaults"), md.find("Scene pendulum_straight"));
+  // the hard study's tables: the flick (quick: euler at 1 ms, lumped and inertial) and one row per
+  // wrap contact change of each path model
+  ASSERT_TRUE(fs::is_regular_file(dir_ / "hard_flick.csv"));
+  EXPECT_EQ(parseCsv(readText(dir_ / "hard_flick.csv")).rows.size(), 2u);
+  ASSERT_TRUE(fs::is_regular_file(dir_ / "hard_wrap_jumps.csv"));
+  EXPECT_GE(parseCsv(readText(dir_ / "hard_wrap_jumps.csv")).rows.size(), 8u);
   const JsonValue summary = JsonValue::parse(readText(dir_ / "summary.json"));
   ASSERT_TRUE(summary.contains("work_precision"));
   EXPECT_TRUE(summary.at("work_precision").contains("finger"));

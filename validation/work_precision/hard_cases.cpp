@@ -419,6 +419,72 @@ NanCase runNanCase(const std::string& integrator) {
   return c;
 }
 
+// ---- 8. finger flick -------------------------------------------------------------------------
+
+std::vector<FlickStudyRow> runFlickCase(const std::string& models_dir, bool quick) {
+  FlickOptions base;
+  base.model_path = models_dir + "/finger.osim";
+  const std::vector<std::string> integrators =
+      quick ? std::vector<std::string>{"euler"} : std::vector<std::string>{"euler", "symplectic", "bdf1", "sdirk2"};
+  const std::vector<double> dts = quick ? std::vector<double>{1e-3} : std::vector<double>{1e-3, 5e-4};
+  return runFlickStudy(base, integrators, {true}, 0.2, dts);
+}
+
+// ---- 9. wrap contact changes -----------------------------------------------------------------
+
+WrapJumpCase runWrapJumpCase(const std::string& models_dir, WrapModel model, double duration) {
+  const WrapPendulum p = makeWrapPendulum(models_dir, model, 1.0);
+  const Model& m = p.system.model();
+  IntegratorOptions io;
+  io.rtol = 1e-12;
+  io.atol = 1e-12;
+  auto integ = makeIntegrator("rk45", io);
+  WrapJumpCase c;
+  c.model = model == WrapModel::Smooth  ? std::string("smooth")
+            : model == WrapModel::Exact ? std::string("exact_fd")
+                                        : "wrap model " + std::to_string(static_cast<int>(model));
+  const int n = static_cast<int>(std::lround(duration / 0.01));
+  std::vector<double> E(n + 1), d(n + 1);
+  State s = p.initial;
+  E[0] = c.energy0 = energy(p.system, s);
+  d[0] = wrapPenetration(m, p.muscle, s);
+  const double c0 = cpuSeconds();
+  for (int k = 1; k <= n; ++k) {
+    integ->advance(p.system, s, p.initial.t + 0.01 * k);
+    E[k] = energy(p.system, s);
+    d[k] = wrapPenetration(m, p.muscle, s);
+    c.drift = std::max(c.drift, std::abs(E[k] - c.energy0));
+  }
+  c.cpu_s = cpuSeconds() - c0;
+  c.steps = integ->stats().steps;
+  // a contact change between samples k-1 and k; its net energy change over a 50 ms window (the
+  // exact model's FD Jdot spikes while its stencil straddles the change, so the energy swings
+  // inside the window before settling at its new level)
+  std::vector<char> change(n + 1, 0);
+  for (int k = 1; k <= n; ++k) change[k] = (d[k] > 0) != (d[k - 1] > 0);
+  c.min_jump = std::numeric_limits<double>::infinity();
+  for (int k = 1; k <= n; ++k) {
+    if (!change[k]) continue;
+    ++c.contact_changes;
+    if (k < 3 || k + 2 > n) continue;
+    WrapContactChange w;
+    w.time = p.initial.t + 0.01 * k;
+    w.wrapping = d[k] > 0;
+    w.jump = E[k + 2] - E[k - 3];
+    for (int j = k - 2; j <= k + 2; ++j) w.transient = std::max(w.transient, std::abs(E[j] - E[k - 3]));
+    c.max_jump = std::max(c.max_jump, std::abs(w.jump));
+    c.min_jump = std::min(c.min_jump, std::abs(w.jump));
+    c.changes.push_back(w);
+  }
+  if (c.changes.empty()) c.min_jump = 0.0;
+  for (int k = 1; k <= n; ++k) {
+    bool near = false;
+    for (int j = std::max(1, k - 4); j <= std::min(n, k + 4); ++j) near = near || change[j];
+    if (!near) c.quiet_change = std::max(c.quiet_change, std::abs(E[k] - E[k - 1]));
+  }
+  return c;
+}
+
 // ---- everything ------------------------------------------------------------------------------
 
 HardCasesResult runHardCases(const std::string& models_dir, bool quick, std::ostream* progress) {
@@ -497,6 +563,44 @@ HardCasesResult runHardCases(const std::string& models_dir, bool quick, std::ost
             " J, max |measured - predicted| " + fmt(dev) + " J, drift between switches " + fmt(c.smooth_drift) + " J",
         "jump = predicted kinetic+potential change", !c.switches.empty() && dev <= 0.02 * jmax + 1e-7);
   }
+  say("wrap contact changes (smooth and exact-FD path models)");
+  for (const WrapModel wm : {WrapModel::Smooth, WrapModel::Exact}) {
+    const WrapJumpCase c = runWrapJumpCase(models_dir, wm, 3.0);
+    const bool smooth = wm == WrapModel::Smooth;
+    const std::string name = "wrap jump " + c.model;
+    add(name,
+        "wrapping double pendulum, 1 kg muscle (20 points), " +
+            std::string(smooth ? "smooth model (exact J, Jdot)" : "exact library, J and Jdot by central differences") +
+            ", 3 s rk45 rtol 1e-12",
+        std::to_string(c.contact_changes) + " contact changes, |net energy jump| " + fmt(c.min_jump) + " .. " +
+            fmt(c.max_jump) + " J (50 ms window), largest 10 ms change away from them " + fmt(c.quiet_change) +
+            " J, max |E - E0| " + fmt(c.drift) + " J of |E0| " + fmt(std::abs(c.energy0)) + " J",
+        smooth ? "jump < 1e-8 J" : "jump > 1e-6 J (J jumps at the contact change)",
+        !c.changes.empty() && (smooth ? c.max_jump < 1e-8 : c.min_jump > 1e-6));
+    res.wrap_jumps.push_back(c);
+  }
+  say("finger flick");
+  {
+    res.flick = runFlickCase(models_dir, quick);
+    // one row per integrator and step: lumped against inertial
+    for (std::size_t i = 0; i + 1 < res.flick.size(); i += 2) {
+      const FlickStudyRow& a = res.flick[i];
+      const FlickStudyRow& b = res.flick[i + 1];  // runFlickStudy: lumped, then inertial
+      auto part = [](const FlickStudyRow& r) {
+        return r.variant + " " + fmt(r.artifact.largest_survived) + " N = " +
+               fmt(1e3 * 0.002 * r.artifact.largest_survived) + " mN s (no artifact), " +
+               fmt(r.divergence.largest_survived) + " N = " + fmt(1e3 * 0.002 * r.divergence.largest_survived) +
+               " mN s (no divergence)";
+      };
+      const bool bracketed = a.artifact.largest_survived > 0 && b.artifact.largest_survived > 0 &&
+                             a.divergence.largest_survived > 0 && b.divergence.largest_survived > 0;
+      add("flick " + a.integrator + " dt " + fmt(1e3 * a.dt) + " ms",
+          "finger, gravity, fingertip force for 2 ms, 1 s; inertial: FDP, FDS 0.2 kg each",
+          part(a) + "; " + part(b) + "; inertial/lumped " +
+              fmt(b.artifact.largest_survived / a.artifact.largest_survived),
+          "largest survived, bisected to 1%", bracketed);
+    }
+  }
   say("NaN mid-run");
   for (const std::string integ : {"euler", "bdf1", "rk45", "cvode"}) {
     const NanCase c = runNanCase(integ);
@@ -531,6 +635,46 @@ void addHardCasesToReport(const HardCasesResult& r, Report& report) {
   }
   md += "\nCPU time of the hard cases: " + fmt(r.cpu_s) + " s.\n";
   report.addTable("hard_cases", t, "hard cases: setup, measured number, bound");
+  if (!r.flick.empty()) {
+    CsvTable f;
+    f.header = {"integrator", "dt_s", "variant", "impulse_time_s", "artifact_survived_N", "artifact_failed_N",
+                "artifact_survived_impulse_Ns", "divergence_survived_N", "divergence_failed_N",
+                "divergence_survived_impulse_Ns", "artifact_runs", "divergence_runs", "first_failure"};
+    JsonValue arr = JsonValue::array();
+    for (const auto& row : r.flick) {
+      f.addRow({row.integrator, formatNumber(row.dt), row.variant, formatNumber(0.002),
+                formatNumber(row.artifact.largest_survived), formatNumber(row.artifact.smallest_failed),
+                formatNumber(0.002 * row.artifact.largest_survived), formatNumber(row.divergence.largest_survived),
+                formatNumber(row.divergence.smallest_failed), formatNumber(0.002 * row.divergence.largest_survived),
+                std::to_string(row.artifact.runs.size()), std::to_string(row.divergence.runs.size()),
+                row.artifact.first_failure});
+      JsonValue o = JsonValue::object();
+      o["integrator"] = JsonValue(row.integrator);
+      o["dt"] = JsonValue(row.dt);
+      o["variant"] = JsonValue(row.variant);
+      o["artifact_survived_N"] = JsonValue(row.artifact.largest_survived);
+      o["divergence_survived_N"] = JsonValue(row.divergence.largest_survived);
+      arr.push(std::move(o));
+    }
+    js["flick"] = std::move(arr);
+    report.addTable("hard_flick", f,
+                    "finger flick: largest fingertip force (N) and impulse (N s, force x 2 ms) survived, lumped "
+                    "vs inertial, per integrator and step");
+    md += "\nFinger flick (" + std::string("hard_flick.csv") + "): largest fingertip force survived, first failing "
+          "force in brackets\n\n" + formatFlickTable(r.flick);
+  }
+  if (!r.wrap_jumps.empty()) {
+    CsvTable w;
+    w.header = {"model", "change", "time_s", "direction", "net_jump_J", "transient_J"};
+    for (const auto& c : r.wrap_jumps)
+      for (std::size_t k = 0; k < c.changes.size(); ++k) {
+        const auto& ch = c.changes[k];
+        w.addRow({c.model, std::to_string(k + 1), formatNumber(ch.time), ch.wrapping ? "wrap" : "unwrap",
+                  formatNumber(ch.jump), formatNumber(ch.transient)});
+      }
+    report.addTable("hard_wrap_jumps", w,
+                    "wrapping double pendulum: net energy change across each contact change, per path model");
+  }
   report.addMarkdown("Hard cases", md);
 }
 

@@ -14,6 +14,10 @@
 //   long_run     60 s of the conservative pendulum_straight scene with rk45: energy drift per second
 //   conditional  a conditional path point switching during a run: energy jump per switch
 //   nan          a force that turns NaN mid-run: the run stops naming time, coordinate and step
+//   flick        finger flick [D Sec. 6.2.5] (validation/simulate/finger_flick.hpp): the largest
+//                fingertip force and impulse survived, lumped vs inertial, per integrator and step
+//   wrap_jump    wrapping double pendulum (makeWrapPendulum): the energy jump at each contact
+//                change for each path model (smooth vs exact library with FD Jacobians)
 #include <functional>
 #include <iosfwd>
 #include <string>
@@ -21,7 +25,9 @@
 
 #include "core/dynamics/system.hpp"
 #include "core/integrators/integrator.hpp"
+#include "core/muscles/mass_points.hpp"
 #include "validation/report/report.hpp"
+#include "validation/simulate/finger_flick.hpp"
 
 namespace redmax::validation {
 
@@ -115,6 +121,35 @@ struct NanCase {
 };
 NanCase runNanCase(const std::string& integrator);
 
+// 8. finger flick
+/// runFlickStudy on models_dir/finger.osim with gravity, 0.2 kg in each of FDP and FDS for the
+/// inertial variant; full: euler, symplectic, bdf1, sdirk2 at dt 1 ms and 0.5 ms; quick: euler
+/// at 1 ms. The flick lasts 2 ms whatever the step, so impulse (N s) = force * 0.002.
+std::vector<FlickStudyRow> runFlickCase(const std::string& models_dir, bool quick);
+
+// 9. wrap contact changes
+struct WrapContactChange {
+  double time = 0.0;       ///< s, end of the 10 ms sample interval in which the penetration changed sign
+  bool wrapping = false;   ///< true: the path starts to wrap (penetration became positive)
+  double jump = 0.0;       ///< net energy change across the change, E(t_k+2) - E(t_k-3) (10 ms samples), J
+  double transient = 0.0;  ///< max |E(t_j) - E(t_k-3)| for j in that window, J
+};
+struct WrapJumpCase {
+  std::string model;       ///< "smooth", "exact_fd" (another WrapModel: "wrap model K")
+  std::vector<WrapContactChange> changes;  ///< those with a full window inside the run
+  int contact_changes = 0; ///< all sign changes of the penetration between samples
+  double max_jump = 0.0;   ///< max |jump|, J
+  double min_jump = 0.0;   ///< min |jump|, J
+  double quiet_change = 0.0;  ///< largest |E_k - E_k-1| with no contact change within 4 samples, J
+  double drift = 0.0;      ///< max |E(t) - E(0)|, J
+  double energy0 = 0.0;    ///< J
+  long steps = 0;
+  double cpu_s = 0.0;
+};
+/// The wrapping double pendulum (makeWrapPendulum, 1 kg muscle) with the given path model,
+/// released at q = (0.3, 0.35) rad, rk45 rtol = atol = 1e-12, total energy sampled every 10 ms.
+WrapJumpCase runWrapJumpCase(const std::string& models_dir, WrapModel model, double duration);
+
 struct HardCasesResult {
   struct Row {
     std::string name, setup, measured, bound;
@@ -122,11 +157,14 @@ struct HardCasesResult {
   };
   std::vector<Row> rows;
   double cpu_s = 0.0;
+  std::vector<FlickStudyRow> flick;  ///< also in hard_flick.csv
+  std::vector<WrapJumpCase> wrap_jumps;  ///< also in hard_wrap_jumps.csv (one row per contact change)
 };
 
 /// Every case (quick: shorter ladders and runs, the long run still 60 s). progress may be null.
 HardCasesResult runHardCases(const std::string& models_dir, bool quick, std::ostream* progress);
-/// report.md "Hard cases" table, hard_cases.csv, summary.json "hard_cases", one check per row.
+/// report.md "Hard cases" table, hard_cases.csv, hard_flick.csv, hard_wrap_jumps.csv, summary.json
+/// "hard_cases", one check per row.
 void addHardCasesToReport(const HardCasesResult& r, Report& report);
 
 }  // namespace redmax::validation

@@ -17,6 +17,10 @@
 //   finger        finger.osim, FDP and FDS 0.2 kg each (the dissertation's 6.2.5), default flexed
 //                 pose, released at rest under gravity, 0.3 s (light phalanges pulled by heavy muscles
 //                 whip: over 1 s the state error of rk45 at rtol 1e-9 is still 3e-4 rad/s)
+//   pendulum_wrap double_pendulum_wrap.osim, wrap_muscle (Type III, quadrant -x cylinder at the
+//                 middle joint) with 1 kg on 20 points, smooth wrap model (the default), q = (0.3,
+//                 0.35) rad at rest: wrapped at the start, q2 swings through the contact change
+//                 (q2 about 0.1 rad) several times a run; conservative, so its drift is the method's
 //   running_leg   running_leg.osim under gravity with physiological muscle mass taken from the bones
 //                 (converter/build/muscle_mass.hpp: 60 N/cm^2, 1059.7 kg/m^3; soleus_r Type I,
 //                 tib_ant_r Type II; the gastrocnemii stay lumped, Type III); the free-floating leg
@@ -31,6 +35,7 @@
 #include <vector>
 
 #include "core/dynamics/system.hpp"
+#include "core/muscles/mass_points.hpp"
 #include "validation/report/report.hpp"
 #include "validation/work_precision/id_studies.hpp"
 
@@ -97,8 +102,23 @@ struct WorkPrecisionResult {
 /// "integrators", "masspoints", "reduction"
 std::vector<std::string> workPrecisionStudyNames();
 
-/// "pendulum_straight", "pendulum_via", "finger", "running_leg"
+/// "pendulum_straight", "pendulum_via", "pendulum_wrap", "finger", "running_leg"
 std::vector<std::string> workPrecisionSceneNames();
+
+/// The wrapping double pendulum of osim_models/double_pendulum_wrap.osim (through the converter):
+/// wrap_muscle with `muscle_kg` on 20 points whose path follows the cylinder by `model`
+/// (core/muscles/wrap_muscle.hpp), gravity only, q = (0.3, 0.35) rad at rest.
+struct WrapPendulum {
+  System system;
+  State initial;
+  Muscle muscle;  ///< wrap_muscle with its mass points, as the system's MuscleTerm holds it
+};
+WrapPendulum makeWrapPendulum(const std::string& models_dir, WrapModel model, double muscle_kg = 1.0);
+
+/// Penetration d (m) of the muscle's straight segment into its (single) wrap surface at state s
+/// (core/muscles/wrap/smooth.hpp): d > 0 where the exact library wraps; its sign change is a
+/// contact change.
+double wrapPenetration(const Model& model, const Muscle& muscle, const State& s);
 /// Build a scene from models_dir. Throws std::invalid_argument for an unknown name and the
 /// converter's ConvertError for a missing or bad model file.
 WorkPrecisionScene makeWorkPrecisionScene(const std::string& name, const std::string& models_dir);
