@@ -4,7 +4,6 @@
 
 #include "core/muscles/muscle_kinematics.hpp"
 #include "core/muscles/path_kinematics.hpp"
-#include "core/muscles/wrap/smooth.hpp"
 #include "core/muscles/wrap_muscle.hpp"
 #include "core/spatial/se3.hpp"
 
@@ -79,24 +78,10 @@ void calcWrapPathMap(const WrapSurface& surface, const WrapMassOptions& wrap, co
     p2ddot = -(R.transpose() * (omega.cross(s2) + omega.cross(r2dot)));
   }
 
-  // the core's wrap model in s [D Eq. 5.38, 5.44]
-  WrapMassPoints wp;
+  // the core's wrap model in s (its one dispatch point: smooth, exact or neural) [D Eq. 5.38, 5.44]
+  WrapModelPoints wp;
   try {
-    if (wrap.model == WrapModel::Smooth) {
-      SmoothWrapOptions so;
-      so.width = wrap.width;
-      wp.x.resize(N);
-      wp.J.resize(N);
-      wp.Jdot.resize(N);
-      for (int a = 0; a < N; ++a) {
-        const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(surface, p1, p2, mp.alpha[a], p1dot, p2dot, so);
-        wp.x[a] = sp.x;
-        wp.J[a] = sp.J;
-        wp.Jdot[a] = sp.Jdot;
-      }
-    } else {
-      calcExactWrapPointsFd(surface, p1, p2, p1dot, p2dot, mp.alpha, wp, wrap.fd_step, vel);
-    }
+    calcWrapModelPoints(wrap, surface, p1, p2, p1dot, p2dot, mp.alpha, {}, false, vel, wp);
   } catch (const std::invalid_argument& e) {
     throw MuscleError("muscle '" + muscle_name + "', wrap surface: " + e.what());
   }

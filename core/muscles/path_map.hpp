@@ -56,8 +56,8 @@ VecX stackPoints(const std::vector<Vec3>& x);
 // with pdot_s = (p1dot, p2dot), p_idot = R^T (rdot_i - w x r_i), pddot_i|_(vdot = 0) =
 // -R^T (w x (rdot_i - w x r_i) + w x rdot_i), rdot_i = xdot_i - pdot, w = omega
 // [D Eq. 5.51-5.57, written in world velocities instead of the reduced coordinates]. The wrap
-// model is the core's (Muscle::wrap, core/muscles/wrap_muscle.hpp): smooth (exact J, Jwdot) or the
-// exact library with finite differences.
+// model is the core's (Muscle::wrap through calcWrapModelPoints, core/muscles/wrap_muscle.hpp):
+// smooth or neural (exact J, Jwdot) or the exact library with finite differences.
 
 /// Velocities of a wrapping segment's inputs (world; m/s, rad/s).
 struct WrapSegmentVelocity {
