@@ -50,13 +50,10 @@ int runId(const std::vector<std::string>& argv) {
                withMuscleMassFlags({"setup", "model", "coordinates", "external-loads", "lowpass", "t0",
                                     "t1", "engine", "out", "forces-to-exclude"}),
                {"exact", "opensim-compat", "quiet", "full-precision"});
-  osim::IdToolSettings settings = parseSettings(a);
+  const osim::IdToolSettings settings = parseSettings(a);
   const std::string engine_name = a.get("engine", "core");
   if (engine_name != "core" && engine_name != "simbody")
     throw UsageError{"--engine must be core or simbody, got '" + engine_name + "'"};
-  // Simbody cannot move mass points over wrap surfaces yet: wrapping muscles stay lumped there
-  // unless --wrap is given (then the engine refuses them by name)
-  if (engine_name == "simbody" && !a.has("wrap")) settings.muscle_mass.wrap_mass = false;
   const bool with_mass = settings.muscle_mass.source != osim::MuscleMassOptions::Source::None;
   const bool quiet = a.has("quiet");
 
@@ -80,6 +77,11 @@ int runId(const std::vector<std::string>& argv) {
       } catch (const simbody::SimbodyBuildError& e) {
         throw osim::ConvertError(config.model_file, 0,
                                  std::string("--engine simbody cannot build this model: ") + e.what());
+      } catch (const ModelError& e) {
+        // e.g. a wrapping muscle shape Simbody's muscle inertia does not take (muscle_mass_flags.hpp)
+        throw osim::ConvertError(config.model_file, 0,
+                                 std::string("--engine simbody: ") + e.what() +
+                                     (with_mass ? " (--wrap lumped keeps wrapping muscles massless)" : ""));
       }
     }
   } catch (const osim::ConvertError& e) {

@@ -7,8 +7,9 @@
 //   --transfer-body BODY        --transfer-fraction F
 //   --wrap smooth|exact|neural|lumped  --wrap-width W  --wrap-network FILE
 //     the wrap model of wrapping (Type III) muscles with mass. Default smooth: every command that
-//     builds muscle mass gives wrapping muscles of a supported shape their mass over the smooth
-//     model (C2, energy-consistent; core/muscles/wrap_muscle.hpp); lumped keeps them massless.
+//     builds muscle mass gives wrapping muscles of a supported shape (core/muscles/wrap_muscle.hpp)
+//     their mass over the smooth model (C2 across contact changes, so energy-consistent); exact and
+//     neural are the dissertation's routes; lumped keeps them massless.
 // Meanings and defaults: converter/build/muscle_mass.hpp.
 #include <set>
 #include <string>

@@ -216,31 +216,34 @@ TEST_F(WrapFlagsCli, RunningLegGastrocnemiiCarryMassAndConserveEnergy) {
               drift, drift_exact, energyDrift(readStorage(path("leg_all.sto"))));
 }
 
-// `redmax id`: the core takes the wrap mass by default; --engine simbody keeps wrapping muscles
-// lumped unless --wrap is given (its muscle inertia has no wrap surfaces), and then names the muscle
-TEST_F(WrapFlagsCli, IdTakesWrapMassAndSimbodyKeepsWrappingMusclesLumped) {
+// `redmax id`: both engines take the wrap mass by default (the running leg's gastrocnemii have the
+// origin -> wrap -> insertion shape Simbody's muscle inertia takes) and agree; --wrap lumped keeps
+// them massless in both; the wrapping muscles' mass changes the torques
+TEST_F(WrapFlagsCli, IdEnginesTakeWrapMassAlike) {
   const std::string leg = "id --model " + scene("running_leg.osim") + " --coordinates " + scene("running_leg_swing.mot") +
-                          " --muscle-mass physiological";
+                          " --muscle-mass physiological --full-precision";
   const CmdResult rc = run(leg + " --out " + path("core.sto"));
   ASSERT_EQ(rc.code, 0) << rc.err;
   EXPECT_NE(rc.err.find("wrapping (Type III): 2 of 2 carry mass (wrap model smooth"), std::string::npos) << rc.err;
-  const CmdResult rl = run(leg + " --wrap lumped --out " + path("lumped.sto"));
-  ASSERT_EQ(rl.code, 0) << rl.err;
   const CmdResult rs = run(leg + " --engine simbody --out " + path("sb.sto"));
   ASSERT_EQ(rs.code, 0) << rs.err;
-  EXPECT_NE(rs.err.find("wrapping (Type III): 0 of 2 carry mass (wrap mass off)"), std::string::npos) << rs.err;
-  // Simbody with the gastrocnemii lumped equals the core with them lumped; the core with them
-  // carrying mass differs (knee and ankle columns)
-  const Storage c = readStorage(path("core.sto")), l = readStorage(path("lumped.sto")), b = readStorage(path("sb.sto"));
+  EXPECT_NE(rs.err.find("wrapping (Type III): 2 of 2 carry mass (wrap model smooth"), std::string::npos) << rs.err;
+  const CmdResult rl = run(leg + " --wrap lumped --out " + path("lumped.sto"));
+  ASSERT_EQ(rl.code, 0) << rl.err;
+  EXPECT_NE(rl.err.find("wrapping (Type III): 0 of 2 carry mass (wrap mass off)"), std::string::npos) << rl.err;
+  const CmdResult rsl = run(leg + " --engine simbody --wrap lumped --out " + path("sb_lumped.sto"));
+  ASSERT_EQ(rsl.code, 0) << rsl.err;
+  const Storage c = readStorage(path("core.sto")), b = readStorage(path("sb.sto"));
+  const Storage l = readStorage(path("lumped.sto")), bl = readStorage(path("sb_lumped.sto"));
   ASSERT_EQ(c.data.rows(), b.data.rows());
-  const double peak = l.data.cwiseAbs().maxCoeff();
-  EXPECT_LE((l.data - b.data).cwiseAbs().maxCoeff(), 1e-6 * peak);
+  ASSERT_EQ(l.data.rows(), bl.data.rows());
+  const double peak = c.data.cwiseAbs().maxCoeff();
+  EXPECT_LE((c.data - b.data).cwiseAbs().maxCoeff(), 1e-9 * peak);
+  EXPECT_LE((l.data - bl.data).cwiseAbs().maxCoeff(), 1e-9 * peak);
   EXPECT_GT((c.data - l.data).cwiseAbs().maxCoeff(), 1e-4 * peak);
-  const CmdResult rw = run(leg + " --engine simbody --wrap smooth --out " + path("never.sto"));
-  EXPECT_NE(rw.code, 0) << rw.err;
-  EXPECT_NE(rw.err.find("error: "), std::string::npos) << rw.err;
-  EXPECT_NE(rw.err.find("gas_r"), std::string::npos) << rw.err;
-  EXPECT_FALSE(fs::exists(path("never.sto")));
+  std::printf("[ measured ] running leg swing, physiological: core vs Simbody with wrap mass %.2g of the peak; "
+              "gastrocnemii's mass changes the torques by up to %.3g of the peak\n",
+              (c.data - b.data).cwiseAbs().maxCoeff() / peak, (c.data - l.data).cwiseAbs().maxCoeff() / peak);
 }
 
 }  // namespace
