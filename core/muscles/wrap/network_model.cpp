@@ -207,6 +207,7 @@ void WrapFallbackMonitor::record(const std::string& muscle, const std::string& w
     Counts& c = counts_[muscle];
     ++c.evaluations;
     if (e.usedNetwork()) return;
+    ++c.by_reason[e.fallback];
     if (++c.fallbacks > 1) return;
     c.first = e.describe(net);
     message = "muscle '" + muscle + "', wrap object '" + wrap +
@@ -252,7 +253,11 @@ std::string WrapFallbackMonitor::summary() const {
   for (const auto& [name, c] : counts_) {
     os << "  " << name << ": " << c.fallbacks << " of " << c.evaluations
        << " evaluations fell back to the smooth model";
-    if (c.fallbacks > 0) os << " (first: " << c.first << ")";
+    if (c.fallbacks > 0) {
+      os << " (";
+      for (const auto& [why, n] : c.by_reason) os << toString(why) << " " << n << "; ";
+      os << "first: " << c.first << ")";
+    }
     os << "\n";
   }
   return os.str();

@@ -120,6 +120,7 @@ class WrapFallbackMonitor {
     long evaluations = 0;  ///< calls of the wrap model for the muscle
     long fallbacks = 0;    ///< of which the smooth model gave the points
     std::string first;     ///< the first fallback's description
+    std::map<NetworkWrapFallback, long> by_reason;  ///< fallbacks per reason
   };
 
   explicit WrapFallbackMonitor(Sink sink = {});
@@ -132,7 +133,8 @@ class WrapFallbackMonitor {
   long fallbacks(const std::string& muscle) const;
   long evaluations(const std::string& muscle) const;
   long totalFallbacks() const;
-  /// one line per muscle: "  M: F of E evaluations fell back to the smooth model (first: ...)";
+  /// one line per muscle: "  M: F of E evaluations fell back to the smooth model (R1 n1, R2 n2;
+  /// first: ...)";
   /// "" when nothing was recorded
   std::string summary() const;
   void reset();

@@ -344,6 +344,13 @@ TEST(NetworkWrapModel, OutOfBoxMuscleFallsBackCountsAndWarnsOnce) {
   EXPECT_NE(messages[0].find("outside the training box"), std::string::npos) << messages[0];
   const std::string all = std::to_string(n) + " of " + std::to_string(n) + " evaluations";
   EXPECT_NE(monitor->summary().find(all), std::string::npos) << monitor->summary();
+  long by_reason = 0;
+  const auto counts = monitor->counts();
+  for (const auto& [why, count] : counts.at("wrap_muscle").by_reason) {
+    EXPECT_NE(why, NetworkWrapFallback::None);
+    by_reason += count;
+  }
+  EXPECT_EQ(by_reason, n);
   // a second muscle on the same monitor warns once for itself
   Muscle other = mu;
   other.name = "other";
