@@ -11,6 +11,7 @@
 #include <memory>
 #include <random>
 #include <sstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,15 @@ int runTrain(const Args& a, const std::vector<std::string>& argv) {
   const auto out = a.get("out");
   if (!out) throw UsageError{"--out NET.txt is required"};
   requireParent(*out, "--out");
+  std::optional<Mlp> init;
+  if (const auto f = a.get("init")) {
+    init = Mlp::load(*f);  // a malformed file throws with its line
+    if (init->meta.count("surface") && init->meta.at("surface") != wrapTypeName(type))
+      throw UsageError{"--init " + *f + " is a " + init->meta.at("surface") + " network, not " + wrapTypeName(type)};
+    if (init->architecture() != Mlp(wrapInputSize(type), opt.hidden, 3, 0).architecture())
+      throw UsageError{"--init " + *f + " is " + init->architecture() + ", --hidden asks for another architecture"};
+    opt.init = &*init;
+  }
   const auto report = a.get("report");
   if (report) requireFolder(*report);
 
@@ -109,6 +119,9 @@ int runTrain(const Args& a, const std::vector<std::string>& argv) {
   // error on fresh samples, all of them (also those near the contact change)
   const WrapTrainingSet test = makeWrapTrainingSet(box, oracle, std::min(samples, 20000L), 0.0, opt.seed + 1000003, opt.threads);
   const WrapErrorStats err = calcWrapNetworkError(net, test);
+  if (init)
+    for (const char* k : {"command", "adam", "epochs", "final_val_rms_m", "train_seconds", "test_rms_m"})
+      if (init->meta.count(k)) net.meta[std::string("init_") + k] = init->meta.at(k);
   net.meta["surface"] = wrapTypeName(type);
   net.meta["command"] = joinArgs(argv);
   net.meta["threshold"] = num(threshold, 6);
@@ -582,7 +595,7 @@ int runPendulums(const Args& a) {
 int runTrainWrap(const std::vector<std::string>& argv) {
   Args a(argv,
          {"surface", "hidden", "samples", "epochs", "batch", "lr", "seed", "threshold", "time-limit", "out", "report",
-          "threads", "shards", "nets", "untrained", "muscles", "mass-points", "width", "thresholds", "architectures",
+          "threads", "shards", "init", "nets", "untrained", "muscles", "mass-points", "width", "thresholds", "architectures",
           "pendulums", "count", "duration", "tol"},
          {"compare", "study", "fd-jdot"});
   if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
@@ -597,7 +610,8 @@ CommandRegistration reg(
     {"train-wrap", "train the Type III wrap network, or compare wrap models (speed against error)",
      "usage: redmax train-wrap --surface cylinder|sphere|ellipsoid|torus [--hidden 6x256] [--samples N]\n"
      "                         [--epochs E] [--batch B] [--lr 1e-4] [--seed S] [--threshold 0.01]\n"
-     "                         [--time-limit SECONDS] [--threads T [--shards S]] --out NET.txt [--report DIR]\n"
+     "                         [--time-limit SECONDS] [--threads T [--shards S]] [--init NET.txt]\n"
+     "                         --out NET.txt [--report DIR]\n"
      "       redmax train-wrap --compare --surface cylinder|sphere [--nets A.txt,B.txt] [--untrained 6x256,...|none]\n"
      "                         [--muscles M] [--mass-points N] [--width W] [--seed S] --report DIR\n"
      "       redmax train-wrap --study [--thresholds 0.01,0.05,0.1] [--architectures 1x32,3x32] [--samples N]\n"
@@ -612,6 +626,8 @@ CommandRegistration reg(
      "the command, seed, losses and the error on fresh samples. --report DIR writes loss.csv and a loss plot.\n"
      "--threads T labels samples and computes gradients on T threads; every mini-batch is cut into S shards\n"
      "(default T) summed in order, so the network depends on S and the seed, not on T (S = 1: serial).\n"
+     "--init NET.txt continues training from that network (same surface and --hidden; its normalisation is kept,\n"
+     "Adam restarts); its command and losses are kept in the new file's meta as init_*.\n"
      "--compare: M muscles (default 200) x N mass points (default 20) with random end points and velocities;\n"
      "for the exact library (J, Jdot by central differences), the smooth model (band width W radii, default\n"
      "0.05) and each network (trained ones from --nets; --untrained sizes are timed only), prints and writes\n"

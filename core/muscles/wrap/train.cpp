@@ -245,6 +245,16 @@ Mlp trainWrapNetwork(const WrapTrainingSet& data, const WrapInputBox& box, const
   };
   stats(Xtr, net.input_mean, net.input_scale);
   stats(Ytr, net.output_mean, net.output_scale);
+  if (opt.init) {
+    // a continued run keeps the first run's normalisation: the weights were learnt in its units
+    if (opt.init->architecture() != net.architecture() || opt.init->input_mean.size() != n_in ||
+        opt.init->output_mean.size() != n_out)
+      throw std::invalid_argument("trainWrapNetwork: the initial network is " + opt.init->architecture() + " with " +
+                                  std::to_string(opt.init->input_mean.size()) + " inputs, expected " +
+                                  net.architecture() + " with " + std::to_string(n_in));
+    net = *opt.init;
+    net.meta.clear();
+  }
   net.input_min = box.lo;
   net.input_max = box.hi;
   if (static_cast<int>(box.names.size()) == n_in) net.input_names = box.names;

@@ -97,6 +97,9 @@ struct TrainOptions {
   double time_limit_s = 0.0;  ///< > 0: stop after the epoch that passes it
   int threads = 1;  ///< worker threads (harness-level parallelism; the core stays single-threaded)
   int shards = 0;   ///< gradient shards per mini-batch (<= 0: = threads); 1 = the serial algorithm
+  /// continue from this network (its weights and normalisation; Adam's moments start at zero);
+  /// its inputs, outputs and hidden widths must match. Null: fresh weights from the seed.
+  const Mlp* init = nullptr;
   std::function<void(const TrainEpoch&)> on_epoch;  ///< progress (called after every epoch)
 };
 
