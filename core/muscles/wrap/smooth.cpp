@@ -839,9 +839,13 @@ V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, con
     // the smooth quadrant cylinder in the anchor's frame (lengths and blends are frame-free);
     // where the library does not wrap at all (no anchor, an end inside the local cylinder) the
     // straight path
-    TorusFrame<T> f;
+    // the anchor and frame do not depend on alpha: shared by a muscle's mass points (per thread)
+    static thread_local SetupCache<TorusFrame<T>, T> cache;
+    const Vec3 key(surf.outer_radius, surf.quadrant_axis, surf.quadrant_sign);
+    const auto& entry = cache.get(key, p1, p2, [&](TorusFrame<T>& fr) { return torusFrame(surf, p1, p2, fr); });
+    const TorusFrame<T>& f = entry.setup;
+    const bool ok = entry.ok;
     const WrapSurface cyl = torusCylinder(surf);
-    const bool ok = torusFrame(surf, p1, p2, f);
     const double ri = cyl.radius;
     const Vec3 q1 = values(f.q1), q2 = values(f.q2);
     if (!ok || std::hypot(q1[0], q1[1]) < ri || std::hypot(q2[0], q2[1]) < ri) {
