@@ -187,8 +187,8 @@ TEST(SimbodyMuscleInertia, MatchesCoreMuscleTermOnRandomTrees) {
   EXPECT_GE(checked, 40);
 }
 
-// Type III: origin -> one surface -> insertion. The surface (radius 0.03 m) is centred within
-// 0.015 m of the ends' midpoint at the state (so the path wraps), randomly oriented, on the
+// Type III: origin -> one surface -> insertion. The surface (radius 0.03 m) is centred 0.012 m off
+// the ends' midpoint at the state, perpendicular to the line (so the path wraps), on the
 // origin's body (variant 0), a body that moves neither end (1), the world (2), or with a moving
 // insertion (3); smooth wrap model.
 Muscle randomWrapMuscle(const Model& m, int variant, std::mt19937& rng, const State& s, bool sphere) {
@@ -215,12 +215,20 @@ Muscle randomWrapMuscle(const Model& m, int variant, std::mt19937& rng, const St
     calcPointLocation(p, s.q, x_b, dx, ddx);
     return p.body < 0 ? x_b : Vec3((sk.E_wi[p.body] * x_b.homogeneous()).head<3>());
   };
-  const Vec3 mid = 0.5 * (world(mu.path.points[0]) + world(mu.path.points[1]));
+  const Vec3 x1 = world(mu.path.points[0]), x2 = world(mu.path.points[1]);
+  // the centre 0.4 radius off the line along o (perpendicular to it), so the line passes at 0.4
+  // radius from the centre or axis (through them, round-off would pick the side of the wrap); the
+  // axis z is o x u tilted 0.3 rad towards the line, so the ends lie at different heights (a line
+  // exactly across the axis keeps the path in one plane, where the smooth cylinder's J disagrees
+  // with differences of its own positions), with a random turn about the axis
+  const Vec3 u = (x2 - x1).normalized();
+  const Vec3 o = u.cross(randomVec(rng, 1.0)).normalized();
+  const Vec3 z = std::cos(0.3) * o.cross(u) + std::sin(0.3) * u;
+  Mat3 R0;
+  R0 << o, z.cross(o), z;  // right-handed
   Mat4 E_ws = Mat4::Identity();
-  E_ws.topLeftCorner<3, 3>() = expSO3(randomVec(rng, 2.0));
-  // off the line by up to half the radius: a line through the axis or centre would leave the side
-  // of the wrap to round-off
-  E_ws.topRightCorner<3, 1>() = mid + randomVec(rng, 0.015 / std::sqrt(3.0));
+  E_ws.topLeftCorner<3, 3>() = R0 * expSO3(Vec3(0.0, 0.0, randomVec(rng, 3.0)[0]));
+  E_ws.topRightCorner<3, 1>() = 0.5 * (x1 + x2) + 0.012 * o;
   PathWrap w;
   w.name = sphere ? "ball" : "drum";
   w.surface = sphere ? WrapSurface::makeSphere(0.03) : WrapSurface::makeCylinder(0.03, 2.0);
