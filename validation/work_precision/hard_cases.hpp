@@ -135,7 +135,9 @@ struct WrapContactChange {
   double transient = 0.0;  ///< max |E(t_j) - E(t_k-3)| for j in that window, J
 };
 struct WrapJumpCase {
-  std::string model;       ///< "smooth", "exact_fd" (another WrapModel: "wrap model K")
+  std::string model;       ///< "smooth", "exact_fd", "neural" (another WrapModel: "wrap model K")
+  std::string scene;       ///< "osim" (double_pendulum_wrap.osim) or "in_box" (scenes::WrapPendulumSpec{})
+  long evaluations = 0, fallbacks = 0;  ///< Neural: wrap-model evaluations, smooth fallbacks
   std::vector<WrapContactChange> changes;  ///< those with a full window inside the run
   int contact_changes = 0; ///< all sign changes of the penetration between samples
   double max_jump = 0.0;   ///< max |jump|, J
@@ -149,6 +151,11 @@ struct WrapJumpCase {
 /// The wrapping double pendulum (makeWrapPendulum, 1 kg muscle) with the given path model,
 /// released at q = (0.3, 0.35) rad, rk45 rtol = atol = 1e-12, total energy sampled every 10 ms.
 WrapJumpCase runWrapJumpCase(const std::string& models_dir, WrapModel model, double duration);
+/// The same measurement on the code-built pendulum scenes::WrapPendulumSpec{}
+/// (validation/scenes/wrap_pendulums.hpp: end points 2.8 radii from the axis, inside the committed
+/// networks' training box, where WrapModel::Neural runs without falling back) with wrap options
+/// `wrap` (for Neural: its network; a fallback monitor is attached here).
+WrapJumpCase runWrapJumpCaseInBox(WrapMassOptions wrap, double duration);
 
 struct HardCasesResult {
   struct Row {

@@ -155,7 +155,7 @@ std::string summaryMarkdown(const std::vector<WorkPrecisionSceneResult>& scenes,
       std::string cell = " - |";
       for (const auto& r : sr.runs)
         if (r.integrator == n && std::abs(r.value / v - 1.0) < 1e-9)
-          cell = r.ok ? " " + fmt(r.energy_drift, "%.2e") + " |" : " diverged |";
+          cell = r.ok ? std::string(" ").append(fmt(r.energy_drift, "%.2e")).append(" |") : " diverged |";
       md << cell;
     }
     md << "\n";
