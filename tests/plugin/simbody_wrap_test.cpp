@@ -11,6 +11,8 @@
 //     1e-11, Simbody accuracy 1e-10); without the muscle's mass q differs by > 1e-3 at 1 s, and the
 //     muscle wraps over part of the run (checked), so the agreement covers the surface's terms.
 //     CPU times of both are printed (not asserted).
+//   - a wrapping path with a via point (which the core may take) is refused by the Simbody side,
+//     naming the muscle.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -26,6 +28,8 @@
 #include "core/muscles/wrap/smooth.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "core/spatial/se3.hpp"
+#include "plugin/simbody/muscle_inertia.hpp"
+#include "plugin/simbody/particle_muscles.hpp"
 #include "plugin/simbody/particle_simulation.hpp"
 
 namespace redmax {
@@ -254,6 +258,31 @@ TEST(SimbodyParticleMuscles, WrappingDoublePendulumMatchesCoreRk45) {
   std::printf("  wrapping pendulum, particles vs core rk45 over 1 s: max |dq| %.3e rad; CPU: simbody %.3f s "
               "(%ld steps), core %.3f s\n",
               worst, sb_s, sim.steps(), core_s);
+}
+
+// shapes the core takes but the Simbody side does not (a via point before the wrap): refused by name
+TEST(SimbodyParticleMuscles, OtherWrappingShapesAreRefusedByName) {
+  WrapPendulum w = wrapPendulum(1.0);
+  const Model& m = w.build.model;
+  Muscle mu = w.muscles[0];
+  mu.path.points.insert(mu.path.points.begin() + 1, makeFixedPoint(0, Vec3(-0.12, -0.8, 0.0), "via"));
+  bool core_takes = true;
+  try {
+    validateMuscle(m, mu);
+  } catch (const ModelError&) {
+    core_takes = false;  // a core without general Type III paths: nothing to refuse here
+  }
+  if (!core_takes) GTEST_SKIP() << "the core refuses this shape too";
+  const std::string why = simbody::simbodyWrapShapeUnsupportedReason(mu);
+  EXPECT_NE(why.find("origin -> one wrap surface -> insertion"), std::string::npos) << why;
+  auto sm = simbody::makeSimbodyModel(m);
+  try {
+    simbody::MuscleInertia mi(*sm, m, {mu});
+    ADD_FAILURE() << "MuscleInertia took a via point on a wrapping path";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find(mu.name), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(simbody::ParticleMuscles(*sm, m, {mu}), simbody::SimbodyBuildError);
 }
 
 }  // namespace
