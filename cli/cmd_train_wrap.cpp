@@ -179,8 +179,6 @@ struct CompareRow {
 
 int runCompare(const Args& a) {
   const WrapType type = parseWrapType(a.get("surface", "cylinder"));
-  if (type != WrapType::Cylinder && type != WrapType::Sphere)
-    throw UsageError{"--compare supports cylinder and sphere (the smooth model's surfaces)"};
   const auto report = a.get("report");
   if (!report) throw UsageError{"--compare needs --report DIR"};
   requireFolder(*report);
@@ -262,32 +260,40 @@ int runCompare(const Args& a) {
   std::vector<CompareRow> rows;
   volatile double sink = 0.0;
 
-  // exact library: position, then J and Jdot by central differences (12 + 24 more evaluations)
+  // exact library: position, then J and Jdot by central differences, one wrap per perturbed pair
+  // of end points shared by the muscle's mass points, as the runtime does (calcExactWrapPointsFd:
+  // 1 + 12 + 24 wraps per muscle)
   {
     CompareRow row{"exact library + central differences", 0};
     const double h = 1e-6;
-    auto eval = [&](const WrapSurface& s, const Vec3& p1, const Vec3& p2, double al) {
-      return calcWrappedPathPoint(s, calcWrap(s, p1, p2), p1, p2, al);
+    std::vector<Vec3> xp(points), xm(points);
+    auto evalAll = [&](const WrapSurface& s, const Vec3& p1, const Vec3& p2, std::vector<Vec3>& xs) {
+      const WrapResult r = calcWrap(s, p1, p2);
+      for (int k = 0; k < points; ++k) xs[k] = calcWrappedPathPoint(s, r, p1, p2, alphas[k]);
     };
-    auto jac = [&](const WrapSurface& s, const Vec3& p1, const Vec3& p2, double al) {
-      Eigen::Matrix<double, 3, 6> J;
+    std::vector<Eigen::Matrix<double, 3, 6>> J(points), Jp(points), Jm(points);
+    auto jac = [&](const WrapSurface& s, const Vec3& p1, const Vec3& p2, std::vector<Eigen::Matrix<double, 3, 6>>& Js) {
       for (int i = 0; i < 6; ++i) {
         Vec3 a1 = p1, a2 = p2, b1 = p1, b2 = p2;
         (i < 3 ? a1 : a2)[i % 3] += h;
         (i < 3 ? b1 : b2)[i % 3] -= h;
-        J.col(i) = (eval(s, a1, a2, al) - eval(s, b1, b2, al)) / (2 * h);
+        evalAll(s, a1, a2, xp);
+        evalAll(s, b1, b2, xm);
+        for (int k = 0; k < points; ++k) Js[k].col(i) = (xp[k] - xm[k]) / (2 * h);
       }
-      return J;
     };
+    std::vector<Vec3> x(points);
     row.us_per_point = timePerPoint([&] {
       for (long m = 0; m < muscles; ++m) {
         const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
         const Vec3 p1 = inputs[m].segment<3>(0), p2 = inputs[m].segment<3>(3);
+        evalAll(s, p1, p2, x);
+        jac(s, p1, p2, J);
+        jac(s, p1 + h * v1s[m], p2 + h * v2s[m], Jp);
+        jac(s, p1 - h * v1s[m], p2 - h * v2s[m], Jm);
         for (int k = 0; k < points; ++k) {
-          const Vec3 x = eval(s, p1, p2, alphas[k]);
-          const auto J = jac(s, p1, p2, alphas[k]);
-          const auto Jdot = (jac(s, p1 + h * v1s[m], p2 + h * v2s[m], alphas[k]) - jac(s, p1 - h * v1s[m], p2 - h * v2s[m], alphas[k])) / (2 * h);
-          sink = sink + x[0] + J(0, 0) + Jdot(0, 0);
+          const Eigen::Matrix<double, 3, 6> Jdot = (Jp[k] - Jm[k]) / (2 * h);
+          sink = sink + x[k][0] + J[k](0, 0) + Jdot(0, 0);
         }
       }
     });
@@ -298,13 +304,19 @@ int runCompare(const Args& a) {
 
   // smooth model
   {
-    CompareRow row{"smooth model (width " + num(width, 3) + " R)", 0};
+    CompareRow row{"smooth model (width " + num(width, 3) + " size)", 0};
     std::vector<Vec3> x(total_points);
+    // the band in units of the surface's size (radius, tube radius, smallest semi-axis)
+    auto bandOf = [&](const WrapSurface& s) {
+      const double size = type == WrapType::Torus       ? s.inner_radius
+                          : type == WrapType::Ellipsoid ? s.dimensions.minCoeff()
+                                                        : s.radius;
+      return SmoothWrapOptions{width * size};
+    };
     for (long m = 0; m < muscles; ++m) {
       const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
       for (int k = 0; k < points; ++k)
-        x[m * points + k] = calcSmoothWrapPoint(s, inputs[m].segment<3>(0), inputs[m].segment<3>(3), alphas[k],
-                                                SmoothWrapOptions{width * s.radius});
+        x[m * points + k] = calcSmoothWrapPoint(s, inputs[m].segment<3>(0), inputs[m].segment<3>(3), alphas[k], bandOf(s));
     }
     errors(x, row);
     row.us_per_point = timePerPoint([&] {
@@ -312,12 +324,13 @@ int runCompare(const Args& a) {
         const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
         for (int k = 0; k < points; ++k) {
           const auto sp = calcSmoothWrapPointDerivatives(s, inputs[m].segment<3>(0), inputs[m].segment<3>(3), alphas[k],
-                                                         v1s[m], v2s[m], SmoothWrapOptions{width * s.radius});
+                                                         v1s[m], v2s[m], bandOf(s));
           sink = sink + sp.x[0] + sp.J(0, 0) + sp.Jdot(0, 0);
         }
       }
     });
-    row.note = "exact J, Jdot (dual numbers)";
+    row.note = type == WrapType::Ellipsoid ? "exact J, Jdot (dual numbers); a muscle's points share the plane construction"
+                                           : "exact J, Jdot (dual numbers)";
     rows.push_back(row);
   }
 
@@ -612,7 +625,8 @@ CommandRegistration reg(
      "                         [--epochs E] [--batch B] [--lr 1e-4] [--seed S] [--threshold 0.01]\n"
      "                         [--time-limit SECONDS] [--threads T [--shards S]] [--init NET.txt]\n"
      "                         --out NET.txt [--report DIR]\n"
-     "       redmax train-wrap --compare --surface cylinder|sphere [--nets A.txt,B.txt] [--untrained 6x256,...|none]\n"
+     "       redmax train-wrap --compare --surface cylinder|sphere|ellipsoid|torus [--nets A.txt,B.txt]\n"
+     "                         [--untrained 6x256,...|none]\n"
      "                         [--muscles M] [--mass-points N] [--width W] [--seed S] --report DIR\n"
      "       redmax train-wrap --study [--thresholds 0.01,0.05,0.1] [--architectures 1x32,3x32] [--samples N]\n"
      "                         [--epochs E] [--batch B] [--lr R] [--seed S] --report DIR\n"
@@ -629,8 +643,9 @@ CommandRegistration reg(
      "--init NET.txt continues training from that network (same surface and --hidden; its normalisation is kept,\n"
      "Adam restarts); its command and losses are kept in the new file's meta as init_*.\n"
      "--compare: M muscles (default 200) x N mass points (default 20) with random end points and velocities;\n"
-     "for the exact library (J, Jdot by central differences), the smooth model (band width W radii, default\n"
-     "0.05) and each network (trained ones from --nets; --untrained sizes are timed only), prints and writes\n"
+     "for the exact library (J, Jdot by central differences, wraps shared by a muscle's points), the smooth\n"
+     "model (band width W surface sizes, default 0.05) and each network (trained ones from --nets; --untrained\n"
+     "sizes are timed only), prints and writes\n"
      "DIR/speed_error.csv and a plot: microseconds per mass point (position + J + Jdot) and position error.\n"
      "--study [D Sec. 6.2.6]: for each threshold and architecture, trains a cylinder network (defaults: 10000\n"
      "samples, 60 epochs, batch 64, lr 1e-3) and writes DIR/study.csv and a plot of x_alpha.x (alpha 0.5) and\n"

@@ -78,6 +78,15 @@ TEST_F(TrainWrapCli, CompareWritesTheSpeedErrorTable) {
   EXPECT_NE(csv.find("exact library"), std::string::npos);
   EXPECT_NE(csv.find("smooth model"), std::string::npos);
   EXPECT_NE(csv.find("2x8 (untrained"), std::string::npos);
+  // every surface type has the smooth model now
+  for (const char* surface : {"ellipsoid", "torus"}) {
+    const std::string rep2 = (dir_ / (std::string("cmp_") + surface)).string();
+    const CmdResult r2 = run(std::string("train-wrap --compare --surface ") + surface +
+                             " --untrained none --muscles 2 --mass-points 3 --report " + rep2);
+    ASSERT_EQ(r2.code, 0) << r2.err;
+    const std::string csv2 = slurp(fs::path(rep2) / "speed_error.csv");
+    EXPECT_NE(csv2.find("smooth model"), std::string::npos) << surface;
+  }
 }
 
 TEST_F(TrainWrapCli, StudyWritesCurvesForEveryThresholdAndArchitecture) {
@@ -104,7 +113,7 @@ TEST_F(TrainWrapCli, BadInputExitsTwoWithAMessage) {
   EXPECT_EQ(r.code, 2);
   r = run("train-wrap --threshold 2" + out);
   EXPECT_EQ(r.code, 2);
-  r = run("train-wrap --compare --surface torus --report " + (dir_ / "c").string());
+  r = run("train-wrap --compare --surface torus --muscles 0 --report " + (dir_ / "c").string());
   EXPECT_EQ(r.code, 2);
   // a file that is not a network: named with its line
   const fs::path bad = dir_ / "bad.txt";
