@@ -291,6 +291,31 @@ TEST(WrapTraining, ShardedGradientsAreTheSerialOnesAndThreadCountFree) {
   EXPECT_NE(t1.meta.at("adam").find("shards 4"), std::string::npos);
 }
 
+TEST(WrapTraining, InitContinuesFromANetwork) {
+  const WrapInputBox box = makeDefaultWrapBox(WrapType::Cylinder);
+  const WrapTrainingSet set = makeWrapTrainingSet(box, makeExactWrapOracle(WrapType::Cylinder), 1500, 0.01, 5);
+  TrainOptions opt;
+  opt.hidden = parseHidden("2x16");
+  opt.epochs = 8;
+  opt.batch = 32;
+  opt.learning_rate = 1e-3;
+  std::vector<TrainEpoch> h1, h2;
+  const Mlp first = trainWrapNetwork(set, box, opt, &h1);
+  // zero epochs from `first` returns its weights unchanged; more epochs start from its loss
+  TrainOptions cont = opt;
+  cont.init = &first;
+  cont.epochs = 0;
+  EXPECT_TRUE(trainWrapNetwork(set, box, cont).weights(0) == first.weights(0));
+  cont.epochs = 4;
+  trainWrapNetwork(set, box, cont, &h2);
+  EXPECT_LT(h2.front().train_mse, 0.8 * h1.front().train_mse);  // not a fresh start
+  EXPECT_LT(h2.back().val_mse, 1.2 * h1.back().val_mse);
+  // another architecture is refused
+  TrainOptions wrong = cont;
+  wrong.hidden = parseHidden("3x16");
+  EXPECT_THROW(trainWrapNetwork(set, box, wrong), std::invalid_argument);
+}
+
 TEST(WrapTraining, ParseHidden) {
   EXPECT_EQ(parseHidden("6x256"), std::vector<int>(6, 256));
   EXPECT_EQ(parseHidden("64-32"), (std::vector<int>{64, 32}));
