@@ -16,6 +16,7 @@
 
 #include "converter/storage.hpp"
 #include "tests/cli/cli_test_util.hpp"
+#include "validation/report/json_value.hpp"
 
 namespace {
 
@@ -23,6 +24,7 @@ using namespace redmax::cli_test;
 
 using redmax::osim::readStorage;
 using redmax::osim::Storage;
+using redmax::validation::JsonValue;
 
 std::string scene(const std::string& file) { return std::string(REDMAX_SOURCE_DIR) + "/osim_models/" + file; }
 
@@ -244,6 +246,44 @@ TEST_F(WrapFlagsCli, IdEnginesTakeWrapMassAlike) {
   std::printf("[ measured ] running leg swing, physiological: core vs Simbody with wrap mass %.2g of the peak; "
               "gastrocnemii's mass changes the torques by up to %.3g of the peak\n",
               (c.data - b.data).cwiseAbs().maxCoeff() / peak, (c.data - l.data).cwiseAbs().maxCoeff() / peak);
+}
+
+// `redmax validate --mass-sweep` with the default wrap mass: the sweep's report says how many
+// wrapping muscles carry mass (summary.json mass_sweep.wrapping), the zero check holds, and Simbody
+// with muscle inertia (which takes the gastrocnemii's origin -> wrap -> insertion) agrees with the
+// core at the largest value within its tolerance (recorded, not counted)
+TEST_F(WrapFlagsCli, ValidateSweepReportsWrappingMuscles) {
+  const CmdResult r = run("validate --model " + scene("running_leg.osim") + " --coordinates " +
+                          scene("running_leg_swing.mot") + " --muscle-mass physiological --mass-sweep 0,0.5,1 --no-plots"
+                          " --quiet --report " + path("rep"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const JsonValue j = JsonValue::parse(slurp(dir_ / "rep" / "summary.json"));
+  const JsonValue& sw = j.at("mass_sweep");
+  ASSERT_TRUE(sw.contains("wrapping")) << sw.dump();
+  const JsonValue& w = sw.at("wrapping");
+  EXPECT_TRUE(w.at("wrap_mass").asBool());
+  EXPECT_EQ(w.at("wrap_model").asString(), "smooth");
+  EXPECT_EQ(w.at("wrapping_muscles").asNumber(), 2);
+  EXPECT_EQ(w.at("with_mass").asNumber(), 2);
+  EXPECT_EQ(w.at("lumped").size(), 0u);
+  EXPECT_TRUE(sw.at("zero_check").at("passed").asBool());
+  EXPECT_NE(slurp(dir_ / "rep" / "report.md").find("wrapping (Type III): 2 of 2 carry mass"), std::string::npos);
+  const JsonValue& sb = sw.at("simbody_check");
+  if (sb.at("ran").asBool()) {
+    ASSERT_TRUE(j.contains("simbody_mass_check")) << j.dump();
+    EXPECT_TRUE(j.at("simbody_mass_check").at("agrees").asBool()) << j.at("simbody_mass_check").dump();
+  } else {
+    ADD_FAILURE() << "Simbody with muscle inertia did not run: " << sb.at("skipped").asString();
+  }
+  // lumped: the report says so
+  const CmdResult rl = run("validate --model " + scene("running_leg.osim") + " --coordinates " +
+                           scene("running_leg_swing.mot") +
+                           " --muscle-mass physiological --mass-sweep 0,1 --wrap lumped --no-plots --no-simbody --quiet"
+                           " --report " + path("rep_lumped"));
+  ASSERT_EQ(rl.code, 0) << rl.err;
+  const JsonValue jl = JsonValue::parse(slurp(dir_ / "rep_lumped" / "summary.json"));
+  EXPECT_EQ(jl.at("mass_sweep").at("wrapping").at("with_mass").asNumber(), 0);
+  EXPECT_EQ(jl.at("mass_sweep").at("wrapping").at("lumped").size(), 2u);
 }
 
 }  // namespace
