@@ -51,31 +51,12 @@ validation::SimulationResult simulateSimbody(const validation::SimulationModel& 
   res.states.labels = m.q_labels;
   res.states.labels.insert(res.states.labels.end(), m.u_labels.begin(), m.u_labels.end());
   for (const char* e : {"kinetic_energy", "potential_energy", "total_energy"}) res.states.labels.push_back(e);
-  const int nr = model.nr();
-  std::vector<VecX> rows;
-  double max_ke = 0.0;
 
   const auto start = std::chrono::steady_clock::now();
   simbody::ParticleSimulation sim(model, m.muscles, initial, po);
+  validation::StateRecorder recorder(res);
   auto record = [&](const State& s) -> bool {
-    const double K = sim.kineticEnergy(), V = sim.potentialEnergy();
-    VecX row(2 * nr + 3);
-    row << s.q, s.qdot, K, V, K + V;
-    if (!row.allFinite()) {
-      std::ostringstream os;
-      os << "non-finite state or energy at t = " << s.t << " s (Simbody)";
-      res.failed = true;
-      res.failure = os.str();
-      res.failure_time = s.t;
-      return false;
-    }
-    if (rows.empty()) res.energy_initial = K + V;
-    res.energy_final = K + V;
-    max_ke = std::max(max_ke, K);
-    res.energy_drift_abs = std::max(res.energy_drift_abs, std::abs(K + V - res.energy_initial));
-    res.states.time.push_back(s.t);
-    rows.push_back(row);
-    return true;
+    return recorder.add(s.t, s.q, s.qdot, sim.kineticEnergy(), sim.potentialEnergy(), " (Simbody)");
   };
 
   bool ok = record(sim.state());
@@ -103,10 +84,7 @@ validation::SimulationResult simulateSimbody(const validation::SimulationModel& 
   res.stats.failed_steps = c.failed_steps;
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   res.final_state = sim.state();
-  const double scale = std::max(std::abs(res.energy_initial), max_ke);
-  res.energy_drift_rel = scale > 0.0 ? res.energy_drift_abs / scale : 0.0;
-  res.states.data.resize(static_cast<Eigen::Index>(rows.size()), 2 * nr + 3);
-  for (size_t r = 0; r < rows.size(); ++r) res.states.data.row(static_cast<Eigen::Index>(r)) = rows[r].transpose();
+  recorder.finish();
   return res;
 }
 

@@ -393,30 +393,13 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
   res.states.labels = m.q_labels;
   res.states.labels.insert(res.states.labels.end(), m.u_labels.begin(), m.u_labels.end());
   for (const char* e : {"kinetic_energy", "potential_energy", "total_energy"}) res.states.labels.push_back(e);
-  const int nr = sys.model().nr();
-  std::vector<VecX> rows;
   DynamicsWorkspace ws(sys.model());
-  double max_ke = 0.0;
+  StateRecorder recorder(res);
 
   auto record = [&](const State& s) -> bool {
     const double K = sys.kineticEnergy(s, ws), V = sys.potentialEnergy(s, ws);
     const State s_r = sys.expandState(s);
-    VecX row(2 * nr + 3);
-    row << s_r.q, s_r.qdot, K, V, K + V;
-    if (!row.allFinite()) {
-      std::ostringstream os;
-      os << "non-finite energy at t = " << s.t << " s";
-      res.failed = true;
-      res.failure = os.str();
-      res.failure_time = s.t;
-      return false;
-    }
-    if (rows.empty()) res.energy_initial = K + V;
-    res.energy_final = K + V;
-    max_ke = std::max(max_ke, K);
-    res.energy_drift_abs = std::max(res.energy_drift_abs, std::abs(K + V - res.energy_initial));
-    res.states.time.push_back(s.t);
-    rows.push_back(row);
+    if (!recorder.add(s.t, s_r.q, s_r.qdot, K, V)) return false;
     if (options.check) {
       const std::string why = options.check(s, K, V);
       if (!why.empty()) {
@@ -467,11 +450,35 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
   if (res.failed && res.failure_step == 0.0) res.failure_step = adaptive ? 0.0 : dt;
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   res.final_state = s;
-  const double scale = std::max(std::abs(res.energy_initial), max_ke);
-  res.energy_drift_rel = scale > 0.0 ? res.energy_drift_abs / scale : 0.0;
-  res.states.data.resize(static_cast<Eigen::Index>(rows.size()), 2 * nr + 3);
-  for (size_t r = 0; r < rows.size(); ++r) res.states.data.row(static_cast<Eigen::Index>(r)) = rows[r].transpose();
+  recorder.finish();
   return res;
+}
+
+bool StateRecorder::add(double t, const VecX& q, const VecX& qdot, double K, double V, const std::string& where) {
+  VecX row(q.size() + qdot.size() + 3);
+  row << q, qdot, K, V, K + V;
+  if (!row.allFinite()) {
+    std::ostringstream os;
+    os << "non-finite state or energy at t = " << t << " s" << where;
+    res_.failed = true;
+    res_.failure = os.str();
+    res_.failure_time = t;
+    return false;
+  }
+  if (rows_.empty()) res_.energy_initial = K + V;
+  res_.energy_final = K + V;
+  max_ke_ = std::max(max_ke_, K);
+  res_.energy_drift_abs = std::max(res_.energy_drift_abs, std::abs(K + V - res_.energy_initial));
+  res_.states.time.push_back(t);
+  rows_.push_back(std::move(row));
+  return true;
+}
+
+void StateRecorder::finish() {
+  const double scale = std::max(std::abs(res_.energy_initial), max_ke_);
+  res_.energy_drift_rel = scale > 0.0 ? res_.energy_drift_abs / scale : 0.0;
+  res_.states.data.resize(static_cast<Eigen::Index>(rows_.size()), static_cast<Eigen::Index>(res_.states.labels.size()));
+  for (size_t r = 0; r < rows_.size(); ++r) res_.states.data.row(static_cast<Eigen::Index>(r)) = rows_[r].transpose();
 }
 
 }  // namespace redmax::validation

@@ -144,6 +144,24 @@ struct SimulationResult {
   double failure_time = 0.0, failure_step = 0.0;
 };
 
+/// The rows of a run's STATES table (time; q, qdot, kinetic, potential and total energy) and its
+/// energy bookkeeping, shared by the core and the Simbody drivers so that both report drift alike.
+class StateRecorder {
+ public:
+  explicit StateRecorder(SimulationResult& res) : res_(res) {}
+  /// Append a row and update res's energies. False when a value is not finite: res.failed is set
+  /// and res.failure says so at time t, followed by `where` (e.g. " (Simbody)").
+  bool add(double t, const VecX& q, const VecX& qdot, double K, double V, const std::string& where = "");
+  /// Copy the rows into res.states.data (one column per label of res.states) and set
+  /// res.energy_drift_rel.
+  void finish();
+
+ private:
+  SimulationResult& res_;
+  std::vector<VecX> rows_;
+  double max_ke_ = 0.0;
+};
+
 /// Integrate from `initial` for options.duration. A NaN, divergence or a failed check stops the run:
 /// failed is set, failure names the time, the coordinate (by name) and the step. Impulse end times
 /// are breakpoints: adaptive methods restart there, so the switch-off is not smoothed over. Throws
