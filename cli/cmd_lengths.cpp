@@ -3,6 +3,13 @@
 // over cylinders, spheres, ellipsoids and tori (core/muscles/wrap/). Coordinates absent from the
 // file keep their defaults; Rotational columns of a degrees file are converted; constraints are not
 // enforced (the file's coupled coordinates are used as written).
+// --wrap smooth|neural: the length with the wrap model that mass points use (issue 7): straight
+// segments between active points plus, on the segment each wrap object acts on
+// (calcSegmentWraps, core/muscles/wrap_muscle.hpp), the model's length of that wrapped segment:
+// the smooth model's (calcWrapModelLength), or the polyline through the network's points
+// (calcNetworkWrapPathLength), with the smooth model where the network falls back. Paths the model
+// refuses (wrapMassPointsUnsupportedReason: two wraps on one segment, unsupported surfaces) keep
+// OpenSim's exact length and are named once.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,13 +19,17 @@
 #include <vector>
 
 #include "cli/args.hpp"
+#include "cli/muscle_mass_flags.hpp"
 #include "converter/build/build_core_model.hpp"
 #include "converter/id/inverse_dynamics_tool.hpp"
 #include "converter/osim_reader.hpp"
 #include "converter/storage.hpp"
 #include "core/muscles/path_kinematics.hpp"
+#include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap/wrap_path.hpp"
+#include "core/muscles/wrap_muscle.hpp"
 #include "core/skeleton/kinematics.hpp"
+#include "core/spatial/se3.hpp"
 
 namespace redmax::cli {
 namespace {
@@ -43,8 +54,64 @@ int findCoordinateColumn(const osim::Storage& s, const osim::CoordinateDesc& c) 
   return -1;
 }
 
+// polyline segments of a network's wrapped path: calcNetworkWrapPathLength converges to 1e-6
+// relative by 200 on cylinder_3x64 (network_model.hpp)
+constexpr int kNetworkLengthSegments = 200;
+
+// The wrap model's length of muscle's path at q (m), see the file header. A wrapped segment whose
+// end lies inside its surface (origin -> surface -> insertion only; calcSegmentWraps skips such
+// segments elsewhere) is straight, as OpenSim's InsideRadius leaves it.
+double calcModelPathLength(const Model& model, const Muscle& muscle, const VecX& q, const std::vector<Mat4>& E_wi,
+                           NetworkWrapWorkspace& ws, std::vector<int>& active, std::vector<Vec3>& x_w) {
+  const MusclePath& path = muscle.path;
+  active.clear();
+  x_w.clear();
+  for (size_t i = 0; i < path.points.size(); ++i) {
+    const PathPoint& pt = path.points[i];
+    if (!isPathPointActive(pt, q)) continue;
+    Vec3 x_b, dx, ddx;
+    calcPointLocation(pt, q, x_b, dx, ddx);
+    active.push_back(static_cast<int>(i));
+    x_w.push_back(pt.body >= 0 ? transformPoint(E_wi[pt.body], x_b) : x_b);
+  }
+  const std::vector<int> seg_wrap = calcSegmentWraps(muscle, active, x_w, E_wi);
+  const WrapMassOptions& o = muscle.wrap;
+  double length = 0.0;
+  for (size_t i = 0; i < seg_wrap.size(); ++i) {
+    const double straight = (x_w[i + 1] - x_w[i]).norm();
+    if (seg_wrap[i] < 0) {
+      length += straight;
+      continue;
+    }
+    const PathWrap& w = path.wraps[seg_wrap[i]];
+    const Mat4 E_ws = w.body >= 0 ? Mat4(E_wi[w.body] * w.E_bs) : w.E_bs;
+    const Mat3 R = E_ws.topLeftCorner<3, 3>();
+    const Vec3 p = E_ws.topRightCorner<3, 1>();
+    const Vec3 p1 = R.transpose() * (x_w[i] - p), p2 = R.transpose() * (x_w[i + 1] - p);
+    try {
+      if (o.model == WrapModel::Neural) {
+        NetworkWrapOptions no;
+        no.fallback.width = o.width;
+        NetworkWrapEval ev;
+        const double l =
+            calcNetworkWrapPathLength(o.network.get(), w.surface, p1, p2, kNetworkLengthSegments, ws, &ev, no);
+        if (o.monitor) o.monitor->record(muscle.name, w.name, ev, o.network.get());
+        // the fallback is the smooth model: its own length, not a polyline through its points
+        length += ev.usedNetwork()
+                      ? l
+                      : calcWrapModelLength(o, w.surface, p1, p2, Vec3::Zero(), Vec3::Zero()).length;
+      } else {
+        length += calcWrapModelLength(o, w.surface, p1, p2, Vec3::Zero(), Vec3::Zero()).length;
+      }
+    } catch (const std::invalid_argument&) {
+      length += straight;  // an end inside the surface: no wrap
+    }
+  }
+  return length;
+}
+
 int runLengths(const std::vector<std::string>& argv) {
-  const Args a(argv, {"model", "coordinates", "wrap", "out", "wrap-lengths"},
+  const Args a(argv, {"model", "coordinates", "wrap", "out", "wrap-lengths", "wrap-width", "wrap-network"},
                {"quiet", "full-precision", "all-paths"});
   if (!a.positionals().empty())
     throw UsageError{"lengths takes no positional arguments (got '" + a.positionals().front() + "')"};
@@ -53,12 +120,20 @@ int runLengths(const std::vector<std::string>& argv) {
   const std::string model_file = *a.get("model"), coords_file = *a.get("coordinates"),
                     out_path = *a.get("out");
   const std::string wrap = a.get("wrap", "exact");
-  if (wrap == "neural" || wrap == "smooth")
-    throw UsageError{"--wrap " + wrap + " chooses how mass points move over wrap surfaces (simulate, id and "
-                     "validate with muscle mass); lengths are OpenSim's: --wrap exact (default) or none"};
-  if (wrap != "exact" && wrap != "none")
-    throw UsageError{"--wrap must be exact, neural, smooth or none, got '" + wrap + "'"};
+  if (wrap != "exact" && wrap != "none" && wrap != "smooth" && wrap != "neural")
+    throw UsageError{"--wrap must be exact, smooth, neural or none, got '" + wrap + "'"};
+  // the shared wrap flags' checks (width only with smooth/neural, network only and always with
+  // neural, the network file loaded); none has no wrap model to configure
+  osim::MuscleMassOptions wrap_flags;
+  if (wrap == "none") {
+    for (const char* f : {"wrap-width", "wrap-network"})
+      if (a.has(f)) throw UsageError{std::string("--") + f + " needs --wrap smooth or neural"};
+  } else {
+    parseWrapFlags(a, wrap_flags);
+  }
+  const bool model_lengths = wrap == "smooth" || wrap == "neural";
   const bool quiet = a.has("quiet");
+  if (quiet && wrap_flags.wrap.monitor) wrap_flags.wrap.monitor->setSink({});
 
   osim::ModelDescription d;
   osim::BuildResult build;
@@ -127,6 +202,31 @@ int runLengths(const std::vector<std::string>& argv) {
     if (wrap == "none") p.wraps.clear();
     paths.push_back(std::move(p));
   }
+  // smooth/neural: which paths take the wrap model's length; the others keep the exact one
+  std::vector<Muscle> model_muscle(paths.size());
+  std::vector<char> use_model(paths.size(), 0);
+  int exact_fallbacks = 0;
+  if (model_lengths) {
+    std::string refused;
+    for (size_t m = 0; m < paths.size(); ++m) {
+      if (paths[m].wraps.empty()) continue;  // no wrap object: the polyline either way
+      Muscle& mu = model_muscle[m];
+      mu.name = build.muscles[report[m]].name;
+      mu.path = paths[m];
+      mu.wrap = wrap_flags.wrap;
+      const std::string why = wrapMassPointsUnsupportedReason(mu);
+      if (why.empty()) {
+        use_model[m] = 1;
+      } else {
+        ++exact_fallbacks;
+        refused += "  " + mu.name + ": " + why + "\n";
+      }
+    }
+    if (exact_fallbacks > 0)
+      std::cerr << "warning: " << exact_fallbacks << " wrapping muscle(s) keep OpenSim's exact length (the " << wrap
+                << " model cannot take their path):\n"
+                << refused;
+  }
 
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -152,6 +252,9 @@ int runLengths(const std::vector<std::string>& argv) {
     wl.data.setZero(coords.numRows(), static_cast<int>(wl_cols.size()));
   }
   std::vector<Mat4> E_wi;
+  NetworkWrapWorkspace nws;
+  std::vector<int> active;
+  std::vector<Vec3> x_w;
   for (int row = 0; row < coords.numRows(); ++row) {
     VecX q = q0;
     for (size_t j = 0; j < column_of.size(); ++j)
@@ -168,7 +271,8 @@ int runLengths(const std::vector<std::string>& argv) {
       }
     }
     for (size_t m = 0; m < paths.size(); ++m) {
-      const double l = calcPathLength(model, paths[m], q, E_wi);
+      const double l = use_model[m] ? calcModelPathLength(model, model_muscle[m], q, E_wi, nws, active, x_w)
+                                    : calcPathLength(model, paths[m], q, E_wi);
       if (!std::isfinite(l)) {
         std::cerr << "error: " << coords_file << ": muscle '" << out.labels[m]
                   << "' has a non-finite length at time " << coords.time[row] << " (row " << row + 1
@@ -190,6 +294,9 @@ int runLengths(const std::vector<std::string>& argv) {
       wo.decimals = 16;
     }
     wo.description = "musculotendon path lengths (m), wrap " + wrap;
+    if (model_lengths && wrap_flags.wrap.width > 0.0)
+      wo.description += " (width " + std::to_string(wrap_flags.wrap.width) + " m)";
+    if (wrap == "neural") wo.description += " (network " + a.get("wrap-network", "") + ")";
     osim::writeStorage(out_path, out, wo);
     if (!wl_path.empty()) {
       wo.description = "surface length l of each wrap object (m; 0 = not wrapping; OpenSim's value)";
@@ -202,18 +309,27 @@ int runLengths(const std::vector<std::string>& argv) {
   if (!quiet) {
     int wrapping = 0;
     for (const auto& p : paths) wrapping += p.wraps.empty() ? 0 : 1;
-    std::printf("lengths: %d frames, %d muscles (%d wrapping, wrap %s), %.4f s wall -> %s\n",
-                coords.numRows(), static_cast<int>(paths.size()), wrapping, wrap.c_str(), wall,
-                out_path.c_str());
+    std::string detail;
+    if (model_lengths && exact_fallbacks > 0)
+      detail = ", " + std::to_string(exact_fallbacks) + " on the exact length";
+    std::printf("lengths: %d frames, %d muscles (%d wrapping, wrap %s%s), %.4f s wall -> %s\n", coords.numRows(),
+                static_cast<int>(paths.size()), wrapping, wrap.c_str(), detail.c_str(), wall, out_path.c_str());
+    if (wrap_flags.wrap.monitor) {
+      long evaluations = 0;
+      for (const auto& [name, c] : wrap_flags.wrap.monitor->counts()) evaluations += c.evaluations;
+      std::printf("network: %ld of %ld wrapped-segment evaluations fell back to the smooth model\n",
+                  wrap_flags.wrap.monitor->totalFallbacks(), evaluations);
+      std::printf("%s", wrap_flags.wrap.monitor->summary().c_str());
+    }
   }
   return 0;
 }
 
 CommandRegistration reg(
     {"lengths", "musculotendon path lengths along a motion, wrapping as OpenSim does",
-     "usage: redmax lengths --model M.osim --coordinates Q.mot [--wrap exact|none]\n"
-     "                      [--wrap-lengths L.sto] [--all-paths] [--full-precision] [--quiet]\n"
-     "                      --out LENGTHS.sto\n"
+     "usage: redmax lengths --model M.osim --coordinates Q.mot [--wrap exact|smooth|neural|none]\n"
+     "                      [--wrap-width W] [--wrap-network FILE] [--wrap-lengths L.sto]\n"
+     "                      [--all-paths] [--full-precision] [--quiet] --out LENGTHS.sto\n"
      "Path length of every muscle at every row of the coordinates file, as OpenSim's\n"
      "GeometryPath computes it: active path points (conditional, moving), then each PathWrap in\n"
      "order over its range (WrapCylinder, WrapSphere, WrapEllipsoid, WrapTorus; quadrants, methods,\n"
@@ -224,9 +340,21 @@ CommandRegistration reg(
      "                       their defaults; Rotational columns of a degrees file are converted;\n"
      "                       constraints are not enforced (coupled coordinates used as written)\n"
      "  --wrap exact         OpenSim-exact wrapping (default); none: straight segments, no wraps\n"
-     "                       (neural and smooth are not available here yet)\n"
+     "  --wrap smooth        the smooth wrap model's length (as mass points use it): straight\n"
+     "                       segments plus, on the segment each wrap acts on, the exact wrapped length\n"
+     "                       outside the transition band and a C2 blend with the straight one inside;\n"
+     "                       paths the model refuses (two wraps on one segment, ...) keep the exact\n"
+     "                       length and are named on stderr\n"
+     "  --wrap neural        the same with the polyline through a network's points (200 pieces) on\n"
+     "                       wrapped segments; where the network falls back (outside its training\n"
+     "                       box, other surfaces) the smooth model's length; counted in the summary\n"
+     "  --wrap-width W       smooth (and neural's fallback): transition width in metres (default 0.05\n"
+     "                       of the surface size)\n"
+     "  --wrap-network FILE  neural (required): a network of `redmax train-wrap`\n"
+     "                       (e.g. osim_models/networks/cylinder_6x256.txt)\n"
      "  --wrap-lengths FILE  also write the surface length l of every wrap object of every path\n"
-     "                       (columns MUSCLE/WRAPOBJECT, 0 when that object does not wrap)\n"
+     "                       (columns MUSCLE/WRAPOBJECT, 0 when that object does not wrap; OpenSim's\n"
+     "                       exact value whatever --wrap)\n"
      "  --all-paths          every force with a path (PathSpring, PathActuator, ...), not only muscles\n"
      "  --out FILE           output .sto: time, then one column per muscle named as the muscle (m)\n"
      "  --full-precision     write %.16e instead of OpenSim's %16.8lf\n"

@@ -59,15 +59,15 @@ void wrapRange(const PathWrap& w, int np, int& lo, int& hi) {
 
 // the candidate segments [first, last) of wrap w over the active points (OpenSim's applyWrapObjects:
 // from the first active point at/after the range's begin to the last one at/before its end)
-bool wrapSegments(const PathWrap& w, const MuscleKinematics& mk, int np, int& first, int& last) {
+bool wrapSegments(const PathWrap& w, const std::vector<int>& active, int np, int& first, int& last) {
   int lo = 0, hi = 0;
   wrapRange(w, np, lo, hi);
-  const int P = static_cast<int>(mk.active.size());
+  const int P = static_cast<int>(active.size());
   first = -1;
   last = -1;
   for (int i = 0; i < P; ++i) {
-    if (first < 0 && mk.active[i] >= lo) first = i;
-    if (mk.active[i] <= hi) last = i;
+    if (first < 0 && active[i] >= lo) first = i;
+    if (active[i] <= hi) last = i;
   }
   return first >= 0 && last > first;
 }
@@ -359,6 +359,56 @@ bool endInsideSurface(const WrapMassOptions& options, const WrapSurface& surface
   }
 }
 
+}  // namespace
+
+std::vector<int> calcSegmentWraps(const Muscle& muscle, const std::vector<int>& active, const std::vector<Vec3>& x_w,
+                                  const std::vector<Mat4>& E_wi) {
+  const MusclePath& path = muscle.path;
+  const int P = static_cast<int>(x_w.size());
+  const int nseg = std::max(P - 1, 0);
+  const int np = static_cast<int>(path.points.size());
+  const int nw = static_cast<int>(path.wraps.size());
+  const bool single_shape = path.points.size() == 2 && path.wraps.size() == 1;
+  std::vector<int> seg_wrap(nseg, -1);
+  for (int w = 0; w < nw; ++w) {
+    const PathWrap& pw = path.wraps[w];
+    if (!pw.surface.active) continue;
+    int first = 0, last = 0;
+    if (!wrapSegments(pw, active, np, first, last)) continue;
+    // the surface frame's pose, as calcSurfaceMotion computes it
+    const Mat4 E_ws = pw.body >= 0 ? Mat4(E_wi[pw.body] * pw.E_bs) : pw.E_bs;
+    const Mat3 R = E_ws.topLeftCorner<3, 3>();
+    const Vec3 p = E_ws.topRightCorner<3, 1>();
+    int best = -1;
+    double best_d = -std::numeric_limits<double>::infinity();
+    for (int i = first; i < last; ++i) {
+      if (seg_wrap[i] >= 0) continue;
+      if (single_shape) {
+        best = i;
+        break;
+      }
+      const Vec3 p1 = R.transpose() * (x_w[i] - p), p2 = R.transpose() * (x_w[i + 1] - p);
+      // OpenSim gives a segment with an end inside the surface no wrap (InsideRadius), and so do
+      // we on general paths (the positions jump there as OpenSim's path does); on origin -> surface ->
+      // insertion it stays a MuscleError (the dissertation's shape, where nothing else can wrap)
+      if (endInsideSurface(muscle.wrap, pw.surface, p1, p2)) continue;
+      if (last - first == 1) {
+        best = i;
+        break;
+      }
+      const double d = calcWrapPenetration(pw.surface, p1, p2);
+      if (d > best_d) {
+        best_d = d;
+        best = i;
+      }
+    }
+    if (best >= 0) seg_wrap[best] = w;
+  }
+  return seg_wrap;
+}
+
+namespace {
+
 bool coversBody(const Model& model, const MuscleKinematics& mk, int b) {
   if (b < 0) return true;
   if (static_cast<int>(mk.col_of.size()) != model.nr()) return false;
@@ -384,15 +434,13 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
   const int k = static_cast<int>(mk.cols.size());
   const int P = static_cast<int>(mk.x_w.size());
   const int nseg = P - 1;
-  const int np = static_cast<int>(path.points.size());
   const int nw = static_cast<int>(path.wraps.size());
   const bool vel = mk.velocity;
   if (P < 2) throw std::logic_error("calcWrapMassPoints: needs the path stage");
   const std::string who = "muscle '" + muscle.name + "'";
 
   // which wrap acts on which segment (header): the candidate penetrating most
-  const bool single_shape = path.points.size() == 2 && path.wraps.size() == 1;
-  std::vector<int> seg_wrap(nseg, -1);
+  const std::vector<int> seg_wrap = calcSegmentWraps(muscle, mk.active, mk.x_w, sk.E_wi);
   std::vector<SurfaceMotion> sm(nw);
   std::vector<char> have_sm(nw, 0);
   auto motion = [&](int w) -> const SurfaceMotion& {
@@ -402,37 +450,6 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
     }
     return sm[w];
   };
-  for (int w = 0; w < nw; ++w) {
-    const PathWrap& pw = path.wraps[w];
-    if (!pw.surface.active) continue;
-    int first = 0, last = 0;
-    if (!wrapSegments(pw, mk, np, first, last)) continue;
-    int best = -1;
-    double best_d = -std::numeric_limits<double>::infinity();
-    for (int i = first; i < last; ++i) {
-      if (seg_wrap[i] >= 0) continue;
-      if (single_shape) {
-        best = i;
-        break;
-      }
-      const SurfaceMotion& m = motion(w);
-      const Vec3 p1 = m.R.transpose() * (mk.x_w[i] - m.p), p2 = m.R.transpose() * (mk.x_w[i + 1] - m.p);
-      // OpenSim gives a segment with an end inside the surface no wrap (InsideRadius), and so do
-      // we on general paths (the positions jump there as OpenSim's do); on origin -> surface ->
-      // insertion it stays a MuscleError (the dissertation's shape, where nothing else can wrap)
-      if (endInsideSurface(muscle.wrap, pw.surface, p1, p2)) continue;
-      if (last - first == 1) {
-        best = i;
-        break;
-      }
-      const double d = calcWrapPenetration(pw.surface, p1, p2);
-      if (d > best_d) {
-        best_d = d;
-        best = i;
-      }
-    }
-    if (best >= 0) seg_wrap[best] = w;
-  }
   std::vector<SegmentEnds> ends(nseg);
   for (int i = 0; i < nseg; ++i)
     if (seg_wrap[i] >= 0) {

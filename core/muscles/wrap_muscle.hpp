@@ -114,6 +114,16 @@ void calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surf
 SmoothWrapLength calcWrapModelLength(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
                                      const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot);
 
+/// The segment construction's choice (header, "Segments"): for each segment between consecutive
+/// active points (active: indices into muscle.path.points, x_w: their world positions, P >= 1),
+/// the index into muscle.path.wraps of the wrap object acting on it, or -1 (straight). Each active
+/// wrap takes the free candidate of its range penetrating most, skipping segments with an end
+/// inside the surface (except origin -> surface -> insertion, which always takes its wrap).
+/// Surface poses from the body poses E_wi (calcBodyPoses). Used by the mass points and by
+/// `redmax lengths --wrap smooth|neural`.
+std::vector<int> calcSegmentWraps(const Muscle& muscle, const std::vector<int>& active, const std::vector<Vec3>& x_w,
+                                  const std::vector<Mat4>& E_wi);
+
 /// The exact library's points at fractions alphas over one surface (frame s), with J = dx/d(p1, p2)
 /// by central differences of step h (m; <= 0: 1e-5 times the surface size) and, when
 /// `with_jdot`, Jdot by central differences of J along (p1dot, p2dot) (else zero). calcWrap runs
