@@ -127,7 +127,6 @@ void HingePointConstraint::calcAcceleration(const Model& model, const State& s, 
 void HingePointConstraint::calcErrors(const Model& model, const State& s, const SkeletonWorkspace& ws,
                                       Eigen::Ref<VecX> pos_err, Eigen::Ref<VecX> vel_err) const {
   const Geometry g = calcGeometry(model, s, ws);
-  const PointKinematics &a = g.a, &b = g.b;
   const RotationKinematics& k = g.k;
   const Vec3 &d = g.d, &ddot = g.ddot;
   for (int j = 0; j < 2; ++j) {
