@@ -16,7 +16,9 @@
 #include "converter/id/core_id_engine.hpp"
 #include "converter/id/inverse_dynamics_tool.hpp"
 #include "plugin/simbody/id_engine.hpp"
+#include "converter/build/inertia_fallback.hpp"
 #include "plugin/simbody/simbody_options.hpp"
+#include "validation/simbody_cross_check.hpp"
 
 namespace redmax::cli {
 namespace {
@@ -49,7 +51,7 @@ int runId(const std::vector<std::string>& argv) {
   const Args a(argv,
                withMuscleMassFlags({"setup", "model", "coordinates", "external-loads", "lowpass", "t0",
                                     "t1", "engine", "out", "forces-to-exclude"}),
-               {"exact", "opensim-compat", "quiet", "full-precision"});
+               {"exact", "opensim-compat", "quiet", "full-precision", "inertia-fallback"});
   const osim::IdToolSettings settings = parseSettings(a);
   const std::string engine_name = a.get("engine", "core");
   if (engine_name != "core" && engine_name != "simbody")
@@ -69,11 +71,27 @@ int runId(const std::vector<std::string>& argv) {
     for (const auto& w : tool->warnings()) std::cerr << "warning: " << w << "\n";
     if (with_mass && !quiet) std::cerr << osim::describeMuscleMass(tool->muscleMassPlan());
     if (engine_name == "core") {
-      engine = std::make_unique<osim::CoreIdEngine>(tool->model(), tool->muscles(), tool->engineOptions());
+      if (a.has("inertia-fallback")) {
+        // the model --engine simbody solves where Debian's Simbody rejects an inertia
+        Model model = tool->model();
+        for (const auto& b : osim::applyOpenSimInertiaFallback(model))
+          std::cerr << "warning: body '" << b << "': inertia replaced by OpenSim's isotropic fallback (--inertia-fallback)\n";
+        engine = std::make_unique<osim::CoreIdEngine>(model, tool->muscles(), tool->engineOptions());
+      } else {
+        engine = std::make_unique<osim::CoreIdEngine>(tool->model(), tool->muscles(), tool->engineOptions());
+      }
     } else {
       try {
-        // muscles with mass points: their inertia through plugin/simbody/muscle_inertia.hpp
-        engine = std::make_unique<simbody::SimbodyIdEngine>(tool->model(), tool->muscles(), tool->engineOptions());
+        // muscles with mass points: their inertia through plugin/simbody/muscle_inertia.hpp; an
+        // inertia Debian's Simbody (a checking build) rejects gets OpenSim's isotropic fallback, as
+        // OpenSim does when its Simbody checks
+        validation::SimbodyCrossCheckEngine built =
+            validation::makeSimbodyCrossCheckEngine(tool->model(), tool->muscles(), tool->engineOptions());
+        if (built.usedFallback())
+          std::cerr << "warning: Simbody rejects the inertia of " << built.replacedBodies() << " (" << built.rejection
+                    << "): --engine simbody uses OpenSim's isotropic fallback for them (--engine core "
+                       "--inertia-fallback solves the same model)\n";
+        engine = std::move(built.engine);
       } catch (const simbody::SimbodyBuildError& e) {
         throw osim::ConvertError(config.model_file, 0,
                                  std::string("--engine simbody cannot build this model: ") + e.what());
@@ -144,7 +162,8 @@ CommandRegistration reg(
      std::string("usage: redmax id (--setup ID_SETUP.xml | --model M.osim --coordinates Q.mot)\n"
      "                 [--external-loads LOADS.xml] [--lowpass HZ] [--t0 S] [--t1 S]\n"
      "                 [--forces-to-exclude LIST] [--engine core|simbody] [--exact]\n"
-     "                 [--full-precision] [--quiet] [MUSCLE-MASS OPTIONS] --out OUT.sto\n"
+     "                 [--inertia-fallback] [--full-precision] [--quiet] [MUSCLE-MASS OPTIONS]\n"
+     "                 --out OUT.sto\n"
      "Computes the generalized forces of a motion, processing the inputs as OpenSim 4.x's\n"
      "InverseDynamicsTool does: coordinates in degrees converted for Rotational coordinates only;\n"
      "with a cutoff >= 0, padding, resampling to the smallest time step and the zero-phase\n"
@@ -161,7 +180,10 @@ CommandRegistration reg(
      "                       (default without a setup: Muscles). Forces OpenSim would still apply\n"
      "                       and redmax does not model are listed as warnings\n"
      "  --engine core|simbody  the REDMAX core (default) or the Simbody system built from the same\n"
-     "                       core model; both get identical inputs\n"
+     "                       core model; both get identical inputs. A body inertia Debian's Simbody\n"
+     "                       rejects (e.g. gait2392's toes) gets OpenSim's isotropic fallback in\n"
+     "                       Simbody, with a warning naming the bodies\n"
+     "  --inertia-fallback   core: apply that same fallback (to compare the engines on one model)\n"
      "  --exact              exact kinematics instead of OpenSim compatibility (the default,\n"
      "                       --opensim-compat): by default CustomJoints use Simbody's approximate\n"
      "                       velocity terms and Ball/Free/Ellipsoid joints read the data's Euler-angle\n"

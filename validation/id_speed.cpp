@@ -9,11 +9,11 @@
 #include <random>
 #include <string>
 
-#include "converter/build/inertia_fallback.hpp"
 #include "converter/id/core_id_engine.hpp"
 #include "converter/storage.hpp"
 #include "plugin/simbody/id_engine.hpp"
 #include "plugin/simbody/simbody_options.hpp"
+#include "validation/simbody_cross_check.hpp"
 
 namespace redmax::validation {
 namespace {
@@ -77,16 +77,14 @@ IdSpeedResult timeIdEngines(const IdSpeedOptions& options) {
   std::unique_ptr<osim::IdEngine> simbody;
   if (options.simbody) {
     try {
-      simbody = std::make_unique<simbody::SimbodyIdEngine>(model, tool.engineOptions());
-    } catch (const simbody::SimbodyBuildError& e) {
-      const auto replaced = osim::applyOpenSimInertiaFallback(model);
-      if (replaced.empty()) {
-        r.simbody_note = std::string("Simbody cannot build the model: ") + e.what();
-      } else {
-        simbody = std::make_unique<simbody::SimbodyIdEngine>(model, tool.engineOptions());
-        r.simbody_note = "both engines timed with OpenSim's isotropic fallback inertia on";
-        for (const auto& b : replaced) r.simbody_note += " " + b;
+      SimbodyCrossCheckEngine built = makeSimbodyCrossCheckEngine(model, {}, tool.engineOptions());
+      simbody = std::move(built.engine);
+      if (built.usedFallback()) {
+        model = *built.fallback_model;
+        r.simbody_note = "both engines timed with OpenSim's isotropic fallback inertia on " + built.replacedBodies();
       }
+    } catch (const std::exception& e) {
+      r.simbody_note = std::string("Simbody cannot build the model: ") + e.what();
     }
   } else {
     r.simbody_note = "not requested";

@@ -9,11 +9,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "converter/build/inertia_fallback.hpp"
 #include "converter/id/core_id_engine.hpp"
 #include "plugin/simbody/id_engine.hpp"
 #include "plugin/simbody/simbody_options.hpp"
 #include "validation/report/progress.hpp"
+#include "validation/simbody_cross_check.hpp"
 
 namespace redmax::validation {
 namespace {
@@ -249,27 +249,16 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
     std::unique_ptr<simbody::SimbodyIdEngine> sb;
     try {
       sw.restart();
-      sb = std::make_unique<simbody::SimbodyIdEngine>(tool.model(), tool.engineOptions());
-      sb_run.build_seconds = sw.seconds();
-    } catch (const simbody::SimbodyBuildError& e) {
       // Debian's Simbody checks inertias that OpenSim's release build keeps (gait2392's toes):
-      // cross-check the engines on the model with OpenSim's isotropic fallback for those bodies
-      Model fallback = tool.model();
-      const auto replaced = osim::applyOpenSimInertiaFallback(fallback);
-      if (replaced.empty()) {
-        sb_run.skipped = std::string("the Simbody engine cannot build this model: ") + e.what();
-      } else {
-        std::string bodies;
-        for (const auto& b : replaced) bodies += (bodies.empty() ? "" : ", ") + b;
-        sw.restart();
-        sb = std::make_unique<simbody::SimbodyIdEngine>(fallback, tool.engineOptions());
-        sb_run.build_seconds = sw.seconds();
-        osim::CoreIdEngine core_fallback(fallback, tool.engineOptions());
+      // then both engines are cross-checked on OpenSim's isotropic fallback for those bodies
+      SimbodyCrossCheckEngine built = makeSimbodyCrossCheckEngine(tool.model(), {}, tool.engineOptions());
+      sb_run.build_seconds = sw.seconds();
+      sb = std::move(built.engine);
+      if (built.usedFallback()) {
+        osim::CoreIdEngine core_fallback(*built.fallback_model, tool.engineOptions());
         core_for_simbody = tool.run(core_fallback);
         core_for_simbody.name = "core";
-        r.warnings.push_back("Simbody rejects the inertia of " + bodies + " (" + e.what() +
-                             "); core vs simbody is compared with OpenSim's isotropic fallback inertia "
-                             "for them in both engines; every other comparison uses the inertia as given");
+        r.warnings.push_back(describeInertiaFallback(built));
       }
     } catch (const std::exception& e) {
       sb_run.skipped = std::string("the Simbody engine cannot build this model: ") + e.what();
@@ -372,16 +361,25 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
       IdEngineRun sbm;
       sbm.name = "simbody_mass";
       try {
-        simbody::SimbodyIdEngine sb(*mass_engine.model, mass_engine.muscles, tool.engineOptions());
-        osim::Storage sbm_result = runEngine(tool, sb, sbm, opt.progress);
+        SimbodyCrossCheckEngine sb =
+            makeSimbodyCrossCheckEngine(*mass_engine.model, mass_engine.muscles, tool.engineOptions());
+        osim::Storage sbm_result = runEngine(tool, *sb.engine, sbm, opt.progress);
         ie.simbody_ran = true;
+        // with the fallback inertia, the core solves that same model and mass points again
+        osim::Storage core_mass_same = mass_result;
+        if (sb.usedFallback()) {
+          osim::CoreIdEngine core_fallback(*sb.fallback_model, mass_engine.muscles, tool.engineOptions());
+          core_mass_same = tool.run(core_fallback);
+          ie.simbody_note = describeInertiaFallback(sb);
+          r.warnings.push_back("simbody with muscle inertia: " + ie.simbody_note);
+        }
         CompareOptions co;
         co.tolerance = {opt.engine_abs, opt.engine_rel, opt.engine_abs, opt.engine_rel};
         co.align.grid_table = 0;
         co.missing_columns_fail = true;
         ie.simbody_check =
-            compareTables("core_mass_vs_simbody_mass", mass_result, "core_mass", sbm_result, "simbody_mass", co);
-        addSimbodyMassCheck(ie.simbody_check, mass_result, sbm_result, report);
+            compareTables("core_mass_vs_simbody_mass", core_mass_same, "core_mass", sbm_result, "simbody_mass", co);
+        addSimbodyMassCheck(ie.simbody_check, core_mass_same, sbm_result, report);
       } catch (const std::exception& e) {
         ie.simbody_skipped = e.what();
         r.warnings.push_back(std::string("simbody with muscle inertia: ") + e.what());
@@ -406,6 +404,7 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
     report.addWallTime("mass_sweep", secs);
     addMassSweepToReport(r.mass_sweep, core_result, report);
     if (!r.mass_sweep.simbody.skipped.empty()) r.warnings.push_back("mass sweep: " + r.mass_sweep.simbody.skipped);
+    if (!r.mass_sweep.simbody.note.empty()) r.warnings.push_back("mass sweep, simbody: " + r.mass_sweep.simbody.note);
   }
 
   // the engines' own results, at full precision, beside the report

@@ -79,6 +79,7 @@ struct InertialEffect {
   bool simbody_ran = false;    ///< Simbody with muscle inertia solved it too
   Comparison simbody_check;    ///< core_mass_vs_simbody_mass: recorded, not counted
   std::string simbody_skipped; ///< why not, when the zero-mass Simbody ran but this one failed
+  std::string simbody_note;    ///< the inertia fallback both engines needed for it ("" when none)
 };
 
 /// Wall time of one engine over the trial.

@@ -10,6 +10,7 @@
 #include "converter/id/core_id_engine.hpp"
 #include "plugin/simbody/id_engine.hpp"
 #include "validation/report/progress.hpp"
+#include "validation/simbody_cross_check.hpp"
 
 namespace redmax::validation {
 namespace {
@@ -257,17 +258,24 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
       if (!e.model) {
         r.simbody.skipped = "the engine factory gave no model";
       } else {
-        std::unique_ptr<simbody::SimbodyIdEngine> sb;
+        SimbodyCrossCheckEngine sb;
         try {
-          sb = std::make_unique<simbody::SimbodyIdEngine>(*e.model, e.muscles, tool.engineOptions());
+          sb = makeSimbodyCrossCheckEngine(*e.model, e.muscles, tool.engineOptions());
         } catch (const std::exception& ex) {
           r.simbody.skipped = std::string("the Simbody engine cannot build this model: ") + ex.what();
         }
-        if (sb) {
+        if (sb.engine) {
           try {
-            r.simbody.result = tool.run(*sb);
+            r.simbody.result = tool.run(*sb.engine);
             r.simbody.result.name = osim::kIdStorageName;
             r.simbody.ran = true;
+            if (sb.usedFallback()) {
+              // the same model for both: the core again, with the fallback inertia
+              osim::CoreIdEngine core_fallback(*sb.fallback_model, e.muscles, tool.engineOptions());
+              r.simbody.core_result = tool.run(core_fallback);
+              r.simbody.core_result.name = osim::kIdStorageName;
+              r.simbody.note = describeInertiaFallback(sb);
+            }
           } catch (const std::exception& ex) {
             // an engine that fails where the core succeeds is a disagreement
             r.simbody.failed = true;
@@ -300,8 +308,8 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
     co.tolerance = {options.engine_abs, options.engine_rel, options.engine_abs, options.engine_rel};
     co.align.grid_table = 0;
     co.missing_columns_fail = true;
-    r.simbody.comparison = compareTables("core_mass_vs_simbody_mass", r.torques.back(), "core_mass",
-                                         r.simbody.result, "simbody_mass", co);
+    r.simbody.comparison = compareTables("core_mass_vs_simbody_mass", r.simbody.coreTorques(r.torques.back()),
+                                         "core_mass", r.simbody.result, "simbody_mass", co);
   }
   r.analysis = analyzeMassSweep(r.options.values, tau, zero_mass.data, options.zero_tolerance);
   for (size_t c = 0; c < r.analysis.columns.size(); ++c) r.analysis.columns[c].name = labels[c];
@@ -397,7 +405,8 @@ void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_ma
     report.addPlot("mass_sweep_peak_change", change, "peak change and largest change against the swept muscle mass");
 
   // Simbody with muscle inertia at the largest value: engines agree to round-off
-  if (r.simbody.ran) addSimbodyMassCheck(r.simbody.comparison, r.torques.back(), r.simbody.result, report);
+  if (r.simbody.ran)
+    addSimbodyMassCheck(r.simbody.comparison, r.simbody.coreTorques(r.torques.back()), r.simbody.result, report);
 
   // the zero check: the only sweep result that can fail
   if (an.zero_index >= 0)
@@ -446,6 +455,7 @@ void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_ma
   sbj["ran"] = r.simbody.ran;
   if (!r.simbody.ran) sbj["skipped"] = r.simbody.skipped.empty() ? "not requested" : r.simbody.skipped;
   sbj["value"] = r.simbody.value;
+  if (!r.simbody.note.empty()) sbj["inertia_fallback"] = r.simbody.note;
   js["simbody_check"] = sbj;
   JsonValue zc = JsonValue::object();
   zc["present"] = an.zero_index >= 0;

@@ -147,6 +147,14 @@ struct MassSweepSimbodyCheck {
   double value = 0;
   osim::Storage result;
   Comparison comparison;   ///< core_mass_vs_simbody_mass (when it ran)
+  /// when Simbody needed OpenSim's fallback inertia (validation/simbody_cross_check.hpp): the core
+  /// on that same model at this value, and the note that says so; empty otherwise
+  osim::Storage core_result;
+  std::string note;
+  /// the core torques this check compares with: core_result, or the sweep's own at this value
+  const osim::Storage& coreTorques(const osim::Storage& sweep_value) const {
+    return core_result.numRows() > 0 ? core_result : sweep_value;
+  }
 };
 
 struct MassSweepResult {
