@@ -81,7 +81,9 @@ TEST_F(WrapFlagsCli, EveryWrapValueIsAcceptedAndTheSummarySaysWhoCarriesMass) {
     EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.flags << "\n" << r.err;
     const bool lumped = c.flags == "--wrap lumped";
     EXPECT_EQ(r.out.find("(0 kg in mass points)") != std::string::npos, lumped) << c.flags << "\n" << r.out;
-    if (lumped) EXPECT_NE(r.err.find("wrap_muscle: Type III path (wrap mass off: --wrap lumped)"), std::string::npos) << r.err;
+    if (lumped) {
+      EXPECT_NE(r.err.find("wrap_muscle: Type III path (wrap mass off: --wrap lumped)"), std::string::npos) << r.err;
+    }
   }
 }
 

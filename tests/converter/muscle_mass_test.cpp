@@ -247,7 +247,9 @@ TEST(MuscleMass, TransferScalesTheBodyAndSplitsByPhysiologicalMass) {
   EXPECT_LE((b1.inertiaMatrix() - 0.6 * b0.inertiaMatrix()).norm(), 1e-15 * b0.inertiaMatrix().norm());
   // other bodies untouched
   for (size_t k = 0; k < d.bodies.size(); ++k)
-    if (static_cast<int>(k) != ti) EXPECT_EQ(r.description.bodies[k].mass, d.bodies[k].mass);
+    if (static_cast<int>(k) != ti) {
+      EXPECT_EQ(r.description.bodies[k].mass, d.bodies[k].mass);
+    }
   ASSERT_EQ(r.plan.bodies.size(), 1u);
   EXPECT_EQ(r.plan.bodies[0].name, "tibia_r");
 

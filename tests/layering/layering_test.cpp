@@ -91,15 +91,20 @@ TEST(Layering, IncludesPointDownOnly) {
       ++checked;
       const std::string where = inc.file + ":" + std::to_string(inc.line) + " includes " + inc.target;
       const std::string l = layerOf(inc.target);
-      if (!l.empty()) EXPECT_TRUE(ok.count(l)) << where << " (upward or sideways dependency)";
-      if (inc.target.rfind("tinyxml2", 0) == 0)
+      if (!l.empty()) {
+        EXPECT_TRUE(ok.count(l)) << where << " (upward or sideways dependency)";
+      }
+      if (inc.target.rfind("tinyxml2", 0) == 0) {
         EXPECT_EQ(dir, "converter") << where << " (tinyxml2 belongs to converter/ only)";
-      if (isSimbody(inc.target))
+      }
+      if (isSimbody(inc.target)) {
         EXPECT_TRUE(dir == "plugin" || dir == "validation") << where << " (Simbody outside plugin/validation)";
-      if (isSundials(inc.target))
+      }
+      if (isSundials(inc.target)) {
         EXPECT_TRUE(dir == "core/integrators" && inc.file.size() > 4 &&
                     inc.file.substr(inc.file.size() - 4) == ".cpp")
             << where << " (SUNDIALS only in core/integrators/*.cpp)";
+      }
     }
   }
   EXPECT_GT(checked, 20) << "the scan found almost no includes: wrong source root?";

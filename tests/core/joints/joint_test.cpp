@@ -141,8 +141,9 @@ TYPED_TEST(JointFd, ReparameterizeKeepsRotationAndTwist) {
     }
   }
   // the exponential-coordinate joints must actually have been exercised
-  if constexpr (std::is_same_v<TypeParam, SphericalExp> || std::is_same_v<TypeParam, Free3D>)
+  if constexpr (std::is_same_v<TypeParam, SphericalExp> || std::is_same_v<TypeParam, Free3D>) {
     EXPECT_GT(fired, 0);
+  }
 }
 
 TEST(Joint, SingularityDistance) {

@@ -90,7 +90,9 @@ TEST_F(Se3Test, ExpLogSO3RoundTripIncludingNearZeroAndNearPi) {
       const Vec3 w2 = logSO3(R);
       // at exactly pi the sign of the axis is ambiguous: compare rotations
       EXPECT_TRUE(nearRel(expSO3(w2), R, 1e-12)) << "angle " << th;
-      if (th < M_PI - 1e-6) EXPECT_TRUE(nearRel(w2, w, 1e-9)) << "angle " << th;
+      if (th < M_PI - 1e-6) {
+        EXPECT_TRUE(nearRel(w2, w, 1e-9)) << "angle " << th;
+      }
     }
   }
 }
