@@ -1062,44 +1062,4 @@ SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1
   return out;
 }
 
-void calcNetworkWrapPoints(const Mlp* net, const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
-                           const Vec3& p2dot, const std::vector<double>& alphas, WrapMassPoints& out, MlpWorkspace& ws,
-                           const SmoothWrapOptions& fallback) {
-  if (surface.type != WrapType::Cylinder && surface.type != WrapType::Sphere)
-    throw std::invalid_argument("network wrap: cylinder and sphere networks only");
-  if (net && (net->inputs() != 8 || net->outputs() != 3)) throw std::invalid_argument("network wrap: the network must map 8 inputs to 3 outputs");
-  if (!(surface.radius > 0.0)) throw std::invalid_argument("network wrap: the radius must be positive");
-  const int n = static_cast<int>(alphas.size());
-  out.x.resize(n);
-  out.J.resize(n);
-  out.Jdot.resize(n);
-  // scaled inputs: end points in radii, radius 1
-  const double c = 1.0 / surface.radius;
-  MatX X(8, n), Xdot = MatX::Zero(8, n);
-  bool inside = net != nullptr;
-  for (int k = 0; k < n && inside; ++k) {
-    X.col(k) << c * p1, c * p2, alphas[k], 1.0;
-    Xdot.col(k) << c * p1dot, c * p2dot, 0.0, 0.0;
-    inside = net->insideBox(X.col(k));
-  }
-  out.used_network = inside;
-  if (inside) {
-    MatX Y, J, Jdot;
-    net->calcJacobianDot(X, Xdot, Y, J, Jdot, ws);
-    for (int k = 0; k < n; ++k) {
-      out.x[k] = surface.radius * Y.col(k);
-      // x = R y(c p): dx/dp = R J_y c = J_y, and its time derivative is Jdot_y along c pdot
-      out.J[k] = J.block<3, 6>(0, 8 * k);
-      out.Jdot[k] = Jdot.block<3, 6>(0, 8 * k);
-    }
-    return;
-  }
-  for (int k = 0; k < n; ++k) {
-    const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(surface, p1, p2, alphas[k], p1dot, p2dot, fallback);
-    out.x[k] = sp.x;
-    out.J[k] = sp.J;
-    out.Jdot[k] = sp.Jdot;
-  }
-}
-
 }  // namespace redmax

@@ -74,7 +74,6 @@
 #include <string>
 #include <vector>
 
-#include "core/muscles/wrap/network.hpp"
 #include "core/muscles/wrap/wrap_surface.hpp"
 
 namespace redmax {
@@ -135,22 +134,12 @@ SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1
                                       const Vec3& p2dot, const SmoothWrapOptions& options = {});
 
 /// A muscle's mass points over one surface (frame s), with J = dx/d(p1, p2) and Jdot along
-/// (p1dot, p2dot) for each; which model produced them.
+/// (p1dot, p2dot) for each; which model produced them (the network's: calcNetworkWrapModel,
+/// core/muscles/wrap/network_model.hpp).
 struct WrapMassPoints {
   std::vector<Vec3> x;
   std::vector<Eigen::Matrix<double, 3, 6>> J, Jdot;
   bool used_network = false;  ///< false: the inputs left the network's training box (or no network)
 };
-
-/// The network's mass points at fractions alphas [D Eq. 5.38, 5.44], one batch for the muscle, with
-/// exact Jdot. Inputs are scaled by 1 / radius before the network and positions back by radius
-/// (wrapping is scale-equivariant; networks are trained in units of the surface size, so the
-/// radius input is 1): J is scale-free, Jdot is evaluated along the scaled velocities. When the
-/// scaled input leaves the network's training box, or net is null, the smooth model gives the points
-/// instead (used_network false; callers warn and count, issue 7). Cylinder and sphere networks only
-/// (8 inputs: origin, insertion, alpha, radius); std::invalid_argument otherwise.
-void calcNetworkWrapPoints(const Mlp* net, const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
-                           const Vec3& p2dot, const std::vector<double>& alphas, WrapMassPoints& out, MlpWorkspace& ws,
-                           const SmoothWrapOptions& fallback = {});
 
 }  // namespace redmax

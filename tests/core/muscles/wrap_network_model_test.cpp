@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/muscles/wrap/network_model.hpp"
+#include "core/muscles/wrap/train.hpp"
 #include "core/muscles/wrap_muscle.hpp"
 #include "core/spatial/se3.hpp"
 #include "tests/core/muscles/muscle_test_util.hpp"
@@ -120,6 +121,30 @@ TEST(NetworkWrapModel, JacobiansMatchCentralDifferencesCylinder) {
 TEST(NetworkWrapModel, JacobiansMatchCentralDifferencesSphere) {
   const auto net = committedNet("sphere_3x64.txt");
   checkModelAgainstFd(*net, WrapSurface::makeSphere(0.03), 2.8, 5);
+}
+
+// the network is trained in units of the surface size: a surface of radius R gets R y(p1 / R,
+// p2 / R, alpha, 1) (positions back in metres)
+TEST(NetworkWrapModel, PositionsAreTheNetworkAtTheSurfaceScale) {
+  const WrapSurface s = WrapSurface::makeCylinder(0.08, 8.0);  // metres, like the pendulum's
+  Mlp net(8, {10, 10}, 3, 4);
+  const WrapInputBox box = makeDefaultWrapBox(WrapType::Cylinder);
+  net.input_min = box.lo;
+  net.input_max = box.hi;
+  const std::vector<double> alphas{0.1, 0.35, 0.6, 0.9};
+  const Vec3 p1(-0.15, 0.12, 0.01), p2(0.11, -0.14, 0.05), v1(0.3, -0.2, 0.1), v2(-0.1, 0.4, 0.2);
+  NetworkWrapWorkspace ws;
+  WrapMassPoints mp;
+  const NetworkWrapEval ev = calcNetworkWrapModel(&net, s, p1, p2, v1, v2, alphas, true, mp, ws);
+  ASSERT_TRUE(ev.usedNetwork()) << ev.describe(&net);
+  MlpWorkspace mws;
+  for (size_t k = 0; k < alphas.size(); ++k) {
+    VecX u(8);
+    u << p1 / 0.08, p2 / 0.08, alphas[k], 1.0;
+    MatX y;
+    net.calcOutput(u, y, mws);
+    EXPECT_LE((mp.x[k] - 0.08 * Vec3(y.col(0))).norm(), 1e-15) << k;
+  }
 }
 
 TEST(NetworkWrapModel, LoadingAndDefaultNetworks) {
