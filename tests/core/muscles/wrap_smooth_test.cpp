@@ -6,6 +6,7 @@
 #include <random>
 
 #include "core/muscles/wrap/smooth.hpp"
+#include "tests/core/muscles/wrap_smooth_fd.hpp"
 
 namespace redmax {
 namespace {
@@ -68,26 +69,14 @@ TEST(WrapSmooth, JacobianAndJdotMatchCentralDifferences) {
       const double d = calcWrapPenetration(s, p1, p2);
       if (d < -0.1) continue;  // mostly wrapped and band cases
       const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(s, p1, p2, alpha, v1, v2, opt);
-      const double h = 1e-5;
-      Eigen::Matrix<double, 3, 6> fd;
-      for (int i = 0; i < 6; ++i) {
-        Vec3 a1 = p1, a2 = p2, b1 = p1, b2 = p2;
-        (i < 3 ? a1 : a2)[i % 3] += h;
-        (i < 3 ? b1 : b2)[i % 3] -= h;
-        fd.col(i) = (calcSmoothWrapPoint(s, a1, a2, alpha, opt) - calcSmoothWrapPoint(s, b1, b2, alpha, opt)) / (2 * h);
-      }
-      const auto Jp = calcSmoothWrapPointDerivatives(s, p1 + h * v1, p2 + h * v2, alpha, v1, v2, opt).J;
-      const auto Jm = calcSmoothWrapPointDerivatives(s, p1 - h * v1, p2 - h * v2, alpha, v1, v2, opt).J;
-      const Eigen::Matrix<double, 3, 6> fd_dot = (Jp - Jm) / (2 * h);
       // a stencil that straddles a piece boundary of the path (the mass point crossing a tangent
       // point) is not a test of the derivatives: skip the rare sample whose FD is not smooth there
-      const auto Jp2 = calcSmoothWrapPointDerivatives(s, p1 + 2 * h * v1, p2 + 2 * h * v2, alpha, v1, v2, opt).J;
-      const auto Jm2 = calcSmoothWrapPointDerivatives(s, p1 - 2 * h * v1, p2 - 2 * h * v2, alpha, v1, v2, opt).J;
-      if (!nearRel((Jp2 - Jm2) / (4 * h), fd_dot, 1e-4)) continue;
+      const test::SmoothWrapFd fd = test::calcSmoothWrapFd(s, p1, p2, alpha, v1, v2, opt, 1e-5, 1e-4);
+      if (!fd.converged) continue;
       ++tested;
       if (sp.weight > 0.0 && sp.weight < 1.0) ++in_band;
-      EXPECT_TRUE(nearRel(sp.J, fd, 1e-6)) << "type " << int(s.type) << " w " << sp.weight << "\n" << sp.J << "\n" << fd;
-      EXPECT_TRUE(nearRel(sp.Jdot, fd_dot, 1e-6)) << "type " << int(s.type) << " w " << sp.weight << "\n" << sp.Jdot << "\n" << fd_dot;
+      EXPECT_TRUE(nearRel(sp.J, fd.J, 1e-6)) << "type " << int(s.type) << " w " << sp.weight << "\n" << sp.J << "\n" << fd.J;
+      EXPECT_TRUE(nearRel(sp.Jdot, fd.Jdot, 1e-6)) << "type " << int(s.type) << " w " << sp.weight << "\n" << sp.Jdot << "\n" << fd.Jdot;
     }
     EXPECT_GE(tested, 150) << "type " << int(s.type);
     EXPECT_GE(in_band, 20) << "type " << int(s.type);

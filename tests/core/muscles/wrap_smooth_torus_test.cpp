@@ -7,6 +7,7 @@
 #include <random>
 
 #include "core/muscles/wrap/smooth.hpp"
+#include "tests/core/muscles/wrap_smooth_fd.hpp"
 
 namespace redmax {
 namespace {
@@ -67,30 +68,15 @@ TEST(WrapSmoothTorus, JacobianAndJdotMatchCentralDifferences) {
       const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(s, p1, p2, alpha, v1, v2, opt);
       if (sp.weight == 0.0 && k % 4 != 0) continue;  // mostly wrapped and band cases
       // a small step: the construction's third derivatives are large here (the differences'
-      // truncation error falls as h^2 down to 1e-8 at this step, measured)
-      const double h = 1e-6;
-      Eigen::Matrix<double, 3, 6> fd;
-      for (int i = 0; i < 6; ++i) {
-        Vec3 a1 = p1, a2 = p2, b1 = p1, b2 = p2;
-        (i < 3 ? a1 : a2)[i % 3] += h;
-        (i < 3 ? b1 : b2)[i % 3] -= h;
-        fd.col(i) = (calcSmoothWrapPoint(s, a1, a2, alpha, opt) - calcSmoothWrapPoint(s, b1, b2, alpha, opt)) / (2 * h);
-      }
-      const auto Jp = calcSmoothWrapPointDerivatives(s, p1 + h * v1, p2 + h * v2, alpha, v1, v2, opt).J;
-      const auto Jm = calcSmoothWrapPointDerivatives(s, p1 - h * v1, p2 - h * v2, alpha, v1, v2, opt).J;
-      const Eigen::Matrix<double, 3, 6> fd_dot = (Jp - Jm) / (2 * h);
-      // skip the stencil whose differences have not converged to the tolerance (their error
-      // falls as h^2, so FD(2h) - FD(h) is 3 times it): one that straddles a piece boundary (a
-      // mass point crossing a tangent point, the library switching roots or quadrant cases), or
-      // lies next to a singular configuration of the library's search
-      const auto Jp2 = calcSmoothWrapPointDerivatives(s, p1 + 2 * h * v1, p2 + 2 * h * v2, alpha, v1, v2, opt).J;
-      const auto Jm2 = calcSmoothWrapPointDerivatives(s, p1 - 2 * h * v1, p2 - 2 * h * v2, alpha, v1, v2, opt).J;
-      if (!nearRel((Jp2 - Jm2) / (4 * h), fd_dot, 3e-7)) continue;
+      // truncation error falls as h^2 down to 1e-8 at this step, measured); skip a stencil that
+      // straddles a piece boundary or lies next to a singular configuration of the library's search
+      const test::SmoothWrapFd fd = test::calcSmoothWrapFd(s, p1, p2, alpha, v1, v2, opt, 1e-6, 3e-7);
+      if (!fd.converged) continue;
       ++tested;
       if (sp.weight > 0.0 && sp.weight < 1.0) ++in_band;
       if (sp.weight == 1.0) ++wrapped;
-      EXPECT_TRUE(nearRel(sp.J, fd, 1e-6)) << "w " << sp.weight << "\n" << sp.J << "\n" << fd;
-      EXPECT_TRUE(nearRel(sp.Jdot, fd_dot, 1e-6)) << "w " << sp.weight << "\n" << sp.Jdot << "\n" << fd_dot;
+      EXPECT_TRUE(nearRel(sp.J, fd.J, 1e-6)) << "w " << sp.weight << "\n" << sp.J << "\n" << fd.J;
+      EXPECT_TRUE(nearRel(sp.Jdot, fd.Jdot, 1e-6)) << "w " << sp.weight << "\n" << sp.Jdot << "\n" << fd.Jdot;
     }
     EXPECT_GE(tested, 150);
     EXPECT_GE(in_band, 10);
