@@ -15,25 +15,16 @@
 #include <sstream>
 #include <string>
 
+#include "tests/cli/cli_test_util.hpp"
+
 namespace redmax_test {
 
 namespace fs = std::filesystem;
 
-// the redmax executable of the same build: <build>/tests/validation_tests -> <build>/cli/redmax
-inline fs::path redmaxExe() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  const fs::path exe = self.parent_path().parent_path() / "cli" / "redmax";
-  return fs::exists(exe) ? exe : fs::path{};
-}
-
-inline std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+// the redmax executable of the same build, output capture: shared with the CLI tests
+using redmax::cli_test::CmdResult;
+using redmax::cli_test::redmaxExe;
+using redmax::cli_test::slurp;
 
 inline std::string num(double x) {
   std::ostringstream os;
@@ -41,11 +32,6 @@ inline std::string num(double x) {
   os << x;
   return os.str();
 }
-
-struct CmdResult {
-  int code;
-  std::string out, err;
-};
 
 // closed-form torques of the pendulum below (Lagrange; link inertia Izz 0.05 about the COM),
 // for q1 = 0.7 sin(2 pi 0.8 t), q2 = 0.9 sin(2 pi 1.1 t)
@@ -76,13 +62,7 @@ class PendulumCliTest : public ::testing::Test {
     if (!dir_.empty()) fs::remove_all(dir_);
   }
 
-  CmdResult run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = "cd " + dir_.string() + " && " + redmaxExe().string() + " " + args + " >" +
-                            out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-  }
+  CmdResult run(const std::string& args) const { return redmax::cli_test::runRedmax(dir_, args, true); }
   void write(const std::string& name, const std::string& text) const {
     fs::create_directories((dir_ / name).parent_path());
     std::ofstream(dir_ / name) << text;
