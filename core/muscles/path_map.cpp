@@ -1,5 +1,6 @@
 #include "core/muscles/path_map.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "core/muscles/muscle_kinematics.hpp"
@@ -106,6 +107,121 @@ void calcWrapPathMap(const WrapSurface& surface, const WrapMassOptions& wrap, co
     const Vec3 RJpp = R * (wp.J[a].leftCols<3>() * p1ddot + wp.J[a].rightCols<3>() * p2ddot);
     out.bias.segment<3>(3 * a) = omega.cross(omega.cross(Rw)) + 2.0 * omega.cross(RJp) + RJdp + RJpp;
   }
+}
+
+std::string generalPathMapUnsupportedReason(const Muscle& muscle) {
+  const MusclePath& path = muscle.path;
+  if (path.wraps.empty() || muscle.wrap.model != WrapModel::Exact) return "";
+  if (path.points.size() == 2 && path.wraps.size() == 1) return "";
+  return "the exact wrap model on a path other than origin -> one wrap surface -> insertion (this one has " +
+         std::to_string(path.points.size()) + " points and " + std::to_string(path.wraps.size()) +
+         " wrap objects) differentiates OpenSim's whole wrapped path in the coordinates, which a map over "
+         "path points and surface frames cannot do: use the smooth or neural wrap model, or the core";
+}
+
+void calcGeneralPathMap(const Muscle& muscle, const std::vector<int>& active, const std::vector<Vec3>& x,
+                        const std::vector<Vec3>* xdot, const std::vector<SurfaceFrameState>& surfaces,
+                        GeneralPathMap& out) {
+  const MusclePath& path = muscle.path;
+  const int P = static_cast<int>(x.size());
+  const int W = static_cast<int>(path.wraps.size());
+  const bool vel = xdot != nullptr;
+  const std::string& name = muscle.name;
+  if (static_cast<int>(active.size()) != P || static_cast<int>(surfaces.size()) != W)
+    throw std::invalid_argument("calcGeneralPathMap: muscle '" + name + "': " + std::to_string(P) + " points, " +
+                                std::to_string(active.size()) + " active indices, " +
+                                std::to_string(surfaces.size()) + " surface frames for " + std::to_string(W) +
+                                " wrap objects");
+  out.velocity = vel;
+  if (W == 0) {
+    // Types I and II: the point map itself
+    calcPathMap(x, xdot, muscle.mass_points, out.pm, name);
+    out.x_a = out.pm.x_a;
+    out.J = out.pm.J_ax;
+    if (vel) out.bias = out.pm.Jdot_ax_xdot;
+    out.seg_wrap.clear();
+    return;
+  }
+  const std::string why = generalPathMapUnsupportedReason(muscle);
+  if (!why.empty()) throw std::invalid_argument("calcGeneralPathMap: muscle '" + name + "': " + why);
+  if (P < 2) throw std::invalid_argument("calcGeneralPathMap: muscle '" + name + "' needs at least two path points");
+  if (vel && static_cast<int>(xdot->size()) != P)
+    throw std::invalid_argument("calcGeneralPathMap: muscle '" + name + "': " + std::to_string(P) + " points but " +
+                                std::to_string(xdot->size()) + " velocities");
+  if (muscle.mass_points.size() == 0)
+    throw std::invalid_argument("calcGeneralPathMap: muscle '" + name + "' has no mass points");
+
+  // origin -> one active surface -> insertion: the dissertation's map, the same numbers (to
+  // round-off) at less cost
+  if (P == 2 && W == 1 && path.points.size() == 2 && path.wraps[0].surface.active) {
+    const SurfaceFrameState& f = surfaces[0];
+    WrapSegmentVelocity v;
+    if (vel) v = WrapSegmentVelocity{(*xdot)[0], (*xdot)[1], f.omega, f.pdot};
+    calcWrapPathMap(path.wraps[0].surface, muscle.wrap, muscle.mass_points, x[0], x[1], f.R, f.p, vel ? &v : nullptr,
+                    out.wmap, name);
+    out.x_a = out.wmap.x_a;
+    out.J = out.wmap.J;
+    if (vel) out.bias = out.wmap.bias;
+    out.seg_wrap.assign(1, 0);
+    return;
+  }
+
+  // the path stage in v's coordinates: J_xr = (I 0), Jdot_xr = 0
+  const int k = 3 * P + 6 * W;
+  MuscleKinematics& mk = out.mk;
+  if (static_cast<int>(mk.cols.size()) != k || mk.J_xr.rows() != 3 * P) {
+    mk.cols.resize(k);
+    for (int c = 0; c < k; ++c) mk.cols[c] = c;
+    mk.col_of = mk.cols;
+    mk.J_xr.setZero(3 * P, k);
+    mk.J_xr.leftCols(3 * P).setIdentity();
+    mk.Jdot_xr.setZero(3 * P, k);
+  }
+  mk.active = active;
+  mk.x_w = x;
+  if (vel) mk.xdot_w = *xdot;
+  mk.velocity = vel;
+  calcPathSegments(mk, vel);
+
+  // the wrap choice needs body poses: a frame's body pose E_wb = E_ws E_bs^-1 (world frames: E_bs)
+  int nb = 0;
+  for (const PathWrap& w : path.wraps) nb = std::max(nb, w.body + 1);
+  std::vector<Mat4> E_wi(nb, Mat4::Identity());
+  for (int w = 0; w < W; ++w) {
+    const PathWrap& pw = path.wraps[w];
+    if (pw.body < 0) continue;
+    Mat4 E_ws = Mat4::Identity();
+    E_ws.topLeftCorner<3, 3>() = surfaces[w].R;
+    E_ws.topRightCorner<3, 1>() = surfaces[w].p;
+    E_wi[pw.body] = E_ws * inverseE(pw.E_bs);
+  }
+  out.seg_wrap = calcSegmentWraps(muscle, active, x, E_wi);
+
+  // each surface's motion: its (omega, pdot) columns of v, constant selectors
+  std::vector<WrapSurfaceMotion> sm(W);
+  for (int w = 0; w < W; ++w) {
+    WrapSurfaceMotion& m = sm[w];
+    m.R = surfaces[w].R;
+    m.p = surfaces[w].p;
+    m.J_om.setZero(3, k);
+    m.J_p.setZero(3, k);
+    m.J_om.middleCols<3>(3 * P + 6 * w).setIdentity();
+    m.J_p.middleCols<3>(3 * P + 6 * w + 3).setIdentity();
+    m.Jdot_om.setZero(3, k);
+    m.Jdot_p.setZero(3, k);
+    if (vel) {
+      m.omega = surfaces[w].omega;
+      m.pdot = surfaces[w].pdot;
+    }
+  }
+  calcWrapMassPointsOnSurfaces(muscle, out.seg_wrap, sm, mk);
+  out.x_a = mk.x_a;
+  out.J = mk.J_ar;
+  if (!vel) return;
+  VecX v(k);
+  v.head(3 * P) = stackPoints(*xdot);
+  for (int w = 0; w < W; ++w) v.segment<6>(3 * P + 6 * w) << surfaces[w].omega, surfaces[w].pdot;
+  out.bias.noalias() = mk.Jdot_ar * v;
 }
 
 }  // namespace redmax

@@ -82,4 +82,55 @@ void calcWrapPathMap(const WrapSurface& surface, const WrapMassOptions& wrap, co
                      const Vec3& x2, const Mat3& R, const Vec3& p, const WrapSegmentVelocity* v, WrapPathMap& out,
                      const std::string& muscle_name = "");
 
+// ---- General path map (Types I, II, III) ------------------------------------------------------
+// Any path the core takes with mass points, as a function of its P active points' world positions
+// and of the poses of its W = path.wraps.size() wrap surface frames (Type I and II: W = 0). The
+// inputs' velocities are v = (xdot_0, ..., xdot_{P-1}, omega_0, pdot_0, ..., omega_{W-1},
+// pdot_{W-1}) (3P + 6W, world; omega_w the frame's angular velocity, pdot_w its origin's velocity):
+//   xdot_a = J v,   xddot_a = J vdot + bias   (vdot: point accelerations, then (alpha_w, pddot_w)).
+// Without wraps it is calcPathMap (J = J_ax, bias = Jdot_ax xdot). With wraps it is the core's
+// segment construction (core/muscles/wrap_muscle.hpp: segments between the active points, the wrap
+// choice of calcSegmentWraps, straight segments by the EOL construction, wrapped ones by the chain
+// rule through the surface, alpha over the whole length) run on a MuscleKinematics whose
+// "coordinates" are v itself: J_xr = (I 0), and for surface w J_om, J_p the selectors of its
+// (omega_w, pdot_w) columns, all with zero time derivative; then J = J_ar and bias = Jdot_ar v.
+// Origin -> one active surface -> insertion goes through calcWrapPathMap, which that construction
+// reduces to (beta = alpha; equal to 1e-13 in tests/plugin/general_path_map_test.cpp).
+// Nothing is re-derived here. The exact wrap model on a path other than origin -> one surface ->
+// insertion differentiates OpenSim's whole path in q, which has no such form: refused.
+
+/// Pose and spatial velocity of one wrap surface frame s (world): an input of calcGeneralPathMap.
+struct SurfaceFrameState {
+  Mat3 R = Mat3::Identity();  ///< R_ws
+  Vec3 p = Vec3::Zero();      ///< p_ws (m)
+  Vec3 omega = Vec3::Zero();  ///< angular velocity (rad/s)
+  Vec3 pdot = Vec3::Zero();   ///< velocity of the frame's origin (m/s)
+};
+
+/// Output (and scratch) of calcGeneralPathMap for one muscle; reuse one per muscle.
+struct GeneralPathMap {
+  std::vector<Vec3> x_a;      ///< mass point positions, world                              (N)
+  MatX J;                     ///< d xdot_a / d v                                (3N x (3P + 6W))
+  VecX bias;                  ///< xddot_a at vdot = 0 (valid with velocity)                (3N)
+  bool velocity = false;      ///< true when bias is valid
+  std::vector<int> seg_wrap;  ///< per segment, the wrap object acting on it or -1 (W > 0)  (P-1)
+  PathMap pm;                 ///< scratch: Types I and II
+  WrapPathMap wmap;           ///< scratch: origin -> one surface -> insertion (calcWrapPathMap)
+  MuscleKinematics mk;        ///< scratch: the segment construction in v's coordinates
+};
+
+/// "" when calcGeneralPathMap takes `muscle` (any path validateMuscle accepts, except the exact
+/// wrap model on a path other than origin -> one surface -> insertion), else why not.
+std::string generalPathMapUnsupportedReason(const Muscle& muscle);
+
+/// Mass points of `muscle` (its path, mass points and wrap options) for its active points `active`
+/// (indices into muscle.path.points, P >= 2) at world positions x (P) with, when xdot is non-null,
+/// velocities xdot (P), and its wrap surface frames `surfaces` (W = muscle.path.wraps.size(): every
+/// wrap object, world; omega, pdot read only with xdot). Throws MuscleError naming the muscle for a
+/// degenerate path, std::invalid_argument for sizes that do not fit or an unsupported muscle
+/// (generalPathMapUnsupportedReason).
+void calcGeneralPathMap(const Muscle& muscle, const std::vector<int>& active, const std::vector<Vec3>& x,
+                        const std::vector<Vec3>* xdot, const std::vector<SurfaceFrameState>& surfaces,
+                        GeneralPathMap& out);
+
 }  // namespace redmax

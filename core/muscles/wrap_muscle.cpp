@@ -72,13 +72,7 @@ bool wrapSegments(const PathWrap& w, const std::vector<int>& active, int np, int
   return first >= 0 && last > first;
 }
 
-// pose and motion of one wrap surface frame, Jacobians in mk's compact columns [D Eq. 5.39-5.41]
-struct SurfaceMotion {
-  Mat3 R = Mat3::Identity();
-  Vec3 p = Vec3::Zero();
-  MatX J_om, J_p, Jdot_om, Jdot_p;
-  Vec3 omega = Vec3::Zero(), pdot = Vec3::Zero();
-};
+using SurfaceMotion = WrapSurfaceMotion;
 
 void calcSurfaceMotion(const Model& model, const SkeletonWorkspace& sk, const PathWrap& w, const MuscleKinematics& mk,
                        bool vel, SurfaceMotion& sm) {
@@ -428,36 +422,45 @@ void sizeMassPointOutputs(int N, int k, MuscleKinematics& mk) {
 // the segment construction of the header (smooth model; exact model with one segment and one wrap)
 void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, const Muscle& muscle,
                                MuscleKinematics& mk) {
+  const MusclePath& path = muscle.path;
+  if (mk.x_w.size() < 2) throw std::logic_error("calcWrapMassPoints: needs the path stage");
+  // which wrap acts on which segment (header): the candidate penetrating most
+  const std::vector<int> seg_wrap = calcSegmentWraps(muscle, mk.active, mk.x_w, sk.E_wi);
+  // the surfaces' motion from the skeleton, for the wraps that act
+  std::vector<SurfaceMotion> sm(path.wraps.size());
+  std::vector<char> have_sm(path.wraps.size(), 0);
+  for (int w : seg_wrap) {
+    if (w < 0 || have_sm[w]) continue;
+    if (!coversBody(model, mk, path.wraps[w].body))
+      throw std::logic_error("calcWrapMassPoints: mk's columns do not cover the wrap body (initWrapMuscleColumns)");
+    calcSurfaceMotion(model, sk, path.wraps[w], mk, mk.velocity, sm[w]);
+    have_sm[w] = 1;
+  }
+  calcWrapMassPointsOnSurfaces(muscle, seg_wrap, sm, mk);
+}
+
+}  // namespace
+
+void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& seg_wrap,
+                                  const std::vector<WrapSurfaceMotion>& surfaces, MuscleKinematics& mk) {
   const MassPoints& mp = muscle.mass_points;
   const MusclePath& path = muscle.path;
   const int N = mp.size();
   const int k = static_cast<int>(mk.cols.size());
   const int P = static_cast<int>(mk.x_w.size());
   const int nseg = P - 1;
-  const int nw = static_cast<int>(path.wraps.size());
   const bool vel = mk.velocity;
   if (P < 2) throw std::logic_error("calcWrapMassPoints: needs the path stage");
+  if (static_cast<int>(seg_wrap.size()) != nseg || surfaces.size() != path.wraps.size())
+    throw std::invalid_argument("calcWrapMassPointsOnSurfaces: muscle '" + muscle.name + "': " +
+                                std::to_string(seg_wrap.size()) + " segment wraps for " + std::to_string(nseg) +
+                                " segments, " + std::to_string(surfaces.size()) + " surfaces for " +
+                                std::to_string(path.wraps.size()) + " wrap objects");
   const std::string who = "muscle '" + muscle.name + "'";
-
-  // which wrap acts on which segment (header): the candidate penetrating most
-  const std::vector<int> seg_wrap = calcSegmentWraps(muscle, mk.active, mk.x_w, sk.E_wi);
-  std::vector<SurfaceMotion> sm(nw);
-  std::vector<char> have_sm(nw, 0);
-  auto motion = [&](int w) -> const SurfaceMotion& {
-    if (!have_sm[w]) {
-      calcSurfaceMotion(model, sk, path.wraps[w], mk, vel, sm[w]);
-      have_sm[w] = 1;
-    }
-    return sm[w];
-  };
+  auto motion = [&](int w) -> const SurfaceMotion& { return surfaces[w]; };
   std::vector<SegmentEnds> ends(nseg);
   for (int i = 0; i < nseg; ++i)
-    if (seg_wrap[i] >= 0) {
-      const int w = seg_wrap[i];
-      if (!coversBody(model, mk, path.wraps[w].body))
-        throw std::logic_error("calcWrapMassPoints: mk's columns do not cover the wrap body (initWrapMuscleColumns)");
-      calcSegmentEnds(motion(w), mk, i, vel, ends[i]);
-    }
+    if (seg_wrap[i] >= 0) calcSegmentEnds(motion(seg_wrap[i]), mk, i, vel, ends[i]);
 
   // Eulerian coordinates s_i = S_i / sum L over the segment lengths (header); one segment: (0, 1)
   mk.s.setZero(P);
@@ -625,6 +628,8 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
     }
   }
 }
+
+namespace {
 
 // the exact model on any path: OpenSim's whole wrapped path, J and Jdot by differences in q (header)
 void calcExactPathMassPointsFd(const Model& model, const State& state, const Muscle& muscle, MuscleKinematics& mk) {

@@ -124,6 +124,27 @@ SmoothWrapLength calcWrapModelLength(const WrapMassOptions& options, const WrapS
 std::vector<int> calcSegmentWraps(const Muscle& muscle, const std::vector<int>& active, const std::vector<Vec3>& x_w,
                                   const std::vector<Mat4>& E_wi);
 
+/// Pose and motion of one wrap surface frame s (world): R = R_ws, p = p_ws (m), its angular
+/// velocity omega (rad/s) and origin velocity pdot (m/s), with J_om = d omega / d qdot and J_p =
+/// d pdot / d qdot in mk's compact columns (3 x k each) and their time derivatives [D Eq. 5.39-5.41].
+struct WrapSurfaceMotion {
+  Mat3 R = Mat3::Identity();
+  Vec3 p = Vec3::Zero();
+  MatX J_om, J_p, Jdot_om, Jdot_p;
+  Vec3 omega = Vec3::Zero(), pdot = Vec3::Zero();
+};
+
+/// The segment construction of the header on surfaces whose motion is given instead of taken from
+/// the skeleton: seg_wrap from calcSegmentWraps (one entry per segment), surfaces[w] for each wrap
+/// object w of muscle.path.wraps (only those named in seg_wrap are read), mk after the path stage
+/// (x_w, J_xr, l, dxbar, active; with mk.velocity xdot_w, Jdot_xr) with its columns. Fills what
+/// calcWrapMassPoints fills; it is that function's route for the smooth and neural models and for
+/// origin -> surface -> insertion, open to an engine that moves the surfaces itself
+/// (core/muscles/path_map.hpp's calcGeneralPathMap). Throws as calcWrapMassPoints,
+/// std::invalid_argument for sizes that do not fit.
+void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& seg_wrap,
+                                  const std::vector<WrapSurfaceMotion>& surfaces, MuscleKinematics& mk);
+
 /// The exact library's points at fractions alphas over one surface (frame s), with J = dx/d(p1, p2)
 /// by central differences of step h (m; <= 0: 1e-5 times the surface size) and, when
 /// `with_jdot`, Jdot by central differences of J along (p1dot, p2dot) (else zero). calcWrap runs

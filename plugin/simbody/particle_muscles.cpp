@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <map>
-#include <memory>
 
 #include <Eigen/LU>
 
@@ -17,22 +16,25 @@ namespace {
 SimTK::Vec3 toSimTKVec3(const Vec3& v) { return SimTK::Vec3(v.x(), v.y(), v.z()); }
 Vec3 fromSimTKVec3(const SimTK::Vec3& v) { return Vec3(v[0], v[1], v[2]); }
 
-// one muscle's 3N holonomic equations x_p - x_a(x) = 0 (header). A moving point x_b(q_c) in body b
-// reads q_c, qdot_c, qddot_c through its coordinate's mobilizer (a constrained mobilizer):
+// one muscle's 3N holonomic equations x_p - x_a(x, surfaces) = 0 (header). A moving point x_b(q_c)
+// in body b reads q_c, qdot_c, qddot_c through its coordinate's mobilizer (a constrained mobilizer):
 //   x = X_AB x_b,  xdot = v_station + R x_b' qdot_c,
 //   xddot = a_station + 2 w x (R x_b' qdot_c) + R (x_b'' qdot_c^2 + x_b' qddot_c),
-// and its constraint force gets the q-force (R x_b')^T F on q_c.
+// and its constraint force gets the q-force (R x_b')^T F on q_c. Each wrap object's surface frame
+// is a frame X_bs on a constrained body; the map is calcGeneralPathMap (core/muscles/path_map.hpp)
+// over v = (xdot, (omega_w, pdot_w) per wrap).
 class PathConstraint : public SimTK::Constraint::Custom::Implementation {
  public:
   // point_bodies: per path point; coord_mobods: per path point, the mobilizer of a moving point's
-  // coordinate (or null) and the coordinate's index within it
-  // surface_body: a Type III muscle's wrap surface body (Ground for a world surface), else null
+  // coordinate (or null) and the coordinate's index within it; surface_bodies: per wrap object of
+  // the path, the body carrying its frame (Ground for a world surface)
   PathConstraint(SimTK::SimbodyMatterSubsystem& matter, const Muscle& mu,
                  const std::vector<SimTK::MobilizedBody>& point_bodies,
                  const std::vector<const SimTK::MobilizedBody*>& coord_mobods, const std::vector<int>& coord_in_mobod,
-                 const std::vector<SimTK::MobilizedBody>& particles, const SimTK::MobilizedBody* surface_body)
-      : Implementation(matter, 3 * mu.mass_points.size(), 0, 0),
-        points_(mu.path.points), mp_(mu.mass_points), name_(mu.name), wrap_opt_(mu.wrap) {
+                 const std::vector<SimTK::MobilizedBody>& particles,
+                 const std::vector<SimTK::MobilizedBody>& surface_bodies)
+      : Implementation(matter, 3 * mu.mass_points.size(), 0, 0), mu_(mu), points_(mu.path.points),
+        mp_(mu.mass_points) {
     // a body (mobilizer) carrying several points (coordinates) is constrained once
     std::map<int, SimTK::ConstrainedBodyIndex> cb_of;
     std::map<int, SimTK::ConstrainedMobilizerIndex> cm_of;
@@ -51,15 +53,12 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       cm_[i] = jt->second;
       mq_[i] = SimTK::MobilizerQIndex(coord_in_mobod[i]);
     }
-    if (surface_body) {
-      const PathWrap& w = mu.path.wraps.at(0);
-      wrap_ = true;
-      surface_ = w.surface;
-      X_bs_ = toTransform(w.E_bs);
-      const int b = surface_body->getMobilizedBodyIndex();
+    for (size_t w = 0; w < surface_bodies.size(); ++w) {
+      const int b = surface_bodies[w].getMobilizedBodyIndex();
       auto it = cb_of.find(b);
-      if (it == cb_of.end()) it = cb_of.emplace(b, addConstrainedBody(*surface_body)).first;
-      surface_cb_ = it->second;
+      if (it == cb_of.end()) it = cb_of.emplace(b, addConstrainedBody(surface_bodies[w])).first;
+      surface_cb_.push_back(it->second);
+      X_bs_.push_back(toTransform(mu.path.wraps.at(w).E_bs));
     }
     for (const SimTK::MobilizedBody& p : particles) particle_cb_.push_back(addConstrainedBody(p));
     x_.resize(P);
@@ -67,6 +66,9 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
     x_b_.resize(P);
     dx_b_.resize(P);
     ddx_b_.resize(P);
+    active_.resize(P);
+    for (int i = 0; i < P; ++i) active_[i] = i;  // conditional points are refused: all active
+    frames_.resize(surface_cb_.size());
   }
 
   Implementation* clone() const override { return new PathConstraint(*this); }
@@ -78,10 +80,11 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       locate(i, moving(i) ? getOneQ(s, cq, cm_[i], mq_[i]) : 0.0);
       x_[i] = fromSimTKVec3(findStationLocation(X_AB, point_cb_[i], toSimTKVec3(x_b_[i])));
     }
-    const std::vector<Vec3>& x_a = mapPositions(wrap_ ? X_AB[surface_cb_] : SimTK::Transform());
+    for (size_t w = 0; w < frames_.size(); ++w) setPose(w, X_AB[surface_cb_[w]]);
+    calcGeneralPathMap(mu_, active_, x_, nullptr, frames_, map_);
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& p = X_AB[particle_cb_[a]].p();
-      for (int k = 0; k < 3; ++k) perr[3 * a + k] = p[k] - x_a[a][k];
+      for (int k = 0; k < 3; ++k) perr[3 * a + k] = p[k] - map_.x_a[a][k];
     }
   }
 
@@ -97,18 +100,14 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
         v += getBodyRotationFromState(s, point_cb_[i]) * toSimTKVec3(dx_b_[i]) * getOneQDot(s, cqdot, cm_[i], mq_[i]);
       xdot_[i] = fromSimTKVec3(v);
     }
-    // xdot_a = J_ax xdot [D Eq. 5.4]; Type III: J (xdot, omega, pdot) (path_map.hpp)
-    VecX xdot_a;
-    if (!wrap_) {
-      calcPathMap(x_, nullptr, mp_, map_, name_);
-      xdot_a = map_.J_ax * stackPoints(xdot_);
-    } else {
-      mapPositions(getBodyTransformFromState(s, surface_cb_));
-      VecX v(12);
-      v << stackPoints(xdot_), fromSimTKVec3(getBodyAngularVelocity(V_AB, surface_cb_)),
-          fromSimTKVec3(findStationVelocity(s, V_AB, surface_cb_, X_bs_.p()));
-      xdot_a = wmap_.J * v;
+    // xdot_a = J v [D Eq. 5.4], v = (xdot, (omega_w, pdot_w) per wrap) (path_map.hpp)
+    for (size_t w = 0; w < frames_.size(); ++w) {
+      setPose(w, getBodyTransformFromState(s, surface_cb_[w]));
+      frames_[w].omega = fromSimTKVec3(getBodyAngularVelocity(V_AB, surface_cb_[w]));
+      frames_[w].pdot = fromSimTKVec3(findStationVelocity(s, V_AB, surface_cb_[w], X_bs_[w].p()));
     }
+    calcGeneralPathMap(mu_, active_, x_, nullptr, frames_, map_);
+    const VecX xdot_a = map_.J * stackVelocities();
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& v = V_AB[particle_cb_[a]][1];
       for (int k = 0; k < 3; ++k) pverr[3 * a + k] = v[k] - xdot_a[3 * a + k];
@@ -118,8 +117,9 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   void calcPositionDotDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& A_AB,
                                 const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& cqddot,
                                 SimTK::Array_<SimTK::Real>& paerr) const override {
-    VecX xddot(3 * static_cast<int>(x_.size()));
-    for (size_t i = 0; i < x_.size(); ++i) {
+    const int P = static_cast<int>(x_.size()), W = static_cast<int>(frames_.size());
+    VecX vdot(3 * P + 6 * W);
+    for (int i = 0; i < P; ++i) {
       locate(i, moving(i) ? getOneQFromState(s, cm_[i], mq_[i]) : 0.0);
       const SimTK::Vec3 station = toSimTKVec3(x_b_[i]);
       x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station));
@@ -135,27 +135,19 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
                R * toSimTKVec3(ddx_b_[i] * qd * qd + dx_b_[i] * qdd);
       }
       xdot_[i] = fromSimTKVec3(v);
-      xddot.segment<3>(3 * static_cast<int>(i)) = fromSimTKVec3(acc);
+      vdot.segment<3>(3 * i) = fromSimTKVec3(acc);
     }
-    // a_a = J_ax xddot + Jdot_ax xdot [D Eq. 5.5]; Type III: J vdot + b (path_map.hpp)
-    VecX a_a;
-    if (!wrap_) {
-      calcPathMap(x_, &xdot_, mp_, map_, name_);
-      a_a = calcMassPointAccelerations(map_, xddot);
-    } else {
-      WrapSegmentVelocity v;
-      v.xdot1 = xdot_[0];
-      v.xdot2 = xdot_[1];
-      v.omega = fromSimTKVec3(getBodyAngularVelocityFromState(s, surface_cb_));
-      v.pdot = fromSimTKVec3(findStationVelocityFromState(s, surface_cb_, X_bs_.p()));
-      const SimTK::Transform X_AS = getBodyTransformFromState(s, surface_cb_) * X_bs_;
-      calcWrapPathMap(surface_, wrap_opt_, mp_, x_[0], x_[1], toMat3(X_AS.R()), fromSimTKVec3(X_AS.p()), &v, wmap_,
-                      name_);
-      VecX vdot(12);
-      vdot << xddot, fromSimTKVec3(getBodyAngularAcceleration(A_AB, surface_cb_)),
-          fromSimTKVec3(findStationAcceleration(s, A_AB, surface_cb_, X_bs_.p()));
-      a_a = wmap_.J * vdot + wmap_.bias;
+    // a_a = J vdot + bias [D Eq. 5.5], vdot = (xddot, (alpha_w, pddot_w) per wrap) (path_map.hpp)
+    for (int w = 0; w < W; ++w) {
+      const SimTK::ConstrainedBodyIndex cb = surface_cb_[w];
+      setPose(w, getBodyTransformFromState(s, cb));
+      frames_[w].omega = fromSimTKVec3(getBodyAngularVelocityFromState(s, cb));
+      frames_[w].pdot = fromSimTKVec3(findStationVelocityFromState(s, cb, X_bs_[w].p()));
+      vdot.segment<6>(3 * P + 6 * w) << fromSimTKVec3(getBodyAngularAcceleration(A_AB, cb)),
+          fromSimTKVec3(findStationAcceleration(s, A_AB, cb, X_bs_[w].p()));
     }
+    calcGeneralPathMap(mu_, active_, x_, &xdot_, frames_, map_);
+    const VecX a_a = map_.J * vdot + map_.bias;
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& acc = A_AB[particle_cb_[a]][1];
       for (int k = 0; k < 3; ++k) paerr[3 * a + k] = acc[k] - a_a[3 * a + k];
@@ -165,29 +157,27 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   void addInPositionConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& lambda,
                                      SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& bodyForcesInA,
                                      SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qForces) const override {
-    for (size_t i = 0; i < x_.size(); ++i) {
+    const int P = static_cast<int>(x_.size());
+    for (int i = 0; i < P; ++i) {
       locate(i, moving(i) ? getOneQFromState(s, cm_[i], mq_[i]) : 0.0);
       x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], toSimTKVec3(x_b_[i])));
     }
-    // G^T lambda with G = (I on the particles, -J_ax on the path points); Type III: -J on
-    // (xdot, omega, pdot), the last six a torque and a force at the surface origin
+    for (size_t w = 0; w < frames_.size(); ++w) setPose(w, getBodyTransformFromState(s, surface_cb_[w]));
+    calcGeneralPathMap(mu_, active_, x_, nullptr, frames_, map_);
+    // G^T lambda with G = (I on the particles, -J on v): forces at the path points and, per wrap,
+    // a torque and a force at its surface origin
     VecX l(3 * mp_.size());
     for (int r = 0; r < l.size(); ++r) l[r] = lambda[r];
     for (int a = 0; a < mp_.size(); ++a)
       addInStationForce(s, particle_cb_[a], SimTK::Vec3(0), toSimTKVec3(l.segment<3>(3 * a)), bodyForcesInA);
-    VecX F;
-    if (!wrap_) {
-      calcPathMap(x_, nullptr, mp_, map_, name_);
-      F = -(map_.J_ax.transpose() * l);
-    } else {
-      mapPositions(getBodyTransformFromState(s, surface_cb_));
-      const VecX G = -(wmap_.J.transpose() * l);
-      F = G.head<6>();
-      addInBodyTorque(s, surface_cb_, toSimTKVec3(G.segment<3>(6)), bodyForcesInA);
-      addInStationForce(s, surface_cb_, X_bs_.p(), toSimTKVec3(G.segment<3>(9)), bodyForcesInA);
+    const VecX F = -(map_.J.transpose() * l);
+    for (size_t w = 0; w < frames_.size(); ++w) {
+      const int c = 3 * P + 6 * static_cast<int>(w);
+      addInBodyTorque(s, surface_cb_[w], toSimTKVec3(F.segment<3>(c)), bodyForcesInA);
+      addInStationForce(s, surface_cb_[w], X_bs_[w].p(), toSimTKVec3(F.segment<3>(c + 3)), bodyForcesInA);
     }
-    for (size_t i = 0; i < x_.size(); ++i) {
-      const SimTK::Vec3 Fi = toSimTKVec3(F.segment<3>(3 * static_cast<int>(i)));
+    for (int i = 0; i < P; ++i) {
+      const SimTK::Vec3 Fi = toSimTKVec3(F.segment<3>(3 * i));
       addInStationForce(s, point_cb_[i], toSimTKVec3(x_b_[i]), Fi, bodyForcesInA);
       // a moving point's column through its coordinate: (R x_b')^T F
       if (moving(i))
@@ -197,22 +187,20 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
 
  private:
   bool moving(size_t i) const { return cm_[i].isValid(); }
-  static Mat3 toMat3(const SimTK::Rotation& R) {
-    Mat3 out;
+  // surface frame w's pose from its body's pose X_AB (ancestor = Ground)
+  void setPose(size_t w, const SimTK::Transform& X_AB) const {
+    const SimTK::Transform X_AS = X_AB * X_bs_[w];
     for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) out(r, c) = R[r][c];
-    return out;
+      for (int c = 0; c < 3; ++c) frames_[w].R(r, c) = X_AS.R()[r][c];
+    frames_[w].p = fromSimTKVec3(X_AS.p());
   }
-  // mass point positions from x_ (and, Type III, the surface body's pose X_AB in the ancestor)
-  const std::vector<Vec3>& mapPositions(const SimTK::Transform& X_AB_surface) const {
-    if (!wrap_) {
-      calcPathMap(x_, nullptr, mp_, map_, name_);
-      return map_.x_a;
-    }
-    const SimTK::Transform X_AS = X_AB_surface * X_bs_;
-    calcWrapPathMap(surface_, wrap_opt_, mp_, x_[0], x_[1], toMat3(X_AS.R()), fromSimTKVec3(X_AS.p()), nullptr, wmap_,
-                    name_);
-    return wmap_.x_a;
+  // v = (xdot, (omega_w, pdot_w) per wrap) from xdot_ and frames_
+  VecX stackVelocities() const {
+    const int P = static_cast<int>(xdot_.size()), W = static_cast<int>(frames_.size());
+    VecX v(3 * P + 6 * W);
+    v.head(3 * P) = stackPoints(xdot_);
+    for (int w = 0; w < W; ++w) v.segment<6>(3 * P + 6 * w) << frames_[w].omega, frames_[w].pdot;
+    return v;
   }
   // x_b and its derivatives along the coordinate, for the coordinate's value q_c (moving points)
   void locate(size_t i, double q_c) const {
@@ -226,22 +214,20 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
     calcPointLocation(p, q_, x_b_[i], dx_b_[i], ddx_b_[i]);
   }
 
+  Muscle mu_;
   std::vector<PathPoint> points_;
   MassPoints mp_;
-  std::string name_;
+  std::vector<int> active_;
   std::vector<SimTK::ConstrainedBodyIndex> point_cb_, particle_cb_;
   std::vector<SimTK::ConstrainedMobilizerIndex> cm_;  // per point; invalid for non-moving points
   std::vector<SimTK::MobilizerQIndex> mq_;
   mutable std::vector<Vec3> x_, xdot_, x_b_, dx_b_, ddx_b_;
   mutable VecX q_;  // scratch core q holding only the coordinate being evaluated
-  mutable PathMap map_;
-  // Type III: the wrap surface, its pose on its body and the constrained body carrying it
-  WrapMassOptions wrap_opt_;
-  bool wrap_ = false;
-  WrapSurface surface_;
-  SimTK::Transform X_bs_;
-  SimTK::ConstrainedBodyIndex surface_cb_;
-  mutable WrapPathMap wmap_;
+  // per wrap object: the constrained body carrying its frame, the frame on it, its state
+  std::vector<SimTK::ConstrainedBodyIndex> surface_cb_;
+  std::vector<SimTK::Transform> X_bs_;
+  mutable std::vector<SurfaceFrameState> frames_;
+  mutable GeneralPathMap map_;
 };
 
 }  // namespace
@@ -291,15 +277,12 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
       coord_mobods.push_back(mob);
       coord_in_mobod.push_back(k_in);
     }
-    // Type III (validateMuscle accepted the supported shape): the surface's body is constrained too
-    std::unique_ptr<SimTK::MobilizedBody> surface_body;
-    if (pathType(mu.path) == PathType::III) {
-      const int b = mu.path.wraps.at(0).body;
-      surface_body = std::make_unique<SimTK::MobilizedBody>(b >= 0 ? sm.mobods[b]
-                                                                   : SimTK::MobilizedBody(sm.matter.updGround()));
-    }
+    // Type III: each wrap object's body is constrained too
+    std::vector<SimTK::MobilizedBody> surface_bodies;
+    for (const PathWrap& w : mu.path.wraps)
+      surface_bodies.push_back(w.body >= 0 ? sm.mobods[w.body] : SimTK::MobilizedBody(sm.matter.updGround()));
     SimTK::Constraint::Custom(
-        new PathConstraint(sm.matter, mu, point_bodies, coord_mobods, coord_in_mobod, mine, surface_body.get()));
+        new PathConstraint(sm.matter, mu, point_bodies, coord_mobods, coord_in_mobod, mine, surface_bodies));
   }
   // the topology changed: a new default state, Euler angles on as makeSimbodyModel sets them
   try {
@@ -325,16 +308,17 @@ void ParticleMuscles::placeParticles(SimTK::State& sb) const {
       q[mm.q_index + k] = q_sb[mm.simbody_q + k];
       qdot[mm.q_index + k] = qdot_sb[mm.simbody_q + k];
     }
-  PathMap map;
-  WrapPathMap wmap;
+  GeneralPathMap map;
   for (size_t m = 0; m < muscles_.size(); ++m) {
     if (first_particle_[m] < 0) continue;
     const Muscle& mu = muscles_[m];
     std::vector<Vec3> x, xdot;
+    std::vector<int> active;
     for (const PathPoint& p : mu.path.points) {
       const SimTK::MobilizedBody& B = p.body >= 0 ? sm_.mobods[p.body] : sm_.matter.getGround();
       Vec3 x_b, dx_b, ddx_b;
       calcPointLocation(p, q, x_b, dx_b, ddx_b);
+      active.push_back(static_cast<int>(active.size()));
       x.push_back(fromSimTKVec3(B.findStationLocationInGround(sb, toSimTKVec3(x_b))));
       SimTK::Vec3 v = B.findStationVelocityInGround(sb, toSimTKVec3(x_b));
       // moving point: R x_b' qdot_c
@@ -342,33 +326,27 @@ void ParticleMuscles::placeParticles(SimTK::State& sb) const {
         v += B.getBodyRotation(sb) * toSimTKVec3(dx_b) * qdot[p.coordinate];
       xdot.push_back(fromSimTKVec3(v));
     }
-    VecX xdot_a;
-    const std::vector<Vec3>* x_a = &map.x_a;
-    if (pathType(mu.path) != PathType::III) {
-      calcPathMap(x, &xdot, mu.mass_points, map, mu.name);
-      xdot_a = map.J_ax * stackPoints(xdot);
-    } else {
-      // Type III: the surface frame's pose and motion (path_map.hpp's calcWrapPathMap)
-      const PathWrap& w = mu.path.wraps.at(0);
-      const SimTK::MobilizedBody& S = w.body >= 0 ? sm_.mobods[w.body] : sm_.matter.getGround();
-      const SimTK::Transform X_bs = toTransform(w.E_bs);
+    // Type III: each surface frame's pose and motion (path_map.hpp's calcGeneralPathMap)
+    const int P = static_cast<int>(x.size()), W = static_cast<int>(mu.path.wraps.size());
+    std::vector<SurfaceFrameState> frames(W);
+    VecX v(3 * P + 6 * W);
+    v.head(3 * P) = stackPoints(xdot);
+    for (int w = 0; w < W; ++w) {
+      const PathWrap& pw = mu.path.wraps[w];
+      const SimTK::MobilizedBody& S = pw.body >= 0 ? sm_.mobods[pw.body] : sm_.matter.getGround();
+      const SimTK::Transform X_bs = toTransform(pw.E_bs);
       const SimTK::Transform X_GS = S.getBodyTransform(sb) * X_bs;
-      Mat3 R;
       for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) R(r, c) = X_GS.R()[r][c];
-      WrapSegmentVelocity v;
-      v.xdot1 = xdot[0];
-      v.xdot2 = xdot[1];
-      v.omega = fromSimTKVec3(S.getBodyAngularVelocity(sb));
-      v.pdot = fromSimTKVec3(S.findStationVelocityInGround(sb, X_bs.p()));
-      calcWrapPathMap(w.surface, mu.wrap, mu.mass_points, x[0], x[1], R, fromSimTKVec3(X_GS.p()), &v, wmap, mu.name);
-      VecX vv(12);
-      vv << xdot[0], xdot[1], v.omega, v.pdot;
-      xdot_a = wmap.J * vv;
-      x_a = &wmap.x_a;
+        for (int c = 0; c < 3; ++c) frames[w].R(r, c) = X_GS.R()[r][c];
+      frames[w].p = fromSimTKVec3(X_GS.p());
+      frames[w].omega = fromSimTKVec3(S.getBodyAngularVelocity(sb));
+      frames[w].pdot = fromSimTKVec3(S.findStationVelocityInGround(sb, X_bs.p()));
+      v.segment<6>(3 * P + 6 * w) << frames[w].omega, frames[w].pdot;
     }
+    calcGeneralPathMap(mu, active, x, nullptr, frames, map);
+    const VecX xdot_a = map.J * v;
     for (int a = 0; a < mu.mass_points.size(); ++a) {
-      x_p[first_particle_[m] + a] = toSimTKVec3((*x_a)[a]);
+      x_p[first_particle_[m] + a] = toSimTKVec3(map.x_a[a]);
       v_p[first_particle_[m] + a] = toSimTKVec3(xdot_a.segment<3>(3 * a));
     }
   }

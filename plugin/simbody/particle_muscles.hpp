@@ -12,12 +12,15 @@
 //
 // A moving point x_b(q_c) makes its coordinate's mobilizer a constrained mobilizer: its position,
 // velocity and acceleration gain the terms of muscle_inertia.hpp, its force a q-force (R x_b')^T F.
-// Type III (origin, one wrap surface, insertion: core/muscles/wrap_muscle.hpp's shape): the
-// surface's body is a constrained body too; x_a comes from calcWrapPathMap (path_map.hpp: the core's
-// wrap model, smooth by default) on the end points and the surface frame's pose, pverr uses
-// J (xdot1, xdot2, omega, pdot), paerr J vdot + b, and the surface's share of G^T lambda is a torque
-// and a force at the surface origin. With the smooth model the path map is C2, so the constraint
-// is smooth across contact changes; the exact model's finite-difference J jumps there.
+// Type III (any path the core takes: via and moving points, wraps on different segments;
+// core/muscles/wrap_muscle.hpp): each wrap object's body is a constrained body too; x_a comes from
+// calcGeneralPathMap (path_map.hpp: the core's segment construction and wrap model, smooth by
+// default) on the path points and the surface frames' poses, pverr uses J v with v = (xdot,
+// (omega_w, pdot_w) per wrap), paerr J vdot + b, and each surface's share of G^T lambda is a torque
+// and a force at its origin. With the smooth model the path map is C2 within a segment choice, so
+// the constraint is smooth across contact changes; the exact model's finite-difference J jumps
+// there, and the exact model on paths other than origin -> one surface -> insertion is refused
+// (simbodyWrapShapeUnsupportedReason).
 // Limits: conditional points are rejected (switching would change the path, and the particles'
 // velocities would have to jump); so is a mass point without mass. Muscles without mass points are
 // skipped.

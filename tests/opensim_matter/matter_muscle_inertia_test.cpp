@@ -1,7 +1,8 @@
-// plugin/opensim/matter_muscle_inertia.hpp, compiled against Debian's Simbody (always built, no OpenSim
-// needed): the OpenSim plugin's mass-point forces on a foreign Simbody system, located through a
-// body/coordinate map, against plugin/simbody's MuscleInertia on the same system (the same algorithm
-// reached through SimbodyModel) and against the core's MuscleTerm [D Eq. 5.6-5.7]:
+// plugin/simbody/matter_muscle_inertia.hpp through plugin/opensim's names (always built, no OpenSim
+// needed): the OpenSim plugin's mass-point forces on a Simbody system located through a
+// body/coordinate map built as a foreign system would give it, against plugin/simbody's MuscleInertia
+// on the same system (the same code behind the map SimbodyModel gives) and against the core's
+// MuscleTerm [D Eq. 5.6-5.7]:
 //   - random trees (Gimbal and Ball mobilizers) with Type I, Type II (1-5 via points), moving and
 //     conditional points, and Type III (one cylinder or sphere); MatterMuscleInertia == MuscleInertia
 //     to 1e-13 of the peak (same arithmetic, only the lookups differ) and, for Types I and II,

@@ -4,10 +4,13 @@
 //   - component: T^T f_u (Simbody, mapped to core velocities) == M_muscle qddot - f_muscle (core),
 //     and the mass points' kinetic and potential energies, on random trees (Gimbal, Ball, Free
 //     mobilizers) with Type I, Type II (1-5 via points), moving and conditional points, and Type III
-//     (one cylinder or sphere on the origin's body, a third body or the world; fixed or moving ends);
+//     (one cylinder or sphere on the origin's body, a third body or the world; fixed or moving ends;
+//     and two surfaces on the two segments of origin -> middle point -> insertion, the middle point
+//     fixed, moving, or conditional on or off);
 //   - engine: SimbodyIdEngine(model, muscles) == core System + MuscleTerm inverse dynamics on the
 //     project's scenes (double pendulums with a Type I, II and III muscle, finger, running leg with its
-//     wrapping gastrocnemii) and
+//     wrapping gastrocnemii; double_pendulum_wrap_via with a via point before the cylinder, as
+//     authored, with the via point conditional and with a moving insertion) and
 //     on set F (gait10dof18musc) with 20% and 80% of tibia_r's mass moved into its muscles.
 // Agreement: max |a - b| <= 1e-9 max |b| (relative to the peak of the reference column) at random
 // states. Each case also checks that the muscles change the torques by more than 1e-4 of the peak,
@@ -20,6 +23,7 @@
 #include <ctime>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <random>
 #include <string>
@@ -33,6 +37,8 @@
 #include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/system.hpp"
 #include "core/muscles/path_kinematics.hpp"
+#include "core/muscles/wrap/smooth.hpp"
+#include "core/muscles/wrap_muscle.hpp"
 #include "core/spatial/se3.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "plugin/simbody/id_engine.hpp"
@@ -134,30 +140,38 @@ Muscle randomMuscle(const Model& m, int variant, std::mt19937& rng, const State&
   return mu;
 }
 
-TEST(SimbodyMuscleInertia, MatchesCoreMuscleTermOnRandomTrees) {
+using MakeMuscles = std::function<std::vector<Muscle>(const Model&, int variant, int trial, const State&, std::mt19937&)>;
+using OnCompared = std::function<void(const Model&, const std::vector<Muscle>&, const State&, int variant)>;
+
+// the component against the core on random trees (a Gimbal and a Ball tree; with_pendulum: also the
+// double pendulum): per system, variants x trials random states, make() giving the muscles at each;
+// T^T f_u == M_muscle qddot - f_muscle to kTol of the peak, and the mass points' kinetic and
+// potential energies. Returns how many states were compared: one where the core finds a path
+// degenerate (two random points coincide, an end inside a surface) is skipped.
+int compareOnRandomTrees(bool with_pendulum, std::uint32_t seed, int variants, int trials, const MakeMuscles& make,
+                         const OnCompared& on_compared = {}) {
   using scenes::TreeJoints;
   using simbody::SphericalAs;
   struct Case {
     Model model;
     SphericalAs spherical;
   };
-  const std::vector<Case> cases{{scenes::randomTree(6, 11, TreeJoints::SimbodyComparable), SphericalAs::Gimbal},
-                                {scenes::randomTree(8, 29, TreeJoints::SimbodyComparable), SphericalAs::Ball},
-                                {scenes::doublePendulum(), SphericalAs::Gimbal}};
-  std::mt19937 rng(2024);
+  std::vector<Case> cases{{scenes::randomTree(6, 11, TreeJoints::SimbodyComparable), SphericalAs::Gimbal},
+                          {scenes::randomTree(8, 29, TreeJoints::SimbodyComparable), SphericalAs::Ball}};
+  if (with_pendulum) cases.push_back({scenes::doublePendulum(), SphericalAs::Gimbal});
+  std::mt19937 rng(seed);
   int checked = 0;
   for (size_t ci = 0; ci < cases.size(); ++ci) {
     const Model& m = cases[ci].model;
     simbody::SimbodyBuildOptions opt;
     opt.spherical = cases[ci].spherical;
     const auto sm = simbody::makeSimbodyModel(m, opt);
-    for (int variant = 0; variant <= 7; ++variant) {
-      for (int trial = 0; trial < 2; ++trial) {
+    for (int variant = 0; variant < variants; ++variant) {
+      for (int trial = 0; trial < trials; ++trial) {
         SCOPED_TRACE("case " + std::to_string(ci) + " variant " + std::to_string(variant) + " trial " +
                      std::to_string(trial));
         const State s = randomState(m.nr(), rng);
-        // two muscles per system, so the batch of stations spans muscles
-        std::vector<Muscle> muscles{randomMuscle(m, variant, rng, s), randomMuscle(m, (variant + 3) % 8, rng, s)};
+        std::vector<Muscle> muscles = make(m, variant, trial, s, rng);
         for (Muscle& mu : muscles) validateMuscle(m, mu);
         const MuscleTerm term(m, muscles);
         simbody::MuscleInertia mi(*sm, m, muscles);
@@ -166,11 +180,10 @@ TEST(SimbodyMuscleInertia, MatchesCoreMuscleTermOnRandomTrees) {
         try {
           core = coreMuscleTau(m, term, s, qddot);
         } catch (const MuscleError&) {
-          continue;  // two random points coincide at this state
+          continue;
         }
         const VecX sb = simbodyMuscleTau(*sm, mi, m, s, qddot);
         EXPECT_TRUE(closeToPeak(sb, core, kTol));
-
         // energies of the mass points (the core's from its own kinematics)
         SkeletonWorkspace sk(m);
         calcKinematics(m, s, sk);
@@ -180,10 +193,20 @@ TEST(SimbodyMuscleInertia, MatchesCoreMuscleTermOnRandomTrees) {
         const double T_core = term.kineticEnergy(m, s, sk), V_core = term.potentialEnergy(m, s, sk);
         EXPECT_NEAR(mi.kineticEnergy(st), T_core, kTol * (1.0 + std::abs(T_core)));
         EXPECT_NEAR(mi.potentialEnergy(st), V_core, kTol * (1.0 + std::abs(V_core)));
+        if (on_compared) on_compared(m, muscles, s, variant);
         ++checked;
       }
     }
   }
+  return checked;
+}
+
+TEST(SimbodyMuscleInertia, MatchesCoreMuscleTermOnRandomTrees) {
+  // two muscles per system, so the batch of stations spans muscles
+  const int checked = compareOnRandomTrees(true, 2024, 8, 2, [](const Model& m, int variant, int, const State& s,
+                                                                  std::mt19937& rng) {
+    return std::vector<Muscle>{randomMuscle(m, variant, rng, s), randomMuscle(m, (variant + 3) % 8, rng, s)};
+  });
   EXPECT_GE(checked, 40);
 }
 
@@ -245,53 +268,11 @@ Muscle randomWrapMuscle(const Model& m, int variant, std::mt19937& rng, const St
 }
 
 TEST(SimbodyMuscleInertia, TypeIIIMatchesCoreMuscleTermOnRandomTrees) {
-  using scenes::TreeJoints;
-  using simbody::SphericalAs;
-  struct Case {
-    Model model;
-    SphericalAs spherical;
-  };
-  const std::vector<Case> cases{{scenes::randomTree(6, 11, TreeJoints::SimbodyComparable), SphericalAs::Gimbal},
-                                {scenes::randomTree(8, 29, TreeJoints::SimbodyComparable), SphericalAs::Ball},
-                                {scenes::doublePendulum(), SphericalAs::Gimbal}};
-  std::mt19937 rng(77);
-  int checked = 0;
-  for (size_t ci = 0; ci < cases.size(); ++ci) {
-    const Model& m = cases[ci].model;
-    simbody::SimbodyBuildOptions opt;
-    opt.spherical = cases[ci].spherical;
-    const auto sm = simbody::makeSimbodyModel(m, opt);
-    for (int variant = 0; variant <= 3; ++variant) {
-      for (int trial = 0; trial < 4; ++trial) {
-        SCOPED_TRACE("case " + std::to_string(ci) + " variant " + std::to_string(variant) + " trial " +
-                     std::to_string(trial));
-        const State s = randomState(m.nr(), rng);
-        // a wrapping muscle next to a Type II one, so the batches span both kinds
-        std::vector<Muscle> muscles{randomWrapMuscle(m, variant, rng, s, trial % 2 == 1), randomMuscle(m, 1, rng, s)};
-        for (Muscle& mu : muscles) validateMuscle(m, mu);
-        const MuscleTerm term(m, muscles);
-        simbody::MuscleInertia mi(*sm, m, muscles);
-        const VecX qddot = VecX::NullaryExpr(m.nr(), [&] { return randomVec(rng, 3.0)[0]; });
-        VecX core;
-        try {
-          core = coreMuscleTau(m, term, s, qddot);
-        } catch (const MuscleError&) {
-          continue;  // an end point inside the surface or two coinciding points at this state
-        }
-        const VecX sb = simbodyMuscleTau(*sm, mi, m, s, qddot);
-        EXPECT_TRUE(closeToPeak(sb, core, kTol));
-        SkeletonWorkspace sk(m);
-        calcKinematics(m, s, sk);
-        SimTK::State st = sm->default_state;
-        simbody::setSimbodyState(*sm, m, s, st);
-        sm->system.realize(st, SimTK::Stage::Velocity);
-        const double T_core = term.kineticEnergy(m, s, sk), V_core = term.potentialEnergy(m, s, sk);
-        EXPECT_NEAR(mi.kineticEnergy(st), T_core, kTol * (1.0 + std::abs(T_core)));
-        EXPECT_NEAR(mi.potentialEnergy(st), V_core, kTol * (1.0 + std::abs(V_core)));
-        ++checked;
-      }
-    }
-  }
+  // a wrapping muscle next to a Type II one, so the batches span both kinds
+  const int checked = compareOnRandomTrees(true, 77, 4, 4, [](const Model& m, int variant, int trial, const State& s,
+                                                                std::mt19937& rng) {
+    return std::vector<Muscle>{randomWrapMuscle(m, variant, rng, s, trial % 2 == 1), randomMuscle(m, 1, rng, s)};
+  });
   EXPECT_GE(checked, 30);
 }
 
@@ -385,7 +366,7 @@ std::string scenePath(const std::string& file) { return std::string(REDMAX_SOURC
 // engine with muscles vs the core's System + MuscleTerm, at random states with q within the
 // coordinates' ranges; returns how many states were compared
 int compareEngines(const osim::ModelDescription& d, const Model& model, const std::vector<Muscle>& muscles,
-                   int states, std::uint32_t seed) {
+                   int states, std::uint32_t seed, const std::function<void(const State&)>& on_state = {}) {
   simbody::SimbodyIdEngine with(model, muscles), without(model);
   System sys(model);
   sys.addTerm(std::make_shared<MuscleTerm>(model, muscles));
@@ -409,6 +390,7 @@ int compareEngines(const osim::ModelDescription& d, const Model& model, const st
     without.calcGeneralizedForces(s.t, s.q, s.qdot, qddot, {}, tau_plain);
     const VecX tau_core = sys.inverseDynamics(s, qddot, ws);
     EXPECT_TRUE(closeToPeak(tau_sb, tau_core, kTol));
+    if (on_state) on_state(s);
     // the muscles matter at this state (else the comparison above proves little)
     EXPECT_GT((tau_sb - tau_plain).cwiseAbs().maxCoeff(), 1e-4 * tau_core.cwiseAbs().maxCoeff());
     ++compared;
@@ -446,6 +428,160 @@ TEST(SimbodyIdEngineMuscles, MatchesCoreOnProjectScenes) {
     const std::vector<Muscle> muscles = withMass(r.muscles, sc.mass);
     EXPECT_EQ(compareEngines(d, r.model, muscles, 6, 5), 6);
   }
+}
+
+// the wrapped segments of `mu` at state s (core kinematics): how many have a straight line that
+// penetrates their surface, i.e. really wrap
+int wrappedSegments(const Model& model, const Muscle& mu, const State& s) {
+  SkeletonWorkspace sk(model);
+  calcKinematics(model, s, sk);
+  std::vector<int> active;
+  std::vector<Vec3> x;
+  for (int k = 0; k < static_cast<int>(mu.path.points.size()); ++k) {
+    const PathPoint& p = mu.path.points[k];
+    if (!isPathPointActive(p, s.q)) continue;
+    Vec3 x_b, dx, ddx;
+    calcPointLocation(p, s.q, x_b, dx, ddx);
+    active.push_back(k);
+    x.push_back(p.body < 0 ? x_b : Vec3((sk.E_wi[p.body] * x_b.homogeneous()).head<3>()));
+  }
+  const std::vector<int> seg_wrap = calcSegmentWraps(mu, active, x, sk.E_wi);
+  int n = 0;
+  for (size_t i = 0; i < seg_wrap.size(); ++i) {
+    if (seg_wrap[i] < 0) continue;
+    const PathWrap& pw = mu.path.wraps[seg_wrap[i]];
+    const Mat4 E_ws = pw.body >= 0 ? Mat4(sk.E_wi[pw.body] * pw.E_bs) : pw.E_bs;
+    const Mat3 Rt = E_ws.topLeftCorner<3, 3>().transpose();
+    const Vec3 p = E_ws.topRightCorner<3, 1>();
+    if (calcWrapPenetration(pw.surface, Rt * (x[i] - p), Rt * (x[i + 1] - p)) > 0.0) ++n;
+  }
+  return n;
+}
+
+// general Type III in Simbody: osim_models/double_pendulum_wrap_via.osim (origin, via point, cylinder
+// on the via -> insertion segment), as authored, with its via point conditional on q2 and with a
+// moving insertion; the engine with muscles against the core at random states (1e-9 of the peak),
+// and the cylinder wraps at some of them
+TEST(SimbodyIdEngineMuscles, ViaPointAndWrapMatchCoreOnWrapViaPendulum) {
+  const osim::ModelDescription d = osim::readOsimModel(scenePath("double_pendulum_wrap_via.osim"));
+  osim::BuildOptions bo;
+  bo.constraints = false;
+  const osim::BuildResult r = osim::buildCoreModel(d, bo);
+  const Model& m = r.model;
+  int gastroc = -1;
+  for (size_t k = 0; k < r.muscles.size(); ++k)
+    if (r.muscles[k].name == "gastroc_like") gastroc = static_cast<int>(k);
+  ASSERT_GE(gastroc, 0);
+  ASSERT_EQ(r.muscles[gastroc].path.points.size(), 3u);
+  ASSERT_EQ(r.muscles[gastroc].path.wraps.size(), 1u);
+  const int q2 = 1;
+  for (int variant = 0; variant < 3; ++variant) {
+    SCOPED_TRACE(variant == 0 ? "as authored" : variant == 1 ? "conditional via point" : "moving insertion");
+    std::vector<Muscle> muscles = r.muscles;
+    auto& pts = muscles[gastroc].path.points;
+    if (variant == 1) {
+      const PathPoint& via = pts[1];
+      pts[1] = makeConditionalPoint(via.body, via.location, q2, -0.4, 0.6, via.name);
+    }
+    if (variant == 2) {
+      const PathPoint& ins = pts[2];
+      auto line = std::make_shared<LinearFunction>(0.02, ins.location.x());
+      auto cubic = std::make_shared<PolynomialFunction>(std::vector<double>{ins.location.y(), 0.01, -0.02, 0.01});
+      pts[2] = makeMovingPoint(ins.body, q2, {line, cubic, nullptr}, Vec3::Zero(), ins.name);
+    }
+    for (Muscle& mu : muscles) validateMuscle(m, mu);
+    const std::vector<Muscle> massive = withMass(muscles, 0.5);
+    int wrapped = 0, via_off = 0;
+    const int n = compareEngines(d, m, massive, 16, 23 + variant, [&](const State& s) {
+      wrapped += wrappedSegments(m, massive[gastroc], s) > 0 ? 1 : 0;
+      via_off += isPathPointActive(massive[gastroc].path.points[1], s.q) ? 0 : 1;
+    });
+    EXPECT_EQ(n, 16);
+    std::printf("  [variant %d] %d of 16 states wrap the cylinder, %d with the via point off\n", variant, wrapped,
+                via_off);
+    EXPECT_GE(wrapped, 3);
+    if (variant == 1) {
+      EXPECT_GE(via_off, 3);
+    }
+  }
+}
+
+// two wraps on different segments: origin -> (surface 0) -> middle point -> (surface 1) ->
+// insertion on random trees, each surface centred near its segment at the state (radius 0.03 m,
+// 0.012 m off the line: the path wraps), on random bodies or the world; the middle point fixed (0),
+// moving (1), conditional and on (2) or off (3, then neither range holds a segment); the cylinder
+// and the sphere swap with the trial; smooth model. Component vs core to 1e-9 of the peak, energies.
+Muscle randomTwoWrapMuscle(const Model& m, int variant, std::mt19937& rng, const State& s, bool swap) {
+  Muscle mu;
+  mu.name = "two_wraps" + std::to_string(variant);
+  auto& pts = mu.path.points;
+  pts.push_back(makeFixedPoint(randomBody(m, rng, true), randomVec(rng, 0.3)));
+  const int bm = randomBody(m, rng, false);
+  const int c = static_cast<int>(rng() % m.nr());
+  if (variant == 1) {
+    auto cubic = std::make_shared<PolynomialFunction>(std::vector<double>{0.05, -0.1, 0.2, 0.1});
+    auto line = std::make_shared<LinearFunction>(0.3, 0.2);
+    pts.push_back(makeMovingPoint(bm, c, {cubic, nullptr, line}, Vec3(0, 0.1, 0)));
+  } else if (variant >= 2) {
+    const double lo = variant == 2 ? s.q[c] - 0.3 : s.q[c] + 1.0;
+    pts.push_back(makeConditionalPoint(bm, randomVec(rng, 0.3), c, lo, lo + 0.6));
+  } else {
+    pts.push_back(makeFixedPoint(bm, randomVec(rng, 0.3)));
+  }
+  pts.push_back(makeFixedPoint(randomBody(m, rng, false), randomVec(rng, 0.3)));
+  SkeletonWorkspace sk(m);
+  calcKinematics(m, s, sk);
+  auto world = [&](const PathPoint& p) {
+    Vec3 x_b, dx, ddx;
+    calcPointLocation(p, s.q, x_b, dx, ddx);
+    return p.body < 0 ? x_b : Vec3((sk.E_wi[p.body] * x_b.homogeneous()).head<3>());
+  };
+  for (int w = 0; w < 2; ++w) {
+    const Vec3 x1 = world(pts[w]), x2 = world(pts[w + 1]);
+    // as randomWrapMuscle: centre 0.4 radius off the line, axis tilted 0.3 rad, random turn
+    const Vec3 u = (x2 - x1).normalized();
+    const Vec3 o = u.cross(randomVec(rng, 1.0)).normalized();
+    const Vec3 z = std::cos(0.3) * o.cross(u) + std::sin(0.3) * u;
+    Mat3 R0;
+    R0 << o, z.cross(o), z;
+    Mat4 E_ws = Mat4::Identity();
+    E_ws.topLeftCorner<3, 3>() = R0 * expSO3(Vec3(0.0, 0.0, randomVec(rng, 3.0)[0]));
+    E_ws.topRightCorner<3, 1>() = 0.5 * (x1 + x2) + 0.012 * o;
+    PathWrap pw;
+    const bool sphere = (w == 1) != swap;
+    pw.name = sphere ? "ball" : "drum";
+    pw.surface = sphere ? WrapSurface::makeSphere(0.03) : WrapSurface::makeCylinder(0.03, 2.0);
+    pw.body = randomBody(m, rng, true);
+    pw.E_bs = pw.body >= 0 ? Mat4(sk.E_wi[pw.body].inverse() * E_ws) : E_ws;
+    pw.range_begin = w + 1;  // OpenSim's 1-based point range: the segment (w, w + 1)
+    pw.range_end = w + 2;
+    mu.path.wraps.push_back(pw);
+  }
+  mu.path.num_wraps = 2;
+  MassPointOptions opt;
+  opt.count = 8;
+  mu.mass_points = makeMassPoints(0.7, 0.5, 0.3, opt);
+  mu.optimal_fiber_length = 0.5;
+  mu.tendon_slack_length = 0.3;
+  return mu;
+}
+
+TEST(SimbodyMuscleInertia, TwoWrapsMatchCoreMuscleTermOnRandomTrees) {
+  int both_wrapped = 0;
+  const int checked = compareOnRandomTrees(
+      false, 4242, 4, 3,
+      [](const Model& m, int variant, int trial, const State& s, std::mt19937& rng) {
+        std::vector<Muscle> muscles{randomTwoWrapMuscle(m, variant, rng, s, trial % 2 == 1),
+                                    randomWrapMuscle(m, 0, rng, s, false)};
+        EXPECT_EQ(simbody::simbodyWrapShapeUnsupportedReason(muscles[0]), "");
+        return muscles;
+      },
+      [&](const Model& m, const std::vector<Muscle>& muscles, const State& s, int variant) {
+        if (variant <= 2 && wrappedSegments(m, muscles[0], s) == 2) ++both_wrapped;
+      });
+  std::printf("  %d states compared, %d with both surfaces wrapping\n", checked, both_wrapped);
+  EXPECT_GE(checked, 18);
+  EXPECT_GE(both_wrapped, 8);
 }
 
 // CPU time per inverse-dynamics call (printed, not asserted): Simbody with and without the muscles,

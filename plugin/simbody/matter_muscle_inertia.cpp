@@ -1,10 +1,10 @@
-#include "plugin/opensim/matter_muscle_inertia.hpp"
+#include "plugin/simbody/matter_muscle_inertia.hpp"
 
 #include <stdexcept>
 
 #include "core/muscles/path_kinematics.hpp"
 
-namespace redmax::opensim {
+namespace redmax::simbody {
 
 namespace {
 
@@ -22,6 +22,12 @@ bool isMoving(const PathPoint& pt) { return pt.kind == PathPointKind::Moving && 
 
 }  // namespace
 
+std::string simbodyWrapShapeUnsupportedReason(const Muscle& mu) {
+  if (mu.mass_points.size() == 0) return "";
+  const std::string why = generalPathMapUnsupportedReason(mu);
+  return why.empty() ? "" : "muscle '" + mu.name + "': the Simbody side cannot carry these mass points: " + why;
+}
+
 MatterMuscleInertia::MatterMuscleInertia(const SimTK::SimbodyMatterSubsystem& matter, MatterMap map,
                                          const Model& model, std::vector<Muscle> muscles, const Vec3& gravity)
     : matter_(matter), map_(std::move(map)), muscles_(std::move(muscles)), gravity_(gravity) {
@@ -35,6 +41,8 @@ MatterMuscleInertia::MatterMuscleInertia(const SimTK::SimbodyMatterSubsystem& ma
     const Muscle& mu = muscles_[m];
     validateMuscle(model, mu);
     if (mu.mass_points.size() == 0) continue;
+    const std::string why = simbodyWrapShapeUnsupportedReason(mu);
+    if (!why.empty()) throw ModelError(why);
     // every body and coordinate the path depends on must be in the foreign system
     for (const PathPoint& pt : mu.path.points) {
       if (pt.body >= 0 && !map_.mobod_of_body[pt.body].isValid())
@@ -46,14 +54,16 @@ MatterMuscleInertia::MatterMuscleInertia(const SimTK::SimbodyMatterSubsystem& ma
     }
     Entry e;
     e.muscle = m;
-    if (pathType(mu.path) == PathType::III) {
-      const PathWrap& w = mu.path.wraps.at(0);
-      e.wrap = true;
-      e.surface_body = w.body;
-      e.X_bs = toTransform(w.E_bs);
+    // Type III: every wrap surface frame is a frame on its body (X_GS = X_GB X_bs)
+    e.wrap = !mu.path.wraps.empty();
+    for (const PathWrap& w : mu.path.wraps) {
       if (w.body >= 0 && !map_.mobod_of_body[w.body].isValid())
-        throw std::invalid_argument("muscle '" + mu.name + "': its wrap surface's body has no mobilized body");
+        throw std::invalid_argument("muscle '" + mu.name + "': the body of wrap object '" + w.name +
+                                    "' has no mobilized body in the Simbody system");
+      e.surface_body.push_back(w.body);
+      e.X_bs.push_back(toTransform(w.E_bs));
     }
+    e.frames.resize(e.X_bs.size());
     entries_.push_back(std::move(e));
   }
   q_core_.setZero(model.nr());
@@ -72,10 +82,15 @@ double MatterMuscleInertia::totalMass() const {
 std::vector<Vec3> MatterMuscleInertia::massPointPositions() const {
   std::vector<Vec3> out;
   for (const Entry& e : entries_) {
-    const std::vector<Vec3>& x = e.wrap ? e.wmap.x_a : e.map.x_a;
+    const std::vector<Vec3>& x = e.wrap ? e.gmap.x_a : e.map.x_a;
     out.insert(out.end(), x.begin(), x.end());
   }
   return out;
+}
+
+const std::vector<Vec3>& MatterMuscleInertia::massPointPositions(int e) const {
+  const Entry& en = entries_.at(e);
+  return en.wrap ? en.gmap.x_a : en.map.x_a;
 }
 
 void MatterMuscleInertia::evaluate(const SimTK::State& state, bool velocity) {
@@ -113,21 +128,19 @@ void MatterMuscleInertia::evaluate(const SimTK::State& state, bool velocity) {
       calcPathMap(e.x, velocity ? &e.xdot : nullptr, mu.mass_points, e.map, mu.name);
       continue;
     }
-    if (P != 2) throw MuscleError("muscle '" + mu.name + "': a wrapping muscle needs its two end points active");
-    const SimTK::MobilizedBody& S = mobod(e.surface_body);
-    const SimTK::Transform X_GS = S.getBodyTransform(state) * e.X_bs;
-    Mat3 R;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) R(r, c) = X_GS.R()[r][c];
-    WrapSegmentVelocity v;
-    if (velocity) {
-      v.xdot1 = e.xdot[0];
-      v.xdot2 = e.xdot[1];
-      v.omega = fromSimTKVec3(S.getBodyAngularVelocity(state));
-      v.pdot = fromSimTKVec3(S.findStationVelocityInGround(state, e.X_bs.p()));
+    // the surface frames: pose, angular velocity and origin velocity (Ground)
+    for (size_t w = 0; w < e.frames.size(); ++w) {
+      const SimTK::MobilizedBody& S = mobod(e.surface_body[w]);
+      const SimTK::Transform X_GS = S.getBodyTransform(state) * e.X_bs[w];
+      SurfaceFrameState& f = e.frames[w];
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) f.R(r, c) = X_GS.R()[r][c];
+      f.p = fromSimTKVec3(X_GS.p());
+      if (!velocity) continue;
+      f.omega = fromSimTKVec3(S.getBodyAngularVelocity(state));
+      f.pdot = fromSimTKVec3(S.findStationVelocityInGround(state, e.X_bs[w].p()));
     }
-    calcWrapPathMap(mu.path.wraps[0].surface, mu.wrap, mu.mass_points, e.x[0], e.x[1], R, fromSimTKVec3(X_GS.p()),
-                    velocity ? &v : nullptr, e.wmap, mu.name);
+    calcGeneralPathMap(mu, e.active, e.x, velocity ? &e.xdot : nullptr, e.frames, e.gmap);
   }
 }
 
@@ -155,20 +168,20 @@ void MatterMuscleInertia::calcGeneralizedForces(const SimTK::State& state, const
   matter_.multiplyByStationJacobian(state, bodies_, stations_, udot, JSudot_);
   matter_.calcBiasForStationJacobian(state, bodies_, stations_, bias_);
   forces_.resize(static_cast<int>(bodies_.size()));
-  // Type III surfaces: one frame each, spatial acceleration JF udot + JFdot u
+  // Type III surfaces: one frame per wrap object, spatial acceleration JF udot + JFdot u
   frame_bodies_.clear();
   frame_origins_.clear();
-  for (const Entry& e : entries_) {
-    if (!e.wrap) continue;
-    frame_bodies_.push_back(mobod(e.surface_body).getMobilizedBodyIndex());
-    frame_origins_.push_back(e.X_bs.p());
-  }
+  for (const Entry& e : entries_)
+    for (size_t w = 0; w < e.X_bs.size(); ++w) {
+      frame_bodies_.push_back(mobod(e.surface_body[w]).getMobilizedBodyIndex());
+      frame_origins_.push_back(e.X_bs[w].p());
+    }
   if (!frame_bodies_.empty()) {
     matter_.multiplyByFrameJacobian(state, frame_bodies_, frame_origins_, udot, JFudot_);
     matter_.calcBiasForFrameJacobian(state, frame_bodies_, frame_origins_, frame_bias_);
     frame_forces_.resize(static_cast<int>(frame_bodies_.size()));
   }
-  int frame = 0;
+  int frame = 0;  // the first frame of the current entry
   SimTK::Vector qddot, f_q;
   if (any_moving) {
     matter_.calcQDotDot(state, udot, qddot);
@@ -202,10 +215,15 @@ void MatterMuscleInertia::calcGeneralizedForces(const SimTK::State& state, const
     if (!e.wrap) {
       a_a = calcMassPointAccelerations(e.map, xddot);
     } else {
-      const SimTK::SpatialVec A = JFudot_[frame] + frame_bias_[frame];
-      VecX vdot(12);
-      vdot << xddot, fromSimTKVec3(A[0]), fromSimTKVec3(A[1]);
-      a_a = e.wmap.J * vdot + e.wmap.bias;
+      // vdot = (xddot, (alpha_w, pddot_w) per wrap); a_a = J vdot + bias (path_map.hpp)
+      const int W = static_cast<int>(e.X_bs.size());
+      VecX vdot(3 * P + 6 * W);
+      vdot.head(3 * P) = xddot;
+      for (int w = 0; w < W; ++w) {
+        const SimTK::SpatialVec A = JFudot_[frame + w] + frame_bias_[frame + w];
+        vdot.segment<6>(3 * P + 6 * w) << fromSimTKVec3(A[0]), fromSimTKVec3(A[1]);
+      }
+      a_a = e.gmap.J * vdot + e.gmap.bias;
     }
     VecX f_a(a_a.size());
     for (int a = 0; a < mu.mass_points.size(); ++a)
@@ -214,11 +232,13 @@ void MatterMuscleInertia::calcGeneralizedForces(const SimTK::State& state, const
     if (!e.wrap) {
       F_x = e.map.J_ax.transpose() * f_a;
     } else {
-      // the (omega, pdot) columns: a torque and a force at the surface origin
-      const VecX F = e.wmap.J.transpose() * f_a;
-      F_x = F.head<6>();
-      frame_forces_[frame] = SimTK::SpatialVec(toSimTKVec3(F.segment<3>(6)), toSimTKVec3(F.segment<3>(9)));
-      ++frame;
+      // each wrap's (omega, pdot) columns: a torque and a force at its surface origin
+      const VecX F = e.gmap.J.transpose() * f_a;
+      F_x = F.head(3 * P);
+      for (size_t w = 0; w < e.X_bs.size(); ++w, ++frame) {
+        const int c = 3 * P + 6 * static_cast<int>(w);
+        frame_forces_[frame] = SimTK::SpatialVec(toSimTKVec3(F.segment<3>(c)), toSimTKVec3(F.segment<3>(c + 3)));
+      }
     }
     for (int i = 0; i < P; ++i) {
       const Vec3 F = F_x.segment<3>(3 * i);
@@ -246,11 +266,11 @@ void MatterMuscleInertia::calcGeneralizedForces(const SimTK::State& state, const
   }
 }
 
-VecX MatterMuscleInertia::wrapVelocity(const SimTK::State& state, const Entry& e) const {
-  const SimTK::MobilizedBody& S = mobod(e.surface_body);
-  VecX v(12);
-  v << e.xdot[0], e.xdot[1], fromSimTKVec3(S.getBodyAngularVelocity(state)),
-      fromSimTKVec3(S.findStationVelocityInGround(state, e.X_bs.p()));
+VecX MatterMuscleInertia::wrapVelocity(const Entry& e) const {
+  const int P = static_cast<int>(e.xdot.size()), W = static_cast<int>(e.frames.size());
+  VecX v(3 * P + 6 * W);
+  v.head(3 * P) = stackPoints(e.xdot);
+  for (int w = 0; w < W; ++w) v.segment<6>(3 * P + 6 * w) << e.frames[w].omega, e.frames[w].pdot;
   return v;
 }
 
@@ -259,10 +279,21 @@ double MatterMuscleInertia::kineticEnergy(const SimTK::State& state) {
   double T = 0.0;
   for (const Entry& e : entries_) {
     const MassPoints& mp = muscles_[e.muscle].mass_points;
-    const VecX xdot_a = e.wrap ? VecX(e.wmap.J * wrapVelocity(state, e)) : VecX(e.map.J_ax * stackPoints(e.xdot));
+    const VecX xdot_a = e.wrap ? VecX(e.gmap.J * wrapVelocity(e)) : VecX(e.map.J_ax * stackPoints(e.xdot));
     for (int a = 0; a < mp.size(); ++a) T += 0.5 * mp.mass[a] * xdot_a.segment<3>(3 * a).squaredNorm();
   }
   return T;
 }
 
-}  // namespace redmax::opensim
+double MatterMuscleInertia::potentialEnergy(const SimTK::State& state) {
+  evaluate(state, false);
+  double V = 0.0;
+  for (const Entry& e : entries_) {
+    const MassPoints& mp = muscles_[e.muscle].mass_points;
+    const std::vector<Vec3>& x_a = e.wrap ? e.gmap.x_a : e.map.x_a;
+    for (int a = 0; a < mp.size(); ++a) V -= mp.mass[a] * gravity_.dot(x_a[a]);
+  }
+  return V;
+}
+
+}  // namespace redmax::simbody
