@@ -12,9 +12,8 @@ SimTK::Vec3 toSimTKVec3(const Vec3& v) { return SimTK::Vec3(v.x(), v.y(), v.z())
 Vec3 fromSimTKVec3(const SimTK::Vec3& v) { return Vec3(v[0], v[1], v[2]); }
 
 SimTK::Transform toTransform(const Mat4& E) {
-  SimTK::Mat33 R;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) R[r][c] = E(r, c);
+  // row-major element constructor (GCC reads row-by-row writes as out of bounds)
+  const SimTK::Mat33 R(E(0, 0), E(0, 1), E(0, 2), E(1, 0), E(1, 1), E(1, 2), E(2, 0), E(2, 1), E(2, 2));
   return SimTK::Transform(SimTK::Rotation(R, true), SimTK::Vec3(E(0, 3), E(1, 3), E(2, 3)));
 }
 

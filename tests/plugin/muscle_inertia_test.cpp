@@ -210,10 +210,50 @@ TEST(SimbodyMuscleInertia, MatchesCoreMuscleTermOnRandomTrees) {
   EXPECT_GE(checked, 40);
 }
 
-// Type III: origin -> one surface -> insertion. The surface (radius 0.03 m) is centred 0.012 m off
-// the ends' midpoint at the state, perpendicular to the line (so the path wraps), on the
-// origin's body (variant 0), a body that moves neither end (1), the world (2), or with a moving
-// insertion (3); smooth wrap model.
+// a path point's world position at state s (sk: the skeleton at s)
+Vec3 worldPoint(const PathPoint& p, const State& s, const SkeletonWorkspace& sk) {
+  Vec3 x_b, dx, ddx;
+  calcPointLocation(p, s.q, x_b, dx, ddx);
+  return p.body < 0 ? x_b : Vec3((sk.E_wi[p.body] * x_b.homogeneous()).head<3>());
+}
+
+// a surface (radius 0.03 m) on body `body` (-1: world) that the segment x1 -> x2 (world, at the
+// state of sk) wraps: centred 0.012 m off the segment's midpoint, perpendicular to it. The centre
+// is 0.4 radius off the line along o (perpendicular to it), so the line passes at 0.4 radius from
+// the centre or axis (through them, round-off would pick the side of the wrap); the axis z is o x u
+// tilted 0.3 rad towards the line, so the ends lie at different heights (a line exactly across the
+// axis keeps the path in one plane, where the smooth cylinder's J disagrees with differences of its
+// own positions), with a random turn about the axis
+PathWrap wrapAcross(const Vec3& x1, const Vec3& x2, int body, bool sphere, const SkeletonWorkspace& sk,
+                    std::mt19937& rng) {
+  const Vec3 u = (x2 - x1).normalized();
+  const Vec3 o = u.cross(randomVec(rng, 1.0)).normalized();
+  const Vec3 z = std::cos(0.3) * o.cross(u) + std::sin(0.3) * u;
+  Mat3 R0;
+  R0 << o, z.cross(o), z;  // right-handed
+  Mat4 E_ws = Mat4::Identity();
+  E_ws.topLeftCorner<3, 3>() = R0 * expSO3(Vec3(0.0, 0.0, randomVec(rng, 3.0)[0]));
+  E_ws.topRightCorner<3, 1>() = 0.5 * (x1 + x2) + 0.012 * o;
+  PathWrap w;
+  w.name = sphere ? "ball" : "drum";
+  w.surface = sphere ? WrapSurface::makeSphere(0.03) : WrapSurface::makeCylinder(0.03, 2.0);
+  w.body = body;
+  w.E_bs = body >= 0 ? Mat4(sk.E_wi[body].inverse() * E_ws) : E_ws;
+  return w;
+}
+
+// mass points and fibre data of the random wrapping muscles
+void giveMass(Muscle& mu, int count) {
+  MassPointOptions opt;
+  opt.count = count;
+  mu.mass_points = makeMassPoints(0.7, 0.5, 0.3, opt);
+  mu.optimal_fiber_length = 0.5;
+  mu.tendon_slack_length = 0.3;
+}
+
+// Type III: origin -> one surface -> insertion. The surface (wrapAcross) on the origin's body
+// (variant 0), a body that moves neither end (1), the world (2), or with a moving insertion (3);
+// smooth wrap model.
 Muscle randomWrapMuscle(const Model& m, int variant, std::mt19937& rng, const State& s, bool sphere) {
   Muscle mu;
   mu.name = "wrap" + std::to_string(variant);
@@ -233,37 +273,10 @@ Muscle randomWrapMuscle(const Model& m, int variant, std::mt19937& rng, const St
   // the ends at this state (world), the surface centred between them
   SkeletonWorkspace sk(m);
   calcKinematics(m, s, sk);
-  auto world = [&](const PathPoint& p) {
-    Vec3 x_b, dx, ddx;
-    calcPointLocation(p, s.q, x_b, dx, ddx);
-    return p.body < 0 ? x_b : Vec3((sk.E_wi[p.body] * x_b.homogeneous()).head<3>());
-  };
-  const Vec3 x1 = world(mu.path.points[0]), x2 = world(mu.path.points[1]);
-  // the centre 0.4 radius off the line along o (perpendicular to it), so the line passes at 0.4
-  // radius from the centre or axis (through them, round-off would pick the side of the wrap); the
-  // axis z is o x u tilted 0.3 rad towards the line, so the ends lie at different heights (a line
-  // exactly across the axis keeps the path in one plane, where the smooth cylinder's J disagrees
-  // with differences of its own positions), with a random turn about the axis
-  const Vec3 u = (x2 - x1).normalized();
-  const Vec3 o = u.cross(randomVec(rng, 1.0)).normalized();
-  const Vec3 z = std::cos(0.3) * o.cross(u) + std::sin(0.3) * u;
-  Mat3 R0;
-  R0 << o, z.cross(o), z;  // right-handed
-  Mat4 E_ws = Mat4::Identity();
-  E_ws.topLeftCorner<3, 3>() = R0 * expSO3(Vec3(0.0, 0.0, randomVec(rng, 3.0)[0]));
-  E_ws.topRightCorner<3, 1>() = 0.5 * (x1 + x2) + 0.012 * o;
-  PathWrap w;
-  w.name = sphere ? "ball" : "drum";
-  w.surface = sphere ? WrapSurface::makeSphere(0.03) : WrapSurface::makeCylinder(0.03, 2.0);
-  w.body = bs;
-  w.E_bs = bs >= 0 ? Mat4(sk.E_wi[bs].inverse() * E_ws) : E_ws;
-  mu.path.wraps = {w};
+  mu.path.wraps = {wrapAcross(worldPoint(mu.path.points[0], s, sk), worldPoint(mu.path.points[1], s, sk), bs, sphere,
+                              sk, rng)};
   mu.path.num_wraps = 1;
-  MassPointOptions opt;
-  opt.count = 6;
-  mu.mass_points = makeMassPoints(0.7, 0.5, 0.3, opt);
-  mu.optimal_fiber_length = 0.5;
-  mu.tendon_slack_length = 0.3;
+  giveMass(mu, 6);
   return mu;
 }
 
@@ -531,38 +544,15 @@ Muscle randomTwoWrapMuscle(const Model& m, int variant, std::mt19937& rng, const
   pts.push_back(makeFixedPoint(randomBody(m, rng, false), randomVec(rng, 0.3)));
   SkeletonWorkspace sk(m);
   calcKinematics(m, s, sk);
-  auto world = [&](const PathPoint& p) {
-    Vec3 x_b, dx, ddx;
-    calcPointLocation(p, s.q, x_b, dx, ddx);
-    return p.body < 0 ? x_b : Vec3((sk.E_wi[p.body] * x_b.homogeneous()).head<3>());
-  };
   for (int w = 0; w < 2; ++w) {
-    const Vec3 x1 = world(pts[w]), x2 = world(pts[w + 1]);
-    // as randomWrapMuscle: centre 0.4 radius off the line, axis tilted 0.3 rad, random turn
-    const Vec3 u = (x2 - x1).normalized();
-    const Vec3 o = u.cross(randomVec(rng, 1.0)).normalized();
-    const Vec3 z = std::cos(0.3) * o.cross(u) + std::sin(0.3) * u;
-    Mat3 R0;
-    R0 << o, z.cross(o), z;
-    Mat4 E_ws = Mat4::Identity();
-    E_ws.topLeftCorner<3, 3>() = R0 * expSO3(Vec3(0.0, 0.0, randomVec(rng, 3.0)[0]));
-    E_ws.topRightCorner<3, 1>() = 0.5 * (x1 + x2) + 0.012 * o;
-    PathWrap pw;
-    const bool sphere = (w == 1) != swap;
-    pw.name = sphere ? "ball" : "drum";
-    pw.surface = sphere ? WrapSurface::makeSphere(0.03) : WrapSurface::makeCylinder(0.03, 2.0);
-    pw.body = randomBody(m, rng, true);
-    pw.E_bs = pw.body >= 0 ? Mat4(sk.E_wi[pw.body].inverse() * E_ws) : E_ws;
+    const int body = randomBody(m, rng, true);
+    PathWrap pw = wrapAcross(worldPoint(pts[w], s, sk), worldPoint(pts[w + 1], s, sk), body, (w == 1) != swap, sk, rng);
     pw.range_begin = w + 1;  // OpenSim's 1-based point range: the segment (w, w + 1)
     pw.range_end = w + 2;
     mu.path.wraps.push_back(pw);
   }
   mu.path.num_wraps = 2;
-  MassPointOptions opt;
-  opt.count = 8;
-  mu.mass_points = makeMassPoints(0.7, 0.5, 0.3, opt);
-  mu.optimal_fiber_length = 0.5;
-  mu.tendon_slack_length = 0.3;
+  giveMass(mu, 8);
   return mu;
 }
 
