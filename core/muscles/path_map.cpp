@@ -218,10 +218,15 @@ void calcGeneralPathMap(const Muscle& muscle, const std::vector<int>& active, co
   out.x_a = mk.x_a;
   out.J = mk.J_ar;
   if (!vel) return;
-  VecX v(k);
-  v.head(3 * P) = stackPoints(*xdot);
-  for (int w = 0; w < W; ++w) v.segment<6>(3 * P + 6 * w) << surfaces[w].omega, surfaces[w].pdot;
-  out.bias.noalias() = mk.Jdot_ar * v;
+  out.bias.noalias() = mk.Jdot_ar * stackGeneralVelocities(*xdot, surfaces);
+}
+
+VecX stackGeneralVelocities(const std::vector<Vec3>& xdot, const std::vector<SurfaceFrameState>& frames) {
+  const int P = static_cast<int>(xdot.size()), W = static_cast<int>(frames.size());
+  VecX v(3 * P + 6 * W);
+  v.head(3 * P) = stackPoints(xdot);
+  for (int w = 0; w < W; ++w) v.segment<6>(3 * P + 6 * w) << frames[w].omega, frames[w].pdot;
+  return v;
 }
 
 }  // namespace redmax

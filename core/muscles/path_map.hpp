@@ -119,6 +119,10 @@ struct GeneralPathMap {
   MuscleKinematics mk;        ///< scratch: the segment construction in v's coordinates
 };
 
+/// v = (xdot_0, ..., xdot_{P-1}, omega_0, pdot_0, ...) (3P + 6W) from the point velocities and
+/// the frames' omega, pdot: the vector calcGeneralPathMap's J multiplies.
+VecX stackGeneralVelocities(const std::vector<Vec3>& xdot, const std::vector<SurfaceFrameState>& frames);
+
 /// "" when calcGeneralPathMap takes `muscle` (any path validateMuscle accepts, except the exact
 /// wrap model on a path other than origin -> one surface -> insertion), else why not.
 std::string generalPathMapUnsupportedReason(const Muscle& muscle);

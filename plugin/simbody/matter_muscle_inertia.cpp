@@ -265,20 +265,12 @@ void MatterMuscleInertia::calcGeneralizedForces(const SimTK::State& state, const
   }
 }
 
-VecX MatterMuscleInertia::wrapVelocity(const Entry& e) const {
-  const int P = static_cast<int>(e.xdot.size()), W = static_cast<int>(e.frames.size());
-  VecX v(3 * P + 6 * W);
-  v.head(3 * P) = stackPoints(e.xdot);
-  for (int w = 0; w < W; ++w) v.segment<6>(3 * P + 6 * w) << e.frames[w].omega, e.frames[w].pdot;
-  return v;
-}
-
 double MatterMuscleInertia::kineticEnergy(const SimTK::State& state) {
   evaluate(state, true);
   double T = 0.0;
   for (const Entry& e : entries_) {
     const MassPoints& mp = muscles_[e.muscle].mass_points;
-    const VecX xdot_a = e.wrap ? VecX(e.gmap.J * wrapVelocity(e)) : VecX(e.map.J_ax * stackPoints(e.xdot));
+    const VecX xdot_a = e.wrap ? VecX(e.gmap.J * stackGeneralVelocities(e.xdot, e.frames)) : VecX(e.map.J_ax * stackPoints(e.xdot));
     for (int a = 0; a < mp.size(); ++a) T += 0.5 * mp.mass[a] * xdot_a.segment<3>(3 * a).squaredNorm();
   }
   return T;

@@ -109,8 +109,6 @@ class MatterMuscleInertia {
   const SimTK::MobilizedBody& mobod(int body) const;
   // active points, positions and velocities (and the path maps) of every entry
   void evaluate(const SimTK::State& state, bool velocity);
-  // v = (xdot, (omega_w, pdot_w) per wrap) of a Type III entry after evaluate(state, true)
-  VecX wrapVelocity(const Entry& e) const;
 
   const SimTK::SimbodyMatterSubsystem& matter_;
   MatterMap map_;

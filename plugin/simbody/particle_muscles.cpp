@@ -107,7 +107,7 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       frames_[w].pdot = fromSimTKVec3(findStationVelocity(s, V_AB, surface_cb_[w], X_bs_[w].p()));
     }
     calcGeneralPathMap(mu_, active_, x_, nullptr, frames_, map_);
-    const VecX xdot_a = map_.J * stackVelocities();
+    const VecX xdot_a = map_.J * stackGeneralVelocities(xdot_, frames_);
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& v = V_AB[particle_cb_[a]][1];
       for (int k = 0; k < 3; ++k) pverr[3 * a + k] = v[k] - xdot_a[3 * a + k];
@@ -193,14 +193,6 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) frames_[w].R(r, c) = X_AS.R()[r][c];
     frames_[w].p = fromSimTKVec3(X_AS.p());
-  }
-  // v = (xdot, (omega_w, pdot_w) per wrap) from xdot_ and frames_
-  VecX stackVelocities() const {
-    const int P = static_cast<int>(xdot_.size()), W = static_cast<int>(frames_.size());
-    VecX v(3 * P + 6 * W);
-    v.head(3 * P) = stackPoints(xdot_);
-    for (int w = 0; w < W; ++w) v.segment<6>(3 * P + 6 * w) << frames_[w].omega, frames_[w].pdot;
-    return v;
   }
   // x_b and its derivatives along the coordinate, for the coordinate's value q_c (moving points)
   void locate(size_t i, double q_c) const {
@@ -327,10 +319,8 @@ void ParticleMuscles::placeParticles(SimTK::State& sb) const {
       xdot.push_back(fromSimTKVec3(v));
     }
     // Type III: each surface frame's pose and motion (path_map.hpp's calcGeneralPathMap)
-    const int P = static_cast<int>(x.size()), W = static_cast<int>(mu.path.wraps.size());
+    const int W = static_cast<int>(mu.path.wraps.size());
     std::vector<SurfaceFrameState> frames(W);
-    VecX v(3 * P + 6 * W);
-    v.head(3 * P) = stackPoints(xdot);
     for (int w = 0; w < W; ++w) {
       const PathWrap& pw = mu.path.wraps[w];
       const SimTK::MobilizedBody& S = pw.body >= 0 ? sm_.mobods[pw.body] : sm_.matter.getGround();
@@ -341,10 +331,9 @@ void ParticleMuscles::placeParticles(SimTK::State& sb) const {
       frames[w].p = fromSimTKVec3(X_GS.p());
       frames[w].omega = fromSimTKVec3(S.getBodyAngularVelocity(sb));
       frames[w].pdot = fromSimTKVec3(S.findStationVelocityInGround(sb, X_bs.p()));
-      v.segment<6>(3 * P + 6 * w) << frames[w].omega, frames[w].pdot;
     }
     calcGeneralPathMap(mu, active, x, nullptr, frames, map);
-    const VecX xdot_a = map.J * v;
+    const VecX xdot_a = map.J * stackGeneralVelocities(xdot, frames);
     for (int a = 0; a < mu.mass_points.size(); ++a) {
       x_p[first_particle_[m] + a] = toSimTKVec3(map.x_a[a]);
       v_p[first_particle_[m] + a] = toSimTKVec3(xdot_a.segment<3>(3 * a));

@@ -112,14 +112,6 @@ Inputs inputsAt(const Scene& sc, const std::vector<int>& active, double t, bool 
   return in;
 }
 
-VecX velocityVector(const Inputs& in) {
-  const int P = static_cast<int>(in.x.size()), W = static_cast<int>(in.frames.size());
-  VecX v(3 * P + 6 * W);
-  v.head(3 * P) = stackPoints(in.xdot);
-  for (int w = 0; w < W; ++w) v.segment<6>(3 * P + 6 * w) << in.frames[w].omega, in.frames[w].pdot;
-  return v;
-}
-
 const std::vector<std::vector<int>> kActiveSets{{0, 1, 2, 3}, {0, 1, 3}};
 
 TEST(GeneralPathMap, JacobianMatchesCentralDifferences) {
@@ -187,7 +179,7 @@ TEST(GeneralPathMap, BiasMatchesCentralDifferences) {
       const Inputs d = inputsAt(sc, active, t, false);
       GeneralPathMap m2;
       calcGeneralPathMap(sc.mu, active, d.x, nullptr, d.frames, m2);
-      return VecX(m2.J * velocityVector(d));
+      return VecX(m2.J * stackGeneralVelocities(d.xdot, d.frames));
     };
     const VecX bias_fd = (Jv(h) - Jv(-h)) / (2.0 * h);
     const double err = (map.bias - bias_fd).cwiseAbs().maxCoeff(), peak = bias_fd.cwiseAbs().maxCoeff();
