@@ -8,7 +8,7 @@
 //     to 1e-13 of the peak (same arithmetic, only the lookups differ) and, for Types I and II,
 //     T^T f_u == core M_muscle qddot - f_muscle to 1e-9;
 //   - set F (gait10dof18musc) with 80% of tibia_r's mass in its muscles, at random states;
-//   - the map is checked: wrong sizes, a path body or coordinate the system lacks.
+//   - the map is checked: wrong sizes, a path body, coordinate or wrap body the system lacks.
 #include "plugin/opensim/matter_muscle_inertia.hpp"
 
 #include <gtest/gtest.h>
@@ -299,6 +299,22 @@ TEST(MatterMuscleInertia, RejectsMapsThatDoNotFit) {
   Muscle lumped = mu;
   lumped.mass_points = MassPoints();
   EXPECT_NO_THROW(opensim::MatterMuscleInertia(sm->matter, no_body, m, {lumped}, m.gravity));
+  // a wrap surface on a body the system lacks (its points elsewhere): refused, naming the wrap
+  Muscle wrapped = mu;
+  wrapped.path.points = {makeFixedPoint(-1, Vec3(0.1, 0, 0)), makeFixedPoint(0, Vec3(0, -0.5, 0))};
+  PathWrap w;
+  w.name = "drum_on_link2";
+  w.surface = WrapSurface::makeCylinder(0.03, 1.0);
+  w.body = 1;
+  wrapped.path.wraps = {w};
+  wrapped.path.num_wraps = 1;
+  EXPECT_NO_THROW(opensim::MatterMuscleInertia(sm->matter, good, m, {wrapped}, m.gravity));
+  try {
+    opensim::MatterMuscleInertia(sm->matter, no_body, m, {wrapped}, m.gravity);
+    ADD_FAILURE() << "a wrap body outside the system was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("drum_on_link2"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
