@@ -51,7 +51,8 @@ std::vector<std::pair<std::string, double>> parseMassList(const std::string& tex
 int runSimulate(const std::vector<std::string>& argv) {
   const Args a(argv,
                withMuscleMassFlags({"model", "duration", "integrator", "dt", "rtol", "atol", "max-step", "initial",
-                                    "initial-time", "wrap", "output-dt", "out", "muscle-mass-kg", "impulse", "engine"}),
+                                    "initial-time", "wrap", "output-dt", "out", "muscle-mass-kg", "impulse", "engine",
+                                    "simbody-method", "simbody-norm"}),
                {"no-qvv", "progress", "quiet", "full-precision"});
   if (!a.positionals().empty())
     throw UsageError{"simulate takes no positional arguments (got '" + a.positionals().front() + "')"};
@@ -61,6 +62,7 @@ int runSimulate(const std::vector<std::string>& argv) {
   const std::string model_path = *a.get("model"), out_path = *a.get("out");
   const std::string engine = a.get("engine", "core");
   if (engine != "core" && engine != "simbody") throw UsageError{"--engine must be core or simbody, got '" + engine + "'"};
+  const SimbodyEngineFlags simbody_flags = parseSimbodyEngineFlags(a, engine);
 
   validation::SimulateOptions so;
   so.duration = a.getDouble("duration", 0.0);
@@ -174,7 +176,7 @@ int runSimulate(const std::vector<std::string>& argv) {
   validation::SimulationResult res;
   if (engine == "simbody") {
     try {
-      res = simulateSimbody(model, initial, so);
+      res = simulateSimbody(model, initial, so, simbody_flags);
     } catch (const std::invalid_argument& e) {
       std::cerr << "error: " << model_path << ": --engine simbody: " << e.what() << "\n";
       return 2;
@@ -208,6 +210,9 @@ int runSimulate(const std::vector<std::string>& argv) {
     }
     std::ostringstream desc;
     desc << "redmax simulate: model " << model_path << ", engine " << engine << ", integrator " << so.integrator;
+    if (!simbody_flags.method.empty() || simbody_flags.infinity_norm)
+      desc << " (Simbody " << (simbody_flags.method.empty() ? "default" : simbody_flags.method) << ", "
+           << (simbody_flags.infinity_norm ? "inf" : "rms") << " norm)";
     if (so.integrator == "rk45" || so.integrator == "cvode")
       desc << " (rtol " << io.rtol << ", atol " << io.atol << ")";
     else
@@ -223,7 +228,7 @@ int runSimulate(const std::vector<std::string>& argv) {
   if (!quiet) {
     std::printf("simulate: %g s with %s (engine %s): %ld steps, %ld rhs evaluations, %ld failed steps, %.3f s wall, "
                 "%.3f s CPU; energy %.10g -> %.10g J, drift %.3e relative (%.3e J) -> %s\n",
-                so.duration, so.integrator.c_str(), engine.c_str(), res.stats.steps, res.stats.rhs_evals,
+                so.duration, (simbody_flags.method.empty() ? so.integrator : simbody_flags.method).c_str(), engine.c_str(), res.stats.steps, res.stats.rhs_evals,
                 res.stats.failed_steps, res.wall_s, cpu_s, res.energy_initial, res.energy_final, res.energy_drift_rel, res.energy_drift_abs,
                 out_path.c_str());
   }
@@ -243,7 +248,8 @@ CommandRegistration reg(
      "                       [--initial STATE.sto [--initial-time T]]\n"
      "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
      "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
-     "                       [--engine core|simbody] [--progress] [--quiet] [--full-precision]\n"
+     "                       [--engine core|simbody [--simbody-method M] [--simbody-norm rms|inf]]\n"
+     "                       [--progress] [--quiet] [--full-precision]\n"
      "Integrates the model under gravity from its default pose (each coordinate's default_value and\n"
      "default_speed_value) with its constraints (locked, coupled and prescribed coordinates, welds).\n"
      "  --integrator NAME    euler (semi-implicit, fixed step), symplectic (variational Euler), bdf1\n"
@@ -266,6 +272,7 @@ CommandRegistration reg(
      "                       per muscle); --integrator rk45 (RungeKuttaMerson) or cvode (CPodes), --rtol is\n"
      "                       Simbody's accuracy, --atol its constraint tolerance; no core constraints,\n"
      "                       --impulse or --no-qvv; same output columns (Simbody's energies)\n"
+     + std::string(simbodyEngineFlagsUsage()) +
      "  --progress           progress on stderr (otherwise shown once a run takes over 2 s)\n"
      "  --full-precision     write %.16e instead of %16.8lf (restarts from the file are then exact)\n"
      "Output: time, /jointset/<joint>/<coord>/value and .../speed for every coordinate (radians, SI),\n"

@@ -23,9 +23,10 @@ ParticleSimulation::ParticleSimulation(const Model& model, std::vector<Muscle> m
   Impl& m = *impl_;
   if (!(options.accuracy > 0.0) || !(options.constraint_tolerance > 0.0))
     throw std::invalid_argument("particle simulation: accuracy and constraint tolerance must be positive");
-  if (options.integrator != "merson" && options.integrator != "feldberg" && options.integrator != "cpodes")
+  if (options.integrator != "merson" && options.integrator != "feldberg" && options.integrator != "rk3" &&
+      options.integrator != "verlet" && options.integrator != "cpodes")
     throw std::invalid_argument("particle simulation: unknown integrator '" + options.integrator +
-                                "' (merson, feldberg or cpodes)");
+                                "' (merson, feldberg, rk3, verlet or cpodes)");
   if (!(options.max_step >= 0.0)) throw std::invalid_argument("particle simulation: negative maximum step");
   m.model = model;
   m.sm = makeSimbodyModel(model);
@@ -37,11 +38,16 @@ ParticleSimulation::ParticleSimulation(const Model& model, std::vector<Muscle> m
     m.integ = std::make_unique<SimTK::RungeKuttaMersonIntegrator>(m.sm->system);
   else if (options.integrator == "feldberg")
     m.integ = std::make_unique<SimTK::RungeKuttaFeldbergIntegrator>(m.sm->system);
+  else if (options.integrator == "rk3")
+    m.integ = std::make_unique<SimTK::RungeKutta3Integrator>(m.sm->system);
+  else if (options.integrator == "verlet")
+    m.integ = std::make_unique<SimTK::VerletIntegrator>(m.sm->system);
   else
     m.integ = std::make_unique<SimTK::CPodesIntegrator>(m.sm->system, SimTK::CPodes::BDF, SimTK::CPodes::Newton);
   m.integ->setAccuracy(options.accuracy);
   if (options.max_step > 0.0) m.integ->setMaximumStepSize(options.max_step);
   m.integ->setConstraintTolerance(options.constraint_tolerance);
+  m.integ->setUseInfinityNorm(options.infinity_norm);
   m.stepper = std::make_unique<SimTK::TimeStepper>(m.sm->system, *m.integ);
   m.stepper->initialize(st);
   m.state = m.particles->coreState(model, m.stepper->getState());

@@ -257,65 +257,7 @@ TEST(SimbodyParticleSimulation, EnergyMatchesCoreAndIsConserved) {
   std::printf("  particle simulation: energy drift %.3e J of %.3f J over 1 s, %ld steps\n", drift, E0, sim.steps());
 }
 
-// the finger scene (osim_models/finger.osim): FDP (7 points) and FDS (6 points), 0.2 kg each over
-// 5 fibre points, falling from the default pose under gravity for 0.3 s (1 s costs Simbody ~30 s of
-// CPU). The fibre points stay in their segments (checked with the core every 10 ms), so the
-// particles can follow them exactly.
-TEST(SimbodyParticleMuscles, FingerMatchesCoreRk45) {
-  const osim::ModelDescription d = osim::readOsimModel(std::string(REDMAX_SOURCE_DIR) + "/osim_models/finger.osim");
-  osim::BuildOptions bo;
-  bo.constraints = false;
-  const osim::BuildResult r = osim::buildCoreModel(d, bo);
-  const Model& m = r.model;
-  MassPointOptions mpo;
-  mpo.count = 5;
-  const std::vector<Muscle> muscles =
-      osim::addMusclePointMasses(r.muscles, std::vector<double>(r.muscles.size(), 0.2), mpo);
-  State s0;
-  s0.t = 0.0;
-  s0.q = VecX(m.nr());
-  for (int c = 0; c < m.nr(); ++c) s0.q[c] = d.coordinates[c].default_value;
-  s0.qdot = VecX::Zero(m.nr());
-  {
-    System sys(m);
-    sys.addTerm(std::make_shared<MuscleTerm>(m, muscles));
-    IntegratorOptions o;
-    o.rtol = 1e-10;
-    o.atol = 1e-12;
-    auto integ = makeIntegrator("rk45", o);
-    State s = s0;
-    std::vector<std::vector<int>> seg0;
-    for (int k = 0; k <= 30; ++k) {
-      integ->advance(sys, s, 0.01 * k);
-      SkeletonWorkspace sk(m);
-      calcKinematics(m, s, sk);
-      MuscleWorkspace ws(m, muscles);
-      calcMuscleKinematics(m, s, sk, muscles, ws);
-      for (size_t j = 0; j < muscles.size(); ++j) {
-        if (k == 0) seg0.push_back(ws.muscles[j].segment);
-        ASSERT_EQ(ws.muscles[j].segment, seg0[j]) << muscles[j].name << ": a mass point crossed a via point at t = " << s.t;
-      }
-    }
-  }
-  const std::vector<double> times{0.1, 0.2, 0.3};
-  double core_s = 0.0;
-  const std::vector<VecX> q_core = coreTrajectory(m, muscles, s0, core_s, times);
-  simbody::ParticleSimulationOptions opt;
-  opt.accuracy = 1e-11;
-  opt.constraint_tolerance = 1e-12;
-  const std::clock_t t0 = std::clock();
-  simbody::ParticleSimulation sim(m, muscles, s0, opt);
-  double worst = 0.0;
-  for (size_t k = 0; k < times.size(); ++k) {
-    sim.advance(times[k]);
-    worst = std::max(worst, (sim.state().q - q_core[k]).cwiseAbs().maxCoeff());
-    EXPECT_LT((sim.state().q - q_core[k]).cwiseAbs().maxCoeff(), 1e-6) << "t = " << times[k];
-  }
-  EXPECT_GT((q_core.back() - s0.q).cwiseAbs().maxCoeff(), 1e-2);  // it moved
-  const double sb_s = double(std::clock() - t0) / CLOCKS_PER_SEC;
-  std::printf("  finger, particles vs core rk45 over 0.3 s: max |dq| %.3e rad; CPU: simbody %.3f s (%ld steps), core %.3f s\n",
-              worst, sb_s, sim.steps(), core_s);
-}
+// the finger scene over 1 s: tests/plugin/particle_finger_test.cpp
 
 TEST(SimbodyParticleMuscles, RejectsConditionalPoints) {
   const Model m = scenes::doublePendulum();
