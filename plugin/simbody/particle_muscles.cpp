@@ -81,7 +81,7 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       x_[i] = fromSimTKVec3(findStationLocation(X_AB, point_cb_[i], toSimTKVec3(x_b_[i])));
     }
     for (size_t w = 0; w < frames_.size(); ++w) setPose(w, X_AB[surface_cb_[w]]);
-    calcGeneralPathMap(mu_, active_, x_, nullptr, frames_, map_);
+    mapPositions();
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& p = X_AB[particle_cb_[a]].p();
       for (int k = 0; k < 3; ++k) perr[3 * a + k] = p[k] - map_.x_a[a][k];
@@ -106,7 +106,7 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       frames_[w].omega = fromSimTKVec3(getBodyAngularVelocity(V_AB, surface_cb_[w]));
       frames_[w].pdot = fromSimTKVec3(findStationVelocity(s, V_AB, surface_cb_[w], X_bs_[w].p()));
     }
-    calcGeneralPathMap(mu_, active_, x_, nullptr, frames_, map_);
+    mapPositions();
     const VecX xdot_a = map_.J * stackGeneralVelocities(xdot_, frames_);
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& v = V_AB[particle_cb_[a]][1];
@@ -147,6 +147,7 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
           fromSimTKVec3(findStationAcceleration(s, A_AB, cb, X_bs_[w].p()));
     }
     calcGeneralPathMap(mu_, active_, x_, &xdot_, frames_, map_);
+    keyMap();
     const VecX a_a = map_.J * vdot + map_.bias;
     for (int a = 0; a < mp_.size(); ++a) {
       const SimTK::Vec3& acc = A_AB[particle_cb_[a]][1];
@@ -163,7 +164,7 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], toSimTKVec3(x_b_[i])));
     }
     for (size_t w = 0; w < frames_.size(); ++w) setPose(w, getBodyTransformFromState(s, surface_cb_[w]));
-    calcGeneralPathMap(mu_, active_, x_, nullptr, frames_, map_);
+    mapPositions();
     // G^T lambda with G = (I on the particles, -J on v): forces at the path points and, per wrap,
     // a torque and a force at its surface origin
     VecX l(3 * mp_.size());
@@ -187,6 +188,22 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
 
  private:
   bool moving(size_t i) const { return cm_[i].isValid(); }
+  // the position-level map (x_a, J) for x_ and the frames' poses. Simbody asks for it once per
+  // constraint row while it assembles G M^-1 G^T (30 rows on the finger), always at the same
+  // positions: reuse the last map when its inputs are bit-identical (it is a function of them)
+  void mapPositions() const {
+    bool same = map_valid_ && map_x_ == x_ && map_frames_.size() == frames_.size();
+    for (size_t w = 0; same && w < frames_.size(); ++w)
+      same = map_frames_[w].R == frames_[w].R && map_frames_[w].p == frames_[w].p;
+    if (same) return;
+    calcGeneralPathMap(mu_, active_, x_, nullptr, frames_, map_);
+    keyMap();
+  }
+  void keyMap() const {
+    map_x_ = x_;
+    map_frames_ = frames_;
+    map_valid_ = true;
+  }
   // surface frame w's pose from its body's pose X_AB (ancestor = Ground)
   void setPose(size_t w, const SimTK::Transform& X_AB) const {
     const SimTK::Transform X_AS = X_AB * X_bs_[w];
@@ -220,6 +237,10 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   std::vector<SimTK::Transform> X_bs_;
   mutable std::vector<SurfaceFrameState> frames_;
   mutable GeneralPathMap map_;
+  // the inputs map_ was computed for (mapPositions)
+  mutable bool map_valid_ = false;
+  mutable std::vector<Vec3> map_x_;
+  mutable std::vector<SurfaceFrameState> map_frames_;
 };
 
 }  // namespace
