@@ -264,7 +264,8 @@ int runCompare(const Args& a) {
   // of end points shared by the muscle's mass points, as the runtime does (calcExactWrapPointsFd:
   // 1 + 12 + 24 wraps per muscle)
   {
-    CompareRow row{"exact library + central differences", 0};
+    CompareRow row;
+    row.method = "exact library + central differences";
     const double h = 1e-6;
     std::vector<Vec3> xp(points), xm(points);
     auto evalAll = [&](const WrapSurface& s, const Vec3& p1, const Vec3& p2, std::vector<Vec3>& xs) {
@@ -304,7 +305,8 @@ int runCompare(const Args& a) {
 
   // smooth model
   {
-    CompareRow row{"smooth model (width " + num(width, 3) + " size)", 0};
+    CompareRow row;
+    row.method = "smooth model (width " + num(width, 3) + " size)";
     std::vector<Vec3> x(total_points);
     // the band in units of the surface's size (radius, tube radius, smallest semi-axis)
     auto bandOf = [&](const WrapSurface& s) {
@@ -363,7 +365,9 @@ int runCompare(const Args& a) {
       }
     }
     const bool untrained = name.find("untrained") != std::string::npos;
-    CompareRow row{"network " + name, net.parameterCount()};
+    CompareRow row;
+    row.method = "network " + name;
+    row.parameters = net.parameterCount();
     if (!untrained) errors(x, row);
     row.us_per_point = timePerPoint([&] {
       for (long m = 0; m < muscles; ++m) {

@@ -24,8 +24,6 @@
 namespace redmax::osim {
 namespace {
 
-bool nearRel(const MatX& A, const MatX& B, double tol) { return (A - B).norm() <= tol * (1.0 + B.norm()); }
-
 // the shape supported before general paths: two points, one wrap covering their segment, a
 // surface the smooth model takes
 bool oldShape(const Muscle& mu) {

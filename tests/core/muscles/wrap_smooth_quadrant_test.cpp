@@ -25,7 +25,7 @@ ScanResult scan(const WrapSurface& s, const std::function<Vec3(double)>& p1, con
   ScanResult r;
   const SmoothWrapOptions opt{width};
   for (double alpha : {0.15, 0.5, 0.85}) {
-    Vec3 xs_prev, xe_prev;
+    Vec3 xs_prev = Vec3::Zero(), xe_prev = Vec3::Zero();
     for (int i = 0; i <= n; ++i) {
       const double t = static_cast<double>(i) / n;
       const Vec3 a = p1(t), b = p2(t);
