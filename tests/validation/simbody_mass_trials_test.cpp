@@ -1,6 +1,8 @@
 // Core vs Simbody with muscle inertia on the real trials (issue 8): sets E (gait2392, subject01
 // walk, 21 muscles span tibia_r) and F (gait10dof18musc, 6 muscles), each at 0%, 20% and 80% of
-// tibia_r's mass moved into its muscles, through `redmax validate`'s library (runIdValidation):
+// tibia_r's mass moved into its muscles, and with physiological mass in every muscle (E: 11.5 kg
+// in 92 muscles, the wrapping ones over the smooth wrap model), through `redmax validate`'s library
+// (runIdValidation):
 // every column at every frame, |core - simbody| <= 1e-9 of the column peak (absolute floor
 // 1e-10 N m). Debian's Simbody rejects gait2392's toe inertias; both engines then solve the model
 // with OpenSim's isotropic fallback for them (validation/simbody_cross_check.hpp), and the run
@@ -96,9 +98,35 @@ class SimbodyMassTrials : public PendulumCliTest {
                   tr.toes ? " (toes with OpenSim's fallback inertia in both engines)" : "");
     }
   }
+
+  // physiological mass in every muscle (set E: wrapping muscles over the smooth wrap model)
+  void checkPhysiological(const Trial& tr) {
+    for (const auto& f : {tr.setup, tr.model})
+      if (!fs::exists(f)) GTEST_SKIP() << "shared OpenSim data not found: " << f << " (needs ../shared/opensim)";
+    redmax::validation::IdValidationOptions opt;
+    opt.settings.setup_file = tr.setup;
+    opt.settings.model_file = tr.model;
+    opt.report_dir = (dir_ / (std::string(tr.name) + "phys")).string();
+    opt.gnuplot = "none";
+    opt.muscle_mass.source = MuscleMassOptions::Source::Physiological;
+    const auto r = redmax::validation::runIdValidation(opt);
+    ASSERT_TRUE(r.has_inertial_effect);
+    const auto& ie = r.inertial_effect;
+    ASSERT_TRUE(ie.simbody_ran) << ie.simbody_skipped;
+    EXPECT_TRUE(ie.simbody_check.passed);
+    EXPECT_LE(worstMaxRel(ie.simbody_check), 1e-9);
+    EXPECT_GT(ie.muscles_with_mass, 10);
+    std::printf("[ measured ] set %s, physiological (%.2f kg in %d muscles): core vs simbody max/peak %.3g\n", tr.name,
+                ie.muscle_mass, ie.muscles_with_mass, worstMaxRel(ie.simbody_check));
+  }
 };
 
 TEST_F(SimbodyMassTrials, SetFAgreesAtZeroTwentyAndEightyPercent) { check(setF()); }
+
+TEST_F(SimbodyMassTrials, SetsEAndFAgreeWithPhysiologicalMassInEveryMuscle) {
+  checkPhysiological(setE());
+  checkPhysiological(setF());
+}
 
 TEST_F(SimbodyMassTrials, SetEAgreesAtZeroTwentyAndEightyPercentWithTheToeFallback) { check(setE()); }
 
