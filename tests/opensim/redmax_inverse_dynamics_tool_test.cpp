@@ -205,6 +205,34 @@ TEST_P(PluginOnSet, TransferAgreesWithRedmaxId) {
               set.name.c_str(), set.transfer_body.c_str(), effect, worst_abs, worst_rel, worst_mass, peak_mass);
 }
 
+// physiological mass in every muscle (wrapping muscles over the smooth wrap model, also on OpenSim's
+// Simbody): the mass points' share of the plugin's torques equals redmax id's
+TEST_P(PluginOnSet, PhysiologicalMassAgreesWithRedmaxId) {
+  const IdSet set = GetParam();
+  SKIP_WITHOUT(set);
+  const fs::path dir = tempDir("physiological_" + set.name);
+  const osim::Storage p0 = runPlugin(writeSetup(set, dir, "RedmaxInverseDynamicsTool", "p0.sto", kFull));
+  const osim::Storage pp = runPlugin(writeSetup(set, dir, "RedmaxInverseDynamicsTool", "pp.sto",
+                                                std::string("    <muscle_mass>physiological</muscle_mass>\n") + kFull));
+  const std::string plain = writeSetup(set, dir, "InverseDynamicsTool", "unused.sto");
+  osim::MuscleMassOptions mm;
+  const osim::Storage r0 = runRedmaxId(plain, mm);
+  mm.source = osim::MuscleMassOptions::Source::Physiological;
+  const osim::Storage rp = runRedmaxId(plain, mm);
+  osim::Storage dp = pp, dr = rp;
+  dp.data -= p0.data;
+  dr.data -= r0.data;
+  double worst_mass = 0.0, peak_mass = 0.0;
+  for (const ColumnDiff& d : compare(dp, dr)) {
+    EXPECT_LE(d.max_abs, 1e-8 * std::max(1.0, d.peak)) << d.label;
+    worst_mass = std::max(worst_mass, d.max_abs);
+    peak_mass = std::max(peak_mass, d.peak);
+  }
+  EXPECT_GT(peak_mass, 1e-3);  // the mass points matter
+  std::printf("set %s, physiological: mass part plugin vs redmax id max abs %.3g (peak %.4g)\n", set.name.c_str(),
+              worst_mass, peak_mass);
+}
+
 INSTANTIATE_TEST_SUITE_P(Sets, PluginOnSet, ::testing::Values(setA(), setE(), setF()),
                          [](const ::testing::TestParamInfo<IdSet>& i) { return i.param.name; });
 
