@@ -23,8 +23,8 @@ struct ParticleSimulationOptions {
   double constraint_tolerance = 1e-10;  ///< path constraints (m, m/s)
   double max_step = 0.0;              ///< s; > 0 caps the step size (Integrator::setMaximumStepSize)
   /// Simbody's step error norm: false = its default RMS over all q (and over all u), the
-  /// particles' included, which dilutes a skeleton coordinate's error by sqrt(n_q / n_skeleton);
-  /// true = the largest weighted component (Integrator::setUseInfinityNorm)
+  /// particles' included, so one skeleton coordinate's error is averaged with theirs; true = the
+  /// largest weighted component (Integrator::setUseInfinityNorm)
   /// The finger (FDP, FDS 0.2 kg over 5 points each, 1 s) reaches 1e-6 rad against the core with
   /// the least CPU as feldberg, infinity_norm, accuracy 3e-12, constraint_tolerance 3e-13.
   bool infinity_norm = false;
