@@ -162,6 +162,22 @@ TEST_P(PluginOnSet, ZeroMassIsOpenSimsOwnInverseDynamics) {
   std::printf("set %s, no muscle mass: plugin vs OpenSim's InverseDynamicsTool, max abs diff %.3g\n", set.name.c_str(), worst);
 }
 
+// the mass points' share of the torques (with mass minus without: differences of differences) of
+// the plugin against redmax id's, every column to 1e-8 of its peak; returns (worst, largest peak)
+std::pair<double, double> compareMassShare(const osim::Storage& plugin_mass, const osim::Storage& plugin_zero,
+                                           const osim::Storage& redmax_mass, const osim::Storage& redmax_zero) {
+  osim::Storage dp = plugin_mass, dr = redmax_mass;
+  dp.data -= plugin_zero.data;
+  dr.data -= redmax_zero.data;
+  double worst = 0.0, peak = 0.0;
+  for (const ColumnDiff& d : compare(dp, dr)) {
+    EXPECT_LE(d.max_abs, 1e-8 * std::max(1.0, d.peak)) << d.label;
+    worst = std::max(worst, d.max_abs);
+    peak = std::max(peak, d.peak);
+  }
+  return {worst, peak};
+}
+
 // at 80% transfer the plugin (mass points on OpenSim's Simbody) agrees with `redmax id` (the
 // converter's tool with the core engine: the core's kinematics)
 TEST_P(PluginOnSet, TransferAgreesWithRedmaxId) {
@@ -189,17 +205,8 @@ TEST_P(PluginOnSet, TransferAgreesWithRedmaxId) {
     worst_abs = std::max(worst_abs, d.max_abs);
     worst_rel = std::max(worst_rel, d.max_abs / std::max(1e-300, d.peak));
   }
-  // ... and on the muscle-mass part alone (differences of differences): the same mass points moved
-  // by OpenSim's Simbody and by the core
-  osim::Storage dp = p80, dr = r80;
-  dp.data -= p0.data;
-  dr.data -= r0.data;
-  double worst_mass = 0.0, peak_mass = 0.0;
-  for (const ColumnDiff& d : compare(dp, dr)) {
-    EXPECT_LE(d.max_abs, 1e-8 * std::max(1.0, d.peak)) << d.label;
-    worst_mass = std::max(worst_mass, d.max_abs);
-    peak_mass = std::max(peak_mass, d.peak);
-  }
+  // ... and on the muscle-mass part alone: the same mass points moved by OpenSim's Simbody and by the core
+  const auto [worst_mass, peak_mass] = compareMassShare(p80, p0, r80, r0);
   std::printf("set %s, 80%% %s transfer: largest effect of the mass %.4g; plugin vs redmax id max abs %.3g, "
               "max rel (of column peak) %.3g; mass part alone max abs %.3g (peak %.4g)\n",
               set.name.c_str(), set.transfer_body.c_str(), effect, worst_abs, worst_rel, worst_mass, peak_mass);
@@ -219,15 +226,7 @@ TEST_P(PluginOnSet, PhysiologicalMassAgreesWithRedmaxId) {
   const osim::Storage r0 = runRedmaxId(plain, mm);
   mm.source = osim::MuscleMassOptions::Source::Physiological;
   const osim::Storage rp = runRedmaxId(plain, mm);
-  osim::Storage dp = pp, dr = rp;
-  dp.data -= p0.data;
-  dr.data -= r0.data;
-  double worst_mass = 0.0, peak_mass = 0.0;
-  for (const ColumnDiff& d : compare(dp, dr)) {
-    EXPECT_LE(d.max_abs, 1e-8 * std::max(1.0, d.peak)) << d.label;
-    worst_mass = std::max(worst_mass, d.max_abs);
-    peak_mass = std::max(peak_mass, d.peak);
-  }
+  const auto [worst_mass, peak_mass] = compareMassShare(pp, p0, rp, r0);
   EXPECT_GT(peak_mass, 1e-3);  // the mass points matter
   std::printf("set %s, physiological: mass part plugin vs redmax id max abs %.3g (peak %.4g)\n", set.name.c_str(),
               worst_mass, peak_mass);
