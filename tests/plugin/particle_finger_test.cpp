@@ -11,9 +11,9 @@
 //     tolerance;
 //   - MatchesCoreOverOneSecond: Simbody's RungeKuttaFeldberg with the infinity error norm at
 //     accuracy 3e-12 (constraint tolerance 3e-13) agrees with the core (rk45 rtol 1e-12) to 1e-6 rad
-//     at every 0.1 s up to 1 s (measured 7e-8) and to 2e-5 rad/s in speed (of a peak of 80 rad/s);
-//     the fibre points never cross a via point on the way (checked every 10 ms), which constrained
-//     particles could not follow. CPU times are printed, not asserted.
+//     at every 0.1 s up to 1 s (measured 6.1e-8) and to 2e-5 rad/s in speed (measured 3.2e-6, peak
+//     80 rad/s); the fibre points never cross a via point on the way (checked every 10 ms), which
+//     constrained particles could not follow. CPU times are printed, not asserted.
 #include <gtest/gtest.h>
 
 #include <cstdio>
