@@ -379,7 +379,8 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
         co.missing_columns_fail = true;
         ie.simbody_check =
             compareTables("core_mass_vs_simbody_mass", core_mass_same, "core_mass", sbm_result, "simbody_mass", co);
-        addSimbodyMassCheck(ie.simbody_check, core_mass_same, sbm_result, report);
+        ie.simbody_not_counted = simbodyMassCheckNotCountedReason(opt.muscle_mass, mass_engine.wrap);
+        addSimbodyMassCheck(ie.simbody_check, core_mass_same, sbm_result, report, ie.simbody_not_counted);
       } catch (const std::exception& e) {
         ie.simbody_skipped = e.what();
         r.warnings.push_back(std::string("simbody with muscle inertia: ") + e.what());
@@ -467,7 +468,7 @@ std::string formatIdValidationSummary(const IdValidationResult& r) {
       os << ": largest " << m.name << " max/peak " << fmt("%.3g", m.max_rel) << " rms/peak " << fmt("%.3g", m.rms_rel);
     }
     os << " (measured, not pass/fail)\n";
-    if (ie.simbody_ran) os << formatSimbodyMassCheck(ie.simbody_check);
+    if (ie.simbody_ran) os << formatSimbodyMassCheck(ie.simbody_check, ie.simbody_not_counted);
   }
   if (r.has_mass_sweep) os << formatMassSweepSummary(r.mass_sweep);
   os << "validate: " << (r.passed ? "PASS" : "FAIL") << "\n";

@@ -22,7 +22,8 @@
 // reproduces the zero-mass result) can fail. In both cases, when the Simbody engine runs, Simbody
 // with muscle inertia (plugin/simbody, the same model and mass points) solves the muscle-mass
 // trial (the sweep's largest value) too: core_mass_vs_simbody_mass at the engine tolerance, a
-// cross-check that is recorded (summary.simbody_mass_check) but not counted in the verdict.
+// check in the verdict (summary.simbody_mass_check), recorded only when wrapping muscles carry
+// mass over the exact wrap model (simbodyMassCheckNotCountedReason).
 #include <limits>
 #include <string>
 #include <vector>
@@ -77,7 +78,8 @@ struct InertialEffect {
   std::vector<ColumnMetrics> metrics;  ///< every column, table order
   int largest = -1;            ///< the column with the largest max_rel (-1 if none)
   bool simbody_ran = false;    ///< Simbody with muscle inertia solved it too
-  Comparison simbody_check;    ///< core_mass_vs_simbody_mass: recorded, not counted
+  Comparison simbody_check;    ///< core_mass_vs_simbody_mass: counted unless simbody_not_counted says why
+  std::string simbody_not_counted;
   std::string simbody_skipped; ///< why not, when the zero-mass Simbody ran but this one failed
   std::string simbody_note;    ///< the inertia fallback both engines needed for it ("" when none)
 };

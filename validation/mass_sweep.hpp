@@ -137,9 +137,8 @@ struct MassSweepPoint {
 };
 
 /// The Simbody engine with muscle inertia (plugin/simbody) at the sweep's largest value, solved on
-/// the same inputs and compared with the core at that value: an engine cross-check, recorded
-/// (addSimbodyMassCheck) but not counted in the verdict (the sweep is a measurement; the core's
-/// muscle share is checked against Lagrange's equations in tests/validation/mass_sweep_test.cpp).
+/// the same inputs and compared with the core at that value: an engine cross-check
+/// (addSimbodyMassCheck), counted in the verdict unless simbodyMassCheckNotCountedReason says why not.
 struct MassSweepSimbodyCheck {
   bool ran = false;
   bool failed = false;     ///< it was built but failed on a frame
@@ -151,6 +150,7 @@ struct MassSweepSimbodyCheck {
   /// on that same model at this value, and the note that says so; empty otherwise
   osim::Storage core_result;
   std::string note;
+  std::string not_counted;  ///< simbodyMassCheckNotCountedReason at this value ("" = counted)
   /// the core torques this check compares with: core_result, or the sweep's own at this value
   const osim::Storage& coreTorques(const osim::Storage& sweep_value) const {
     return core_result.numRows() > 0 ? core_result : sweep_value;
@@ -181,14 +181,22 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
 /// check (summary.checks; it fails the run when violated).
 void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_mass, Report& report);
 
-/// Record an engine cross-check with muscle mass (core_mass_vs_simbody_mass) without counting it in
-/// the verdict: <name>_metrics.csv (per column, PASS/DIFFERS against its tolerance), an overlay
-/// <name>_overlay, summary.json "simbody_mass_check" and a report.md section.
-void addSimbodyMassCheck(const Comparison& c, const osim::Storage& core_mass, const osim::Storage& simbody_mass,
-                         Report& report);
+/// Why core vs Simbody with muscle mass does not count in the verdict, "" when it does. It counts
+/// unless wrapping muscles carry mass over the exact wrap model: both engines then take its J by
+/// finite differences, in different variables (the core in q over OpenSim's whole path, Simbody in
+/// the path points and surface frames), and agree only to the differences' truncation error
+/// (2.7e-8 of the peak on the running leg), not to round-off.
+std::string simbodyMassCheckNotCountedReason(const osim::MuscleMassOptions& options, const osim::WrapMassCount& wrap);
 
-/// One line for a recorded cross-check: "<name>: worst COL max/peak X -> agrees | DIFFERS (recorded, not counted)".
-std::string formatSimbodyMassCheck(const Comparison& c);
+/// Record an engine cross-check with muscle mass (core_mass_vs_simbody_mass): <name>_metrics.csv
+/// (per column, PASS/DIFFERS against its tolerance), an overlay <name>_overlay, summary.json
+/// "simbody_mass_check", a report.md section, and, when `not_counted` is empty, a check in the
+/// verdict (summary.checks: a disagreement fails the run); otherwise the reason is recorded.
+void addSimbodyMassCheck(const Comparison& c, const osim::Storage& core_mass, const osim::Storage& simbody_mass,
+                         Report& report, const std::string& not_counted = "");
+
+/// One line: "<name>: worst COL max/peak X -> agrees | DIFFERS" and "(not counted: ...)" when not counted.
+std::string formatSimbodyMassCheck(const Comparison& c, const std::string& not_counted = "");
 
 /// The wrapping muscles at the sweep's largest value in one line per reason: "wrapping (Type III):
 /// W of N carry mass" then "  lumped K: REASON (names...)" (names up to 6 per reason). Empty when

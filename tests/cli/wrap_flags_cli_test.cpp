@@ -253,7 +253,7 @@ TEST_F(WrapFlagsCli, IdEnginesTakeWrapMassAlike) {
 // `redmax validate --mass-sweep` with the default wrap mass: the sweep's report says how many
 // wrapping muscles carry mass (summary.json mass_sweep.wrapping), the zero check holds, and Simbody
 // with muscle inertia (which takes the gastrocnemii's origin -> wrap -> insertion) agrees with the
-// core at the largest value within its tolerance (recorded, not counted)
+// core at the largest value within its tolerance (counted in the verdict)
 TEST_F(WrapFlagsCli, ValidateSweepReportsWrappingMuscles) {
   const CmdResult r = run("validate --model " + scene("running_leg.osim") + " --coordinates " +
                           scene("running_leg_swing.mot") + " --muscle-mass physiological --mass-sweep 0,0.5,1 --no-plots"
