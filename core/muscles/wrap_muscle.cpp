@@ -72,10 +72,8 @@ bool wrapSegments(const PathWrap& w, const std::vector<int>& active, int np, int
   return first >= 0 && last > first;
 }
 
-using SurfaceMotion = WrapSurfaceMotion;
-
 void calcSurfaceMotion(const Model& model, const SkeletonWorkspace& sk, const PathWrap& w, const MuscleKinematics& mk,
-                       bool vel, SurfaceMotion& sm) {
+                       bool vel, WrapSurfaceMotion& sm) {
   const int k = static_cast<int>(mk.cols.size());
   const int b = w.body;
   const Mat4 E_ws = b >= 0 ? Mat4(sk.E_wi[b] * w.E_bs) : w.E_bs;
@@ -113,7 +111,7 @@ struct SegmentEnds {
   MatX A1, A2, A1dot, A2dot;
 };
 
-void calcSegmentEnds(const SurfaceMotion& sm, const MuscleKinematics& mk, int i, bool vel, SegmentEnds& e) {
+void calcSegmentEnds(const WrapSurfaceMotion& sm, const MuscleKinematics& mk, int i, bool vel, SegmentEnds& e) {
   const Mat3& R = sm.R;
   const Vec3 r1 = mk.x_w[i] - sm.p, r2 = mk.x_w[i + 1] - sm.p;
   e.p1 = R.transpose() * r1;
@@ -343,14 +341,12 @@ SmoothWrapLength calcWrapModelLength(const WrapMassOptions& options, const WrapS
 
 namespace {
 
-// true when the wrap model refuses the segment p1 -> p2 (frame s): an end inside the surface
-bool endInsideSurface(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1, const Vec3& p2) {
-  try {
-    calcWrapModelLength(options, surface, p1, p2, Vec3::Zero(), Vec3::Zero());
-    return false;
-  } catch (const std::invalid_argument&) {
-    return true;
-  }
+// true when the smooth (and network) wrap model refuses the segment p1 -> p2 (frame s): an end
+// inside the surface, or input it cannot take (its checkInputs), tested directly rather than by
+// computing a wrapped length that is thrown away on this per-evaluation path
+bool endInsideSurface(const WrapSurface& surface, const Vec3& p1, const Vec3& p2) {
+  if (!p1.allFinite() || !p2.allFinite() || p1 == p2 || !smoothWrapUnsupportedReason(surface).empty()) return true;
+  return surface.contains(p1) || surface.contains(p2);
 }
 
 }  // namespace
@@ -385,7 +381,7 @@ std::vector<int> calcSegmentWraps(const Muscle& muscle, const std::vector<int>& 
       // OpenSim gives a segment with an end inside the surface no wrap (InsideRadius), and so do
       // we on general paths (the positions jump there as OpenSim's path does); on origin -> surface ->
       // insertion it stays a MuscleError (the dissertation's shape, where nothing else can wrap)
-      if (endInsideSurface(muscle.wrap, pw.surface, p1, p2)) continue;
+      if (endInsideSurface(pw.surface, p1, p2)) continue;
       if (last - first == 1) {
         best = i;
         break;
@@ -427,7 +423,7 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
   // which wrap acts on which segment (header): the candidate penetrating most
   const std::vector<int> seg_wrap = calcSegmentWraps(muscle, mk.active, mk.x_w, sk.E_wi);
   // the surfaces' motion from the skeleton, for the wraps that act
-  std::vector<SurfaceMotion> sm(path.wraps.size());
+  std::vector<WrapSurfaceMotion> sm(path.wraps.size());
   std::vector<char> have_sm(path.wraps.size(), 0);
   for (int w : seg_wrap) {
     if (w < 0 || have_sm[w]) continue;
@@ -457,10 +453,9 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
                                 " segments, " + std::to_string(surfaces.size()) + " surfaces for " +
                                 std::to_string(path.wraps.size()) + " wrap objects");
   const std::string who = "muscle '" + muscle.name + "'";
-  auto motion = [&](int w) -> const SurfaceMotion& { return surfaces[w]; };
   std::vector<SegmentEnds> ends(nseg);
   for (int i = 0; i < nseg; ++i)
-    if (seg_wrap[i] >= 0) calcSegmentEnds(motion(seg_wrap[i]), mk, i, vel, ends[i]);
+    if (seg_wrap[i] >= 0) calcSegmentEnds(surfaces[seg_wrap[i]], mk, i, vel, ends[i]);
 
   // Eulerian coordinates s_i = S_i / sum L over the segment lengths (header); one segment: (0, 1)
   mk.s.setZero(P);
@@ -586,7 +581,7 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
       }
     if (idx.empty()) continue;
     const PathWrap& pw = path.wraps[w];
-    const SurfaceMotion& m = motion(w);
+    const WrapSurfaceMotion& m = surfaces[w];
     const SegmentEnds& e = ends[i];
     try {
       calcWrapModelPoints(muscle.wrap, pw.surface, e.p1, e.p2, e.p1dot, e.p2dot, betas, betadots, moving_beta, vel, wp);

@@ -42,10 +42,7 @@ bool quadrantChangesPath(const WrapSurface& s, const Vec3& a, const Vec3& b) {
 void checkEndPoints(const WrapSurface& s, const Vec3& p1, const Vec3& p2) {
   if (!p1.allFinite() || !p2.allFinite() || p1 == p2)
     throw std::invalid_argument("network wrap: degenerate end points");
-  const double R = s.radius;
-  const bool inside = s.type == WrapType::Cylinder ? (p1.head<2>().norm() < R || p2.head<2>().norm() < R)
-                                                   : (p1.norm() < R || p2.norm() < R);
-  if (inside) throw std::invalid_argument("network wrap: an end point lies inside the surface");
+  if (s.contains(p1) || s.contains(p2)) throw std::invalid_argument("network wrap: an end point lies inside the surface");
 }
 
 }  // namespace

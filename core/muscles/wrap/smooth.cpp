@@ -920,19 +920,7 @@ void checkInputs(const WrapSurface& surf, const Vec3& p1, const Vec3& p2) {
   const std::string why = smoothWrapUnsupportedReason(surf);
   if (!why.empty()) throw std::invalid_argument("smooth wrap: " + why);
   if (!p1.allFinite() || !p2.allFinite() || p1 == p2) throw std::invalid_argument("smooth wrap: degenerate end points");
-  auto inside = [&](const Vec3& p) {
-    switch (surf.type) {
-      case WrapType::Cylinder: return p.head<2>().norm() < surf.radius;
-      case WrapType::Sphere: return p.norm() < surf.radius;
-      case WrapType::Ellipsoid: return p.cwiseQuotient(surf.dimensions).squaredNorm() < 1.0;
-      case WrapType::Torus: {
-        const double rho = p.head<2>().norm() - surf.outer_radius;
-        return rho * rho + p[2] * p[2] < surf.inner_radius * surf.inner_radius;
-      }
-    }
-    return false;
-  };
-  if (inside(p1) || inside(p2)) throw std::invalid_argument("smooth wrap: an end point lies inside the surface");
+  if (surf.contains(p1) || surf.contains(p2)) throw std::invalid_argument("smooth wrap: an end point lies inside the surface");
 }
 
 // the surface's size: the default band is 5% of it

@@ -10,6 +10,19 @@ namespace redmax {
 
 using namespace detail;
 
+bool WrapSurface::contains(const Vec3& p) const {
+  switch (type) {
+    case WrapType::Cylinder: return p.head<2>().norm() < radius;
+    case WrapType::Sphere: return p.norm() < radius;
+    case WrapType::Ellipsoid: return p.cwiseQuotient(dimensions).squaredNorm() < 1.0;
+    case WrapType::Torus: {
+      const double rho = p.head<2>().norm() - outer_radius;
+      return rho * rho + p[2] * p[2] < inner_radius * inner_radius;
+    }
+  }
+  return false;
+}
+
 WrapSurface WrapSurface::makeCylinder(double radius, double length, int axis, int sign) {
   WrapSurface s;
   s.type = WrapType::Cylinder;

@@ -64,6 +64,10 @@ struct WrapSurface {
   int quadrant_sign = 0;              ///< +1, -1; 0 = all
   bool active = true;                 ///< inactive surfaces never wrap
 
+  /// p (frame s, m) strictly inside the solid: cylinder radially (any z), sphere, ellipsoid, torus
+  /// tube. The smooth and network wrap models refuse such an end point.
+  bool contains(const Vec3& p) const;
+
   static WrapSurface makeCylinder(double radius, double length, int axis = -1, int sign = 0);
   static WrapSurface makeSphere(double radius, int axis = -1, int sign = 0);
   static WrapSurface makeEllipsoid(const Vec3& dimensions, int axis = -1, int sign = 0);
