@@ -3,19 +3,11 @@
 #include <stdexcept>
 
 #include "core/muscles/path_kinematics.hpp"
+#include "plugin/simbody/simtk_convert.hpp"
 
 namespace redmax::simbody {
 
 namespace {
-
-SimTK::Vec3 toSimTKVec3(const Vec3& v) { return SimTK::Vec3(v.x(), v.y(), v.z()); }
-Vec3 fromSimTKVec3(const SimTK::Vec3& v) { return Vec3(v[0], v[1], v[2]); }
-
-SimTK::Transform toTransform(const Mat4& E) {
-  // row-major element constructor (GCC reads row-by-row writes as out of bounds)
-  const SimTK::Mat33 R(E(0, 0), E(0, 1), E(0, 2), E(1, 0), E(1, 1), E(1, 2), E(2, 0), E(2, 1), E(2, 2));
-  return SimTK::Transform(SimTK::Rotation(R, true), SimTK::Vec3(E(0, 3), E(1, 3), E(2, 3)));
-}
 
 bool isMoving(const PathPoint& pt) { return pt.kind == PathPointKind::Moving && pt.coordinate >= 0; }
 
@@ -54,7 +46,6 @@ MatterMuscleInertia::MatterMuscleInertia(const SimTK::SimbodyMatterSubsystem& ma
     Entry e;
     e.muscle = m;
     // Type III: every wrap surface frame is a frame on its body (X_GS = X_GB X_bs)
-    e.wrap = !mu.path.wraps.empty();
     for (const PathWrap& w : mu.path.wraps) {
       if (w.body >= 0 && !map_.mobod_of_body[w.body].isValid())
         throw std::invalid_argument("muscle '" + mu.name + "': the body of wrap object '" + w.name +
@@ -81,15 +72,13 @@ double MatterMuscleInertia::totalMass() const {
 std::vector<Vec3> MatterMuscleInertia::massPointPositions() const {
   std::vector<Vec3> out;
   for (const Entry& e : entries_) {
-    const std::vector<Vec3>& x = e.wrap ? e.gmap.x_a : e.map.x_a;
-    out.insert(out.end(), x.begin(), x.end());
+    out.insert(out.end(), e.gmap.x_a.begin(), e.gmap.x_a.end());
   }
   return out;
 }
 
 const std::vector<Vec3>& MatterMuscleInertia::massPointPositions(int e) const {
-  const Entry& en = entries_.at(e);
-  return en.wrap ? en.gmap.x_a : en.map.x_a;
+  return entries_.at(e).gmap.x_a;
 }
 
 void MatterMuscleInertia::evaluate(const SimTK::State& state, bool velocity) {
@@ -123,11 +112,7 @@ void MatterMuscleInertia::evaluate(const SimTK::State& state, bool velocity) {
       if (isMoving(pt)) v += B.getBodyRotation(state) * toSimTKVec3(e.dx_b[i]) * (*qdot)[map_.q_of_coordinate[pt.coordinate]];
       e.xdot[i] = fromSimTKVec3(v);
     }
-    if (!e.wrap) {
-      calcPathMap(e.x, velocity ? &e.xdot : nullptr, mu.mass_points, e.map, mu.name);
-      continue;
-    }
-    // the surface frames: pose, angular velocity and origin velocity (Ground)
+    // the surface frames (Type III): pose, angular velocity and origin velocity (Ground)
     for (size_t w = 0; w < e.frames.size(); ++w) {
       const SimTK::MobilizedBody& S = mobod(e.surface_body[w]);
       const SimTK::Transform X_GS = S.getBodyTransform(state) * e.X_bs[w];
@@ -209,38 +194,27 @@ void MatterMuscleInertia::calcGeneralizedForces(const SimTK::State& state, const
       }
       xddot.segment<3>(3 * i) = fromSimTKVec3(a);
     }
-    // f_a = m_a (a_a - g) [D Eq. 5.6-5.7], pulled back to the path points
-    VecX a_a;
-    if (!e.wrap) {
-      a_a = calcMassPointAccelerations(e.map, xddot);
-    } else {
-      // vdot = (xddot, (alpha_w, pddot_w) per wrap); a_a = J vdot + bias (path_map.hpp)
-      const int W = static_cast<int>(e.X_bs.size());
-      VecX vdot(3 * P + 6 * W);
-      vdot.head(3 * P) = xddot;
-      for (int w = 0; w < W; ++w) {
-        const SimTK::SpatialVec A = JFudot_[frame + w] + frame_bias_[frame + w];
-        vdot.segment<6>(3 * P + 6 * w) << fromSimTKVec3(A[0]), fromSimTKVec3(A[1]);
-      }
-      a_a = e.gmap.J * vdot + e.gmap.bias;
+    // a_a = J vdot + bias (path_map.hpp), vdot = (xddot, (alpha_w, pddot_w) per wrap)
+    const int W = static_cast<int>(e.X_bs.size());
+    VecX vdot(3 * P + 6 * W);
+    vdot.head(3 * P) = xddot;
+    for (int w = 0; w < W; ++w) {
+      const SimTK::SpatialVec A = JFudot_[frame + w] + frame_bias_[frame + w];
+      vdot.segment<6>(3 * P + 6 * w) << fromSimTKVec3(A[0]), fromSimTKVec3(A[1]);
     }
+    const VecX a_a = e.gmap.J * vdot + e.gmap.bias;
+    // f_a = m_a (a_a - g) [D Eq. 5.6-5.7], pulled back to the path points
     VecX f_a(a_a.size());
     for (int a = 0; a < mu.mass_points.size(); ++a)
       f_a.segment<3>(3 * a) = mu.mass_points.mass[a] * (a_a.segment<3>(3 * a) - gravity_);
-    VecX F_x;
-    if (!e.wrap) {
-      F_x = e.map.J_ax.transpose() * f_a;
-    } else {
-      // each wrap's (omega, pdot) columns: a torque and a force at its surface origin
-      const VecX F = e.gmap.J.transpose() * f_a;
-      F_x = F.head(3 * P);
-      for (size_t w = 0; w < e.X_bs.size(); ++w, ++frame) {
-        const int c = 3 * P + 6 * static_cast<int>(w);
-        frame_forces_[frame] = SimTK::SpatialVec(toSimTKVec3(F.segment<3>(c)), toSimTKVec3(F.segment<3>(c + 3)));
-      }
+    const VecX F_v = e.gmap.J.transpose() * f_a;
+    // each wrap's (omega, pdot) columns: a torque and a force at its surface origin
+    for (int w = 0; w < W; ++w, ++frame) {
+      const int c = 3 * P + 6 * w;
+      frame_forces_[frame] = SimTK::SpatialVec(toSimTKVec3(F_v.segment<3>(c)), toSimTKVec3(F_v.segment<3>(c + 3)));
     }
     for (int i = 0; i < P; ++i) {
-      const Vec3 F = F_x.segment<3>(3 * i);
+      const Vec3 F = F_v.segment<3>(3 * i);
       forces_[row + i] = toSimTKVec3(F);
       const PathPoint& pt = mu.path.points[e.active[i]];
       if (isMoving(pt)) {
@@ -270,7 +244,7 @@ double MatterMuscleInertia::kineticEnergy(const SimTK::State& state) {
   double T = 0.0;
   for (const Entry& e : entries_) {
     const MassPoints& mp = muscles_[e.muscle].mass_points;
-    const VecX xdot_a = e.wrap ? VecX(e.gmap.J * stackGeneralVelocities(e.xdot, e.frames)) : VecX(e.map.J_ax * stackPoints(e.xdot));
+    const VecX xdot_a = e.gmap.J * stackGeneralVelocities(e.xdot, e.frames);
     for (int a = 0; a < mp.size(); ++a) T += 0.5 * mp.mass[a] * xdot_a.segment<3>(3 * a).squaredNorm();
   }
   return T;
@@ -281,8 +255,7 @@ double MatterMuscleInertia::potentialEnergy(const SimTK::State& state) {
   double V = 0.0;
   for (const Entry& e : entries_) {
     const MassPoints& mp = muscles_[e.muscle].mass_points;
-    const std::vector<Vec3>& x_a = e.wrap ? e.gmap.x_a : e.map.x_a;
-    for (int a = 0; a < mp.size(); ++a) V -= mp.mass[a] * gravity_.dot(x_a[a]);
+    for (int a = 0; a < mp.size(); ++a) V -= mp.mass[a] * gravity_.dot(e.gmap.x_a[a]);
   }
   return V;
 }

@@ -94,11 +94,9 @@ class MatterMuscleInertia {
  private:
   struct Entry {
     int muscle = 0;  // index into muscles_
-    PathMap map;
+    GeneralPathMap gmap;  // the path map, every type (Types I and II: no frames)
     // Type III: per wrap object (path.wraps), its body (-1: Ground), its frame X_bs on it and the
-    // frame's pose and velocity refreshed by evaluate(); the general path map
-    bool wrap = false;
-    GeneralPathMap gmap;
+    // frame's pose and velocity refreshed by evaluate()
     std::vector<int> surface_body;
     std::vector<SimTK::Transform> X_bs;
     std::vector<SurfaceFrameState> frames;

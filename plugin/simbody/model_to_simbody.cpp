@@ -151,14 +151,6 @@ MatX fromSimTK(const SimTK::Matrix& m) {
   return out;
 }
 
-SimTK::Transform toTransform(const Mat4& E) {
-  SimTK::Mat33 R;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) R(r, c) = E(r, c);
-  // `true`: trust the (orthonormal to round-off) rotation instead of re-fitting it
-  return SimTK::Transform(SimTK::Rotation(R, true), SimTK::Vec3(E(0, 3), E(1, 3), E(2, 3)));
-}
-
 std::unique_ptr<SimbodyModel> makeSimbodyModel(const Model& model, const SimbodyBuildOptions& opt) {
   auto sm = std::make_unique<SimbodyModel>();
   const int nb = model.nb();

@@ -28,6 +28,7 @@
 #include "core/skeleton/model.hpp"
 #include "core/skeleton/state.hpp"
 #include "plugin/simbody/simbody_options.hpp"
+#include "plugin/simbody/simtk_convert.hpp"
 
 namespace redmax::simbody {
 
@@ -76,10 +77,9 @@ VecX calcSimbodyInverseDynamicsCore(const SimbodyModel& sm, const Model& model, 
 /// qddot = T^-1 (udot - Tdot qdot).
 VecX calcSimbodyForwardDynamicsCore(const SimbodyModel& sm, const Model& model, const State& s);
 
-/// conversions between Eigen and SimTK containers
+/// conversions between Eigen and SimTK containers (vectors and transforms: simtk_convert.hpp)
 SimTK::Vector toSimTK(const VecX& v);
 VecX fromSimTK(const SimTK::Vector& v);
 MatX fromSimTK(const SimTK::Matrix& m);
-SimTK::Transform toTransform(const Mat4& E);
 
 }  // namespace redmax::simbody

@@ -13,9 +13,6 @@ namespace redmax::simbody {
 
 namespace {
 
-SimTK::Vec3 toSimTKVec3(const Vec3& v) { return SimTK::Vec3(v.x(), v.y(), v.z()); }
-Vec3 fromSimTKVec3(const SimTK::Vec3& v) { return Vec3(v[0], v[1], v[2]); }
-
 // one muscle's 3N holonomic equations x_p - x_a(x, surfaces) = 0 (header). A moving point x_b(q_c)
 // in body b reads q_c, qdot_c, qddot_c through its coordinate's mobilizer (a constrained mobilizer):
 //   x = X_AB x_b,  xdot = v_station + R x_b' qdot_c,
