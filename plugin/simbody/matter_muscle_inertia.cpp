@@ -239,14 +239,25 @@ void MatterMuscleInertia::calcGeneralizedForces(const SimTK::State& state, const
   }
 }
 
-double MatterMuscleInertia::kineticEnergy(const SimTK::State& state) {
+void MatterMuscleInertia::calcMassPointMotion(const SimTK::State& state, std::vector<Vec3>& x,
+                                              std::vector<Vec3>& xdot) {
   evaluate(state, true);
-  double T = 0.0;
+  x.clear();
+  xdot.clear();
   for (const Entry& e : entries_) {
-    const MassPoints& mp = muscles_[e.muscle].mass_points;
     const VecX xdot_a = e.gmap.J * stackGeneralVelocities(e.xdot, e.frames);
-    for (int a = 0; a < mp.size(); ++a) T += 0.5 * mp.mass[a] * xdot_a.segment<3>(3 * a).squaredNorm();
+    x.insert(x.end(), e.gmap.x_a.begin(), e.gmap.x_a.end());
+    for (int a = 0; a < static_cast<int>(e.gmap.x_a.size()); ++a) xdot.push_back(xdot_a.segment<3>(3 * a));
   }
+}
+
+double MatterMuscleInertia::kineticEnergy(const SimTK::State& state) {
+  std::vector<Vec3> x, xdot;
+  calcMassPointMotion(state, x, xdot);
+  double T = 0.0;
+  size_t k = 0;
+  for (const Entry& e : entries_)
+    for (double m : muscles_[e.muscle].mass_points.mass) T += 0.5 * m * xdot[k++].squaredNorm();
   return T;
 }
 

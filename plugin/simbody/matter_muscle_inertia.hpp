@@ -77,6 +77,9 @@ class MatterMuscleInertia {
 
   /// kinetic energy 1/2 sum m_a |xdot_a|^2 (J) of the mass points at `state` (Stage::Velocity)
   double kineticEnergy(const SimTK::State& state);
+  /// positions x_a (world, m) and velocities xdot_a = J v (m/s) of every mass point at `state`
+  /// (Stage::Velocity), concatenated in muscle order (muscles with mass points only)
+  void calcMassPointMotion(const SimTK::State& state, std::vector<Vec3>& x, std::vector<Vec3>& xdot);
   /// gravitational potential -sum m_a g . x_a (J, world origin) at `state` (Stage::Position)
   double potentialEnergy(const SimTK::State& state);
   /// mass point positions (world, m) of every muscle with mass, after the last evaluation,

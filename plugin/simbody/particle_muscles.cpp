@@ -246,10 +246,7 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
     : sm_(sm), muscles_(std::move(muscles)) {
   for (const Muscle& mu : muscles_) {
     validateMuscle(model, mu);
-    if (mu.mass_points.size() == 0) {
-      first_particle_.push_back(-1);
-      continue;
-    }
+    if (mu.mass_points.size() == 0) continue;
     const std::string why = simbodyWrapShapeUnsupportedReason(mu);
     if (!why.empty()) throw SimbodyBuildError(why);
     for (const PathPoint& p : mu.path.points)
@@ -261,7 +258,6 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
         throw SimbodyBuildError("muscle '" + mu.name + "': a mass point without mass cannot be a Simbody particle");
 
     // particles: point masses translating freely from Ground, placed by placeParticles
-    first_particle_.push_back(static_cast<int>(particles_.size()));
     std::vector<SimTK::MobilizedBody> mine;
     for (double m : mu.mass_points.mass) {
       SimTK::Body::Rigid body(SimTK::MassProperties(m, SimTK::Vec3(0), SimTK::Inertia(0)));
@@ -294,6 +290,9 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
     SimTK::Constraint::Custom(
         new PathConstraint(sm.matter, mu, point_bodies, coord_mobods, coord_in_mobod, mine, surface_bodies));
   }
+  // the mass points' motion on the skeleton (placeParticles): the skeleton's bodies and q slots,
+  // which the particles added above do not move
+  motion_ = std::make_unique<MatterMuscleInertia>(sm.matter, makeMatterMap(sm, model), model, muscles_, model.gravity);
   // the topology changed: a new default state, Euler angles on as makeSimbodyModel sets them
   try {
     sm.default_state = sm.system.realizeTopology();
@@ -306,61 +305,13 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
 
 void ParticleMuscles::placeParticles(SimTK::State& sb) const {
   sm_.system.realize(sb, SimTK::Stage::Velocity);
-  std::vector<SimTK::Vec3> x_p(particles_.size()), v_p(particles_.size());
-  // the skeleton's q and qdot in core order (Simbody q = core q with Euler angles)
-  const SimTK::Vector& q_sb = sm_.matter.getQ(sb);
-  const SimTK::Vector& qdot_sb = sm_.matter.getQDot(sb);
-  int nr = 0;
-  for (const MobilizerMap& mm : sm_.map) nr = std::max(nr, mm.q_index + mm.nq);
-  VecX q(nr), qdot(nr);
-  for (const MobilizerMap& mm : sm_.map)
-    for (int k = 0; k < mm.nq; ++k) {
-      q[mm.q_index + k] = q_sb[mm.simbody_q + k];
-      qdot[mm.q_index + k] = qdot_sb[mm.simbody_q + k];
-    }
-  GeneralPathMap map;
-  for (size_t m = 0; m < muscles_.size(); ++m) {
-    if (first_particle_[m] < 0) continue;
-    const Muscle& mu = muscles_[m];
-    std::vector<Vec3> x, xdot;
-    std::vector<int> active;
-    for (const PathPoint& p : mu.path.points) {
-      const SimTK::MobilizedBody& B = p.body >= 0 ? sm_.mobods[p.body] : sm_.matter.getGround();
-      Vec3 x_b, dx_b, ddx_b;
-      calcPointLocation(p, q, x_b, dx_b, ddx_b);
-      active.push_back(static_cast<int>(active.size()));
-      x.push_back(fromSimTKVec3(B.findStationLocationInGround(sb, toSimTKVec3(x_b))));
-      SimTK::Vec3 v = B.findStationVelocityInGround(sb, toSimTKVec3(x_b));
-      // moving point: R x_b' qdot_c
-      if (p.kind == PathPointKind::Moving && p.coordinate >= 0)
-        v += B.getBodyRotation(sb) * toSimTKVec3(dx_b) * qdot[p.coordinate];
-      xdot.push_back(fromSimTKVec3(v));
-    }
-    // Type III: each surface frame's pose and motion (path_map.hpp's calcGeneralPathMap)
-    const int W = static_cast<int>(mu.path.wraps.size());
-    std::vector<SurfaceFrameState> frames(W);
-    for (int w = 0; w < W; ++w) {
-      const PathWrap& pw = mu.path.wraps[w];
-      const SimTK::MobilizedBody& S = pw.body >= 0 ? sm_.mobods[pw.body] : sm_.matter.getGround();
-      const SimTK::Transform X_bs = toTransform(pw.E_bs);
-      const SimTK::Transform X_GS = S.getBodyTransform(sb) * X_bs;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) frames[w].R(r, c) = X_GS.R()[r][c];
-      frames[w].p = fromSimTKVec3(X_GS.p());
-      frames[w].omega = fromSimTKVec3(S.getBodyAngularVelocity(sb));
-      frames[w].pdot = fromSimTKVec3(S.findStationVelocityInGround(sb, X_bs.p()));
-    }
-    calcGeneralPathMap(mu, active, x, nullptr, frames, map);
-    const VecX xdot_a = map.J * stackGeneralVelocities(xdot, frames);
-    for (int a = 0; a < mu.mass_points.size(); ++a) {
-      x_p[first_particle_[m] + a] = toSimTKVec3(map.x_a[a]);
-      v_p[first_particle_[m] + a] = toSimTKVec3(xdot_a.segment<3>(3 * a));
-    }
-  }
+  // the mass points' positions and velocities as inverse dynamics computes them (same path maps)
+  std::vector<Vec3> x, xdot;
+  motion_->calcMassPointMotion(sb, x, xdot);
   // set after every read: writing q invalidates the stage the reads above need
   for (size_t k = 0; k < particles_.size(); ++k) {
-    particles_[k].setQToFitTranslation(sb, x_p[k]);
-    particles_[k].setUToFitLinearVelocity(sb, v_p[k]);
+    particles_[k].setQToFitTranslation(sb, toSimTKVec3(x[k]));
+    particles_[k].setUToFitLinearVelocity(sb, toSimTKVec3(xdot[k]));
   }
 }
 

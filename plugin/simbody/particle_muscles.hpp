@@ -24,8 +24,10 @@
 // Limits: conditional points are rejected (switching would change the path, and the particles'
 // velocities would have to jump); so is a mass point without mass. Muscles without mass points are
 // skipped.
+#include <memory>
 #include <vector>
 
+#include "plugin/simbody/matter_muscle_inertia.hpp"
 #include "plugin/simbody/model_to_simbody.hpp"
 
 #include "core/muscles/mass_points.hpp"
@@ -56,8 +58,9 @@ class ParticleMuscles {
  private:
   const SimbodyModel& sm_;
   std::vector<Muscle> muscles_;
-  std::vector<SimTK::MobilizedBody> particles_;
-  std::vector<int> first_particle_;  // per muscle (-1 when it has no mass points)
+  std::vector<SimTK::MobilizedBody> particles_;  // muscles in order, their mass points in order
+  // the mass points' positions and velocities on the skeleton (placeParticles)
+  std::unique_ptr<MatterMuscleInertia> motion_;
 };
 
 }  // namespace redmax::simbody
