@@ -2,11 +2,15 @@
 // Running the `redmax` executable of the same build from the CLI tests.
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "converter/storage.hpp"
 
 namespace redmax::cli_test {
 
@@ -41,6 +45,19 @@ inline CmdResult runRedmax(const fs::path& dir, const std::string& args, bool in
                           args + " >" + out.string() + " 2>" + err.string();
   const int status = std::system(cmd.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+/// a project-authored scene: <source>/osim_models/FILE
+inline std::string scene(const std::string& file) { return std::string(REDMAX_SOURCE_DIR) + "/osim_models/" + file; }
+
+/// relative energy drift of written states: max |E(t) - E(0)| / max(|E(0)|, max kinetic energy)
+/// from the total_energy and kinetic_energy columns; -1 when either column is missing
+inline double energyDrift(const osim::Storage& s) {
+  const int e = s.findColumn("total_energy"), k = s.findColumn("kinetic_energy");
+  if (e < 0 || k < 0) return -1.0;
+  const double E0 = s.data(0, e);
+  const double scale = std::max(std::abs(E0), s.data.col(k).maxCoeff());
+  return (s.data.col(e).array() - E0).abs().maxCoeff() / scale;
 }
 
 }  // namespace redmax::cli_test

@@ -40,8 +40,6 @@ using redmax::osim::Storage;
 const std::string kShared = REDMAX_SHARED_DIR;
 const std::string kMoco = kShared + "/opensim/opensim-core/OpenSim/Moco/Test/";
 
-std::string scene(const std::string& file) { return std::string(REDMAX_SOURCE_DIR) + "/osim_models/" + file; }
-
 // Per frame and reported muscle: whether a wrapped segment of the smooth model lies in the band
 // (0 < w < 1), and the sum of |L_wrapped - L_straight| over those segments (m): the most the
 // smooth length can differ from the exact one there.

@@ -23,17 +23,6 @@ namespace fs = std::filesystem;
 using redmax::osim::readStorage;
 using redmax::osim::Storage;
 
-std::string scene(const std::string& file) { return std::string(REDMAX_SOURCE_DIR) + "/osim_models/" + file; }
-
-// max |E(t) - E(0)| / max(|E(0)|, max kinetic energy) from the written columns
-double energyDrift(const Storage& s) {
-  const int e = s.findColumn("total_energy"), k = s.findColumn("kinetic_energy");
-  if (e < 0 || k < 0) return -1.0;
-  const double E0 = s.data(0, e);
-  const double scale = std::max(std::abs(E0), s.data.col(k).maxCoeff());
-  return (s.data.col(e).array() - E0).abs().maxCoeff() / scale;
-}
-
 class SimulateCli : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -33,8 +33,6 @@ using namespace redmax::cli_test;
 using redmax::osim::readStorage;
 using redmax::osim::Storage;
 
-std::string scene(const std::string& file) { return std::string(REDMAX_SOURCE_DIR) + "/osim_models/" + file; }
-
 class SimulateEngineCli : public ::testing::Test {
  public:
   void SetUp() override {

@@ -26,16 +26,6 @@ using redmax::osim::readStorage;
 using redmax::osim::Storage;
 using redmax::validation::JsonValue;
 
-std::string scene(const std::string& file) { return std::string(REDMAX_SOURCE_DIR) + "/osim_models/" + file; }
-
-double energyDrift(const Storage& s) {
-  const int e = s.findColumn("total_energy"), k = s.findColumn("kinetic_energy");
-  if (e < 0 || k < 0) return -1.0;
-  const double E0 = s.data(0, e);
-  const double scale = std::max(std::abs(E0), s.data.col(k).maxCoeff());
-  return (s.data.col(e).array() - E0).abs().maxCoeff() / scale;
-}
-
 // largest |E(t_{i+1}) - E(t_i)| between written rows, J
 double largestEnergyStep(const Storage& s) {
   const int e = s.findColumn("total_energy");
