@@ -115,6 +115,7 @@ TEST_F(TrainWrapCli, BadInputExitsTwoWithAMessage) {
   EXPECT_EQ(r.code, 2);
   r = run("train-wrap --compare --surface torus --muscles 0 --report " + (dir_ / "c").string());
   EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--muscles and --mass-points must be positive"), std::string::npos) << r.err;
   // a file that is not a network: named with its line
   const fs::path bad = dir_ / "bad.txt";
   std::ofstream(bad) << "redmax-mlp 1\ninputs 8\noutputs 3\nhidden 1 4\nactivation relu\n";
