@@ -14,9 +14,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "converter/build/muscle_mass.hpp"
 #include "converter/osim_reader.hpp"
@@ -181,7 +185,13 @@ int compareAt(const simbody::SimbodyModel& sm, const Model& m, const std::vector
   return 1;
 }
 
-TEST(MatterMuscleInertia, EqualsMuscleInertiaAndCoreOnRandomTrees) {
+using MakeMuscles = std::function<std::vector<Muscle>(const Model&, int variant, int trial, const State&, std::mt19937&)>;
+
+// compareAt on random trees (a Gimbal and a Ball tree, and the double pendulum): per system,
+// variants x trials random states, make() giving the muscles at each; returns how many states were
+// compared, and the worst relative differences (worst_core: 0 unless with_core)
+int compareOnRandomTrees(std::uint32_t seed, int variants, int trials, bool with_core, const MakeMuscles& make,
+                         double& worst_same, double& worst_core) {
   using scenes::TreeJoints;
   using simbody::SphericalAs;
   struct Case {
@@ -191,59 +201,50 @@ TEST(MatterMuscleInertia, EqualsMuscleInertiaAndCoreOnRandomTrees) {
   const std::vector<Case> cases{{scenes::randomTree(6, 11, TreeJoints::SimbodyComparable), SphericalAs::Gimbal},
                                 {scenes::randomTree(8, 29, TreeJoints::SimbodyComparable), SphericalAs::Ball},
                                 {scenes::doublePendulum(), SphericalAs::Gimbal}};
-  std::mt19937 rng(4242);
+  std::mt19937 rng(seed);
   int checked = 0;
-  double worst_same = 0.0, worst_core = 0.0;
+  worst_same = worst_core = 0.0;
   for (size_t ci = 0; ci < cases.size(); ++ci) {
     const Model& m = cases[ci].model;
     simbody::SimbodyBuildOptions opt;
     opt.spherical = cases[ci].spherical;
     const auto sm = simbody::makeSimbodyModel(m, opt);
-    for (int variant = 0; variant <= 7; ++variant) {
-      for (int trial = 0; trial < 2; ++trial) {
+    for (int variant = 0; variant < variants; ++variant) {
+      for (int trial = 0; trial < trials; ++trial) {
         SCOPED_TRACE("case " + std::to_string(ci) + " variant " + std::to_string(variant));
         const State s = randomState(m.nr(), rng);
-        std::vector<Muscle> muscles{randomMuscle(m, variant, rng, s), randomMuscle(m, (variant + 3) % 8, rng, s)};
+        const std::vector<Muscle> muscles = make(m, variant, trial, s, rng);
         const VecX qddot = VecX::NullaryExpr(m.nr(), [&] { return randomVec(rng, 3.0)[0]; });
-        checked += compareAt(*sm, m, muscles, s, qddot, true, worst_same, worst_core);
+        checked += compareAt(*sm, m, muscles, s, qddot, with_core, worst_same, worst_core);
       }
     }
   }
+  return checked;
+}
+
+TEST(MatterMuscleInertia, EqualsMuscleInertiaAndCoreOnRandomTrees) {
+  double worst_same = 0.0, worst_core = 0.0;
+  const int checked = compareOnRandomTrees(
+      4242, 8, 2, true,
+      [](const Model& m, int variant, int, const State& s, std::mt19937& rng) {
+        return std::vector<Muscle>{randomMuscle(m, variant, rng, s), randomMuscle(m, (variant + 3) % 8, rng, s)};
+      },
+      worst_same, worst_core);
   EXPECT_GE(checked, 40);
   std::printf("  random trees: %d states; vs MuscleInertia %.2e, vs core MuscleTerm %.2e (of the peak)\n", checked,
               worst_same, worst_core);
 }
 
 TEST(MatterMuscleInertia, TypeIIIEqualsMuscleInertiaOnRandomTrees) {
-  using scenes::TreeJoints;
-  using simbody::SphericalAs;
-  struct Case {
-    Model model;
-    SphericalAs spherical;
-  };
-  const std::vector<Case> cases{{scenes::randomTree(6, 11, TreeJoints::SimbodyComparable), SphericalAs::Gimbal},
-                                {scenes::randomTree(8, 29, TreeJoints::SimbodyComparable), SphericalAs::Ball},
-                                {scenes::doublePendulum(), SphericalAs::Gimbal}};
-  std::mt19937 rng(99);
-  int checked = 0;
   double worst_same = 0.0, worst_core = 0.0;
-  for (size_t ci = 0; ci < cases.size(); ++ci) {
-    const Model& m = cases[ci].model;
-    simbody::SimbodyBuildOptions opt;
-    opt.spherical = cases[ci].spherical;
-    const auto sm = simbody::makeSimbodyModel(m, opt);
-    for (int variant = 0; variant <= 3; ++variant) {
-      for (int trial = 0; trial < 4; ++trial) {
-        SCOPED_TRACE("case " + std::to_string(ci) + " variant " + std::to_string(variant));
-        const State s = randomState(m.nr(), rng);
-        // a wrapping muscle next to a Type II one, so the station and frame batches span both
-        std::vector<Muscle> muscles{randomWrapMuscle(m, variant, rng, s, trial % 2 == 1), randomMuscle(m, 1, rng, s)};
-        const VecX qddot = VecX::NullaryExpr(m.nr(), [&] { return randomVec(rng, 3.0)[0]; });
-        // (core vs MuscleInertia for Type III is tests/plugin's check; here the port alone)
-        checked += compareAt(*sm, m, muscles, s, qddot, false, worst_same, worst_core);
-      }
-    }
-  }
+  // a wrapping muscle next to a Type II one, so the station and frame batches span both
+  // (core vs MuscleInertia for Type III is tests/plugin's check; here the port alone)
+  const int checked = compareOnRandomTrees(
+      99, 4, 4, false,
+      [](const Model& m, int variant, int trial, const State& s, std::mt19937& rng) {
+        return std::vector<Muscle>{randomWrapMuscle(m, variant, rng, s, trial % 2 == 1), randomMuscle(m, 1, rng, s)};
+      },
+      worst_same, worst_core);
   EXPECT_GE(checked, 30);
   std::printf("  Type III: %d states; vs MuscleInertia %.2e (of the peak)\n", checked, worst_same);
 }
