@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
 
 #include "core/dynamics/muscle_term.hpp"
 #include "core/integrators/integrator.hpp"
@@ -50,20 +51,18 @@ std::vector<WrapPendulumSpec> makeWrapPendulumGroup(int n, unsigned seed) {
   return out;
 }
 
-namespace {
-
-double penetrationAt(const Model& m, const Muscle& mu, const State& s) {
-  SkeletonWorkspace sk(m);
-  calcKinematics(m, s, sk);
+double wrapPenetration(const Model& model, const Muscle& muscle, const State& s) {
+  if (muscle.path.wraps.size() != 1)
+    throw std::invalid_argument("wrapPenetration: muscle '" + muscle.name + "' does not have one wrap surface");
+  SkeletonWorkspace sk(model);
+  calcKinematics(model, s, sk);
   MuscleKinematics mk;
-  initMuscleKinematics(m, mu.path, mk);
-  calcPathPoints(m, s, sk, mu.path, mk, false);
-  const PathWrap& w = mu.path.wraps[0];
+  initMuscleKinematics(model, muscle.path, mk);
+  calcPathPoints(model, s, sk, muscle.path, mk, false);
+  const PathWrap& w = muscle.path.wraps[0];
   const Mat4 E_sw = inverseE(w.body >= 0 ? Mat4(sk.E_wi[w.body] * w.E_bs) : w.E_bs);
-  return calcWrapPenetration(w.surface, transformPoint(E_sw, mk.x_w[0]), transformPoint(E_sw, mk.x_w[1]));
+  return calcWrapPenetration(w.surface, transformPoint(E_sw, mk.x_w.front()), transformPoint(E_sw, mk.x_w.back()));
 }
-
-}  // namespace
 
 WrapPendulumRun runWrapPendulum(const WrapPendulumSpec& spec, WrapMassOptions wrap, double duration, double tol) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -89,10 +88,10 @@ WrapPendulumRun runWrapPendulum(const WrapPendulumSpec& spec, WrapMassOptions wr
   r.spec = spec;
   const int n = static_cast<int>(std::lround(duration * 100));
   double E_prev = r.E0 = energy(s);
-  double d_prev = penetrationAt(m, mu, s);
+  double d_prev = wrapPenetration(m, mu, s);
   for (int k = 1; k <= n; ++k) {
     integ->advance(sys, s, 0.01 * k);
-    const double E = energy(s), d = penetrationAt(m, mu, s);
+    const double E = energy(s), d = wrapPenetration(m, mu, s);
     r.max_drift = std::max(r.max_drift, std::abs(E - r.E0));
     r.max_step_change = std::max(r.max_step_change, std::abs(E - E_prev));
     r.contact_changes += (d > 0) != (d_prev > 0);

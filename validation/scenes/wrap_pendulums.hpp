@@ -17,6 +17,7 @@
 
 #include "core/muscles/mass_points.hpp"
 #include "core/skeleton/model.hpp"
+#include "core/skeleton/state.hpp"
 
 namespace redmax::scenes {
 
@@ -55,5 +56,10 @@ WrapPendulumRun runWrapPendulum(const WrapPendulumSpec& spec, WrapMassOptions wr
 
 /// The group's table, one line per pendulum (spec, drift, steps, fallbacks).
 std::string formatWrapPendulumTable(const std::vector<WrapPendulumRun>& runs);
+
+/// Penetration d (m) of the muscle's straight segment (first to last active point) into its single
+/// wrap surface at state s (core/muscles/wrap/smooth.hpp): d > 0 where the exact library wraps; its
+/// sign change is a contact change. std::invalid_argument unless the muscle has one wrap object.
+double wrapPenetration(const Model& model, const Muscle& muscle, const State& s);
 
 }  // namespace redmax::scenes

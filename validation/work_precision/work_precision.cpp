@@ -18,11 +18,6 @@
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/integrators/integrator.hpp"
-#include "core/muscles/muscle_workspace.hpp"
-#include "core/muscles/path_kinematics.hpp"
-#include "core/muscles/wrap/smooth.hpp"
-#include "core/skeleton/kinematics.hpp"
-#include "core/spatial/se3.hpp"
 
 namespace redmax::validation {
 
@@ -191,19 +186,6 @@ WrapPendulum makeWrapPendulum(const std::string& models_dir, WrapModel model, do
   p.initial.q(coordinate(b.model, "q2")) = 0.35;
   p.initial.qdot.setZero();
   return p;
-}
-
-double wrapPenetration(const Model& model, const Muscle& muscle, const State& s) {
-  if (muscle.path.wraps.size() != 1)
-    throw std::invalid_argument("wrapPenetration: muscle '" + muscle.name + "' does not have one wrap surface");
-  SkeletonWorkspace sk(model);
-  calcKinematics(model, s, sk);
-  MuscleKinematics mk;
-  initMuscleKinematics(model, muscle.path, mk);
-  calcPathPoints(model, s, sk, muscle.path, mk, false);
-  const PathWrap& w = muscle.path.wraps[0];
-  const Mat4 E_sw = inverseE(w.body >= 0 ? Mat4(sk.E_wi[w.body] * w.E_bs) : w.E_bs);
-  return calcWrapPenetration(w.surface, transformPoint(E_sw, mk.x_w.front()), transformPoint(E_sw, mk.x_w.back()));
 }
 
 WorkPrecisionScene makeWorkPrecisionScene(const std::string& name, const std::string& models_dir) {

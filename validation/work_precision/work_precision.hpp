@@ -37,6 +37,7 @@
 #include "core/dynamics/system.hpp"
 #include "core/muscles/mass_points.hpp"
 #include "validation/report/report.hpp"
+#include "validation/scenes/wrap_pendulums.hpp"
 #include "validation/work_precision/id_studies.hpp"
 
 namespace redmax::validation {
@@ -115,10 +116,8 @@ struct WrapPendulum {
 };
 WrapPendulum makeWrapPendulum(const std::string& models_dir, WrapModel model, double muscle_kg = 1.0);
 
-/// Penetration d (m) of the muscle's straight segment into its (single) wrap surface at state s
-/// (core/muscles/wrap/smooth.hpp): d > 0 where the exact library wraps; its sign change is a
-/// contact change.
-double wrapPenetration(const Model& model, const Muscle& muscle, const State& s);
+/// the penetration of a single-wrap muscle's straight segment (validation/scenes/wrap_pendulums.hpp)
+using scenes::wrapPenetration;
 /// Build a scene from models_dir. Throws std::invalid_argument for an unknown name and the
 /// converter's ConvertError for a missing or bad model file.
 WorkPrecisionScene makeWorkPrecisionScene(const std::string& name, const std::string& models_dir);
