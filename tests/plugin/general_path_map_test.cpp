@@ -20,23 +20,12 @@
 #include "core/muscles/path_map.hpp"
 #include "core/muscles/wrap/smooth.hpp"
 #include "core/spatial/se3.hpp"
+#include "tests/plugin/wrap_test_geometry.hpp"
 
 namespace redmax {
 namespace {
 
-// a surface of radius 0.03 m centred 0.4 radius off the segment a -> b at its middle, its axis
-// tilted 0.3 rad from the perpendicular so the ends lie at different heights (the path wraps)
-Mat4 surfacePose(const Vec3& a, const Vec3& b, const Vec3& side, double turn) {
-  const Vec3 u = (b - a).normalized();
-  const Vec3 o = u.cross(side).normalized();
-  const Vec3 z = std::cos(0.3) * o.cross(u) + std::sin(0.3) * u;
-  Mat3 R0;
-  R0 << o, z.cross(o), z;
-  Mat4 E = Mat4::Identity();
-  E.topLeftCorner<3, 3>() = R0 * expSO3(Vec3(0.0, 0.0, turn));
-  E.topRightCorner<3, 1>() = 0.5 * (a + b) + 0.012 * o;
-  return E;
-}
+using test::surfacePoseAcross;
 
 struct Scene {
   Muscle mu;
@@ -49,8 +38,8 @@ struct Scene {
 Scene makeScene() {
   Scene sc;
   sc.x = {Vec3(0.0, 0.5, 0.0), Vec3(0.05, 0.2, 0.02), Vec3(0.0, -0.15, 0.03), Vec3(0.04, -0.5, -0.02)};
-  sc.E_ws = {surfacePose(sc.x[0], sc.x[1], Vec3(0.3, 0.1, 1.0), 0.7),
-             surfacePose(sc.x[2], sc.x[3], Vec3(-0.2, 0.4, 1.0), -1.2)};
+  sc.E_ws = {surfacePoseAcross(sc.x[0], sc.x[1], Vec3(0.3, 0.1, 1.0), 0.7),
+             surfacePoseAcross(sc.x[2], sc.x[3], Vec3(-0.2, 0.4, 1.0), -1.2)};
   Muscle& mu = sc.mu;
   mu.name = "two_wraps";
   for (int i = 0; i < 4; ++i) mu.path.points.push_back(makeFixedPoint(i % 2, Vec3::Zero()));

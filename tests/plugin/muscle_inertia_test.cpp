@@ -42,6 +42,7 @@
 #include "core/spatial/se3.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "plugin/simbody/id_engine.hpp"
+#include "tests/plugin/wrap_test_geometry.hpp"
 #include "validation/scenes/scenes.hpp"
 
 namespace redmax {
@@ -218,22 +219,13 @@ Vec3 worldPoint(const PathPoint& p, const State& s, const SkeletonWorkspace& sk)
 }
 
 // a surface (radius 0.03 m) on body `body` (-1: world) that the segment x1 -> x2 (world, at the
-// state of sk) wraps: centred 0.012 m off the segment's midpoint, perpendicular to it. The centre
-// is 0.4 radius off the line along o (perpendicular to it), so the line passes at 0.4 radius from
-// the centre or axis (through them, round-off would pick the side of the wrap); the axis z is o x u
-// tilted 0.3 rad towards the line, so the ends lie at different heights (a line exactly across the
-// axis keeps the path in one plane, where the smooth cylinder's J disagrees with differences of its
-// own positions), with a random turn about the axis
+// state of sk) wraps (test::surfacePoseAcross), perpendicular to it from a random side, with a
+// random turn about its axis
 PathWrap wrapAcross(const Vec3& x1, const Vec3& x2, int body, bool sphere, const SkeletonWorkspace& sk,
                     std::mt19937& rng) {
-  const Vec3 u = (x2 - x1).normalized();
-  const Vec3 o = u.cross(randomVec(rng, 1.0)).normalized();
-  const Vec3 z = std::cos(0.3) * o.cross(u) + std::sin(0.3) * u;
-  Mat3 R0;
-  R0 << o, z.cross(o), z;  // right-handed
-  Mat4 E_ws = Mat4::Identity();
-  E_ws.topLeftCorner<3, 3>() = R0 * expSO3(Vec3(0.0, 0.0, randomVec(rng, 3.0)[0]));
-  E_ws.topRightCorner<3, 1>() = 0.5 * (x1 + x2) + 0.012 * o;
+  const Vec3 side = randomVec(rng, 1.0);
+  const double turn = randomVec(rng, 3.0)[0];
+  const Mat4 E_ws = test::surfacePoseAcross(x1, x2, side, turn);
   PathWrap w;
   w.name = sphere ? "ball" : "drum";
   w.surface = sphere ? WrapSurface::makeSphere(0.03) : WrapSurface::makeCylinder(0.03, 2.0);
