@@ -35,16 +35,6 @@
 namespace redmax {
 namespace {
 
-// the map a foreign system would give: the SimbodyModel's own mobilized bodies and q slots
-opensim::MatterMap mapOf(const simbody::SimbodyModel& sm, const Model& m) {
-  opensim::MatterMap map;
-  for (int b = 0; b < m.nb(); ++b) map.mobod_of_body.push_back(sm.mobods[b].getMobilizedBodyIndex());
-  map.q_of_coordinate.assign(m.nr(), -1);
-  for (const simbody::MobilizerMap& mm : sm.map)
-    for (int k = 0; k < mm.nq; ++k) map.q_of_coordinate[mm.q_index + k] = mm.simbody_q + k;
-  return map;
-}
-
 double relDiff(const VecX& a, const VecX& b) {
   return (a - b).cwiseAbs().maxCoeff() / std::max(1e-300, b.cwiseAbs().maxCoeff());
 }
@@ -145,7 +135,8 @@ Muscle randomWrapMuscle(const Model& m, int variant, std::mt19937& rng, const St
 int compareAt(const simbody::SimbodyModel& sm, const Model& m, const std::vector<Muscle>& muscles,
               const State& s, const VecX& qddot, bool with_core, double& worst_same, double& worst_core) {
   simbody::MuscleInertia reference(sm, m, muscles);
-  opensim::MatterMuscleInertia ours(sm.matter, mapOf(sm, m), m, muscles, m.gravity);
+  // the map a foreign system would give: the SimbodyModel's own mobilized bodies and q slots
+  opensim::MatterMuscleInertia ours(sm.matter, simbody::makeMatterMap(sm, m), m, muscles, m.gravity);
   SimTK::State sb = sm.default_state;
   simbody::setSimbodyState(sm, m, s, sb);
   sm.system.realize(sb, SimTK::Stage::Velocity);
@@ -288,7 +279,7 @@ TEST(MatterMuscleInertia, RejectsMapsThatDoNotFit) {
   MassPointOptions opt;
   opt.count = 3;
   mu.mass_points = makeMassPoints(0.5, 0.5, 0.2, opt);
-  const opensim::MatterMap good = mapOf(*sm, m);
+  const opensim::MatterMap good = simbody::makeMatterMap(*sm, m);
   EXPECT_NO_THROW(opensim::MatterMuscleInertia(sm->matter, good, m, {mu}, m.gravity));
   opensim::MatterMap short_map = good;
   short_map.mobod_of_body.pop_back();
