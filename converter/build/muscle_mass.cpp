@@ -323,13 +323,16 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
     const PathForceDesc& pf = d.muscles[base.muscle_source[k]];
     MuscleMassEntry& e = out.plan.muscles[k];
     phys[k] = physiologicalMass(pf, options);
+    // why the wrap model refuses this wrapping muscle's path ("" = it takes it)
+    const std::string wrap_why = pf.is_muscle && e.wraps && options.wrap_mass
+                                     ? redmax::wrapMassPointsUnsupportedReason(base.muscles[k])
+                                     : std::string();
     if (!pf.is_muscle) {
       e.lumped_why = "not a muscle (" + pf.class_name + ")";
-    } else if (pathType(base.muscles[k].path) == redmax::PathType::III && !options.wrap_mass) {
+    } else if (e.wraps && !options.wrap_mass) {
       e.lumped_why = "Type III path (wrap mass off: --wrap lumped)";
-    } else if (pathType(base.muscles[k].path) == redmax::PathType::III &&
-               !redmax::wrapMassPointsUnsupportedReason(base.muscles[k]).empty()) {
-      e.lumped_why = "Type III path (" + redmax::wrapMassPointsUnsupportedReason(base.muscles[k]) + ")";
+    } else if (!wrap_why.empty()) {
+      e.lumped_why = "Type III path (" + wrap_why + ")";
     } else if (!(phys[k] > 0.0) || !std::isfinite(phys[k])) {
       e.lumped_why = "zero physiological mass (max_isometric_force " + fmt(pf.max_isometric_force) +
                      " N, optimal_fiber_length " + fmt(pf.optimal_fiber_length) + " m)";
