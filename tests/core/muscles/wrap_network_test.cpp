@@ -305,7 +305,18 @@ TEST(WrapTraining, InitContinuesFromANetwork) {
   TrainOptions cont = opt;
   cont.init = &first;
   cont.epochs = 0;
-  EXPECT_TRUE(trainWrapNetwork(set, box, cont).weights(0) == first.weights(0));
+  Mlp zero = trainWrapNetwork(set, box, cont);
+  EXPECT_TRUE(zero.weights(0) == first.weights(0));
+  zero.meta = first.meta;  // the wall time differs
+  EXPECT_TRUE(zero.identical(first));  // every layer, and the normalisation
+  // the first run's normalisation is kept on another training set (its own statistics differ)
+  const WrapTrainingSet other = makeWrapTrainingSet(box, makeExactWrapOracle(WrapType::Cylinder), 300, 0.01, 6);
+  const Mlp moved = trainWrapNetwork(other, box, cont);
+  EXPECT_TRUE(moved.input_mean == first.input_mean && moved.input_scale == first.input_scale);
+  EXPECT_TRUE(moved.output_mean == first.output_mean && moved.output_scale == first.output_scale);
+  TrainOptions fresh = opt;  // without init the statistics are the set's own: the check above can fail
+  fresh.epochs = 0;
+  EXPECT_FALSE(trainWrapNetwork(other, box, fresh).input_mean == first.input_mean);
   cont.epochs = 4;
   trainWrapNetwork(set, box, cont, &h2);
   EXPECT_LT(h2.front().train_mse, 0.8 * h1.front().train_mse);  // not a fresh start
