@@ -8,10 +8,13 @@
 #include <cstdio>
 #include <string>
 
+#include "converter/build/build_core_model.hpp"
 #include "converter/build/muscle_mass.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/system.hpp"
+#include "core/muscles/wrap_muscle.hpp"
+#include "tests/converter/converter_test_util.hpp"
 
 namespace redmax::osim {
 namespace {
@@ -62,6 +65,37 @@ TEST(WrapMuscleMass, RunningLegGastrocnemiiTakeMassWithWrapMass) {
   std::printf("[ measured ] running_leg with wrapping muscle mass: root block of M differs by %.1e relative\n", diff);
   EXPECT_LE(diff, 1e-10);
   EXPECT_GT((w1.M - w0.M).norm(), 1e-6 * w0.M.norm());
+}
+
+// a wrapping muscle whose path the wrap model refuses stays lumped, and the plan gives the model's
+// own reason: subject_walk_armless's med_gas_r (two cylinders that can act on one segment) is
+// refused by the smooth model and taken by the exact one
+TEST(WrapMuscleMass, RefusedWrappingMuscleStaysLumpedWithTheModelsReason) {
+  REDMAX_REQUIRE_SHARED();
+  const ModelDescription d = readOsimModel(std::string(REDMAX_SHARED_DIR) +
+                                           "/opensim/opensim-core/OpenSim/Moco/Test/subject_walk_armless_18musc.osim");
+  BuildOptions bo;
+  bo.constraints = false;
+  MuscleMassOptions o;
+  o.source = MuscleMassOptions::Source::Physiological;
+  o.muscles = "med_gas_r";  // all of them would leave tibia_r non-physical
+  o.wrap_mass = true;
+  o.wrap.model = WrapModel::Smooth;
+  const MuscleMassModel r = applyMuscleMass(d, bo, o);
+  const int k = findEntry(r.plan, "med_gas_r");
+  ASSERT_GE(k, 0);
+  // the reason, asked of the plain build's muscle independently of the plan
+  Muscle mu = buildCoreModel(d, bo).muscles[k];
+  ASSERT_EQ(mu.name, "med_gas_r");
+  mu.wrap.model = WrapModel::Smooth;
+  const std::string why = wrapMassPointsUnsupportedReason(mu);
+  ASSERT_FALSE(why.empty());
+  EXPECT_EQ(r.plan.muscles[k].mass, 0.0);
+  EXPECT_EQ(r.plan.muscles[k].lumped_why, "Type III path (" + why + ")");
+  o.wrap.model = WrapModel::Exact;
+  const MuscleMassModel e = applyMuscleMass(d, bo, o);
+  EXPECT_GT(e.plan.muscles[k].mass, 0.0) << e.plan.muscles[k].lumped_why;
+  EXPECT_EQ(e.plan.muscles[k].lumped_why, "");
 }
 
 }  // namespace
