@@ -58,18 +58,9 @@ double timeMuscle(const Model& m, const Muscle& mu, const State& s) {
 void checkMuscle(const Model& m, const Muscle& mu, const State& s, double tol_J, double tol_Jdot, Tally& t) {
   const double h = mu.wrap.model == WrapModel::Exact ? 1e-5 : 1e-6;
   const MuscleKinematics mk = redmax::test::evalMuscle(m, mu, s);
-  const int N = mu.mass_points.size(), nr = m.nr();
-  MatX J_fd = MatX::Zero(3 * N, nr);
-  for (int c : mk.cols) {
-    State sp = s, sm = s;
-    sp.q[c] += h;
-    sm.q[c] -= h;
-    const MuscleKinematics kp = redmax::test::evalMuscle(m, mu, sp, false), km = redmax::test::evalMuscle(m, mu, sm, false);
-    for (int a = 0; a < N; ++a) J_fd.block<3, 1>(3 * a, c) = (kp.x_a[a] - km.x_a[a]) / (2 * h);
-  }
-  const MuscleKinematics kp = redmax::test::evalMuscle(m, mu, redmax::test::along(s, h));
-  const MuscleKinematics km = redmax::test::evalMuscle(m, mu, redmax::test::along(s, -h));
-  const MatX Jdot_fd = (kp.J_ar - km.J_ar) / (2 * h);
+  const int N = mu.mass_points.size();
+  const MatX J_fd = redmax::test::calcJarFd(m, mu, s, h);
+  const MatX Jdot_fd = redmax::test::calcJdotArFd(m, mu, s, h);
   const double eJ = (mk.J_ar - J_fd).norm() / (1.0 + J_fd.norm());
   const double eJd = (mk.Jdot_ar - Jdot_fd).norm() / (1.0 + Jdot_fd.norm());
   const int e = mu.wrap.model == WrapModel::Exact;

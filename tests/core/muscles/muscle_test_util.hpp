@@ -51,6 +51,25 @@ inline State along(const State& s, double t) {
   return r;
 }
 
+/// J_ar by central differences (step h) of the mass points x_a in each coordinate, 3 N x nr
+inline MatX calcJarFd(const Model& model, const Muscle& muscle, const State& s, double h) {
+  const int N = muscle.mass_points.size(), nr = model.nr();
+  MatX J(3 * N, nr);
+  for (int j = 0; j < nr; ++j) {
+    State sp = s, sm = s;
+    sp.q[j] += h;
+    sm.q[j] -= h;
+    const MuscleKinematics kp = evalMuscle(model, muscle, sp, false), km = evalMuscle(model, muscle, sm, false);
+    for (int a = 0; a < N; ++a) J.block<3, 1>(3 * a, j) = (kp.x_a[a] - km.x_a[a]) / (2 * h);
+  }
+  return J;
+}
+
+/// Jdot_ar by central differences (step h) of J_ar along the state's own velocity (along())
+inline MatX calcJdotArFd(const Model& model, const Muscle& muscle, const State& s, double h) {
+  return (evalMuscle(model, muscle, along(s, h)).J_ar - evalMuscle(model, muscle, along(s, -h)).J_ar) / (2 * h);
+}
+
 /// point at arc fraction alpha of the polyline through pts (independent of the library's code)
 inline Vec3 pointAtArcFraction(const std::vector<Vec3>& pts, double alpha) {
   double total = 0.0;

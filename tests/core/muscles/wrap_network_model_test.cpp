@@ -267,18 +267,9 @@ WrapMassOptions neural(std::shared_ptr<const Mlp> net, std::shared_ptr<WrapFallb
 void checkMuscleAgainstFd(const Model& m, const Muscle& mu, const State& s, double tol) {
   const double h = 1e-6;
   const MuscleKinematics mk = test::evalMuscle(m, mu, s);
-  const int N = mu.mass_points.size(), nr = m.nr();
-  MatX J_fd(3 * N, nr);
-  for (int j = 0; j < nr; ++j) {
-    State sp = s, sm = s;
-    sp.q[j] += h;
-    sm.q[j] -= h;
-    const MuscleKinematics kp = test::evalMuscle(m, mu, sp, false), km = test::evalMuscle(m, mu, sm, false);
-    for (int a = 0; a < N; ++a) J_fd.block<3, 1>(3 * a, j) = (kp.x_a[a] - km.x_a[a]) / (2 * h);
-  }
+  const MatX J_fd = test::calcJarFd(m, mu, s, h);
   EXPECT_TRUE(closeRel(mk.J_ar, J_fd, tol, "J_ar"));
-  const MuscleKinematics kp = test::evalMuscle(m, mu, test::along(s, h)), km = test::evalMuscle(m, mu, test::along(s, -h));
-  EXPECT_TRUE(closeRel(mk.Jdot_ar, (kp.J_ar - km.J_ar) / (2 * h), tol, "Jdot_ar"));
+  EXPECT_TRUE(closeRel(mk.Jdot_ar, test::calcJdotArFd(m, mu, s, h), tol, "Jdot_ar"));
 }
 
 TEST(NetworkWrapModel, MuscleJacobiansOnAMovingSurfaceMatchCentralDifferences) {

@@ -95,19 +95,10 @@ double segmentPenetration(const Model& m, const Muscle& mu, const State& st, int
 void checkAgainstFd(const Model& m, const Muscle& mu, const State& s, double tol, const std::string& what) {
   const double h = 1e-6;
   const MuscleKinematics mk = test::evalMuscle(m, mu, s);
-  const int N = mu.mass_points.size(), nr = m.nr();
-  MatX J_fd(3 * N, nr);
-  for (int j = 0; j < nr; ++j) {
-    State sp = s, sm = s;
-    sp.q[j] += h;
-    sm.q[j] -= h;
-    const MuscleKinematics kp = test::evalMuscle(m, mu, sp, false), km = test::evalMuscle(m, mu, sm, false);
-    for (int a = 0; a < N; ++a) J_fd.block<3, 1>(3 * a, j) = (kp.x_a[a] - km.x_a[a]) / (2 * h);
-  }
+  const MatX J_fd = test::calcJarFd(m, mu, s, h);
   EXPECT_TRUE(nearRel(mk.J_ar, J_fd, tol)) << what << ": J_ar vs x_a, |diff| " << (mk.J_ar - J_fd).norm() << " |J| "
                                            << J_fd.norm();
-  const MuscleKinematics kp = test::evalMuscle(m, mu, test::along(s, h)), km = test::evalMuscle(m, mu, test::along(s, -h));
-  const MatX Jdot_fd = (kp.J_ar - km.J_ar) / (2 * h);
+  const MatX Jdot_fd = test::calcJdotArFd(m, mu, s, h);
   EXPECT_TRUE(nearRel(mk.Jdot_ar, Jdot_fd, tol)) << what << ": Jdot_ar vs J_ar, |diff| " << (mk.Jdot_ar - Jdot_fd).norm()
                                                  << " |Jdot| " << Jdot_fd.norm();
 }

@@ -37,23 +37,9 @@ Muscle chainMuscle(const WrapSurface& surface, WrapModel model) {
 // tolerance (a stencil across one of the library's own kinks, e.g. the hybrid ellipsoid method's
 // linear blends, or a mass point crossing a tangent point)
 bool checkAgainstFd(const Model& m, const Muscle& mu, const State& s, const char* what) {
-  const int N = mu.mass_points.size(), nr = m.nr();
-  auto fdJ = [&](double h) {
-    MatX J(3 * N, nr);
-    for (int j = 0; j < nr; ++j) {
-      State sp = s, sm = s;
-      sp.q[j] += h;
-      sm.q[j] -= h;
-      const MuscleKinematics kp = test::evalMuscle(m, mu, sp, false), km = test::evalMuscle(m, mu, sm, false);
-      for (int a = 0; a < N; ++a) J.block<3, 1>(3 * a, j) = (kp.x_a[a] - km.x_a[a]) / (2 * h);
-    }
-    return J;
-  };
-  auto fdJdot = [&](double h) {
-    return MatX((test::evalMuscle(m, mu, test::along(s, h)).J_ar - test::evalMuscle(m, mu, test::along(s, -h)).J_ar) / (2 * h));
-  };
   const double h = 1e-6;
-  const MatX J1 = fdJ(h), J2 = fdJ(2 * h), D1 = fdJdot(h), D2 = fdJdot(2 * h);
+  const MatX J1 = test::calcJarFd(m, mu, s, h), J2 = test::calcJarFd(m, mu, s, 2 * h);
+  const MatX D1 = test::calcJdotArFd(m, mu, s, h), D2 = test::calcJdotArFd(m, mu, s, 2 * h);
   if (!nearRel(J2, J1, 3e-7) || !nearRel(D2, D1, 3e-7)) return false;
   const MuscleKinematics mk = test::evalMuscle(m, mu, s);
   EXPECT_TRUE(nearRel(mk.J_ar, J1, 1e-6)) << what << ": |J_ar - FD| " << (mk.J_ar - J1).norm() << " |J| " << J1.norm();
