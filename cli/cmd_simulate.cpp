@@ -10,6 +10,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -48,12 +49,17 @@ std::vector<std::pair<std::string, double>> parseMassList(const std::string& tex
   return out;
 }
 
+// the value flags: simulate's own, the muscle-mass ones and the Simbody engine's (simulate_simbody.hpp)
+std::set<std::string> simulateFlags() {
+  std::set<std::string> names = withMuscleMassFlags({"model", "duration", "integrator", "dt", "rtol", "atol",
+                                                     "max-step", "initial", "initial-time", "wrap", "output-dt", "out",
+                                                     "muscle-mass-kg", "impulse", "engine"});
+  for (const std::string& n : simbodyEngineFlagNames()) names.insert(n);
+  return names;
+}
+
 int runSimulate(const std::vector<std::string>& argv) {
-  const Args a(argv,
-               withMuscleMassFlags({"model", "duration", "integrator", "dt", "rtol", "atol", "max-step", "initial",
-                                    "initial-time", "wrap", "output-dt", "out", "muscle-mass-kg", "impulse", "engine",
-                                    "simbody-method", "simbody-norm"}),
-               {"no-qvv", "progress", "quiet", "full-precision"});
+  const Args a(argv, simulateFlags(), {"no-qvv", "progress", "quiet", "full-precision"});
   if (!a.positionals().empty())
     throw UsageError{"simulate takes no positional arguments (got '" + a.positionals().front() + "')"};
   if (!a.has("model")) throw UsageError{"simulate needs --model M.osim"};
