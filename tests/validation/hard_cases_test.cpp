@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 
+#include "tests/validation/hard_cases_test_util.hpp"
 #include "validation/simulate/simulate.hpp"
 #include "validation/work_precision/hard_cases.hpp"
 
@@ -16,14 +17,8 @@ namespace {
 using namespace redmax;
 using namespace redmax::validation;
 
-std::string modelsDir() { return std::string(REDMAX_SOURCE_DIR) + "/osim_models"; }
-
-void record(const std::string& key, double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3e", v);
-  ::testing::Test::RecordProperty(key, buf);
-  std::printf("%s = %s\n", key.c_str(), buf);
-}
+using redmax_test::modelsDir;
+using redmax_test::record;
 
 // 1. exponential coordinates near |q| = pi and through the chart switch at 1.5 pi: 2 s of the
 // spinning body (20 revolutions) keep energy and world angular momentum to 1e-7 (rk45 rtol 1e-10).

@@ -4,9 +4,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "core/muscles/wrap/network_model.hpp"
+#include "tests/validation/hard_cases_test_util.hpp"
 #include "validation/work_precision/hard_cases.hpp"
 
 namespace {
@@ -14,14 +16,8 @@ namespace {
 using namespace redmax;
 using namespace redmax::validation;
 
-std::string modelsDir() { return std::string(REDMAX_SOURCE_DIR) + "/osim_models"; }
-
-void record(const std::string& key, double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3e", v);
-  ::testing::Test::RecordProperty(key, buf);
-  std::printf("%s = %s\n", key.c_str(), buf);
-}
+using redmax_test::modelsDir;
+using redmax_test::record;
 
 // The physical claim of [D Sec. 6.2.5] for the wrapping pendulum: with the exact wrap library and
 // finite-difference Jacobians the mass matrix jumps where the path starts or stops touching the
