@@ -157,7 +157,7 @@ int runLengths(const std::vector<std::string>& argv) {
 
   // which built paths are reported: muscles (every path force with --all-paths)
   std::vector<int> report;
-  for (size_t k = 0; k < build.muscles.size(); ++k)
+  for (size_t k = 0; k < build.model.muscles().size(); ++k)
     if (a.has("all-paths") || d.muscles[build.muscle_source[k]].is_muscle)
       report.push_back(static_cast<int>(k));
   if (report.empty()) {
@@ -198,7 +198,7 @@ int runLengths(const std::vector<std::string>& argv) {
   // the paths without their wraps when asked (--wrap none: straight segments only)
   std::vector<MusclePath> paths;
   for (int k : report) {
-    MusclePath p = build.muscles[k].path;
+    MusclePath p = build.model.muscles()[k].path;
     if (wrap == "none") p.wraps.clear();
     paths.push_back(std::move(p));
   }
@@ -211,7 +211,7 @@ int runLengths(const std::vector<std::string>& argv) {
     for (size_t m = 0; m < paths.size(); ++m) {
       if (paths[m].wraps.empty()) continue;  // no wrap object: the polyline either way
       Muscle& mu = model_muscle[m];
-      mu.name = build.muscles[report[m]].name;
+      mu.name = build.model.muscles()[report[m]].name;
       mu.path = paths[m];
       mu.wrap = wrap_flags.wrap;
       const std::string why = wrapMassPointsUnsupportedReason(mu);
@@ -233,7 +233,7 @@ int runLengths(const std::vector<std::string>& argv) {
   osim::Storage out;
   out.name = "MuscleTendonLengths";
   out.in_degrees = false;
-  for (int k : report) out.labels.push_back(build.muscles[k].name);
+  for (int k : report) out.labels.push_back(build.model.muscles()[k].name);
   out.time = coords.time;
   out.data.resize(coords.numRows(), static_cast<int>(report.size()));
   // optional: the surface length l of every wrap object of every reported path (0 when unused)

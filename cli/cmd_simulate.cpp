@@ -148,11 +148,11 @@ int runSimulate(const std::vector<std::string>& argv) {
     const Model& core = model.system->model();
     std::printf("simulate: %s, %d coordinates, %d constraint rows, %zu muscles (%.4g kg in mass points)\n",
                 model.description.name.c_str(), core.nr(), model.system->numConstraintRows(),
-                model.muscles.size(), model.muscle_mass);
+                model.build.model.muscles().size(), model.muscle_mass);
     // where the mass went, on stderr as the other commands print it (muscle_mass_flags.hpp)
     if (!model.mass_summary.empty()) std::fprintf(stderr, "%s", model.mass_summary.c_str());
     if (model.added_mass > 0.0)
-      for (const Muscle& mu : model.muscles)
+      for (const Muscle& mu : model.build.model.muscles())
         if (pathType(mu.path) == PathType::III && mu.mass_points.size() == 0)
           std::fprintf(stderr, "  muscle %s: lumped (Type III path, no mass given)\n", mu.name.c_str());
   }

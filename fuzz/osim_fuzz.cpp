@@ -30,7 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const redmax::osim::BuildResult r = redmax::osim::buildCoreModel(d, opt);
       const redmax::Model& m = r.model;
       redmax::VecX q(m.nr()), qdot = redmax::VecX::Ones(m.nr());
-      for (int k = 0; k < m.nr(); ++k) q[k] = m.coordinates[k].default_value;
+      for (int k = 0; k < m.nr(); ++k) q[k] = m.coordinates()[k].default_value;
       redmax::SkeletonWorkspace ws(m);
       redmax::calcKinematics(m, redmax::State{0.0, q, qdot}, ws);
       q.array() += 0.5;

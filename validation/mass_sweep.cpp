@@ -85,9 +85,9 @@ MassSweepEngineFactory makeCoreMassEngineFactory(const osim::InverseDynamicsTool
     e.description = osim::describeMuscleMass(mm.plan);
     e.wrap = osim::countWrapMass(mm.plan);
     e.model = std::make_shared<const Model>(mm.build.model);
-    e.muscles = mm.build.muscles;
+    e.muscles = mm.build.model.muscles();
     // the core with the muscles' mass points as a MuscleTerm (core_id_engine.hpp)
-    e.engine = std::make_unique<osim::CoreIdEngine>(mm.build.model, std::move(mm.build.muscles), t->engineOptions());
+    e.engine = std::make_unique<osim::CoreIdEngine>(mm.build.model, mm.build.model.muscles(), t->engineOptions());
     return e;
   };
 }

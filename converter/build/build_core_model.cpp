@@ -148,6 +148,7 @@ class Builder {
   Builder(const ModelDescription& d, const BuildOptions& opt) : d_(d), opt_(opt), mb_(d.name) {}
 
   BuildResult build() {
+    r_.options = opt_;
     r_.body_index.assign(d_.bodies.size(), -1);
     r_.coordinate_index.assign(d_.coordinates.size(), -1);
     mb_.setGravity(d_.gravity);
@@ -168,13 +169,17 @@ class Builder {
                                               "is left out"});
     }
     try {
-      r_.model = mb_.finalize();
+      skeleton_ = mb_.finalize();
     } catch (const ModelError& e) {
       // mass properties the reader passed but the core rejects (negative mass, NaN inertia)
       throw ConvertError(d_.source_file, 0, e.what());
     }
+    model_ = std::make_unique<MusculoskeletalModelBuilder>(skeleton_);
+    model_->settings().simbody_compat = opt_.simbody_compat;
     if (opt_.constraints) buildConstraints();
     if (opt_.muscles) buildMuscles();
+    // every muscle was validated against the skeleton as it was added
+    r_.model = model_->finalize();
     return std::move(r_);
   }
 
@@ -217,13 +222,10 @@ class Builder {
                              ": mass must be finite and >= 0, mass_center and inertia finite");
     auto cp = copies_.find(mass_body);
     const double share = cp == copies_.end() ? 1.0 : 1.0 / (1.0 + cp->second);
-    double mass = b.mass * share;
-    Mat3 I = b.inertiaMatrix() * share;
-    if (std::abs(mass) <= 1e-14 && !I.isZero(0.0)) {
-      I.setZero();
+    const CoreMassProperties mp = coreMassProperties(b, share);
+    if (mp.zeroed)
       r_.warnings.push_back("body " + quoted(b.name) +
                             " is massless; its nonzero inertia is set to zero, as Simbody does");
-    }
 
     CoreJoint cj;
     if (j.kind == JointKind::Unsupported) {
@@ -248,13 +250,15 @@ class Builder {
     const Mat4& E_bm = m.reversed ? X_PF : X_BM;
     int body = -1;
     try {
-      body = mb_.addBody(m.outboard_body, mass, b.mass_center, I, parent, j.name, std::move(joint),
-                         E_pf, E_bm);
+      body = mb_.addBody(m.outboard_body, mp.mass, mp.com, mp.inertia_com, parent, j.name,
+                         std::move(joint), E_pf, E_bm);
     } catch (const ModelError& e) {
       throw ConvertError(d_.source_file, j.line, "joint " + quoted(j.name) + ": " + e.what());
     }
     core_body_[m.outboard_body] = body;
     if (sm == slave_master_.end()) r_.body_index[bi] = body;
+    r_.body_source.push_back(bi);
+    r_.body_mass_share.push_back(share);
 
     // coordinates: names, defaults; q slots in creation order = the description's order
     if (j.kind == JointKind::Unsupported) return;
@@ -303,26 +307,26 @@ class Builder {
             const AxisFunctionPtr f = makeCoreFunction(*c.function, static_cast<int>(indep.size()),
                                                        d_.source_file, what);
             if (opt_.couplers == CouplerHandling::Eliminate) {
-              if (!map) map = std::make_shared<CoordinateMap>(r_.model);
+              if (!map) map = std::make_shared<CoordinateMap>(skeleton_);
               map->addDependent(dep, indep, f, c.scale_factor);
             } else {
-              r_.constraints.push_back(std::make_shared<CoordinateCoupler>(
-                  r_.model, dep, indep, f, c.scale_factor, c.name));
+              model_->addConstraint(std::make_shared<CoordinateCoupler>(
+                  skeleton_, dep, indep, f, c.scale_factor, c.name));
             }
             break;
           }
           case ConstraintKind::Weld: {
             if (!opt_.body_constraints) break;
             const int b1 = coreBody(c.body1, c.line), b2 = coreBody(c.body2, c.line);
-            r_.constraints.push_back(
-                std::make_shared<WeldConstraint>(r_.model, b1, c.X_B1F1, b2, c.X_B2F2, c.name));
+            model_->addConstraint(
+                std::make_shared<WeldConstraint>(skeleton_, b1, c.X_B1F1, b2, c.X_B2F2, c.name));
             break;
           }
           case ConstraintKind::Point: {
             if (!opt_.body_constraints) break;
             const int b1 = coreBody(c.body1, c.line), b2 = coreBody(c.body2, c.line);
-            r_.constraints.push_back(std::make_shared<PointConstraint>(
-                r_.model, b1, c.location1, b2, c.location2, c.name));
+            model_->addConstraint(std::make_shared<PointConstraint>(
+                skeleton_, b1, c.location1, b2, c.location2, c.name));
             break;
           }
           case ConstraintKind::Unsupported:
@@ -333,7 +337,7 @@ class Builder {
         throw ConvertError(d_.source_file, c.line, what + ": " + e.what());
       }
     }
-    if (map) r_.coordinate_map = map;
+    if (map) model_->setCoordinateMap(map);
 
     // locked and prescribed coordinates (PrescribedMotion constraints in OpenSim)
     for (size_t ci = 0; ci < d_.coordinates.size(); ++ci) {
@@ -344,12 +348,12 @@ class Builder {
         if (c.prescribed && c.prescribed_function)
           r_.warnings.push_back("coordinate " + quoted(c.name) +
                                 " is locked and prescribed: it is held locked");
-        r_.constraints.push_back(PrescribedCoordinate::makeLocked(r_.model, k, c.default_value));
+        model_->addConstraint(PrescribedCoordinate::makeLocked(skeleton_, k, c.default_value));
       } else if (!c.locked && c.prescribed && c.prescribed_function && opt_.prescribed_coordinates) {
         const std::string what = "coordinate " + quoted(c.name) + " prescribed_function";
         const AxisFunctionPtr f = makeCoreFunction(*c.prescribed_function, 1, d_.source_file, what);
-        r_.constraints.push_back(
-            std::make_shared<PrescribedCoordinate>(r_.model, k, f, c.name + "_prescribed"));
+        model_->addConstraint(
+            std::make_shared<PrescribedCoordinate>(skeleton_, k, f, c.name + "_prescribed"));
       }
     }
   }
@@ -474,12 +478,12 @@ class Builder {
       m.path.num_wraps = static_cast<int>(pf.wraps.size());
       for (const PathWrapDesc& pw : pf.wraps) m.path.wraps.push_back(makeWrap(pw, what));
       try {
-        validateMuscle(r_.model, m);
+        validateMuscle(skeleton_, m);
       } catch (const ModelError& e) {
         r_.unsupported.push_back({pf.line, what + " is left out: " + e.what()});
         continue;
       }
-      r_.muscles.push_back(std::move(m));
+      model_->addMuscle(std::move(m), pf.class_name);
       r_.muscle_source.push_back(static_cast<int>(mi));
     }
   }
@@ -488,6 +492,8 @@ class Builder {
   const BuildOptions& opt_;
   ModelBuilder mb_;
   BuildResult r_;
+  Model skeleton_;                                  // mb_ finalized
+  std::unique_ptr<MusculoskeletalModelBuilder> model_;
   std::map<std::string, int> copies_;               // master body -> number of slaves
   std::map<std::string, std::string> slave_master_; // slave body -> master
   std::map<std::string, int> core_body_;            // body or slave name -> core index
@@ -556,11 +562,16 @@ BuildResult buildCoreModel(const ModelDescription& d, const BuildOptions& option
   return b.build();
 }
 
-System BuildResult::makeSystem() const {
-  System sys(model);
-  for (const auto& c : constraints) sys.addConstraint(c);
-  if (coordinate_map) sys.setCoordinateMap(coordinate_map);
-  return sys;
+CoreMassProperties coreMassProperties(const BodyDesc& b, double share) {
+  CoreMassProperties p;
+  p.mass = b.mass * share;
+  p.com = b.mass_center;
+  p.inertia_com = b.inertiaMatrix() * share;
+  if (std::abs(p.mass) <= 1e-14 && !p.inertia_com.isZero(0.0)) {
+    p.inertia_com.setZero();
+    p.zeroed = true;
+  }
+  return p;
 }
 
 std::vector<Muscle> addMusclePointMasses(const std::vector<Muscle>& muscles,

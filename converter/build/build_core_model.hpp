@@ -1,7 +1,8 @@
 #pragma once
 // The last step of the converter: the plain-data model description (converter/model_description.hpp)
-// -> a core Model, its constraints, an optional coordinate map, and muscles, so that converted
-// OpenSim models run in the REDMAX core.
+// -> one core MusculoskeletalModel (core/model/musculoskeletal_model.hpp: the skeleton Model, its
+// constraints, an optional coordinate map, and muscles), so that converted OpenSim models run in
+// the REDMAX core, plus the bookkeeping that ties it to the description.
 //
 // Bodies. Core bodies are created in the description's mobilizer order (tree.mobilizers, the
 // order Simbody creates MobilizedBodies, OPENSIM_SEMANTICS.md 3.1), so parents precede children
@@ -46,6 +47,7 @@
 #include "core/dynamics/constraint.hpp"
 #include "core/dynamics/coordinate_map.hpp"
 #include "core/dynamics/system.hpp"
+#include "core/model/musculoskeletal_model.hpp"
 #include "core/muscles/mass_points.hpp"
 #include "core/skeleton/model.hpp"
 
@@ -75,17 +77,23 @@ struct BuildOptions {
 };
 
 struct BuildResult {
-  Model model;
-  /// constraints to add to a System (empty when BuildOptions::constraints is false)
-  std::vector<std::shared_ptr<const Constraint>> constraints;
-  /// hyper-reduced coordinates when couplers are eliminated (null otherwise)
-  std::shared_ptr<const CoordinateMap> coordinate_map;
-  /// one per built path force, massless (no mass points), in description order
-  std::vector<Muscle> muscles;
+  /// The model: skeleton, constraints (empty when BuildOptions::constraints is false), the
+  /// coordinate map when couplers are eliminated (null otherwise), and one muscle per built path
+  /// force, massless (no mass points), in description order, read as its OpenSim class.
+  /// Immutable: edits (muscle mass) go through a MusculoskeletalModelBuilder.
+  MusculoskeletalModel model;
+
+  // bookkeeping of the conversion (not model data)
+  /// the options the model was built with
+  BuildOptions options;
   /// index into ModelDescription::muscles of each built muscle
   std::vector<int> muscle_source;
   /// ModelDescription::bodies[k] -> core body index (-1 if it has none)
   std::vector<int> body_index;
+  /// core body -> the description body whose mass properties it carries (a split body's slaves
+  /// carry their master's), and the share of them it carries (1 / (1 + slaves))      (nb)
+  std::vector<int> body_source;
+  std::vector<double> body_mass_share;
   /// ModelDescription::coordinates[k] -> core coordinate index (-1 if it has none, e.g. the
   /// coordinates of a joint that is not modelled); the identity for every supported model
   std::vector<int> coordinate_index;
@@ -94,8 +102,8 @@ struct BuildResult {
   std::vector<UnsupportedItem> unsupported;
   std::vector<std::string> warnings;
 
-  /// a System over the model with the constraints and the coordinate map (no force terms)
-  System makeSystem() const;
+  /// a System over the model with the constraints and the coordinate map (no muscle term)
+  System makeSystem() const { return model.makeSystem(); }
 };
 
 /// Build the core model. Throws ConvertError ("FILE:LINE: what") when the description cannot be
@@ -104,6 +112,16 @@ struct BuildResult {
 /// passed the reader. Items that can be left out without changing the skeleton (a muscle whose
 /// path the core rejects, a constraint of an unsupported kind) go to BuildResult::unsupported.
 BuildResult buildCoreModel(const ModelDescription& d, const BuildOptions& options = {});
+
+/// The core mass properties of a body carrying `share` of description body b's (mass, centre of
+/// mass, inertia about it); a massless body gets zero inertia, as Simbody does (`zeroed` set).
+struct CoreMassProperties {
+  double mass = 0.0;
+  Vec3 com = Vec3::Zero();
+  Mat3 inertia_com = Mat3::Zero();
+  bool zeroed = false;  ///< a nonzero inertia of a massless body was set to zero
+};
+CoreMassProperties coreMassProperties(const BodyDesc& b, double share);
 
 /// The muscles with mass points: muscle k gets masses[k] kg (0 keeps it massless) spread by
 /// makeMassPoints over its fibre. Throws ModelError if the sizes differ, a mass is negative or

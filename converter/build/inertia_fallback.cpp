@@ -26,12 +26,25 @@ Mat3 openSimFallbackInertia(const Mat3& I) {
 
 std::vector<std::string> applyOpenSimInertiaFallback(Model& model) {
   std::vector<std::string> changed;
-  for (Body& b : model.bodies) {
+  ModelBuilder edit(model);
+  for (int i = 0; i < model.nb(); ++i) {
+    const Body& b = model.bodies()[i];
     if (b.mass == 0.0 || isValidInertia(b.inertia_com)) continue;
-    b.inertia_com = openSimFallbackInertia(b.inertia_com);
-    b.M = spatialInertia(b.mass, b.com, b.inertia_com);
+    edit.setBodyMassProperties(i, b.mass, b.com, openSimFallbackInertia(b.inertia_com));
     changed.push_back(b.name);
   }
+  // the builder derives the spatial inertias of the changed bodies
+  if (!changed.empty()) model = edit.finalize();
+  return changed;
+}
+
+std::vector<std::string> applyOpenSimInertiaFallback(MusculoskeletalModel& model) {
+  Model skeleton = model.skeleton();
+  std::vector<std::string> changed = applyOpenSimInertiaFallback(skeleton);
+  if (changed.empty()) return changed;
+  MusculoskeletalModelBuilder edit(model);
+  edit.setSkeleton(skeleton);
+  model = edit.finalize();
   return changed;
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/model/musculoskeletal_model.hpp"
 #include "core/skeleton/model.hpp"
 
 namespace redmax::osim {
@@ -25,5 +26,7 @@ Mat3 openSimFallbackInertia(const Mat3& I_com);
 /// Replace every invalid body inertia of `model` (bodies with mass) by OpenSim's fallback and
 /// update the body's spatial inertia. Returns the names of the bodies that changed.
 std::vector<std::string> applyOpenSimInertiaFallback(Model& model);
+/// The same on the skeleton of a musculoskeletal model (its builder re-validates the muscles).
+std::vector<std::string> applyOpenSimInertiaFallback(MusculoskeletalModel& model);
 
 }  // namespace redmax::osim

@@ -134,10 +134,10 @@ Bones calcBones(const Model& model, const SkeletonWorkspace& sk) {
   b.segments.resize(model.nb());
   for (int i = 0; i < model.nb(); ++i) {
     const Vec3 o = sk.E_wi[i].topRightCorner<3, 1>();
-    b.segments[i].push_back({o, transformPoint(sk.E_wi[i], model.bodies[i].com)});
+    b.segments[i].push_back({o, transformPoint(sk.E_wi[i], model.bodies()[i].com)});
   }
   for (int j = 0; j < model.nb(); ++j) {
-    const int p = model.joints[j].parent;
+    const int p = model.joints()[j].parent;
     if (p < 0) continue;
     const Vec3 o = sk.E_wi[p].topRightCorner<3, 1>();
     // the child's origin at the default pose (joint translations such as gait2392's knee live in
@@ -162,7 +162,7 @@ std::vector<int> muscleSpan(const Model& model, const MusclePath& path) {
   if (ends.empty()) return {};
   auto chain = [&](int b) {  // b, its parent, ..., root, then -1 (ground)
     std::vector<int> c;
-    for (int i = b; i >= 0; i = model.joints[i].parent) c.push_back(i);
+    for (int i = b; i >= 0; i = model.joints()[i].parent) c.push_back(i);
     c.push_back(-1);
     return c;
   };
@@ -176,7 +176,7 @@ std::vector<int> muscleSpan(const Model& model, const MusclePath& path) {
   const int lca = first[lca_at];
   std::vector<int> span;
   for (int e : ends)
-    for (int i = e; i >= 0; i = model.joints[i].parent) {
+    for (int i = e; i >= 0; i = model.joints()[i].parent) {
       if (std::find(span.begin(), span.end(), i) == span.end()) span.push_back(i);
       if (i == lca) break;
     }
@@ -277,29 +277,46 @@ double physiologicalMass(const PathForceDesc& muscle, const MuscleMassOptions& o
 
 MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& build_options,
                                 const MuscleMassOptions& options, const std::vector<VecX>& samples) {
+  checkOptions(d, options);
+  parseSelector(options.muscles);  // bad options fail before the model is built
+  BuildOptions bo = build_options;
+  bo.muscles = true;  // the muscles carry the mass, whatever the caller builds them for
+  return addMuscleMass(d, buildCoreModel(d, bo), options, samples);
+}
+
+MuscleMassModel addMuscleMass(const ModelDescription& d, BuildResult base,
+                              const MuscleMassOptions& options, const std::vector<VecX>& samples) {
   using Source = MuscleMassOptions::Source;
   checkOptions(d, options);
   const Selector selector = parseSelector(options.muscles);
+  if (!base.options.muscles)
+    throw std::invalid_argument("muscle mass: the model was built without its muscles (BuildOptions::muscles)");
 
   MuscleMassModel out;
   out.plan.options = options;
   out.description = d;
-  BuildOptions bo = build_options;
-  bo.muscles = true;  // the muscles carry the mass, whatever the caller builds them for
-  BuildResult base = buildCoreModel(d, bo);
-  const Model& model = base.model;
-  const int nm = static_cast<int>(base.muscles.size());
+  const Model& model = base.model.skeleton();
+  // the muscles as they will be: wrap model set, mass points added below
+  std::vector<Muscle> muscles = base.model.muscles();
+  const int nm = static_cast<int>(muscles.size());
   out.plan.muscles.resize(nm);
   for (int k = 0; k < nm; ++k) {
-    out.plan.muscles[k].name = base.muscles[k].name;
-    out.plan.muscles[k].wraps = pathType(base.muscles[k].path) == redmax::PathType::III;
+    out.plan.muscles[k].name = muscles[k].name;
+    out.plan.muscles[k].wraps = pathType(muscles[k].path) == redmax::PathType::III;
     // the wrap model decides which surfaces a Type III muscle may carry mass over
-    if (out.plan.muscles[k].wraps) base.muscles[k].wrap = options.wrap;
+    if (out.plan.muscles[k].wraps) muscles[k].wrap = options.wrap;
   }
+  // the one edit of the built model: bodies' mass properties and the muscles
+  MusculoskeletalModelBuilder edit(base.model);
+  auto finish = [&]() {
+    for (int k = 0; k < nm; ++k) edit.muscle(k) = muscles[k];
+    out.build = std::move(base);
+    out.build.model = edit.finalize();
+  };
 
   if (options.source == Source::None) {
     for (auto& e : out.plan.muscles) e.lumped_why = "--muscle-mass none";
-    out.build = std::move(base);
+    finish();
     return out;
   }
 
@@ -325,7 +342,7 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
     phys[k] = physiologicalMass(pf, options);
     // why the wrap model refuses this wrapping muscle's path ("" = it takes it)
     const std::string wrap_why = pf.is_muscle && e.wraps && options.wrap_mass
-                                     ? redmax::wrapMassPointsUnsupportedReason(base.muscles[k])
+                                     ? redmax::wrapMassPointsUnsupportedReason(muscles[k])
                                      : std::string();
     if (!pf.is_muscle) {
       e.lumped_why = "not a muscle (" + pf.class_name + ")";
@@ -339,7 +356,7 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
     } else if (selector.kind == Selector::Kind::Regex && !std::regex_match(pf.name, *selector.re)) {
       e.lumped_why = "not selected (--muscles " + options.muscles + ")";
     } else if (transfer_core >= 0 &&
-               std::none_of(base.muscles[k].path.points.begin(), base.muscles[k].path.points.end(),
+               std::none_of(muscles[k].path.points.begin(), muscles[k].path.points.end(),
                             [&](const PathPoint& p) { return p.body == transfer_core; })) {
       e.lumped_why = "does not span " + options.transfer_body;
     } else {
@@ -349,7 +366,7 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
 
   const MassPointOptions mpo{options.mass_points, options.region};
   auto withPoints = [&](int k, double m) {
-    Muscle mu = base.muscles[k];
+    Muscle mu = muscles[k];
     const PathForceDesc& pf = d.muscles[base.muscle_source[k]];
     mu.mass_points = makeMassPoints(m, pf.optimal_fiber_length, pf.tendon_slack_length, mpo);
     return mu;
@@ -381,7 +398,7 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
                      [](const auto& a, const auto& b) { return a.first > b.first; });
     for (size_t r = 0; r < rank.size(); ++r) {
       const int k = rank[r].second;
-      out.plan.ranking.push_back({base.muscles[k].name, rank[r].first});
+      out.plan.ranking.push_back({muscles[k].name, rank[r].first});
       if (static_cast<int>(r) >= selector.top_k) {
         candidate[k] = false;
         out.plan.muscles[k].lumped_why =
@@ -490,24 +507,37 @@ MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& b
     out.plan.bodies.push_back(c);
   }
 
-  // the reduced model, its muscles with their points
-  out.build = buildCoreModel(out.description, bo);
-  // Type III muscles (wrap_mass) get their points here: addMusclePointMasses keeps refusing them
+  // the bodies that gave mass: the core bodies carrying them (a split body's slaves too) take the
+  // new properties exactly as buildCoreModel derives them from the description
+  for (const auto& [bi, r] : removals) {
+    const BodyDesc& nb = out.description.bodies[bi];
+    for (int c = 0; c < model.nb(); ++c) {
+      if (base.body_source[c] != bi) continue;
+      const CoreMassProperties mp = coreMassProperties(nb, base.body_mass_share[c]);
+      if (mp.zeroed)
+        base.warnings.push_back("body " + quoted(nb.name) +
+                                " is massless; its nonzero inertia is set to zero, as Simbody does");
+      edit.skeleton().setBodyMassProperties(c, mp.mass, mp.com, mp.inertia_com);
+    }
+  }
+
+  // the muscles with their points; Type III muscles (wrap_mass) get theirs here:
+  // addMusclePointMasses keeps refusing them
   std::vector<double> plain = mass;
   for (int k = 0; k < nm; ++k)
-    if (pathType(out.build.muscles[k].path) == redmax::PathType::III) plain[k] = 0.0;
-  out.build.muscles = addMusclePointMasses(out.build.muscles, plain, mpo);
+    if (pathType(muscles[k].path) == redmax::PathType::III) plain[k] = 0.0;
+  muscles = addMusclePointMasses(muscles, plain, mpo);
   for (int k = 0; k < nm; ++k) {
-    Muscle& mu = out.build.muscles[k];
-    if (pathType(mu.path) == redmax::PathType::III) mu.wrap = options.wrap;
+    Muscle& mu = muscles[k];
     if (plain[k] == mass[k] || !(mass[k] > 0.0)) continue;
     mu.mass_points = makeMassPoints(mass[k], mu.optimal_fiber_length, mu.tendon_slack_length, mpo);
-    validateMuscle(out.build.model, mu);
   }
+  // finalize validates every muscle against the edited skeleton (ModelError)
+  finish();
   for (int k = 0; k < nm; ++k) {
     MuscleMassEntry& e = out.plan.muscles[k];
     e.mass = mass[k];
-    e.points = out.build.muscles[k].mass_points.size();
+    e.points = out.build.model.muscles()[k].mass_points.size();
     if (mass[k] > 0.0) {
       e.lumped_why.clear();
     } else if (e.lumped_why.empty()) {

@@ -94,8 +94,10 @@ struct MuscleMassPlan {
   double total_muscle_mass = 0.0;  ///< kg
 };
 
-/// The model with its muscle mass: the description with the bodies' mass reduced, the core model
-/// built from it, its muscles carrying mass points, and the plan that says what moved where.
+/// The model with its muscle mass: the description with the bodies' mass reduced (for engines
+/// that build from a description, such as Simbody's), the core model edited to match it (bodies'
+/// mass properties, muscles carrying mass points; built once, edited through its builder), and
+/// the plan that says what moved where.
 struct MuscleMassModel {
   ModelDescription description;
   BuildResult build;
@@ -112,6 +114,13 @@ struct MuscleMassModel {
 MuscleMassModel applyMuscleMass(const ModelDescription& d, const BuildOptions& build_options,
                                 const MuscleMassOptions& options,
                                 const std::vector<VecX>& samples = {});
+
+/// The same on a model already built from `d` with its muscles (BuildOptions::muscles; throws
+/// std::invalid_argument otherwise): the built model is edited once through a
+/// MusculoskeletalModelBuilder, not rebuilt. Same numbers as applyMuscleMass.
+MuscleMassModel addMuscleMass(const ModelDescription& d, BuildResult built,
+                              const MuscleMassOptions& options,
+                              const std::vector<VecX>& samples = {});
 
 /// The wrapping (Type III) muscles of a plan: how many there are, how many carry mass, and the
 /// others with the reason each stays lumped (MuscleMassEntry::lumped_why), in plan order.

@@ -104,8 +104,8 @@ CoreIdEngine::CoreIdEngine(Model model, IdEngineOptions options)
                         " joints; the model has " + std::to_string(m.nb()));
   for (int j = 0; j < m.nb(); ++j) {
     if (!options_.marked(j)) continue;
-    if (!hasOpenSimSpeedMap(m.joints[j].joint))
-      throw IdEngineError("joint '" + m.joints[j].name + "' (" + m.joints[j].joint.typeName() +
+    if (!hasOpenSimSpeedMap(m.joints()[j].joint))
+      throw IdEngineError("joint '" + m.joints()[j].name + "' (" + m.joints()[j].joint.typeName() +
                           ") cannot take OpenSim's Euler-rate speeds");
     marked_.push_back(j);
   }
@@ -138,7 +138,7 @@ void CoreIdEngine::calcGeneralizedForces(double t, const VecX& q, const VecX& v,
 
   // OpenSim's u -> the core's qdot for marked joints: qdot = T^-1 u, qddot = T^-1 (udot - Tdot qdot)
   for (size_t k = 0; k < marked_.size(); ++k) {
-    const JointSlot& slot = m.joints[marked_[k]];
+    const JointSlot& slot = m.joints()[marked_[k]];
     const int i0 = slot.q_index, n = slot.nq;
     const VecJ qj = q.segment(i0, n);
     MatJ T, Tdot;
@@ -166,7 +166,7 @@ void CoreIdEngine::calcGeneralizedForces(double t, const VecX& q, const VecX& v,
 
   // back to OpenSim's u: tau_u = T^-T tau_qdot
   for (size_t k = 0; k < marked_.size(); ++k) {
-    const JointSlot& slot = m.joints[marked_[k]];
+    const JointSlot& slot = m.joints()[marked_[k]];
     const MatJ Tt = T_[k].transpose();
     tau.segment(slot.q_index, slot.nq) =
         Eigen::PartialPivLU<MatJ>(Tt).solve(VecJ(tau.segment(slot.q_index, slot.nq)));

@@ -118,11 +118,12 @@ InverseDynamicsTool::InverseDynamicsTool(IdToolConfig config) : config_(std::mov
   description_ = readOsimModel(config_.model_file);
 
   // the model as OpenSim's ID sees it: no constraints (calcResidualForceIgnoringConstraints), no
-  // muscles (redmax models no muscle forces; see checkForces)
+  // muscles (redmax models no muscle forces; see checkForces) unless they take mass: then the
+  // muscles are built here, once, and applyMuscleMassOptions edits this model
   BuildOptions bo;
   bo.simbody_compat = config_.opensim_compat;
   bo.constraints = false;
-  bo.muscles = false;
+  bo.muscles = config_.muscle_mass.source != MuscleMassOptions::Source::None;
   try {
     build_ = std::make_unique<BuildResult>(buildCoreModel(description_, bo));
   } catch (const ConvertError&) {
@@ -149,7 +150,7 @@ InverseDynamicsTool::InverseDynamicsTool(IdToolConfig config) : config_(std::mov
         continue;
       if (j.coordinates.empty()) continue;
       const int k = build_->coordinate_index[j.coordinates.front()];
-      engine_options_.rates_as_u[model().coordinates[k].joint] = true;
+      engine_options_.rates_as_u[model().coordinates()[k].joint] = true;
     }
   }
 
@@ -159,9 +160,8 @@ InverseDynamicsTool::InverseDynamicsTool(IdToolConfig config) : config_(std::mov
   prepareLoads();
 }
 
-// the model with muscle mass replaces the lumped one; its q order, coordinates and body indices
-// are the same (only mass properties change and the muscles are built), so the coordinate sources
-// stay valid
+// the model with muscle mass is an edit of the built one (bodies' mass properties, the muscles'
+// mass points), so its q order, coordinates and body indices stay and so do the coordinate sources
 void InverseDynamicsTool::applyMuscleMassOptions() {
   muscle_mass_plan_.options = config_.muscle_mass;
   if (config_.muscle_mass.source == MuscleMassOptions::Source::None) {
@@ -175,12 +175,9 @@ void InverseDynamicsTool::applyMuscleMassOptions() {
     calcInputs(frameTime(k), q, v, vdot, no_loads);
     samples.push_back(q);
   }
-  BuildOptions bo;
-  bo.simbody_compat = config_.opensim_compat;
-  bo.constraints = false;
   MuscleMassModel mm;
   try {
-    mm = applyMuscleMass(description_, bo, config_.muscle_mass, samples);
+    mm = addMuscleMass(description_, *build_, config_.muscle_mass, samples);
   } catch (const ConvertError&) {
     throw;
   } catch (const std::invalid_argument&) {
@@ -188,8 +185,6 @@ void InverseDynamicsTool::applyMuscleMassOptions() {
   } catch (const std::exception& e) {
     throw ConvertError(config_.model_file, 0, std::string("muscle mass: ") + e.what());
   }
-  if (mm.build.model.nr() != model().nr() || mm.build.body_index != build_->body_index)
-    throw ConvertError(config_.model_file, 0, "muscle mass: the model with muscle mass has a different tree");
   build_ = std::make_unique<BuildResult>(std::move(mm.build));
   muscle_mass_plan_ = std::move(mm.plan);
   mass_description_ = std::move(mm.description);
@@ -255,8 +250,8 @@ void InverseDynamicsTool::prepareCoordinates() {
   sources_.resize(static_cast<size_t>(m.nr()));
   for (int k = 0; k < m.nr(); ++k) {
     IdCoordinateSource& s = sources_[k];
-    s.name = m.coordinates[k].name;
-    s.constant = m.coordinates[k].default_value;
+    s.name = m.coordinates()[k].name;
+    s.constant = m.coordinates()[k].default_value;
     s.data_column = coordinates_.findColumn(s.name);
     if (s.data_column < 0) {
       missing.push_back(s.name);
@@ -372,7 +367,7 @@ void InverseDynamicsTool::prepareLoads() {
 // ---------------------------------------------------------------------------------------------
 std::vector<std::string> InverseDynamicsTool::outputLabels() const {
   std::vector<std::string> labels;
-  for (const Coordinate& c : model().coordinates) {
+  for (const Coordinate& c : model().coordinates()) {
     const int ci = description_.findCoordinate(c.name);
     const bool rot = ci >= 0 && description_.coordinates[ci].motion_type == MotionType::Rotational;
     labels.push_back(c.name + (rot ? "_moment" : "_force"));

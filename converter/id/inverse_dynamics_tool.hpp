@@ -107,10 +107,12 @@ class InverseDynamicsTool {
   const ModelDescription& description() const { return description_; }
   const BuildResult& build() const { return *build_; }
   /// the core model the engines get: with muscle mass, the bodies' mass already reduced
-  const Model& model() const { return build_->model; }
-  /// the muscles for a CoreIdEngine: with muscle mass, every built muscle (those with mass carry
-  /// their points); without, empty (the model as OpenSim's ID sees it)
-  const std::vector<Muscle>& muscles() const { return build_->muscles; }
+  const Model& model() const { return build_->model.skeleton(); }
+  /// the whole model: skeleton and, with muscle mass, every built muscle (those with mass carry
+  /// their points); without muscle mass no muscles (the model as OpenSim's ID sees it)
+  const MusculoskeletalModel& musculoskeletalModel() const { return build_->model; }
+  /// the muscles for a CoreIdEngine (musculoskeletalModel().muscles())
+  const std::vector<Muscle>& muscles() const { return build_->model.muscles(); }
   /// what the muscle-mass options did (source None: every muscle lumped, no bodies changed)
   const MuscleMassPlan& muscleMassPlan() const { return muscle_mass_plan_; }
   /// the description the model was built from (bodies with their mass reduced); the file's own

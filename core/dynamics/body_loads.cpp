@@ -5,7 +5,7 @@ namespace redmax {
 namespace {
 void addBodyWrench(const Model& model, const SkeletonWorkspace& ws, int body, const Vec6& w_i, VecX& f) {
   for (int a : model.ancestors(body)) {
-    const JointSlot& sa = model.joints[a];
+    const JointSlot& sa = model.joints()[a];
     if (sa.nq == 0) continue;
     f.segment(sa.q_index, sa.nq).noalias() += ws.J_mr.block(6 * body, sa.q_index, 6, sa.nq).transpose() * w_i;
   }

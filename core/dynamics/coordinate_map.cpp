@@ -8,7 +8,7 @@
 namespace redmax {
 
 CoordinateMap::CoordinateMap(const Model& model) : nr_(model.nr()) {
-  for (const Coordinate& c : model.coordinates) names_.push_back(c.name);
+  for (const Coordinate& c : model.coordinates()) names_.push_back(c.name);
   rebuild();
 }
 

@@ -65,7 +65,7 @@ void MuscleTerm::addForce(const Model& model, const State& s, const SkeletonWork
     gatherColumns(s.qdot, mk, qdot_c_);
     fc_.setZero(qdot_c_.size());
     for (int a = 0; a < mp.size(); ++a) {
-      Vec3 fa = mp.mass[a] * model.gravity;
+      Vec3 fa = mp.mass[a] * model.gravity();
       if (options_.quadratic_velocity) fa.noalias() -= mp.mass[a] * (mk.Jdot_ar.middleRows<3>(3 * a) * qdot_c_);
       fc_.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * fa;
     }
@@ -112,7 +112,7 @@ double MuscleTerm::potentialEnergy(const Model& model, const State& s, const Ske
   update(model, s, sk);
   double V = 0.0;
   for (size_t m = 0; m < massive_.size(); ++m)
-    V += musclePotentialEnergy(massive_[m].mass_points, ws_.muscles[m], model.gravity);
+    V += musclePotentialEnergy(massive_[m].mass_points, ws_.muscles[m], model.gravity());
   return V;
 }
 

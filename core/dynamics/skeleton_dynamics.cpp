@@ -17,13 +17,13 @@ void calcSkeletonMass(const Model& model, const SkeletonWorkspace& ws, MatX& M_r
   for (int i = 0; i < model.nb(); ++i) {
     cols.clear();
     for (int a : model.ancestors(i)) {
-      const JointSlot& sa = model.joints[a];
+      const JointSlot& sa = model.joints()[a];
       for (int k = 0; k < sa.nq; ++k) cols.push_back(sa.q_index + k);
     }
     const int k = static_cast<int>(cols.size());
     if (k == 0) continue;
     for (int c = 0; c < k; ++c) Jc.col(c) = ws.J_mr.block<6, 1>(6 * i, cols[c]);
-    MJc.leftCols(k).noalias() = model.bodies[i].M * Jc.leftCols(k);
+    MJc.leftCols(k).noalias() = model.bodies()[i].M * Jc.leftCols(k);
     Mc.topLeftCorner(k, k).noalias() = Jc.leftCols(k).transpose() * MJc.leftCols(k);
     for (int c = 0; c < k; ++c)
       for (int r = 0; r < k; ++r) M_r(cols[r], cols[c]) += Mc(r, c);
@@ -33,12 +33,12 @@ void calcSkeletonMass(const Model& model, const SkeletonWorkspace& ws, MatX& M_r
 void calcMaximalForce(const Model& model, const SkeletonWorkspace& ws, VecX& f_m) {
   f_m.resize(model.nm());
   for (int i = 0; i < model.nb(); ++i) {
-    const Body& b = model.bodies[i];
+    const Body& b = model.bodies()[i];
     const Vec6& phi = ws.phi[i];
     // Coriolis [D Eq. 3.21]
     Vec6 f = ad(phi).transpose() * (b.M * phi);
     // gravity at the COM, in body coordinates [D Eq. 3.22] with the general inertia
-    const Vec3 g_i = ws.E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity);
+    const Vec3 g_i = ws.E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity());
     f += Gamma(b.com).transpose() * g_i;
     f_m.segment<6>(6 * i) = f;
   }
@@ -48,32 +48,32 @@ void calcSkeletonForce(const Model& model, const State& state, const SkeletonWor
   const int nr = model.nr();
   f_r.setZero(nr);
   for (int i = 0; i < model.nb(); ++i) {
-    const Body& b = model.bodies[i];
+    const Body& b = model.bodies()[i];
     const auto Ji = ws.J_mr.middleRows<6>(6 * i);
     const auto Jdi = ws.Jdot_mr.middleRows<6>(6 * i);
     const Vec6& phi = ws.phi[i];
     Vec6 f = ad(phi).transpose() * (b.M * phi);
-    const Vec3 g_i = ws.E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity);
+    const Vec3 g_i = ws.E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity());
     f += Gamma(b.com).transpose() * g_i;
     // quadratic velocity vector -M_m Jdot_mr qdot [D Eq. 4.18]
     f.noalias() -= b.M * (Jdi * state.qdot.head(nr));
     for (int a : model.ancestors(i)) {
-      const JointSlot& sa = model.joints[a];
+      const JointSlot& sa = model.joints()[a];
       if (sa.nq == 0) continue;
       f_r.segment(sa.q_index, sa.nq).noalias() += Ji.middleCols(sa.q_index, sa.nq).transpose() * f;
     }
   }
   // joint springs and dampers [D Eq. 4.75, 4.77]
   for (int k = 0; k < nr; ++k) {
-    const Coordinate& c = model.coordinates[k];
+    const Coordinate& c = model.coordinates()[k];
     f_r[k] += -c.stiffness * (state.q[k] - c.rest_value) - c.damping * state.qdot[k];
   }
 }
 
 void addJointStiffnessDamping(const Model& model, MatX& K_r, MatX& D_r) {
   for (int k = 0; k < model.nr(); ++k) {
-    K_r(k, k) += model.coordinates[k].stiffness;
-    D_r(k, k) += model.coordinates[k].damping;
+    K_r(k, k) += model.coordinates()[k].stiffness;
+    D_r(k, k) += model.coordinates()[k].damping;
   }
 }
 
@@ -89,7 +89,7 @@ VecX inverseDynamicsRecursive(const Model& model, const State& state, const VecX
   std::vector<Mat6X> S_i(nb);
   JointKinematics jk;
   for (int i = 0; i < nb; ++i) {
-    const JointSlot& s = model.joints[i];
+    const JointSlot& s = model.joints()[i];
     s.joint.calc(state.q.segment(s.q_index, s.nq), state.qdot.segment(s.q_index, s.nq), jk);
     const Mat4 E_pi = s.E_pf * jk.Q * s.E_mi;
     const Mat6 Ad_ij = AdInv(s.E_mi);
@@ -111,19 +111,19 @@ VecX inverseDynamicsRecursive(const Model& model, const State& state, const VecX
       phidot[i] = acc;
     }
     // net wrench the body needs minus what gravity and Coriolis give [D Eq. 3.21]
-    const Body& b = model.bodies[i];
-    const Vec3 g_i = E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity);
+    const Body& b = model.bodies()[i];
+    const Vec3 g_i = E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity());
     w[i] = b.M * phidot[i] - ad(phi[i]).transpose() * (b.M * phi[i]) - Gamma(b.com).transpose() * g_i;
   }
   VecX tau(model.nr());
   for (int i = nb - 1; i >= 0; --i) {
-    const JointSlot& s = model.joints[i];
+    const JointSlot& s = model.joints()[i];
     if (s.nq > 0) tau.segment(s.q_index, s.nq) = S_i[i].transpose() * w[i];
     // transmit to the parent: wrenches map with Ad^T
     if (s.parent >= 0) w[s.parent] += Ad_ip[i].transpose() * w[i];
   }
   for (int k = 0; k < model.nr(); ++k) {
-    const Coordinate& c = model.coordinates[k];
+    const Coordinate& c = model.coordinates()[k];
     tau[k] -= -c.stiffness * (state.q[k] - c.rest_value) - c.damping * state.qdot[k];
   }
   return tau;
@@ -131,18 +131,18 @@ VecX inverseDynamicsRecursive(const Model& model, const State& state, const VecX
 
 double skeletonKineticEnergy(const Model& model, const SkeletonWorkspace& ws) {
   double T = 0.0;
-  for (int i = 0; i < model.nb(); ++i) T += 0.5 * ws.phi[i].dot(model.bodies[i].M * ws.phi[i]);
+  for (int i = 0; i < model.nb(); ++i) T += 0.5 * ws.phi[i].dot(model.bodies()[i].M * ws.phi[i]);
   return T;
 }
 
 double skeletonPotentialEnergy(const Model& model, const State& state, const SkeletonWorkspace& ws) {
   double V = 0.0;
   for (int i = 0; i < model.nb(); ++i) {
-    const Body& b = model.bodies[i];
-    V -= b.mass * model.gravity.dot(transformPoint(ws.E_wi[i], b.com));
+    const Body& b = model.bodies()[i];
+    V -= b.mass * model.gravity().dot(transformPoint(ws.E_wi[i], b.com));
   }
   for (int k = 0; k < model.nr(); ++k) {
-    const Coordinate& c = model.coordinates[k];
+    const Coordinate& c = model.coordinates()[k];
     const double d = state.q[k] - c.rest_value;
     V += 0.5 * c.stiffness * d * d;
   }

@@ -78,7 +78,7 @@ int System::reparameterize(State& s) const {
   if (!map_) return reparameterizeJoints(model_, s);
   int count = 0;
   VecJ q, qd;
-  for (const JointSlot& slot : model_.joints) {
+  for (const JointSlot& slot : model_.joints()) {
     if (slot.nq == 0) continue;
     // only joints entirely made of independent coordinates that drive no dependent one
     bool free = true;
@@ -150,13 +150,13 @@ void skeletonMassDotTimesVelocity(const Model& model, const State& s, const Skel
   const int nr = model.nr();
   out.setZero(nr);
   for (int i = 0; i < model.nb(); ++i) {
-    const Body& b = model.bodies[i];
+    const Body& b = model.bodies()[i];
     const auto Ji = sk.J_mr.middleRows<6>(6 * i);
     const auto Jdi = sk.Jdot_mr.middleRows<6>(6 * i);
     const Vec6 Mphi = b.M * sk.phi[i];
     const Vec6 MJdv = b.M * (Jdi * s.qdot.head(nr));
     for (int a : model.ancestors(i)) {
-      const JointSlot& sa = model.joints[a];
+      const JointSlot& sa = model.joints()[a];
       if (sa.nq == 0) continue;
       out.segment(sa.q_index, sa.nq).noalias() += Jdi.middleCols(sa.q_index, sa.nq).transpose() * Mphi;
       out.segment(sa.q_index, sa.nq).noalias() += Ji.middleCols(sa.q_index, sa.nq).transpose() * MJdv;

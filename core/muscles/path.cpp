@@ -75,7 +75,7 @@ void validatePath(const Model& model, const MusclePath& path, const std::string&
     const std::string where = who + "wrap object '" + w.name + "': ";
     if (w.body < -1 || w.body >= model.nb())
       throw ModelError(where + "body index " + std::to_string(w.body) + " is not a body of model '" +
-                       model.name + "' (" + std::to_string(model.nb()) + " bodies; -1 = world)");
+                       model.name() + "' (" + std::to_string(model.nb()) + " bodies; -1 = world)");
     if (!w.E_bs.allFinite()) throw ModelError(where + "non-finite pose");
     const WrapSurface& s = w.surface;
     const bool ok = s.type == WrapType::Cylinder    ? (s.radius > 0.0 && s.length >= 0.0)
@@ -91,7 +91,7 @@ void validatePath(const Model& model, const MusclePath& path, const std::string&
     const std::string where = who + pointLabel(path, k) + ": ";
     if (p.body < -1 || p.body >= model.nb())
       throw ModelError(where + "body index " + std::to_string(p.body) + " is not a body of model '" +
-                       model.name + "' (" + std::to_string(model.nb()) + " bodies; -1 = world)");
+                       model.name() + "' (" + std::to_string(model.nb()) + " bodies; -1 = world)");
     if (!p.location.allFinite()) throw ModelError(where + "non-finite location");
     const bool needs_coord = p.kind == PathPointKind::Conditional || p.kind == PathPointKind::Moving;
     if (needs_coord && (p.coordinate < -1 || p.coordinate >= model.nr()))

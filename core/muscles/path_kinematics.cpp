@@ -12,7 +12,7 @@ void initMuscleKinematics(const Model& model, const MusclePath& path, MuscleKine
   for (const PathPoint& pt : path.points) {
     if (pt.body >= 0)
       for (int j : model.ancestors(pt.body))
-        for (int c = 0; c < model.joints[j].nq; ++c) used[model.joints[j].q_index + c] = 1;
+        for (int c = 0; c < model.joints()[j].nq; ++c) used[model.joints()[j].q_index + c] = 1;
     if (pt.kind == PathPointKind::Moving && pt.coordinate >= 0) used[pt.coordinate] = 1;
   }
   mk.cols.clear();
@@ -80,7 +80,7 @@ bool columnsCover(const Model& model, const MusclePath& path, const MuscleKinema
   for (const PathPoint& pt : path.points) {
     if (pt.body >= 0)
       for (int j : model.ancestors(pt.body))
-        if (model.joints[j].nq > 0 && mk.col_of[model.joints[j].q_index] < 0) return false;
+        if (model.joints()[j].nq > 0 && mk.col_of[model.joints()[j].q_index] < 0) return false;
     if (pt.kind == PathPointKind::Moving && pt.coordinate >= 0 && mk.col_of[pt.coordinate] < 0) return false;
   }
   return true;
@@ -174,7 +174,7 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
     // J_xr = J_xm J_mr over the columns of b's ancestor joints (others are zero in J_mr); a
     // joint's coordinates are consecutive in q and hence in the compact columns
     for (int j : model.ancestors(b)) {
-      const JointSlot& sj = model.joints[j];
+      const JointSlot& sj = model.joints()[j];
       if (sj.nq == 0) continue;
       J.middleCols(mk.col_of[sj.q_index], sj.nq).noalias() =
           mk.J_xm[a] * sk.J_mr.block(6 * b, sj.q_index, 6, sj.nq);
@@ -194,7 +194,7 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
     auto Jd = mk.Jdot_xr.middleRows<3>(3 * a);
     // product rule on J_xm J_mr [D Eq. 5.5]
     for (int j : model.ancestors(b)) {
-      const JointSlot& sj = model.joints[j];
+      const JointSlot& sj = model.joints()[j];
       if (sj.nq == 0) continue;
       Jd.middleCols(mk.col_of[sj.q_index], sj.nq).noalias() =
           mk.Jdot_xm[a] * sk.J_mr.block(6 * b, sj.q_index, 6, sj.nq) +

@@ -31,14 +31,14 @@ double surfaceSize(const WrapSurface& s) {
 void markBody(const Model& model, int b, std::vector<char>& used) {
   if (b < 0) return;
   for (int j : model.ancestors(b))
-    for (int c = 0; c < model.joints[j].nq; ++c) used[model.joints[j].q_index + c] = 1;
+    for (int c = 0; c < model.joints()[j].nq; ++c) used[model.joints()[j].q_index + c] = 1;
 }
 
 // rows (6 x k, compact columns) of J_mr (or Jdot_mr) for body b
 void gatherBodyRows(const Model& model, const MatX& J_mr, int b, const MuscleKinematics& mk, MatX& out) {
   out.setZero(6, static_cast<int>(mk.cols.size()));
   for (int j : model.ancestors(b)) {
-    const JointSlot& sj = model.joints[j];
+    const JointSlot& sj = model.joints()[j];
     if (sj.nq == 0) continue;
     out.middleCols(mk.col_of[sj.q_index], sj.nq) = J_mr.block(6 * b, sj.q_index, 6, sj.nq);
   }
@@ -403,7 +403,7 @@ bool coversBody(const Model& model, const MuscleKinematics& mk, int b) {
   if (b < 0) return true;
   if (static_cast<int>(mk.col_of.size()) != model.nr()) return false;
   for (int j : model.ancestors(b))
-    if (model.joints[j].nq > 0 && mk.col_of[model.joints[j].q_index] < 0) return false;
+    if (model.joints()[j].nq > 0 && mk.col_of[model.joints()[j].q_index] < 0) return false;
   return true;
 }
 

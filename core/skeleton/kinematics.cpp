@@ -5,11 +5,11 @@ namespace redmax {
 SkeletonWorkspace::SkeletonWorkspace(const Model& model) {
   const int nb = model.nb();
   jk.resize(nb);
-  for (int i = 0; i < nb; ++i) jk[i].resize(model.joints[i].nq);
+  for (int i = 0; i < nb; ++i) jk[i].resize(model.joints()[i].nq);
   E_wi.assign(nb, Mat4::Identity());
   Ad_ip.assign(nb, Mat6::Identity());
   Ad_ij.resize(nb);
-  for (int i = 0; i < nb; ++i) Ad_ij[i] = AdInv(model.joints[i].E_mi);  // E_im = E_mi^-1
+  for (int i = 0; i < nb; ++i) Ad_ij[i] = AdInv(model.joints()[i].E_mi);  // E_im = E_mi^-1
   J_mr.setZero(model.nm(), model.nr());
   phi.assign(nb, Vec6::Zero());
   psi.assign(nb, Vec6::Zero());
@@ -19,7 +19,7 @@ SkeletonWorkspace::SkeletonWorkspace(const Model& model) {
 void calcKinematics(const Model& model, const State& state, SkeletonWorkspace& ws) {
   const int nb = model.nb();
   for (int i = 0; i < nb; ++i) {
-    const JointSlot& s = model.joints[i];
+    const JointSlot& s = model.joints()[i];
     const VecJ q = state.q.segment(s.q_index, s.nq);
     const VecJ qd = state.qdot.segment(s.q_index, s.nq);
     JointKinematics& jk = ws.jk[i];
@@ -54,7 +54,7 @@ void calcKinematics(const Model& model, const State& state, SkeletonWorkspace& w
     const Mat6 Addot_ip = -ad(ws.psi[i]) * ws.Ad_ip[i];
     const int rp = 6 * p;
     for (int a : model.ancestors(p)) {
-      const JointSlot& sa = model.joints[a];
+      const JointSlot& sa = model.joints()[a];
       if (sa.nq == 0) continue;
       const auto Jp = ws.J_mr.block(rp, sa.q_index, 6, sa.nq);
       const auto Jdp = ws.Jdot_mr.block(rp, sa.q_index, 6, sa.nq);
@@ -70,7 +70,7 @@ void calcBodyPoses(const Model& model, const VecX& q, std::vector<Mat4>& E_wi) {
   JointKinematics jk;
   const VecJ zero = VecJ::Zero(6);
   for (int i = 0; i < model.nb(); ++i) {
-    const JointSlot& s = model.joints[i];
+    const JointSlot& s = model.joints()[i];
     s.joint.calc(q.segment(s.q_index, s.nq), zero.head(s.nq), jk);
     const Mat4 E_pi = s.E_pf * jk.Q * s.E_mi;
     E_wi[i] = s.parent >= 0 ? Mat4(E_wi[s.parent] * E_pi) : E_pi;
@@ -91,7 +91,7 @@ void pointJacobian(const Model& model, const SkeletonWorkspace& ws, int body, co
   J.setZero();
   const Mat3x6 RG = ws.E_wi[body].topLeftCorner<3, 3>() * Gamma(x_i);
   for (int a : model.ancestors(body)) {
-    const JointSlot& sa = model.joints[a];
+    const JointSlot& sa = model.joints()[a];
     if (sa.nq == 0) continue;
     J.middleCols(sa.q_index, sa.nq).noalias() = RG * ws.J_mr.block(6 * body, sa.q_index, 6, sa.nq);
   }
@@ -99,7 +99,7 @@ void pointJacobian(const Model& model, const SkeletonWorkspace& ws, int body, co
 
 int reparameterizeJoints(const Model& model, State& state) {
   int count = 0;
-  for (const JointSlot& s : model.joints) {
+  for (const JointSlot& s : model.joints()) {
     if (s.nq == 0) continue;
     VecJ q = state.q.segment(s.q_index, s.nq);
     VecJ qd = state.qdot.segment(s.q_index, s.nq);

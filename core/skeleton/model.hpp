@@ -47,15 +47,18 @@ struct Coordinate {
   double damping = 0.0;            // joint damping D [D Eq. 4.77]
 };
 
+/// Immutable after ModelBuilder::finalize(): every edit (a body's mass properties, a joint
+/// spring, gravity) goes through a ModelBuilder, which re-derives everything that depends on it
+/// (Body::M, the coordinate indices, the ancestor lists). Copyable.
 class Model {
  public:
-  std::string name;
-  Vec3 gravity = Vec3(0.0, -9.80665, 0.0);   // world frame
-  std::vector<Body> bodies;                  // (nb)
-  std::vector<JointSlot> joints;             // (nb), joints[i].body == i
-  std::vector<Coordinate> coordinates;       // (nr)
+  const std::string& name() const { return name_; }
+  const Vec3& gravity() const { return gravity_; }                       // world frame
+  const std::vector<Body>& bodies() const { return bodies_; }            // (nb)
+  const std::vector<JointSlot>& joints() const { return joints_; }       // (nb), joints()[i].body == i
+  const std::vector<Coordinate>& coordinates() const { return coordinates_; }  // (nr)
 
-  int nb() const { return static_cast<int>(bodies.size()); }
+  int nb() const { return static_cast<int>(bodies_.size()); }
   int nr() const { return nr_; }
   int nm() const { return 6 * nb(); }
 
@@ -72,15 +75,26 @@ class Model {
 
  private:
   friend class ModelBuilder;
+  std::string name_;
+  Vec3 gravity_ = Vec3(0.0, -9.80665, 0.0);
+  std::vector<Body> bodies_;
+  std::vector<JointSlot> joints_;
+  std::vector<Coordinate> coordinates_;
   int nr_ = 0;
   std::vector<std::vector<int>> ancestors_;
 };
 
 /// Builds a Model. Bodies are added with the joint that attaches them to an existing body (or
-/// the world), so the tree is ordered parents-first by construction.
+/// the world), so the tree is ordered parents-first by construction. A builder made from an
+/// existing Model edits a copy of it (the tree stays; mass properties, springs, names, gravity
+/// may change); finalize() then re-derives everything, so no caller recomputes Body::M.
 class ModelBuilder {
  public:
   explicit ModelBuilder(std::string name = "model");
+  /// start from a finalized model (its bodies, joints and coordinates, in its order)
+  explicit ModelBuilder(const Model& model);
+
+  void setName(std::string name);
   void setGravity(const Vec3& g);
 
   /// Add a body attached to `parent` (-1 = world) by `joint`. E_pf: joint frame in the parent
@@ -89,9 +103,21 @@ class ModelBuilder {
               int parent, const std::string& joint_name, Joint joint,
               const Mat4& E_pf = Mat4::Identity(), const Mat4& E_bm = Mat4::Identity());
 
+  /// replace body i's mass, centre of mass (body frame) and inertia about the centre of mass
+  /// (body axes); the spatial inertia is derived by finalize()
+  void setBodyMassProperties(int i, double mass, const Vec3& com, const Mat3& inertia_com);
+
+  int nb() const { return m_.nb(); }
+  int nr() const { return m_.nr_; }
+  /// the bodies as built so far (mass properties as last set; Body::M not derived yet)
+  const std::vector<Body>& bodies() const { return m_.bodies_; }
+
   /// name the reduced coordinates of a joint (defaults: <joint>_<k>)
   void setCoordinateNames(int body, const std::vector<std::string>& names);
+  /// coordinate k of body `body`'s joint: default value, spring and damper may be edited
   Coordinate& coordinate(int body, int k);
+  /// reduced coordinate q_index (0 <= q_index < nr), for the same edits
+  Coordinate& coordinateAt(int q_index);
 
   /// validate and derive (spatial inertias, coordinate indices, ancestor lists)
   Model finalize() const;

@@ -209,23 +209,24 @@ bool RedmaxInverseDynamicsTool::run() {
       osim::BuildOptions bo;
       bo.simbody_compat = true;
       bo.constraints = false;
+      bo.muscles = true;  // they carry the mass; the model is built once and then edited
+      osim::BuildResult built = osim::buildCoreModel(description, bo);
       // top:K ranks over the output frames: q of each frame in the core's q order
       std::vector<VecX> samples;
       if (options.muscles.rfind("top:", 0) == 0) {
-        osim::BuildOptions order_options = bo;
-        order_options.muscles = false;
-        const osim::BuildResult order = osim::buildCoreModel(description, order_options);
+        const Model& order = built.model.skeleton();
         for (double t : times) {
-          VecX q(order.model.nr());
-          for (int k = 0; k < order.model.nr(); ++k) {
-            const std::string& name = order.model.coordinates[k].name;
+          VecX q(order.nr());
+          for (int k = 0; k < order.nr(); ++k) {
+            const std::string& name = order.coordinates()[k].name;
             q[k] = splines.contains(name) ? evaluateFunction(splines.get(name), 0, t)
-                                          : order.model.coordinates[k].default_value;
+                                          : order.coordinates()[k].default_value;
           }
           samples.push_back(q);
         }
       }
-      mass = std::make_unique<osim::MuscleMassModel>(osim::applyMuscleMass(description, bo, options, samples));
+      mass = std::make_unique<osim::MuscleMassModel>(
+          osim::addMuscleMass(description, std::move(built), options, samples));
     } catch (const osim::ConvertError& e) {
       throw OpenSim::Exception(std::string("muscle mass: ") + e.what());
     } catch (const std::exception& e) {
@@ -259,19 +260,19 @@ bool RedmaxInverseDynamicsTool::run() {
     MatterMap map;
     map.mobod_of_body.resize(static_cast<size_t>(core.nb()));
     for (int b = 0; b < core.nb(); ++b)
-      if (model->getBodySet().contains(core.bodies[b].name))
-        map.mobod_of_body[b] = model->getBodySet().get(core.bodies[b].name).getMobilizedBodyIndex();
+      if (model->getBodySet().contains(core.bodies()[b].name))
+        map.mobod_of_body[b] = model->getBodySet().get(core.bodies()[b].name).getMobilizedBodyIndex();
     map.q_of_coordinate.assign(static_cast<size_t>(core.nr()), -1);
     const SimTK::SimbodyMatterSubsystem& matter = model->getMatterSubsystem();
     for (int k = 0; k < core.nr(); ++k) {
-      const std::string& name = core.coordinates[k].name;
+      const std::string& name = core.coordinates()[k].name;
       if (!model->getCoordinateSet().contains(name)) continue;
       const OpenSim::Coordinate& c = model->getCoordinateSet().get(name);
       map.q_of_coordinate[k] = matter.getMobilizedBody(c.getBodyIndex()).getFirstQIndex(*s) + c.getMobilizerQIndex();
     }
     const SimTK::Vec3 g = model->getGravity();
     try {
-      inertia = std::make_unique<MatterMuscleInertia>(matter, std::move(map), core, mass->build.muscles,
+      inertia = std::make_unique<MatterMuscleInertia>(matter, std::move(map), core, mass->build.model.muscles(),
                                                       Vec3(g[0], g[1], g[2]));
     } catch (const std::exception& e) {
       fail(model_file, std::string("muscle mass: ") + e.what());

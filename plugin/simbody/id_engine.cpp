@@ -49,13 +49,13 @@ SimbodyIdEngine::SimbodyIdEngine(const Model& model, const osim::IdEngineOptions
   SimbodyBuildOptions opt;
   opt.spherical = SphericalAs::Gimbal;
   for (int j = 0; j < model.nb(); ++j)
-    if (options.marked(j) && isSpherical(model.joints[j].joint)) opt.spherical = SphericalAs::Ball;
+    if (options.marked(j) && isSpherical(model.joints()[j].joint)) opt.spherical = SphericalAs::Ball;
   m.sm = makeSimbodyModel(model, opt);
   for (int j = 0; j < model.nb(); ++j) {
     if (!options.marked(j)) continue;
     // Ball, Free (and any mobilizer whose u is not qdot, e.g. Ellipsoid): u = w_FM in F
     if (m.sm->map[j].u_is_qdot)
-      throw SimbodyBuildError("joint '" + model.joints[j].name +
+      throw SimbodyBuildError("joint '" + model.joints()[j].name +
                               "': OpenSim's Euler-rate speeds need a Simbody mobilizer whose u is the "
                               "angular velocity (Ball, Free), not its q rates");
   }

@@ -37,10 +37,10 @@ MatterMuscleInertia::MatterMuscleInertia(const SimTK::SimbodyMatterSubsystem& ma
     // every body and coordinate the path depends on must be in the foreign system
     for (const PathPoint& pt : mu.path.points) {
       if (pt.body >= 0 && !map_.mobod_of_body[pt.body].isValid())
-        throw std::invalid_argument("muscle '" + mu.name + "': body '" + model.bodies[pt.body].name +
+        throw std::invalid_argument("muscle '" + mu.name + "': body '" + model.bodies()[pt.body].name +
                                     "' has no mobilized body in the Simbody system");
       if (pt.coordinate >= 0 && map_.q_of_coordinate[pt.coordinate] < 0)
-        throw std::invalid_argument("muscle '" + mu.name + "': coordinate '" + model.coordinates[pt.coordinate].name +
+        throw std::invalid_argument("muscle '" + mu.name + "': coordinate '" + model.coordinates()[pt.coordinate].name +
                                     "' has no q in the Simbody system");
     }
     Entry e;

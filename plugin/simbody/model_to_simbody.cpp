@@ -158,13 +158,13 @@ std::unique_ptr<SimbodyModel> makeSimbodyModel(const Model& model, const Simbody
   sm->map.resize(nb);
 
   for (int i = 0; i < nb; ++i) {
-    const JointSlot& s = model.joints[i];
+    const JointSlot& s = model.joints()[i];
     const MobilizerChoice c = chooseMobilizer(s.joint, s.name, opt);
     SimTK::MobilizedBody& parent = s.parent < 0 ? sm->matter.updGround() : sm->mobods[s.parent];
     const Mat4 E_rot = makeE(c.R_frame, Vec3::Zero());
     const SimTK::Transform X_PF = toTransform(s.E_pf * E_rot);
     const SimTK::Transform X_BM = toTransform(inverseE(s.E_mi) * E_rot);
-    const SimTK::Body::Rigid body(massProperties(model.bodies[i]));
+    const SimTK::Body::Rigid body(massProperties(model.bodies()[i]));
     MobilizerMap& m = sm->map[i];
     m.kind = c.kind;
     m.q_index = s.q_index;
@@ -216,14 +216,14 @@ std::unique_ptr<SimbodyModel> makeSimbodyModel(const Model& model, const Simbody
   }
 
   if (opt.gravity) {
-    const Vec3& g = model.gravity;
+    const Vec3& g = model.gravity();
     SimTK::Force::UniformGravity(sm->forces, sm->matter, SimTK::Vec3(g.x(), g.y(), g.z()));
   }
   if (opt.joint_springs) {
     for (int i = 0; i < nb; ++i) {
       const MobilizerMap& m = sm->map[i];
       for (int k = 0; k < m.nq; ++k) {
-        const Coordinate& cd = model.coordinates[m.q_index + k];
+        const Coordinate& cd = model.coordinates()[m.q_index + k];
         if (cd.stiffness == 0.0 && cd.damping == 0.0) continue;
         // Free translations keep u = qdot; every Ball coordinate and Free rotation does not
         const bool exact = m.u_is_qdot || (m.kind == MobilizerKind::Free && k >= 3);
@@ -263,7 +263,7 @@ std::unique_ptr<SimbodyModel> makeSimbodyModel(const Model& model, const Simbody
     m.simbody_q = sm->mobods[i].getFirstQIndex(st);
     m.simbody_u = sm->mobods[i].getFirstUIndex(st);
     if (sm->mobods[i].getNumQ(st) != m.nq || sm->mobods[i].getNumU(st) != m.nq)
-      throw SimbodyBuildError("joint '" + model.joints[i].name + "': Simbody mobilizer has " +
+      throw SimbodyBuildError("joint '" + model.joints()[i].name + "': Simbody mobilizer has " +
                               std::to_string(sm->mobods[i].getNumQ(st)) + " q, core joint has " +
                               std::to_string(m.nq));
   }
@@ -292,7 +292,7 @@ void calcVelocityMap(const SimbodyModel& sm, const Model& model, const State& s,
     // with w = (S qdot)_w in M
     const auto q = s.q.segment(m.q_index, m.nq);
     const auto qd = s.qdot.segment(m.q_index, m.nq);
-    model.joints[i].joint.calc(q, qd, jk);
+    model.joints()[i].joint.calc(q, qd, jk);
     const Mat3 R = jk.Q.topLeftCorner<3, 3>();
     Eigen::Matrix<double, 6, 6> D = Eigen::Matrix<double, 6, 6>::Zero();
     D.topLeftCorner<3, 3>() = R;

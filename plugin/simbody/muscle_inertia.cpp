@@ -13,7 +13,7 @@ MatterMap makeMatterMap(const SimbodyModel& sm, const Model& model) {
 }
 
 MuscleInertia::MuscleInertia(const SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles)
-    : MuscleInertia(sm, model, std::move(muscles), model.gravity) {}
+    : MuscleInertia(sm, model, std::move(muscles), model.gravity()) {}
 
 MuscleInertia::MuscleInertia(const SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles,
                              const Vec3& gravity)

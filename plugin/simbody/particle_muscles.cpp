@@ -292,7 +292,7 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
   }
   // the mass points' motion on the skeleton (placeParticles): the skeleton's bodies and q slots,
   // which the particles added above do not move
-  motion_ = std::make_unique<MatterMuscleInertia>(sm.matter, makeMatterMap(sm, model), model, muscles_, model.gravity);
+  motion_ = std::make_unique<MatterMuscleInertia>(sm.matter, makeMatterMap(sm, model), model, muscles_, model.gravity());
   // the topology changed: a new default state, Euler angles on as makeSimbodyModel sets them
   try {
     sm.default_state = sm.system.realizeTopology();

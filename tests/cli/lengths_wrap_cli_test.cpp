@@ -72,9 +72,9 @@ BandInfo calcBand(const std::string& model_file, const std::string& coords_file,
   }
   std::vector<Muscle> muscles;
   BandInfo info;
-  for (size_t k = 0; k < b.muscles.size(); ++k) {
+  for (size_t k = 0; k < b.model.muscles().size(); ++k) {
     if (!d.muscles[b.muscle_source[k]].is_muscle) continue;
-    Muscle m = b.muscles[k];
+    Muscle m = b.model.muscles()[k];
     m.wrap = WrapMassOptions{};
     m.wrap.model = WrapModel::Smooth;
     m.wrap.width = width;

@@ -22,7 +22,7 @@ using test::sharedOpenSim;
 template <class T>
 int countOf(const BuildResult& r) {
   int n = 0;
-  for (const auto& c : r.constraints) n += dynamic_cast<const T*>(c.get()) != nullptr;
+  for (const auto& c : r.model.constraints()) n += dynamic_cast<const T*>(c.get()) != nullptr;
   return n;
 }
 
@@ -47,8 +47,8 @@ TEST(BuildConstraints, Leg39CouplersAsRowsOrEliminatedAgree) {
   const BuildResult rows = buildCoreModel(d);
   EXPECT_EQ(countOf<CoordinateCoupler>(rows), 5);
   EXPECT_EQ(countOf<PrescribedCoordinate>(rows), 3);
-  EXPECT_EQ(rows.coordinate_map, nullptr);
-  for (const auto& c : rows.constraints) {
+  EXPECT_EQ(rows.model.coordinateMap(), nullptr);
+  for (const auto& c : rows.model.constraints()) {
     if (const auto* p = dynamic_cast<const PrescribedCoordinate*>(c.get())) {
       EXPECT_EQ(p->position(0.7), d.coordinates[p->coordinate()].default_value);
     }
@@ -57,8 +57,8 @@ TEST(BuildConstraints, Leg39CouplersAsRowsOrEliminatedAgree) {
   BuildOptions opt;
   opt.couplers = CouplerHandling::Eliminate;
   const BuildResult elim = buildCoreModel(d, opt);
-  ASSERT_NE(elim.coordinate_map, nullptr);
-  EXPECT_EQ(elim.coordinate_map->nR(), d.numDofs() - 5);
+  ASSERT_NE(elim.model.coordinateMap(), nullptr);
+  EXPECT_EQ(elim.model.coordinateMap()->nR(), d.numDofs() - 5);
   EXPECT_EQ(countOf<CoordinateCoupler>(elim), 0);
   EXPECT_EQ(countOf<PrescribedCoordinate>(elim), 3);
 
@@ -67,14 +67,14 @@ TEST(BuildConstraints, Leg39CouplersAsRowsOrEliminatedAgree) {
   std::uniform_real_distribution<double> u(-0.8, 0.8);
   SkeletonWorkspace ws(rows.model);
   for (int t = 0; t < 5; ++t) {
-    VecX q_R(elim.coordinate_map->nR()), qd_R(elim.coordinate_map->nR());
+    VecX q_R(elim.model.coordinateMap()->nR()), qd_R(elim.model.coordinateMap()->nR());
     for (int k = 0; k < q_R.size(); ++k) q_R[k] = u(rng), qd_R[k] = u(rng);
     VecX q_r, qd_r;
     MatX J, Jd;
-    elim.coordinate_map->calc(q_R, qd_R, q_r, qd_r, J, Jd);
+    elim.model.coordinateMap()->calc(q_R, qd_R, q_r, qd_r, J, Jd);
     const State s{0.0, q_r, qd_r};
     calcKinematics(rows.model, s, ws);
-    for (const auto& c : rows.constraints) {
+    for (const auto& c : rows.model.constraints()) {
       if (!dynamic_cast<const CoordinateCoupler*>(c.get())) continue;
       VecX pe(1), ve(1);
       c->calcErrors(rows.model, s, ws, pe, ve);
@@ -121,7 +121,7 @@ TEST(BuildConstraints, ShoulderPointConstraintAndOptions) {
   EXPECT_EQ(countOf<PointConstraint>(buildCoreModel(d, no_bodies)), 0);
   BuildOptions off;
   off.constraints = false;
-  EXPECT_TRUE(buildCoreModel(d, off).constraints.empty());
+  EXPECT_TRUE(buildCoreModel(d, off).model.constraints().empty());
 }
 
 TEST(BuildConstraints, LockedAndPrescribedCoordinatesFromTheFile) {
@@ -141,7 +141,7 @@ TEST(BuildConstraints, LockedAndPrescribedCoordinatesFromTheFile) {
   const ModelDescription d = readOsimModel(dir.write("m.osim", test::modernOsim(body, joints)));
   const BuildResult r = buildCoreModel(d);
   ASSERT_EQ(countOf<PrescribedCoordinate>(r), 2);
-  for (const auto& c : r.constraints) {
+  for (const auto& c : r.model.constraints()) {
     const auto* p = dynamic_cast<const PrescribedCoordinate*>(c.get());
     ASSERT_NE(p, nullptr);
     const double t = 0.37;

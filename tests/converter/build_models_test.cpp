@@ -197,8 +197,8 @@ void expectJacobiansMatchDifferences(const Model& model, const VecX& q, const Ve
       const Mat4 fd = inverseE(E[i]) * (Ep[i] - Em[i]) / (2 * kH);
       const Vec6 col = J.block<6, 1>(6 * i, k);
       EXPECT_TRUE(nearRel(bracket6(col), fd, kFdTol))
-          << what << " body " << model.bodies[i].name << " coordinate "
-          << model.coordinates[k].name << "\nJ  = " << col.transpose()
+          << what << " body " << model.bodies()[i].name << " coordinate "
+          << model.coordinates()[k].name << "\nJ  = " << col.transpose()
           << "\nfd = " << unbracket6(fd).transpose();
     }
   }
@@ -219,20 +219,20 @@ TEST_P(BuildSharedModels, BuildsWithTheDescriptionsCoordinatesAndPoses) {
   const Model& m = r.model;
   ASSERT_EQ(m.nr(), d.numDofs());
   for (int k = 0; k < d.numDofs(); ++k) {
-    EXPECT_EQ(m.coordinates[k].name, d.coordinates[k].name);
+    EXPECT_EQ(m.coordinates()[k].name, d.coordinates[k].name);
     EXPECT_EQ(r.coordinate_index[k], k);
-    EXPECT_EQ(m.coordinates[k].default_value, d.coordinates[k].default_value);
+    EXPECT_EQ(m.coordinates()[k].default_value, d.coordinates[k].default_value);
   }
   EXPECT_EQ(m.nb(), static_cast<int>(d.bodies.size() + d.tree.slaves.size()));
   // total mass is kept (slaves share their master's)
   double mass_d = 0, mass_c = 0;
   for (const auto& b : d.bodies) mass_d += b.mass;
-  for (const auto& b : m.bodies) mass_c += b.mass;
+  for (const auto& b : m.bodies()) mass_c += b.mass;
   EXPECT_NEAR(mass_c, mass_d, 1e-12 * (1 + mass_d));
   // parents precede children
-  for (int i = 0; i < m.nb(); ++i) EXPECT_LT(m.joints[i].parent, i);
+  for (int i = 0; i < m.nb(); ++i) EXPECT_LT(m.joints()[i].parent, i);
   // every path force becomes a muscle
-  EXPECT_EQ(r.muscles.size(), d.muscles.size());
+  EXPECT_EQ(r.model.muscles().size(), d.muscles.size());
   for (const auto& u : r.unsupported) ADD_FAILURE() << GetParam() << ": " << u.what;
 
   expectPosesMatchReference(d, r, defaultQ(d), "default q");
@@ -259,9 +259,9 @@ TEST_P(BuildSharedModels, BuildsWithTheDescriptionsCoordinatesAndPoses) {
   none.constraints = false;
   none.muscles = false;
   const BuildResult rn = buildCoreModel(d, none);
-  EXPECT_TRUE(rn.constraints.empty());
-  EXPECT_TRUE(rn.muscles.empty());
-  EXPECT_EQ(rn.coordinate_map, nullptr);
+  EXPECT_TRUE(rn.model.constraints().empty());
+  EXPECT_TRUE(rn.model.muscles().empty());
+  EXPECT_EQ(rn.model.coordinateMap(), nullptr);
 }
 
 INSTANTIATE_TEST_SUITE_P(Readme, BuildSharedModels, ::testing::ValuesIn(sharedModels()),
@@ -368,7 +368,7 @@ TEST(BuildSynthetic, EveryJointTypeWithOffsetFramesAndReversedJoints) {
   ASSERT_EQ(reversed, 3) << "the model should exercise reversed free, pin and custom joints";
   const BuildResult r = buildCoreModel(d);
   ASSERT_EQ(r.model.nr(), d.numDofs());
-  for (int k = 0; k < d.numDofs(); ++k) EXPECT_EQ(r.model.coordinates[k].name, d.coordinates[k].name);
+  for (int k = 0; k < d.numDofs(); ++k) EXPECT_EQ(r.model.skeleton().coordinates()[k].name, d.coordinates[k].name);
   expectPosesMatchReference(d, r, defaultQ(d), "default q");
   std::mt19937 rng(23);
   for (int t = 0; t < 5; ++t) expectPosesMatchReference(d, r, randomQ(d, rng), "random q");
@@ -378,7 +378,7 @@ TEST(BuildSynthetic, EveryJointTypeWithOffsetFramesAndReversedJoints) {
     expectJacobiansMatchDifferences(r.model, randomQ(d, rng), qdot, "synthetic");
   }
   // mass properties are taken as given: products of inertia are matrix entries
-  const Body& b = r.model.bodies[r.body_index[d.findBody("b")]];
+  const Body& b = r.model.skeleton().bodies()[r.body_index[d.findBody("b")]];
   EXPECT_EQ(b.mass, 1.5);
   EXPECT_TRUE(nearRel(b.com, Vec3(0.01, -0.1, 0.02), 0.0));
   Mat3 I;
@@ -405,13 +405,13 @@ TEST(BuildSynthetic, LoopIsCutBySlaveBodyWithHalfTheMassAndAWeld) {
   const BuildResult r = buildCoreModel(d);
   ASSERT_EQ(r.model.nb(), 3);
   const int master = r.body_index[d.findBody("b")];
-  const int slave = r.model.findBody(d.tree.slaves[0].name);
+  const int slave = r.model.skeleton().findBody(d.tree.slaves[0].name);
   ASSERT_GE(slave, 0);
-  EXPECT_EQ(r.model.bodies[master].mass, 1.5);
-  EXPECT_EQ(r.model.bodies[slave].mass, 1.5);
-  EXPECT_TRUE(nearRel(r.model.bodies[slave].inertia_com, 0.5 * d.bodies[1].inertiaMatrix(), 1e-15));
+  EXPECT_EQ(r.model.skeleton().bodies()[master].mass, 1.5);
+  EXPECT_EQ(r.model.skeleton().bodies()[slave].mass, 1.5);
+  EXPECT_TRUE(nearRel(r.model.skeleton().bodies()[slave].inertia_com, 0.5 * d.bodies[1].inertiaMatrix(), 1e-15));
   // one weld (master-slave); satisfied where the loop closes, violated elsewhere
-  ASSERT_EQ(r.constraints.size(), 1u);
+  ASSERT_EQ(r.model.constraints().size(), 1u);
   System sys = r.makeSystem();
   DynamicsWorkspace ws(sys.model());
   State s = sys.defaultState();
@@ -499,7 +499,7 @@ TEST(BuildProjectScenes, EveryOsimModelBuildsWithMatchingPosesAndJacobians) {
     const BuildResult r = buildCoreModel(d);
     ASSERT_EQ(r.model.nr(), d.numDofs()) << name;
     for (const auto& u : r.unsupported) ADD_FAILURE() << name << ": " << u.what;
-    EXPECT_EQ(r.muscles.size(), d.muscles.size()) << name;
+    EXPECT_EQ(r.model.muscles().size(), d.muscles.size()) << name;
     std::mt19937 rng(41);
     expectPosesMatchReference(d, r, defaultQ(d), name);
     expectPosesMatchReference(d, r, randomQ(d, rng), name);

@@ -44,7 +44,7 @@ TEST(BuildMuscles, WalkGait1018LengthsEqualOpenSims) {
   BuildOptions opt;
   opt.constraints = false;
   const BuildResult r = buildCoreModel(d, opt);
-  ASSERT_EQ(r.muscles.size(), 18u);
+  ASSERT_EQ(r.model.muscles().size(), 18u);
   ASSERT_EQ(motion.numRows(), ref.numRows());
   ASSERT_TRUE(motion.in_degrees);
 
@@ -57,26 +57,26 @@ TEST(BuildMuscles, WalkGait1018LengthsEqualOpenSims) {
     column_coord[c] = r.coordinate_index[k];
     if (d.coordinates[k].motion_type == MotionType::Rotational) column_scale[c] = std::numbers::pi / 180;
   }
-  std::vector<int> ref_column(r.muscles.size());
-  for (size_t m = 0; m < r.muscles.size(); ++m) {
-    ref_column[m] = ref.findColumn("/forceset/" + r.muscles[m].name + "|length");
-    ASSERT_GE(ref_column[m], 0) << r.muscles[m].name;
+  std::vector<int> ref_column(r.model.muscles().size());
+  for (size_t m = 0; m < r.model.muscles().size(); ++m) {
+    ref_column[m] = ref.findColumn("/forceset/" + r.model.muscles()[m].name + "|length");
+    ASSERT_GE(ref_column[m], 0) << r.model.muscles()[m].name;
   }
 
-  std::vector<double> max_err(r.muscles.size(), 0.0);
+  std::vector<double> max_err(r.model.muscles().size(), 0.0);
   std::vector<Mat4> E;
   for (int row = 0; row < motion.numRows(); ++row) {
     ASSERT_NEAR(motion.time[row], ref.time[row], 1e-6);
-    VecX q = r.model.defaultQ();  // coordinates absent from the file keep their defaults
+    VecX q = r.model.skeleton().defaultQ();  // coordinates absent from the file keep their defaults
     for (int c = 0; c < motion.numColumns(); ++c) q[column_coord[c]] = motion.data(row, c) * column_scale[c];
     calcBodyPoses(r.model, q, E);
-    for (size_t m = 0; m < r.muscles.size(); ++m) {
-      const double l = calcPathLength(r.model, r.muscles[m].path, q, E);
+    for (size_t m = 0; m < r.model.muscles().size(); ++m) {
+      const double l = calcPathLength(r.model, r.model.muscles()[m].path, q, E);
       max_err[m] = std::max(max_err[m], std::abs(l - ref.data(row, ref_column[m])));
     }
   }
-  for (size_t m = 0; m < r.muscles.size(); ++m)
-    EXPECT_LT(max_err[m], 1e-12) << r.muscles[m].name << ": max |l - l_OpenSim| = " << max_err[m] << " m";
+  for (size_t m = 0; m < r.model.muscles().size(); ++m)
+    EXPECT_LT(max_err[m], 1e-12) << r.model.muscles()[m].name << ": max |l - l_OpenSim| = " << max_err[m] << " m";
 }
 
 TEST(BuildMuscles, EverySharedModelHasPositiveLengthsAtTheDefaultPose) {
@@ -95,17 +95,17 @@ TEST(BuildMuscles, EverySharedModelHasPositiveLengthsAtTheDefaultPose) {
         "opensim-core/OpenSim/Simulation/Test/testMomentArmsConstraintB.osim"}) {
     const ModelDescription d = readOsimModel(sharedOpenSim(path));
     const BuildResult r = buildCoreModel(d);
-    ASSERT_EQ(r.muscles.size(), d.muscles.size()) << path;
-    const VecX q = r.model.defaultQ();
+    ASSERT_EQ(r.model.muscles().size(), d.muscles.size()) << path;
+    const VecX q = r.model.skeleton().defaultQ();
     std::vector<Mat4> E;
     calcBodyPoses(r.model, q, E);
-    for (size_t m = 0; m < r.muscles.size(); ++m) {
-      const double l = calcPathLength(r.model, r.muscles[m].path, q, E);
-      EXPECT_TRUE(std::isfinite(l) && l > 0.0) << path << " " << r.muscles[m].name << " " << l;
+    for (size_t m = 0; m < r.model.muscles().size(); ++m) {
+      const double l = calcPathLength(r.model, r.model.muscles()[m].path, q, E);
+      EXPECT_TRUE(std::isfinite(l) && l > 0.0) << path << " " << r.model.muscles()[m].name << " " << l;
       // path type and wrap count as the description says
       const PathForceDesc& pf = d.muscles[r.muscle_source[m]];
-      EXPECT_EQ(r.muscles[m].path.num_wraps, static_cast<int>(pf.wraps.size()));
-      EXPECT_EQ(std::string(pathTypeName(pathType(r.muscles[m].path))), toString(pf.path_type))
+      EXPECT_EQ(r.model.muscles()[m].path.num_wraps, static_cast<int>(pf.wraps.size()));
+      EXPECT_EQ(std::string(pathTypeName(pathType(r.model.muscles()[m].path))), toString(pf.path_type))
           << path << " " << pf.name;
     }
   }
@@ -143,8 +143,8 @@ TEST(BuildMuscles, PointsInOffsetFramesMovingAndConditionalPoints) {
   const ModelDescription d =
       readOsimModel(dir.write("m.osim", test::modernOsim(bodies, joints, forces)));
   const BuildResult r = buildCoreModel(d);
-  ASSERT_EQ(r.muscles.size(), 1u);
-  const MusclePath& path = r.muscles[0].path;
+  ASSERT_EQ(r.model.muscles().size(), 1u);
+  const MusclePath& path = r.model.muscles()[0].path;
   ASSERT_EQ(path.points.size(), 3u);
   EXPECT_EQ(path.points[1].kind, redmax::PathPointKind::Conditional);
   EXPECT_EQ(path.points[2].kind, redmax::PathPointKind::Moving);
@@ -172,27 +172,27 @@ TEST(BuildMuscles, PointMassesAreAddedOnRequest) {
   const ModelDescription d =
       readOsimModel(sharedOpenSim("opensim-models/Models/Gait10dof18musc/gait10dof18musc.osim"));
   const BuildResult r = buildCoreModel(d);
-  for (const Muscle& m : r.muscles) EXPECT_EQ(m.mass_points.size(), 0);  // massless as built
-  std::vector<double> masses(r.muscles.size());
+  for (const Muscle& m : r.model.muscles()) EXPECT_EQ(m.mass_points.size(), 0);  // massless as built
+  std::vector<double> masses(r.model.muscles().size());
   for (size_t k = 0; k < masses.size(); ++k) masses[k] = k == 3 ? 0.0 : 0.1 * (k + 1);
   MassPointOptions opt;
   opt.count = 7;
-  const std::vector<Muscle> with = addMusclePointMasses(r.muscles, masses, opt);
-  ASSERT_EQ(with.size(), r.muscles.size());
+  const std::vector<Muscle> with = addMusclePointMasses(r.model.muscles(), masses, opt);
+  ASSERT_EQ(with.size(), r.model.muscles().size());
   for (size_t k = 0; k < with.size(); ++k) {
     EXPECT_EQ(with[k].mass_points.size(), k == 3 ? 0 : 7);
     EXPECT_NEAR(with[k].mass_points.totalMass(), masses[k], 1e-15);
   }
-  EXPECT_THROW(addMusclePointMasses(r.muscles, {1.0}), ModelError);
+  EXPECT_THROW(addMusclePointMasses(r.model.muscles(), {1.0}), ModelError);
   masses[0] = -1.0;
-  EXPECT_THROW(addMusclePointMasses(r.muscles, masses), ModelError);
+  EXPECT_THROW(addMusclePointMasses(r.model.muscles(), masses), ModelError);
   // a wrapping (Type III) muscle stays lumped
   const ModelDescription arm = readOsimModel(sharedOpenSim("opensim-models/Models/Arm26/arm26.osim"));
   const BuildResult ra = buildCoreModel(arm);
-  std::vector<double> m(ra.muscles.size(), 0.0);
+  std::vector<double> m(ra.model.muscles().size(), 0.0);
   for (size_t k = 0; k < m.size(); ++k)
-    if (ra.muscles[k].path.num_wraps > 0) m[k] = 0.2;
-  EXPECT_THROW(addMusclePointMasses(ra.muscles, m), ModelError);
+    if (ra.model.muscles()[k].path.num_wraps > 0) m[k] = 0.2;
+  EXPECT_THROW(addMusclePointMasses(ra.model.muscles(), m), ModelError);
 }
 
 }  // namespace

@@ -54,7 +54,7 @@ struct MassMoment {
 MassMoment massMoment(const ModelDescription& d, const BuildResult& r) {
   MassMoment out;
   std::vector<Mat4> E_wi;
-  const VecX q = r.model.defaultQ();
+  const VecX q = r.model.skeleton().defaultQ();
   calcBodyPoses(r.model, q, E_wi);
   for (size_t bi = 0; bi < d.bodies.size(); ++bi) {
     const int cb = r.body_index[bi];
@@ -67,7 +67,7 @@ MassMoment massMoment(const ModelDescription& d, const BuildResult& r) {
   s.qdot = VecX::Zero(r.model.nr());
   SkeletonWorkspace sk(r.model);
   calcKinematics(r.model, s, sk);
-  for (const Muscle& m : r.muscles) {
+  for (const Muscle& m : r.model.muscles()) {
     if (m.mass_points.size() == 0) continue;
     MuscleKinematics mk;
     calcMuscleKinematics(r.model, s, sk, m, mk, false);
@@ -107,9 +107,9 @@ double rootBlockDifference(const ModelDescription& d, const MuscleMassOptions& o
   EXPECT_GT(after.plan.total_muscle_mass, 0.0);
   System s0(before.model);
   System s1(after.build.model);
-  s1.addTerm(std::make_shared<MuscleTerm>(after.build.model, after.build.muscles));
+  s1.addTerm(std::make_shared<MuscleTerm>(after.build.model, after.build.model.muscles()));
   State st;
-  st.q = before.model.defaultQ();
+  st.q = before.model.skeleton().defaultQ();
   st.qdot = VecX::Zero(st.q.size());
   DynamicsWorkspace w0(s0.model()), w1(s1.model());
   s0.calcMassAndForce(st, w0);
@@ -156,7 +156,7 @@ TEST(MuscleMass, NoneBuildsTheModelAsIs) {
   ASSERT_EQ(r.plan.muscles.size(), 1u);
   EXPECT_EQ(r.plan.muscles[0].mass, 0.0);
   EXPECT_FALSE(r.plan.muscles[0].lumped_why.empty());
-  EXPECT_EQ(r.build.muscles[0].mass_points.size(), 0);
+  EXPECT_EQ(r.build.model.muscles()[0].mass_points.size(), 0);
   EXPECT_TRUE(r.plan.bodies.empty());
   EXPECT_EQ(r.description.bodies[0].mass, d.bodies[0].mass);
 }
@@ -268,7 +268,7 @@ TEST(MuscleMass, TransferScalesTheBodyAndSplitsByPhysiologicalMass) {
   const double p_ta = physiologicalMass(d.muscles[r.build.muscle_source[ta]], o);
   EXPECT_NEAR(m_sol / m_ta, p_sol / p_ta, 1e-12 * p_sol / p_ta);
   EXPECT_EQ(r.plan.muscles[sol].points, 20);
-  EXPECT_NEAR(r.build.muscles[sol].mass_points.totalMass(), m_sol, 1e-15);
+  EXPECT_NEAR(r.build.model.muscles()[sol].mass_points.totalMass(), m_sol, 1e-15);
 
   // --muscles narrows the set: all of it goes to the soleus
   o.muscles = "soleus.*";
@@ -352,10 +352,10 @@ TEST(MuscleMass, TopKRanksByInertiaShare) {
   o.muscles = "top:4";
   // a few poses: the default and knees/hips bent
   const BuildResult base = buildCoreModel(d, idBuild());
-  std::vector<VecX> samples{base.model.defaultQ()};
-  VecX q = base.model.defaultQ();
+  std::vector<VecX> samples{base.model.skeleton().defaultQ()};
+  VecX q = base.model.skeleton().defaultQ();
   for (const char* c : {"hip_flexion_r", "knee_angle_r", "hip_flexion_l", "knee_angle_l"}) {
-    const int k = base.model.findCoordinate(c);
+    const int k = base.model.skeleton().findCoordinate(c);
     ASSERT_GE(k, 0) << c;
     q[k] = std::string(c).find("knee") != std::string::npos ? -0.8 : 0.6;
   }

@@ -251,8 +251,8 @@ TEST(OsimModels, EverySceneBuildsInTheCoreWithTheSameLengths) {
     const ModelDescription d = readOsimModel(scenePath(s.file));
     const BuildResult r = buildCoreModel(d);
     EXPECT_TRUE(r.unsupported.empty()) << r.unsupported.front().what;
-    ASSERT_EQ(r.muscles.size(), d.muscles.size());
-    ASSERT_EQ(r.model.defaultQ().size(), d.numDofs());
+    ASSERT_EQ(r.model.muscles().size(), d.muscles.size());
+    ASSERT_EQ(r.model.skeleton().defaultQ().size(), d.numDofs());
     for (int c = 0; c < d.numDofs(); ++c) EXPECT_EQ(r.coordinate_index[c], c);
     // the leg's Custom pelvis and hip are outside chainPoses; lengths do not depend on the root
     const std::string root = s.file == std::string("running_leg.osim") ? "femur_r" : "ground";
@@ -266,13 +266,13 @@ TEST(OsimModels, EverySceneBuildsInTheCoreWithTheSameLengths) {
     }
     std::vector<Mat4> E;
     for (const Coords& pose : poses) {
-      VecX q = r.model.defaultQ();
+      VecX q = r.model.skeleton().defaultQ();
       for (int c = 0; c < d.numDofs(); ++c) q[c] = coordValue(d, c, pose);
       calcBodyPoses(r.model, q, E);
-      for (size_t m = 0; m < r.muscles.size(); ++m) {
+      for (size_t m = 0; m < r.model.muscles().size(); ++m) {
         const PathForceDesc& pf = d.muscles[r.muscle_source[m]];
         if (pf.path_type == PathType::III) continue;  // the core lumps wraps for now
-        EXPECT_NEAR(calcPathLength(r.model, r.muscles[m].path, q, E),
+        EXPECT_NEAR(calcPathLength(r.model, r.model.muscles()[m].path, q, E),
                     polylineLength(d, pf, root, pose), 1e-12)
             << pf.name;
       }
@@ -284,7 +284,7 @@ TEST(OsimModels, FingerTakesItsIntendedMuscleMasses) {
   // the 0.2 kg per flexor of 6.2.5 goes on through the muscle-mass machinery: 20 points each
   const ModelDescription d = readOsimModel(scenePath("finger.osim"));
   const BuildResult r = buildCoreModel(d);
-  const auto heavy = addMusclePointMasses(r.muscles, {0.2, 0.2});
+  const auto heavy = addMusclePointMasses(r.model.muscles(), {0.2, 0.2});
   ASSERT_EQ(heavy.size(), 2u);
   for (const auto& m : heavy) {
     EXPECT_EQ(m.mass_points.size(), 20) << m.name;

@@ -46,16 +46,16 @@ TEST(WrapMuscleMass, RunningLegGastrocnemiiTakeMassWithWrapMass) {
     const double phys = physiologicalMass(d.muscles[r.build.muscle_source[k]], o);
     EXPECT_GT(phys, 0.0);
     EXPECT_NEAR(r.plan.muscles[k].mass, phys, 1e-15) << name << ": " << r.plan.muscles[k].lumped_why;
-    EXPECT_EQ(r.build.muscles[k].mass_points.size(), 20) << name;
+    EXPECT_EQ(r.build.model.muscles()[k].mass_points.size(), 20) << name;
     std::printf("[ measured ] running_leg %s: %.4f kg over 20 mass points (Type III, smooth wrap)\n", name,
                 r.plan.muscles[k].mass);
   }
   // the mass came from the bones where the points sit: the whole leg's inertia is unchanged
   const BuildResult before = buildCoreModel(d, bo);
   System s0(before.model), s1(r.build.model);
-  s1.addTerm(std::make_shared<MuscleTerm>(r.build.model, r.build.muscles));
+  s1.addTerm(std::make_shared<MuscleTerm>(r.build.model, r.build.model.muscles()));
   State st;
-  st.q = before.model.defaultQ();
+  st.q = before.model.skeleton().defaultQ();
   st.qdot = VecX::Zero(st.q.size());
   DynamicsWorkspace w0(s0.model()), w1(s1.model());
   s0.calcMassAndForce(st, w0);
@@ -85,7 +85,7 @@ TEST(WrapMuscleMass, RefusedWrappingMuscleStaysLumpedWithTheModelsReason) {
   const int k = findEntry(r.plan, "med_gas_r");
   ASSERT_GE(k, 0);
   // the reason, asked of the plain build's muscle independently of the plan
-  Muscle mu = buildCoreModel(d, bo).muscles[k];
+  Muscle mu = buildCoreModel(d, bo).model.muscles()[k];
   ASSERT_EQ(mu.name, "med_gas_r");
   mu.wrap.model = WrapModel::Smooth;
   const std::string why = wrapMassPointsUnsupportedReason(mu);

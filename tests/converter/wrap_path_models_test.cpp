@@ -96,7 +96,7 @@ Tally checkModel(const std::string& file, const char* label) {
   // plain Type I soleus of subject_walk_armless misses its Jdot central differences by 1e-3 there)
   s.q += 0.1 * VecX::NullaryExpr(m.nr(), [&] { return u(rng); });
   Tally t;
-  for (const Muscle& base : r.muscles) {
+  for (const Muscle& base : r.model.muscles()) {
     if (pathType(base.path) != redmax::PathType::III) continue;
     ++t.wrapping;
     Muscle mu = base;
@@ -180,7 +180,7 @@ TEST(WrapPathModels, SmoothMusclesAtRandomPosesStayOnOpenSimsPath) {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     int total = 0, errors = 0, on = 0, band = 0, far = 0;
     double worst = 0.0;
-    for (const Muscle& base : r.muscles) {
+    for (const Muscle& base : r.model.muscles()) {
       if (pathType(base.path) != redmax::PathType::III) continue;
       Muscle mu = base;
       mu.mass_points = makeMassPoints(1.0, 0.0, 0.0, {10, MassPointOptions::Region::WholePath});

@@ -136,7 +136,7 @@ int compareAt(const simbody::SimbodyModel& sm, const Model& m, const std::vector
               const State& s, const VecX& qddot, bool with_core, double& worst_same, double& worst_core) {
   simbody::MuscleInertia reference(sm, m, muscles);
   // the map a foreign system would give: the SimbodyModel's own mobilized bodies and q slots
-  opensim::MatterMuscleInertia ours(sm.matter, simbody::makeMatterMap(sm, m), m, muscles, m.gravity);
+  opensim::MatterMuscleInertia ours(sm.matter, simbody::makeMatterMap(sm, m), m, muscles, m.gravity());
   SimTK::State sb = sm.default_state;
   simbody::setSimbodyState(sm, m, s, sb);
   sm.system.realize(sb, SimTK::Stage::Velocity);
@@ -264,7 +264,7 @@ TEST(MatterMuscleInertia, EqualsMuscleInertiaOnSetFWithTibiaTransfer) {
     State s = randomState(m.nr(), rng);
     s.q *= 0.5;  // stay near walking poses
     const VecX qddot = VecX::NullaryExpr(m.nr(), [&] { return randomVec(rng, 10.0)[0]; });
-    checked += compareAt(*sm, m, mm.build.muscles, s, qddot, false, worst_same, worst_core);
+    checked += compareAt(*sm, m, mm.build.model.muscles(), s, qddot, false, worst_same, worst_core);
   }
   EXPECT_EQ(checked, 8);
   std::printf("  set F, 80%% tibia_r: %d states; vs MuscleInertia %.2e of the peak\n", checked, worst_same);
@@ -280,17 +280,17 @@ TEST(MatterMuscleInertia, RejectsMapsThatDoNotFit) {
   opt.count = 3;
   mu.mass_points = makeMassPoints(0.5, 0.5, 0.2, opt);
   const opensim::MatterMap good = simbody::makeMatterMap(*sm, m);
-  EXPECT_NO_THROW(opensim::MatterMuscleInertia(sm->matter, good, m, {mu}, m.gravity));
+  EXPECT_NO_THROW(opensim::MatterMuscleInertia(sm->matter, good, m, {mu}, m.gravity()));
   opensim::MatterMap short_map = good;
   short_map.mobod_of_body.pop_back();
-  EXPECT_THROW(opensim::MatterMuscleInertia(sm->matter, short_map, m, {mu}, m.gravity), std::invalid_argument);
+  EXPECT_THROW(opensim::MatterMuscleInertia(sm->matter, short_map, m, {mu}, m.gravity()), std::invalid_argument);
   opensim::MatterMap no_body = good;
   no_body.mobod_of_body[1] = SimTK::MobilizedBodyIndex();  // the insertion's body is not in the system
-  EXPECT_THROW(opensim::MatterMuscleInertia(sm->matter, no_body, m, {mu}, m.gravity), std::invalid_argument);
+  EXPECT_THROW(opensim::MatterMuscleInertia(sm->matter, no_body, m, {mu}, m.gravity()), std::invalid_argument);
   // a massless muscle may sit anywhere: it is skipped
   Muscle lumped = mu;
   lumped.mass_points = MassPoints();
-  EXPECT_NO_THROW(opensim::MatterMuscleInertia(sm->matter, no_body, m, {lumped}, m.gravity));
+  EXPECT_NO_THROW(opensim::MatterMuscleInertia(sm->matter, no_body, m, {lumped}, m.gravity()));
   // a wrap surface on a body the system lacks (its points elsewhere): refused, naming the wrap
   Muscle wrapped = mu;
   wrapped.path.points = {makeFixedPoint(-1, Vec3(0.1, 0, 0)), makeFixedPoint(0, Vec3(0, -0.5, 0))};
@@ -300,9 +300,9 @@ TEST(MatterMuscleInertia, RejectsMapsThatDoNotFit) {
   w.body = 1;
   wrapped.path.wraps = {w};
   wrapped.path.num_wraps = 1;
-  EXPECT_NO_THROW(opensim::MatterMuscleInertia(sm->matter, good, m, {wrapped}, m.gravity));
+  EXPECT_NO_THROW(opensim::MatterMuscleInertia(sm->matter, good, m, {wrapped}, m.gravity()));
   try {
-    opensim::MatterMuscleInertia(sm->matter, no_body, m, {wrapped}, m.gravity);
+    opensim::MatterMuscleInertia(sm->matter, no_body, m, {wrapped}, m.gravity());
     ADD_FAILURE() << "a wrap body outside the system was taken";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("drum_on_link2"), std::string::npos) << e.what();

@@ -139,13 +139,13 @@ TEST(FkSharedModels, CoreAndSimbodyAgreeOnEveryBodyPose) {
     double worst = 0.0;
     int body = -1;
     const double d0 = poseDifference(*sm, r.model, defaultQ(d), body);
-    EXPECT_LE(d0, kTol) << "default pose, body " << r.model.bodies[std::max(body, 0)].name;
+    EXPECT_LE(d0, kTol) << "default pose, body " << r.model.skeleton().bodies()[std::max(body, 0)].name;
     worst = std::max(worst, d0);
     std::mt19937 rng(20261123);
     for (int t = 0; t < kRandomPoses; ++t) {
       const double dt = poseDifference(*sm, r.model, randomQ(d, rng), body);
       EXPECT_LE(dt, kTol) << "random pose " << t << ", body "
-                          << r.model.bodies[std::max(body, 0)].name;
+                          << r.model.skeleton().bodies()[std::max(body, 0)].name;
       worst = std::max(worst, dt);
     }
     worst_all = std::max(worst_all, worst);

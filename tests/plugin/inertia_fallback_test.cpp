@@ -57,10 +57,10 @@ TEST(InertiaFallback, ReplacesOnlyInvalidBodiesWithOpenSimsIsotropicTensor) {
   ASSERT_EQ(changed.size(), 1u);
   EXPECT_EQ(changed[0], "bad");
   const double diag = std::sqrt(0.001 * 0.001 + 0.001 * 0.001 + 0.0025 * 0.0025) / std::sqrt(3.0);
-  EXPECT_NEAR((m.bodies[0].inertia_com - diag * Mat3::Identity()).norm(), 0.0, 1e-18);
-  EXPECT_NEAR((m.bodies[0].M - spatialInertia(1.0, Vec3(0.1, 0, 0), diag * Mat3::Identity())).norm(), 0.0, 1e-15);
-  EXPECT_EQ(m.bodies[1].inertia_com, good);
-  EXPECT_TRUE(simbodyAccepts(m.bodies[0].inertia_com));
+  EXPECT_NEAR((m.bodies()[0].inertia_com - diag * Mat3::Identity()).norm(), 0.0, 1e-18);
+  EXPECT_NEAR((m.bodies()[0].M - spatialInertia(1.0, Vec3(0.1, 0, 0), diag * Mat3::Identity())).norm(), 0.0, 1e-15);
+  EXPECT_EQ(m.bodies()[1].inertia_com, good);
+  EXPECT_TRUE(simbodyAccepts(m.bodies()[0].inertia_com));
 }
 
 }  // namespace

@@ -308,7 +308,7 @@ TEST(SimbodyIdEngineMuscles, RatesAsUMatchesCoreOnRandomTrees) {
     const Model m = scenes::randomTree(7, seed, TreeJoints::SimbodyComparable);
     osim::IdEngineOptions opt;
     opt.rates_as_u.assign(m.nb(), false);
-    for (int j = 0; j < m.nb(); ++j) opt.rates_as_u[j] = osim::hasOpenSimSpeedMap(m.joints[j].joint);
+    for (int j = 0; j < m.nb(); ++j) opt.rates_as_u[j] = osim::hasOpenSimSpeedMap(m.joints()[j].joint);
     for (int j = 0; j < m.nb(); ++j) marked_total += opt.rates_as_u[j] ? 1 : 0;
     const State s_any = randomState(m.nr(), rng);
     std::vector<Muscle> muscles{randomMuscle(m, 2, rng, s_any), randomMuscle(m, 6, rng, s_any)};
@@ -332,7 +332,7 @@ TEST(SimbodyIdEngineMuscles, RatesAsUMatchesCoreOnRandomTrees) {
       }
       for (int j = 0; j < m.nb(); ++j) {
         if (!opt.marked(j)) continue;
-        const JointSlot& slot = m.joints[j];
+        const JointSlot& slot = m.joints()[j];
         MatJ T;
         osim::calcOpenSimSpeedMap(slot.joint, s.q.segment(slot.q_index, slot.nq),
                                   core_engine.lastState().qdot.segment(slot.q_index, slot.nq), T, nullptr);
@@ -430,7 +430,7 @@ TEST(SimbodyIdEngineMuscles, MatchesCoreOnProjectScenes) {
     bo.simbody_compat = true;  // CustomJoints: Simbody's velocity terms (model_to_simbody.hpp)
     bo.constraints = false;
     const osim::BuildResult r = osim::buildCoreModel(d, bo);
-    const std::vector<Muscle> muscles = withMass(r.muscles, sc.mass);
+    const std::vector<Muscle> muscles = withMass(r.model.muscles(), sc.mass);
     EXPECT_EQ(compareEngines(d, r.model, muscles, 6, 5), 6);
   }
 }
@@ -474,15 +474,15 @@ TEST(SimbodyIdEngineMuscles, ViaPointAndWrapMatchCoreOnWrapViaPendulum) {
   const osim::BuildResult r = osim::buildCoreModel(d, bo);
   const Model& m = r.model;
   int gastroc = -1;
-  for (size_t k = 0; k < r.muscles.size(); ++k)
-    if (r.muscles[k].name == "gastroc_like") gastroc = static_cast<int>(k);
+  for (size_t k = 0; k < r.model.muscles().size(); ++k)
+    if (r.model.muscles()[k].name == "gastroc_like") gastroc = static_cast<int>(k);
   ASSERT_GE(gastroc, 0);
-  ASSERT_EQ(r.muscles[gastroc].path.points.size(), 3u);
-  ASSERT_EQ(r.muscles[gastroc].path.wraps.size(), 1u);
+  ASSERT_EQ(r.model.muscles()[gastroc].path.points.size(), 3u);
+  ASSERT_EQ(r.model.muscles()[gastroc].path.wraps.size(), 1u);
   const int q2 = 1;
   for (int variant = 0; variant < 3; ++variant) {
     SCOPED_TRACE(variant == 0 ? "as authored" : variant == 1 ? "conditional via point" : "moving insertion");
-    std::vector<Muscle> muscles = r.muscles;
+    std::vector<Muscle> muscles = r.model.muscles();
     auto& pts = muscles[gastroc].path.points;
     if (variant == 1) {
       const PathPoint& via = pts[1];
@@ -611,8 +611,8 @@ TEST(SimbodyIdEngineMuscles, MatchesCoreOnSetFWithTibiaTransfer) {
     mo.transfer_fraction = fraction;
     const osim::MuscleMassModel mm = osim::applyMuscleMass(d, bo, mo);
     ASSERT_GT(mm.plan.total_muscle_mass, 0.0);
-    EXPECT_EQ(compareEngines(mm.description, mm.build.model, mm.build.muscles, 8, 17), 8);
-    if (fraction == 0.8) printIdCost(mm.build.model, mm.build.muscles);
+    EXPECT_EQ(compareEngines(mm.description, mm.build.model, mm.build.model.muscles(), 8, 17), 8);
+    if (fraction == 0.8) printIdCost(mm.build.model, mm.build.model.muscles());
   }
 }
 

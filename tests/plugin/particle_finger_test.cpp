@@ -47,7 +47,7 @@ FingerScene makeFinger() {
   f.model = r.model;
   MassPointOptions mpo;
   mpo.count = 5;
-  f.muscles = osim::addMusclePointMasses(r.muscles, std::vector<double>(r.muscles.size(), 0.2), mpo);
+  f.muscles = osim::addMusclePointMasses(r.model.muscles(), std::vector<double>(r.model.muscles().size(), 0.2), mpo);
   f.s0.t = 0.0;
   f.s0.q = VecX(f.model.nr());
   for (int c = 0; c < f.model.nr(); ++c) f.s0.q[c] = d.coordinates[c].default_value;

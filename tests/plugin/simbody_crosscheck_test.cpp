@@ -238,7 +238,7 @@ INSTANTIATE_TEST_SUITE_P(SphericalModes, Crosscheck, ::testing::Values(Spherical
 TEST(CrosscheckSprings, JointSpringsAndDampersMatch) {
   for (const auto& c : kTrees) {
     const Model base = scenes::randomTree(c.n, c.seed, scenes::TreeJoints::SimbodyComparable);
-    Model m = base;
+    ModelBuilder edit(base);
     std::mt19937 rng(400 + c.seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     // every coordinate whose Simbody u is its qdot: all but the rotations of Free mobilizers
@@ -247,7 +247,7 @@ TEST(CrosscheckSprings, JointSpringsAndDampersMatch) {
     for (const auto& mm : plain->map) {
       for (int k = 0; k < mm.nq; ++k) {
         if (mm.kind == simbody::MobilizerKind::Free && k < 3) continue;
-        Coordinate& cd = m.coordinates[mm.q_index + k];
+        Coordinate& cd = edit.coordinateAt(mm.q_index + k);
         cd.stiffness = 50.0 * u(rng);
         cd.damping = 2.0 * u(rng);
         cd.rest_value = u(rng) - 0.5;
@@ -255,6 +255,7 @@ TEST(CrosscheckSprings, JointSpringsAndDampersMatch) {
       }
     }
     ASSERT_GT(springs, 2);
+    const Model m = edit.finalize();
     const auto sm = simbody::makeSimbodyModel(m, {});
     System sys(m), sys_free(base);
     DynamicsWorkspace ws(m), ws_free(base);
@@ -323,10 +324,10 @@ TEST(CrosscheckErrors, UnmappableJointIsNamed) {
 // the comparison can fail: a 1e-6 relative change of one body's mass is visible far above 1e-9
 TEST(CrosscheckSensitivity, PerturbedMassIsDetected) {
   const Model m = scenes::randomTree(10, 3, scenes::TreeJoints::SimbodyComparable);
-  Model m2 = m;
-  m2.bodies[m.nb() - 1].mass *= 1.0 + 1e-6;
-  m2.bodies[m.nb() - 1].M = spatialInertia(m2.bodies[m.nb() - 1].mass, m2.bodies[m.nb() - 1].com,
-                                           m2.bodies[m.nb() - 1].inertia_com);
+  ModelBuilder edit(m);
+  const Body& last = m.bodies()[m.nb() - 1];
+  edit.setBodyMassProperties(m.nb() - 1, last.mass * (1.0 + 1e-6), last.com, last.inertia_com);
+  const Model m2 = edit.finalize();
   const auto sm = simbody::makeSimbodyModel(m2, {});
   std::mt19937 rng(9);
   const State s = randomState(m, rng);

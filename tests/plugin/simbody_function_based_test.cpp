@@ -339,14 +339,16 @@ class SharedModels : public ::testing::TestWithParam<const char*> {};
 // central inertias that fail Simbody's test (triangle inequality with its slop) become isotropic
 int replaceUnphysicalInertias(Model& m) {
   int n = 0;
-  for (Body& b : m.bodies) {
+  ModelBuilder edit(m);
+  for (int i = 0; i < m.nb(); ++i) {
+    const Body& b = m.bodies()[i];
     const Vec3 d = b.inertia_com.diagonal();
     const double slop = std::max(d.sum(), 1.0) * std::sqrt(std::numeric_limits<double>::epsilon());
     if (d[0] + d[1] + slop >= d[2] && d[0] + d[2] + slop >= d[1] && d[1] + d[2] + slop >= d[0]) continue;
-    b.inertia_com = Mat3::Identity() * (d.norm() / std::sqrt(3.0));
-    b.M = spatialInertia(b.mass, b.com, b.inertia_com);
+    edit.setBodyMassProperties(i, b.mass, b.com, Mat3::Identity() * (d.norm() / std::sqrt(3.0)));
     ++n;
   }
+  m = edit.finalize();
   return n;
 }
 

@@ -189,14 +189,14 @@ WrapPendulum wrapPendulum(double mass) {
   bo.constraints = false;
   WrapPendulum w;
   w.build = osim::buildCoreModel(d, bo);
-  w.muscles = w.build.muscles;
+  w.muscles = w.build.model.muscles();
   MassPointOptions opt;
   opt.count = 10;
   for (Muscle& mu : w.muscles)
     if (mass > 0.0) mu.mass_points = makeMassPoints(mass, mu.optimal_fiber_length, mu.tendon_slack_length, opt);
   w.s0.t = 0.0;
   w.s0.q.resize(2);
-  for (int c = 0; c < 2; ++c) w.s0.q[c] = w.build.model.coordinates[c].default_value;
+  for (int c = 0; c < 2; ++c) w.s0.q[c] = w.build.model.skeleton().coordinates()[c].default_value;
   w.s0.qdot = VecX::Zero(2);
   return w;
 }
@@ -289,7 +289,7 @@ TEST(SimbodyParticleMuscles, WrapViaPendulumMatchesCoreRk45) {
   bo.constraints = false;
   const osim::BuildResult r = osim::buildCoreModel(d, bo);
   const Model& m = r.model;
-  std::vector<Muscle> muscles = r.muscles;
+  std::vector<Muscle> muscles = r.model.muscles();
   MassPointOptions opt;
   opt.count = 10;
   int gastroc = -1;
@@ -303,10 +303,10 @@ TEST(SimbodyParticleMuscles, WrapViaPendulumMatchesCoreRk45) {
   ASSERT_EQ(muscles[gastroc].path.points.size(), 3u);
   State s0;
   s0.q.resize(m.nr());
-  for (int c = 0; c < m.nr(); ++c) s0.q[c] = m.coordinates[c].default_value;
+  for (int c = 0; c < m.nr(); ++c) s0.q[c] = m.coordinates()[c].default_value;
   s0.qdot = VecX::Zero(m.nr());
   double min_pen = 1e9, max_pen = -1e9;
-  compareParticlesWithCore(m, muscles, r.muscles, s0, "wrap + via pendulum", [&](const State& s) {
+  compareParticlesWithCore(m, muscles, r.model.muscles(), s0, "wrap + via pendulum", [&](const State& s) {
     const double pen = segmentPenetration(m, muscles[gastroc], s, 1);
     min_pen = std::min(min_pen, pen);
     max_pen = std::max(max_pen, pen);

@@ -41,12 +41,12 @@ TEST(BenchScenes, HumanoidHasTheDocumentedShape) {
   EXPECT_EQ(m.nb(), 17);
   EXPECT_EQ(m.nr(), 37);
   double total = 0.0;
-  for (const auto& b : m.bodies) total += b.mass;
+  for (const auto& b : m.bodies()) total += b.mass;
   EXPECT_NEAR(total, 77.3, 1e-9);
   // pelvis height default, and every spatial inertia positive definite
-  EXPECT_EQ(m.coordinates[4].name, "pelvis_ty");
+  EXPECT_EQ(m.coordinates()[4].name, "pelvis_ty");
   EXPECT_DOUBLE_EQ(m.defaultQ()[4], 0.94);
-  for (const auto& b : m.bodies) EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat6>(b.M).eigenvalues().minCoeff(), 0.0) << b.name;
+  for (const auto& b : m.bodies()) EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat6>(b.M).eigenvalues().minCoeff(), 0.0) << b.name;
   // left and right limbs mirror each other: same masses, coordinates named per side
   EXPECT_GE(m.findCoordinate("knee_angle_r"), 0);
   EXPECT_GE(m.findCoordinate("knee_angle_l"), 0);

@@ -274,7 +274,7 @@ TEST_F(IdMuscleMass, OpenSimSpeedMapAppliesWithMuscleMass) {
   System sys(tool.model());
   sys.addTerm(std::make_shared<MuscleTerm>(tool.model(), tool.muscles()));
   DynamicsWorkspace ws(sys.model());
-  const Joint& ball = tool.model().joints[0].joint;
+  const Joint& ball = tool.model().joints()[0].joint;
   double worst = 0, peak = 0, muscle_effect = 0;
   System lumped(tool.model());
   DynamicsWorkspace wl(lumped.model());

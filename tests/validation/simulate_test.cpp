@@ -221,9 +221,9 @@ TEST(Simulate, EveryIntegratorRunsAndApproachesTheReference) {
 TEST(Simulate, DivergenceStopsWithTimeCoordinateAndStep) {
   SimulationModel m = loadSimulationModel(scene("double_pendulum_via.osim"), {});
   // a stiff joint spring on q2 (w = 1e4 rad/s) with explicit steps of 1 ms: h w = 10 >> 2
-  Model stiff = m.system->model();
-  stiff.coordinates[1].stiffness = 1e8;
-  m.system = std::make_shared<System>(stiff);
+  ModelBuilder stiff(m.system->model());
+  stiff.coordinateAt(1).stiffness = 1e8;
+  m.system = std::make_shared<System>(stiff.finalize());
   SimulateOptions o;
   o.integrator = "euler";
   o.duration = 1.0;

@@ -140,18 +140,19 @@ SimulationModel makeSimulationModel(const osim::ModelDescription& d, const Simul
     m.description = d;
     m.build = osim::buildCoreModel(m.description, options.build);
   }
-  if (options.gravity) m.build.model.gravity = *options.gravity;
-  m.muscles = m.build.muscles;
+  // gravity and explicit masses are edits of the built model
+  MusculoskeletalModelBuilder edit(m.build.model);
+  if (options.gravity) edit.skeleton().setGravity(*options.gravity);
+  edit.settings().muscle_term.quadratic_velocity = options.quadratic_velocity;
+  const std::vector<Muscle>& built = m.build.model.muscles();
 
   // explicit masses: added to the muscles, no body gives any
+  std::vector<double> masses(built.size(), 0.0);
   if (explicit_mass) {
     if (options.muscle_mass.mass_points < 1)
       throw std::invalid_argument("--mass-points must be at least 1");
-    std::vector<double> masses(m.muscles.size(), 0.0);
     for (const auto& [name, kg] : options.explicit_masses) {
-      int found = -1;
-      for (size_t k = 0; k < m.muscles.size(); ++k)
-        if (m.muscles[k].name == name) found = static_cast<int>(k);
+      const int found = m.build.model.findMuscle(name);
       if (found < 0) throw std::invalid_argument("--muscle-mass-kg: the model has no muscle '" + name + "'");
       if (!(kg >= 0.0) || !std::isfinite(kg))
         throw std::invalid_argument("--muscle-mass-kg: mass of '" + name + "' must be a finite number >= 0");
@@ -163,41 +164,44 @@ SimulationModel makeSimulationModel(const osim::ModelDescription& d, const Simul
     // wrapping (Type III) muscles take their points here when wrap mass is on (addMusclePointMasses
     // refuses them); validateMuscle names the reason when the shape is not supported
     std::vector<double> plain = masses;
-    for (size_t k = 0; k < m.muscles.size(); ++k) {
-      if (pathType(m.muscles[k].path) != PathType::III || !(masses[k] > 0.0)) continue;
+    for (size_t k = 0; k < built.size(); ++k) {
+      if (pathType(built[k].path) != PathType::III || !(masses[k] > 0.0)) continue;
       if (!options.muscle_mass.wrap_mass)
-        throw std::invalid_argument("--muscle-mass-kg: muscle '" + m.muscles[k].name +
+        throw std::invalid_argument("--muscle-mass-kg: muscle '" + built[k].name +
                                     "' wraps (Type III) and wrap mass is off (--wrap lumped)");
       plain[k] = 0.0;
     }
-    m.muscles = osim::addMusclePointMasses(m.muscles, plain, mp);
-    for (size_t k = 0; k < m.muscles.size(); ++k) {
+    const std::vector<Muscle> with = osim::addMusclePointMasses(built, plain, mp);
+    for (size_t k = 0; k < with.size(); ++k) {
+      Muscle& mu = edit.muscle(static_cast<int>(k));
+      mu = with[k];
       if (plain[k] == masses[k]) continue;
-      Muscle& mu = m.muscles[k];
       mu.wrap = options.muscle_mass.wrap;
       mu.mass_points = makeMassPoints(masses[k], mu.optimal_fiber_length, mu.tendon_slack_length, mp);
       validateMuscle(m.build.model, mu);
     }
+  }
+  m.build.model = edit.finalize();
+  const std::vector<Muscle>& muscles = m.build.model.muscles();
+  if (explicit_mass) {
     std::ostringstream os;
-    for (size_t k = 0; k < m.muscles.size(); ++k) {
+    for (size_t k = 0; k < muscles.size(); ++k) {
       if (masses[k] <= 0.0) continue;
-      os << "  muscle " << m.muscles[k].name << ": " << masses[k] << " kg on " << m.muscles[k].mass_points.size()
+      os << "  muscle " << muscles[k].name << ": " << masses[k] << " kg on " << muscles[k].mass_points.size()
          << " points (added; no body gives mass)"
-         << (pathType(m.muscles[k].path) == PathType::III
-                 ? std::string(", wrapping, wrap model ") + osim::toString(m.muscles[k].wrap.model)
+         << (pathType(muscles[k].path) == PathType::III
+                 ? std::string(", wrapping, wrap model ") + osim::toString(muscles[k].wrap.model)
                  : std::string())
          << "\n";
       m.added_mass += masses[k];
     }
     m.mass_summary = os.str();
   }
-  for (const Muscle& mu : m.muscles) m.muscle_mass += mu.mass_points.totalMass();
+  m.muscle_mass = m.build.model.muscleMass();
 
   m.system = std::make_shared<System>(m.build.makeSystem());
   if (m.muscle_mass > 0.0) {
-    MuscleTermOptions mo;
-    mo.quadratic_velocity = options.quadratic_velocity;
-    auto term = std::make_shared<MuscleTerm>(m.system->model(), m.muscles, mo);
+    auto term = std::make_shared<MuscleTerm>(m.system->model(), muscles, m.build.model.settings().muscle_term);
     m.muscle_term = term;
     m.system->addTerm(term);
   }
@@ -241,9 +245,9 @@ SimulationModel makeSimulationModel(const osim::ModelDescription& d, const Simul
   m.q_labels.resize(model.nr());
   m.u_labels.resize(model.nr());
   for (int i = 0; i < model.nr(); ++i) {
-    m.coordinate_names[i] = model.coordinates[i].name;
-    m.q_labels[i] = model.coordinates[i].name + "/value";
-    m.u_labels[i] = model.coordinates[i].name + "/speed";
+    m.coordinate_names[i] = model.coordinates()[i].name;
+    m.q_labels[i] = model.coordinates()[i].name + "/value";
+    m.u_labels[i] = model.coordinates()[i].name + "/speed";
   }
   for (size_t k = 0; k < d.coordinates.size(); ++k) {
     const int i = k < m.build.coordinate_index.size() ? m.build.coordinate_index[k] : -1;

@@ -87,8 +87,9 @@ class ImpulseLoads final : public ForceTerm {
 /// A model ready to simulate.
 struct SimulationModel {
   osim::ModelDescription description;  ///< after the muscle mass moved (if it did)
+  /// build.model: the model with everything that defines it (gravity, muscles with their mass
+  /// points, constraints)
   osim::BuildResult build;
-  std::vector<Muscle> muscles;         ///< build.muscles with their mass points
   std::shared_ptr<const MuscleTerm> muscle_term;    ///< null when no muscle carries mass
   std::shared_ptr<const ImpulseLoads> impulses;     ///< null without impulses
   std::shared_ptr<System> system;

@@ -72,7 +72,7 @@ std::string nameCoordinate(const Model& model, const std::string& what) {
   if (!std::regex_search(what, mt, entry)) return what;
   const int k = std::stoi(mt[2].str());
   if (k < 0 || k >= model.nr()) return what;
-  return what + " (coordinate '" + model.coordinates[k].name + "')";
+  return what + " (coordinate '" + model.coordinates()[k].name + "')";
 }
 
 }  // namespace
@@ -131,7 +131,7 @@ HardRun integrateHardCase(const System& sys, const State& s0, const std::string&
 
 double checkJointSingularities(const Model& model, const State& s, double threshold, double h) {
   double dmin = 1.0;
-  for (const JointSlot& j : model.joints) {
+  for (const JointSlot& j : model.joints()) {
     const double d = j.joint.singularityDistance(s.q.segment(j.q_index, j.nq));
     if (d < threshold) {
       std::ostringstream os;
@@ -161,7 +161,7 @@ SpinCase runSpinCase(double duration) {
   auto momentum = [&](const State& st) {
     SkeletonWorkspace ws(m);
     calcKinematics(m, st, ws);
-    return Vec3(ws.E_wi[0].topLeftCorner<3, 3>() * (m.bodies[0].inertia_com * ws.phi[0].head<3>()));
+    return Vec3(ws.E_wi[0].topLeftCorner<3, 3>() * (m.bodies()[0].inertia_com * ws.phi[0].head<3>()));
   };
   const double E0 = energy(sys, s);
   const Vec3 L0 = momentum(s);
@@ -288,8 +288,8 @@ System stiffSystem(State& s) {
   ModelBuilder b("stiff_spring");
   b.setGravity(Vec3::Zero());
   b.addBody("disc", 1.0, Vec3::Zero(), kStiffI * Mat3::Identity(), -1, "hinge", Revolute{Vec3::UnitZ()});
+  b.coordinateAt(0).stiffness = kStiffK;
   Model m = b.finalize();
-  m.coordinates[0].stiffness = kStiffK;
   System sys(m);
   s = sys.defaultState();
   s.q[0] = 0.1;

@@ -69,15 +69,15 @@ osim::BuildResult loadModel(const std::string& models_dir, const std::string& fi
 
 // a System with the built constraints and the given muscle masses (name -> kg; others lumped)
 System makeSystem(const osim::BuildResult& b, const std::vector<std::pair<std::string, double>>& masses) {
-  std::vector<double> m(b.muscles.size(), 0.0);
+  std::vector<double> m(b.model.muscles().size(), 0.0);
   for (const auto& [name, kg] : masses) {
     bool found = false;
-    for (std::size_t k = 0; k < b.muscles.size(); ++k)
-      if (b.muscles[k].name == name) m[k] = kg, found = true;
+    for (std::size_t k = 0; k < b.model.muscles().size(); ++k)
+      if (b.model.muscles()[k].name == name) m[k] = kg, found = true;
     if (!found) throw std::invalid_argument("work-precision scene: model has no muscle '" + name + "'");
   }
   System sys = b.makeSystem();
-  sys.addTerm(std::make_shared<MuscleTerm>(b.model, osim::addMusclePointMasses(b.muscles, m)));
+  sys.addTerm(std::make_shared<MuscleTerm>(b.model, osim::addMusclePointMasses(b.model.muscles(), m)));
   return sys;
 }
 
@@ -168,7 +168,7 @@ std::vector<std::string> workPrecisionSceneNames() {
 
 WrapPendulum makeWrapPendulum(const std::string& models_dir, WrapModel model, double muscle_kg) {
   const auto b = loadModel(models_dir, "double_pendulum_wrap.osim");
-  std::vector<Muscle> muscles = b.muscles;
+  std::vector<Muscle> muscles = b.model.muscles();
   int k = -1;
   for (std::size_t i = 0; i < muscles.size(); ++i)
     if (muscles[i].name == "wrap_muscle") k = static_cast<int>(i);
@@ -228,7 +228,7 @@ WorkPrecisionScene makeWorkPrecisionScene(const std::string& name, const std::st
     const std::string path = (std::filesystem::path(models_dir) / "running_leg.osim").string();
     const osim::MuscleMassModel mm = osim::applyMuscleMass(osim::readOsimModel(path), {}, mo);
     System sys = mm.build.makeSystem();
-    sys.addTerm(std::make_shared<MuscleTerm>(mm.build.model, mm.build.muscles));
+    sys.addTerm(std::make_shared<MuscleTerm>(mm.build.model, mm.build.model.muscles()));
     std::string masses;
     for (const auto& m : mm.plan.muscles)
       if (m.points > 0) masses += (masses.empty() ? "" : ", ") + m.name + " " + fmt(m.mass, "%.3f") + " kg";

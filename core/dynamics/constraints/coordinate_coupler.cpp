@@ -12,7 +12,7 @@ void checkCoordinateIndices(const Model& model, const std::vector<int>& indices,
       throw ModelError(what + ": coordinate index " + std::to_string(i) + " out of range (model has " +
                        std::to_string(model.nr()) + " coordinates)");
     if (std::find(indices.begin(), indices.begin() + static_cast<long>(k), i) != indices.begin() + static_cast<long>(k))
-      throw ModelError(what + ": coordinate '" + model.coordinates[i].name + "' appears twice");
+      throw ModelError(what + ": coordinate '" + model.coordinates()[i].name + "' appears twice");
   }
 }
 

@@ -8,7 +8,7 @@ PrescribedCoordinate::PrescribedCoordinate(const Model& model, int coordinate, C
   if (k_ < 0 || k_ >= model.nr())
     throw ModelError("prescribed coordinate: index " + std::to_string(k_) + " out of range (model has " +
                      std::to_string(model.nr()) + " coordinates)");
-  if (name_.empty()) name_ = "prescribed_" + model.coordinates[k_].name;
+  if (name_.empty()) name_ = "prescribed_" + model.coordinates()[k_].name;
   if (!traj_) throw ModelError(name_ + ": no trajectory function");
   if (!acceptsArguments(*traj_, 1))
     throw ModelError(name_ + ": the trajectory must be a function of time only (1 argument), got " +
@@ -18,7 +18,7 @@ PrescribedCoordinate::PrescribedCoordinate(const Model& model, int coordinate, C
 std::shared_ptr<PrescribedCoordinate> PrescribedCoordinate::makeLocked(const Model& model, int coordinate,
                                                                        double value) {
   const std::string coord_name =
-      coordinate >= 0 && coordinate < model.nr() ? model.coordinates[coordinate].name : std::to_string(coordinate);
+      coordinate >= 0 && coordinate < model.nr() ? model.coordinates()[coordinate].name : std::to_string(coordinate);
   return std::make_shared<PrescribedCoordinate>(model, coordinate, makeConstantFunction(value),
                                                 "locked_" + coord_name);
 }

@@ -13,8 +13,9 @@ namespace redmax {
 namespace {
 
 TEST(BodyLoads, PointForceIsNegativeGradientOfItsPotential) {
-  Model m = scenes::randomTree(7, 41);
-  m.gravity.setZero();
+  ModelBuilder mb(scenes::randomTree(7, 41));
+  mb.setGravity(Vec3::Zero());
+  const Model m = mb.finalize();
   auto loads = std::make_shared<BodyLoads>();
   loads->point_forces.push_back({3, Vec3(0.1, -0.2, 0.3), Vec3(1.0, 2.0, -0.5)});
   loads->point_forces.push_back({6, Vec3(-0.3, 0.0, 0.2), Vec3(-2.0, 0.5, 1.5)});
@@ -70,15 +71,17 @@ TEST(BodyLoads, WrenchEqualsForcePairAndPointForceMatchesPointJacobian) {
 
 TEST(JointSpringsDampers, StiffnessAndDampingAreForceDerivatives) {
   // with zero gravity and zero velocity, -df/dq = K and -df/dqdot = D exactly [D Eq. 4.81]
-  Model m = scenes::randomTree(6, 12);
-  m.gravity.setZero();
+  ModelBuilder mb(scenes::randomTree(6, 12));
+  mb.setGravity(Vec3::Zero());
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> u(0.1, 2.0);
-  for (auto& c : m.coordinates) {
+  for (int k = 0; k < mb.nr(); ++k) {
+    Coordinate& c = mb.coordinateAt(k);
     c.stiffness = 10 * u(rng);
     c.damping = u(rng);
     c.rest_value = u(rng) - 1.0;
   }
+  const Model m = mb.finalize();
   System sys(m);
   State s = sys.defaultState();
   s.q.setConstant(0.3);

@@ -322,7 +322,7 @@ TEST(Weld, HoldsTwoFloatingBodiesTogetherWhileFalling) {
   auto comOf = [&](const State& s) {
     std::vector<Mat4> Ew;
     calcBodyPoses(m, s.q, Ew);
-    return Vec3((2.0 * transformPoint(Ew[A], m.bodies[A].com) + 1.0 * transformPoint(Ew[B], m.bodies[B].com)) / 3.0);
+    return Vec3((2.0 * transformPoint(Ew[A], m.bodies()[A].com) + 1.0 * transformPoint(Ew[B], m.bodies()[B].com)) / 3.0);
   };
 
   System sys = makeSystem();

@@ -50,7 +50,7 @@ System makeScene() {
   System sys(scenes::doublePendulum());
   const int first = sys.addExtraCoordinates(3);
   EXPECT_EQ(first, 2);
-  sys.addTerm(std::make_shared<SpringParticle>(first, 1, Vec3(0, -1, 0), 0.3, 200.0, sys.model().gravity));
+  sys.addTerm(std::make_shared<SpringParticle>(first, 1, Vec3(0, -1, 0), 0.3, 200.0, sys.model().gravity()));
   return sys;
 }
 

@@ -37,13 +37,13 @@ std::vector<Sine> randomSines(int n, std::mt19937& rng) {
 /// a random tree with joint springs and dampers on some coordinates (they belong in f_r, so the
 /// torques must include them)
 Model springyTree(int n, std::uint32_t seed) {
-  Model m = scenes::randomTree(n, seed);
-  for (int k = 0; k < m.nr(); k += 3) {
-    m.coordinates[k].stiffness = 3.0 + k;
-    m.coordinates[k].rest_value = 0.2;
-    m.coordinates[k].damping = 0.5;
+  ModelBuilder edit(scenes::randomTree(n, seed));
+  for (int k = 0; k < edit.nr(); k += 3) {
+    edit.coordinateAt(k).stiffness = 3.0 + k;
+    edit.coordinateAt(k).rest_value = 0.2;
+    edit.coordinateAt(k).damping = 0.5;
   }
-  return m;
+  return edit.finalize();
 }
 
 class Hybrid : public ::testing::TestWithParam<int> {};

@@ -109,7 +109,7 @@ TEST(MuscleTerm, HingeTypeIMatchesClosedForm) {
     for (int a = 0; a < mu.mass_points.size(); ++a) {
       const double al = mu.mass_points.alpha[a], ma = mu.mass_points.mass[a];
       I_a += ma * al * al * (p.x() * p.x() + p.y() * p.y());
-      grav += ma * al * m.gravity.dot(dp);
+      grav += ma * al * m.gravity().dot(dp);
     }
     double M_eff = 0.0;
     const double tau = idDifference(m, {mu}, c, &M_eff);
@@ -161,7 +161,7 @@ TEST(MuscleTerm, HingeTypeIIOverWorldViaMatchesClosedForm) {
         dJ = ddb * d + 2.0 * db * dp + beta * ddp;
       }
       I_a += ma * J.squaredNorm();
-      tau_expected += ma * (J.squaredNorm() * c.thddot + J.dot(dJ) * c.thdot * c.thdot - J.dot(m.gravity));
+      tau_expected += ma * (J.squaredNorm() * c.thddot + J.dot(dJ) * c.thdot * c.thdot - J.dot(m.gravity()));
     }
     double M_eff = 0.0;
     const double tau = idDifference(m, {mu}, c, &M_eff);

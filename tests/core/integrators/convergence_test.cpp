@@ -100,8 +100,12 @@ TEST(Convergence, AdaptiveErrorFollowsTolerance) {
 /// one hinge with a stiff joint spring and damper (omega ~ 550 rad/s, damping ratio ~ 0.02)
 System stiffPendulum() {
   Model m = springDampedPendulum(0.0, 0.0);
-  m.coordinates[0].stiffness = 1e5;
-  m.coordinates[0].damping = 20.0;
+  {
+    ModelBuilder edit(m);
+    edit.coordinateAt(0).stiffness = 1e5;
+    edit.coordinateAt(0).damping = 20.0;
+    m = edit.finalize();
+  }
   return System(m);
 }
 
@@ -158,10 +162,10 @@ TEST(Stiff, Bdf1MatchesBackwardEulerOnLinearOscillator) {
   Mat3 I;
   rod(1.0, 0.5, c, I);
   b.addBody("a", 1.0, c, I, -1, "ja", Revolute{Vec3::UnitZ()});
+  b.coordinateAt(0).stiffness = 1e4;
+  b.coordinateAt(0).damping = 3.0;
+  b.coordinateAt(0).rest_value = 0.2;
   Model m = b.finalize();
-  m.coordinates[0].stiffness = 1e4;
-  m.coordinates[0].damping = 3.0;
-  m.coordinates[0].rest_value = 0.2;
   System sys(m);
   State s = sys.defaultState();
   s.q << 1.0;
@@ -198,7 +202,11 @@ TEST(Stiff, Sdirk2IsLStable) {
   State s = probe.defaultState();
   probe.calcMassAndForce(s, ws);
   const double h = 0.01, omega = 100.0 / h;
-  m.coordinates[0].stiffness = omega * omega * ws.M(0, 0);
+  {
+    ModelBuilder edit(m);
+    edit.coordinateAt(0).stiffness = omega * omega * ws.M(0, 0);
+    m = edit.finalize();
+  }
   System sys(m);
   s.q << 1.0;
   IntegratorOptions opt;
@@ -213,8 +221,12 @@ TEST(Stiff, Sdirk2IsLStable) {
 // makes explicit rk45 stability-limited; cvode's BDF takes far fewer steps for the same answer.
 TEST(Stiff, CvodeTakesFewerStepsThanRk45OnStiffDampedSystem) {
   Model m = springDampedPendulum(0.0, 0.0);
-  m.coordinates[1].stiffness = 1e6;
-  m.coordinates[1].damping = 1e4;
+  {
+    ModelBuilder edit(m);
+    edit.coordinateAt(1).stiffness = 1e6;
+    edit.coordinateAt(1).damping = 1e4;
+    m = edit.finalize();
+  }
   System sys(m);
   State s0 = sys.defaultState();
   s0.q << 1.0, 0.4;
@@ -238,7 +250,11 @@ TEST(Stiff, Sdirk2FallsBackToFiniteDifferenceJacobian) {
   const double k = 1e5;
   System hidden = stiffPendulum();
   Model m = hidden.model();
-  m.coordinates[0].stiffness = 0.0;
+  {
+    ModelBuilder edit(m);
+    edit.coordinateAt(0).stiffness = 0.0;
+    m = edit.finalize();
+  }
   System explicit_spring(m);
   explicit_spring.addTerm(std::make_shared<LambdaForce>([k](const State& s, VecX& f) { f[0] -= k * s.q[0]; }));
   State s0 = hidden.defaultState();

@@ -47,11 +47,10 @@ inline Model mixedChain(double k_stiff = 0.0) {
     parent = b.addBody("link" + std::to_string(i), 1.0 + 0.1 * i, c, I, parent,
                        "joint" + std::to_string(i), joints[i], E_pf);
   }
-  Model m = b.finalize();
-  m.coordinates[3].stiffness = 300.0;  // the slider stays near its link
-  m.coordinates[5].stiffness = 40.0;  // Euler middle angle: 0.5 k (pi/2)^2 > the chain's energy
-  if (k_stiff > 0.0) m.coordinates[0].stiffness = k_stiff;
-  return m;
+  b.coordinateAt(3).stiffness = 300.0;  // the slider stays near its link
+  b.coordinateAt(5).stiffness = 40.0;  // Euler middle angle: 0.5 k (pi/2)^2 > the chain's energy
+  if (k_stiff > 0.0) b.coordinateAt(0).stiffness = k_stiff;
+  return b.finalize();
 }
 
 /// initial state of the chain: bent and moving
@@ -73,10 +72,9 @@ inline Model decoupledMixedJoints() {
   b.addBody("a", 1.0, c, I, -1, "ja", Revolute{Vec3::UnitZ()});
   b.addBody("b", 1.2, c, I, -1, "jb", Prismatic{Vec3(0.6, 0.8, 0.0)}, makeTranslation(Vec3(1, 0, 0)));
   b.addBody("c", 0.8, c, I, -1, "jc", Revolute{Vec3::UnitX()}, makeTranslation(Vec3(2, 0, 0)));
-  Model m = b.finalize();
-  m.coordinates[1].stiffness = 100.0;
-  m.coordinates[2].stiffness = 3.0;
-  return m;
+  b.coordinateAt(1).stiffness = 100.0;
+  b.coordinateAt(2).stiffness = 3.0;
+  return b.finalize();
 }
 
 inline double totalEnergy(const System& sys, const State& s) {
@@ -86,12 +84,12 @@ inline double totalEnergy(const System& sys, const State& s) {
 
 /// double pendulum with joint springs and dampers (so bdf1 differs from euler)
 inline Model springDampedPendulum(double k = 5.0, double d = 0.3) {
-  Model m = scenes::doublePendulum();
-  for (auto& c : m.coordinates) {
-    c.stiffness = k;
-    c.damping = d;
+  ModelBuilder b(scenes::doublePendulum());
+  for (int q = 0; q < b.nr(); ++q) {
+    b.coordinateAt(q).stiffness = k;
+    b.coordinateAt(q).damping = d;
   }
-  return m;
+  return b.finalize();
 }
 
 /// integrate with `name` from s to t_end in one advance() call

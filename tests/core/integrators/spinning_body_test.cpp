@@ -29,7 +29,7 @@ Vec3 angularMomentum(const Model& m, const State& s) {
   SkeletonWorkspace ws(m);
   calcKinematics(m, s, ws);
   const Vec3 omega_i = ws.phi[0].head<3>();
-  return ws.E_wi[0].topLeftCorner<3, 3>() * (m.bodies[0].inertia_com * omega_i);
+  return ws.E_wi[0].topLeftCorner<3, 3>() * (m.bodies()[0].inertia_com * omega_i);
 }
 
 struct SpinResult {

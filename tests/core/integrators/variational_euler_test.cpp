@@ -344,8 +344,8 @@ Model springMass(double m, double k) {
   ModelBuilder b("spring_mass");
   b.setGravity(Vec3::Zero());
   b.addBody("mass", m, Vec3::Zero(), Mat3::Identity() * 0.01, -1, "slider", Prismatic{Vec3::UnitX()});
+  b.coordinateAt(0).stiffness = k;
   Model model = b.finalize();
-  model.coordinates[0].stiffness = k;
   return model;
 }
 

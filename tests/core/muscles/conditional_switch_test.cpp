@@ -37,7 +37,7 @@ Jump measure(const Model& m, const Muscle& mu, const State& before, const State&
   j.jacobian = (b.J_ar - a.J_ar).norm() / a.J_ar.norm();
   j.kinetic_before = muscleKineticEnergy(mu.mass_points, a, before.qdot);
   j.kinetic = muscleKineticEnergy(mu.mass_points, b, after.qdot) - j.kinetic_before;
-  j.potential = musclePotentialEnergy(mu.mass_points, b, m.gravity) - musclePotentialEnergy(mu.mass_points, a, m.gravity);
+  j.potential = musclePotentialEnergy(mu.mass_points, b, m.gravity()) - musclePotentialEnergy(mu.mass_points, a, m.gravity());
   return j;
 }
 

@@ -63,8 +63,8 @@ TEST_P(KinematicsFd, JmrZeroOutsideAncestors) {
   calcKinematics(m, randomState(m, rng), ws);
   for (int i = 0; i < m.nb(); ++i)
     for (int a = 0; a < m.nb(); ++a)
-      if (!m.isAncestor(a, i) && m.joints[a].nq > 0) {
-        EXPECT_EQ(ws.J_mr.block(6 * i, m.joints[a].q_index, 6, m.joints[a].nq).norm(), 0.0);
+      if (!m.isAncestor(a, i) && m.joints()[a].nq > 0) {
+        EXPECT_EQ(ws.J_mr.block(6 * i, m.joints()[a].q_index, 6, m.joints()[a].nq).norm(), 0.0);
       }
 }
 
