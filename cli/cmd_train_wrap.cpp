@@ -1,15 +1,14 @@
 // `redmax train-wrap`: train the Type III wrap network on samples of the exact wrapping library
 // [D Sec. 5.3.3.1], or (--compare) time networks, the smooth model and the exact library per mass
-// point (position + Jacobian + Jdot) against their position error.
+// point (position + Jacobian + Jdot) against their position error. The work is done by
+// tools/wrap_training/ (train.hpp, compare.hpp, study.hpp); this file parses, calls and prints.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <iostream>
 #include <memory>
-#include <random>
 #include <sstream>
 #include <optional>
 #include <string>
@@ -18,11 +17,11 @@
 #include "cli/args.hpp"
 #include "converter/atomic_file.hpp"
 #include "core/muscles/wrap/network_model.hpp"
-#include "core/muscles/wrap/smooth.hpp"
+#include "tools/wrap_training/compare.hpp"
+#include "tools/wrap_training/study.hpp"
+#include "tools/wrap_training/train.hpp"
 #include "validation/report/csv.hpp"
 #include "validation/report/plot.hpp"
-#include "tools/wrap_training/compare.hpp"
-#include "tools/wrap_training/train.hpp"
 #include "validation/scenes/wrap_pendulums.hpp"
 
 namespace redmax::cli {
@@ -244,87 +243,64 @@ int runStudy(const Args& a) {
   const auto report = a.get("report");
   if (!report) throw UsageError{"--study needs --report DIR"};
   requireFolder(*report);
-  std::vector<double> thresholds;
+  WrapStudyOptions o;
+  o.thresholds.clear();
   for (const auto& t : splitList(a.get("thresholds", "0.01,0.05,0.1"))) {
     char* end = nullptr;
     const double v = std::strtod(t.c_str(), &end);
     if (*end != '\0' || !(v >= 0.0 && v < 1.0)) throw UsageError{"--thresholds: '" + t + "' is not in [0, 1)"};
-    thresholds.push_back(v);
+    o.thresholds.push_back(v);
   }
-  std::vector<std::string> archs = splitList(a.get("architectures", "1x32,3x32"));
-  for (const auto& h : archs) parseHidden(h);  // validate before training
-  const long samples = a.getInt("samples", 10000);
-  if (samples < 10) throw UsageError{"--samples must be at least 10"};
-  TrainOptions opt;
+  o.architectures = splitList(a.get("architectures", "1x32,3x32"));
+  for (const auto& h : o.architectures) parseHidden(h);  // validate before training
+  o.samples = a.getInt("samples", 10000);
+  if (o.samples < 10) throw UsageError{"--samples must be at least 10"};
+  TrainOptions& opt = o.train;
   opt.epochs = static_cast<int>(a.getInt("epochs", 60));
   opt.batch = static_cast<int>(a.getInt("batch", 64));
   opt.learning_rate = a.getDouble("lr", 1e-3);
   opt.seed = static_cast<unsigned long long>(a.getInt("seed", 1));
   if (opt.epochs < 1 || opt.batch < 1) throw UsageError{"--epochs and --batch must be positive"};
 
-  // Fig. 6.8's scene: unit cylinder, origin fixed, the insertion moves along x through the contact
-  // change (the straight line touches the cylinder at ins_x = -0.33)
-  const WrapType type = WrapType::Cylinder;
-  const WrapSurface surf = WrapSurface::makeCylinder(1.0, 1000.0);
-  const Vec3 ori(-2.0, 1.2, 0.3);
-  const double alpha = 0.5;
-  const int n = 251;
-  std::vector<double> xs(n), x_exact(n), j_exact(n);
-  auto exactPoint = [&](double x) {
-    const Vec3 ins(x, -1.3, -0.2);
-    return calcWrappedPathPoint(surf, calcWrap(surf, ori, ins), ori, ins, alpha);
-  };
-  for (int k = 0; k < n; ++k) {
-    xs[k] = -1.5 + 2.5 * k / (n - 1);
-    x_exact[k] = exactPoint(xs[k])[0];
-    const double h = 1e-7;  // one-sided near the kink would mix branches: central, tiny step
-    j_exact[k] = (exactPoint(xs[k] + h)[0] - exactPoint(xs[k] - h)[0]) / (2 * h);
-  }
-  const WrapInputBox box = makeDefaultWrapBox(type);
-  const WrapOracle oracle = makeExactWrapOracle(type);
+  const WrapStudy study = runWrapThresholdStudy(o, [](const WrapStudyCurve& c) {
+    std::cerr << "train-wrap --study: threshold " << c.threshold << ", " << c.architecture << ": validation rms "
+              << c.val_rms << " (size units)\n";
+  });
+
+  // CSV: the sweep, the exact library, then x and its derivative per network; a plot per threshold
+  const std::vector<double>& xs = study.ins_x;
   validation::CsvTable t;
   t.header = {"ins_x", "x_exact", "dxdins_exact"};
-  std::vector<std::vector<double>> cols;
   validation::PlotFigure fig;
   fig.title = "x_alpha (alpha 0.5) and d x_alpha / d ins_x near the contact change, by threshold and network";
   fig.columns = 2;
-  for (double thr : thresholds) {
-    const WrapTrainingSet data = makeWrapTrainingSet(box, oracle, samples, thr, opt.seed);
-    std::vector<validation::PlotLine> lx{validation::makePlotLine("exact library", xs, x_exact)},
-        lj{validation::makePlotLine("exact library (differences)", xs, j_exact)};
-    for (const auto& arch : archs) {
-      opt.hidden = parseHidden(arch);
-      const Mlp net = trainWrapNetwork(data, box, opt);
-      MlpWorkspace ws;
-      MatX X(8, n), Y, J;
-      for (int k = 0; k < n; ++k) X.col(k) << ori, Vec3(xs[k], -1.3, -0.2), alpha, 1.0;
-      net.calcJacobian(X, Y, J, ws);
-      std::vector<double> xn(n), jn(n);
-      for (int k = 0; k < n; ++k) xn[k] = Y(0, k), jn[k] = J(0, 8 * k + 3);
-      const std::string name = arch + " thr " + num(thr, 3);
+  const size_t na = o.architectures.size();  // curves: threshold-major
+  for (size_t i = 0; i < o.thresholds.size(); ++i) {
+    const double thr = o.thresholds[i];
+    std::vector<validation::PlotLine> lx{validation::makePlotLine("exact library", xs, study.x_exact)},
+        lj{validation::makePlotLine("exact library (differences)", xs, study.dxdins_exact)};
+    for (size_t j = 0; j < na; ++j) {
+      const WrapStudyCurve& c = study.curves[i * na + j];
+      const std::string name = c.architecture + " thr " + num(thr, 3);
       t.header.push_back("x_" + name);
       t.header.push_back("dxdins_" + name);
-      cols.push_back(xn);
-      cols.push_back(jn);
-      lx.push_back(validation::makePlotLine(arch, xs, xn));
-      lj.push_back(validation::makePlotLine(arch, xs, jn));
-      std::cerr << "train-wrap --study: threshold " << thr << ", " << arch << ": validation rms "
-                << net.meta.at("final_val_rms_m") << " (size units)\n";
+      lx.push_back(validation::makePlotLine(c.architecture, xs, c.x));
+      lj.push_back(validation::makePlotLine(c.architecture, xs, c.dxdins));
     }
     fig.panels.push_back(validation::makeXYPanel("x_alpha.x, threshold " + num(100 * thr, 3) + "%", "ins_x", "x_alpha.x", lx));
     fig.panels.push_back(validation::makeXYPanel("d x_alpha.x / d ins_x, threshold " + num(100 * thr, 3) + "%", "ins_x",
                                                  "Jacobian entry", lj));
   }
-  for (int k = 0; k < n; ++k) {
-    std::vector<double> row{xs[k], x_exact[k], j_exact[k]};
-    for (const auto& c : cols) row.push_back(c[k]);
+  for (size_t k = 0; k < xs.size(); ++k) {
+    std::vector<double> row{xs[k], study.x_exact[k], study.dxdins_exact[k]};
+    for (const auto& c : study.curves) row.push_back(c.x[k]), row.push_back(c.dxdins[k]);
     t.addRow(row);
   }
   osim::writeFileAtomic(*report + "/study.csv", validation::formatCsv(t));
   const auto gp = validation::findGnuplot();
   if (gp.available) {
-    const auto o = validation::renderPlot(gp, validation::PlotFormat::Auto, fig, *report + "/study");
-    if (!o.ok) std::cerr << "note: plot not drawn: " << o.error << "\n";
+    const auto drawn = validation::renderPlot(gp, validation::PlotFormat::Auto, fig, *report + "/study");
+    if (!drawn.ok) std::cerr << "note: plot not drawn: " << drawn.error << "\n";
   }
   std::cout << "wrote " << *report << "/study.csv and the plot\n";
   return 0;

@@ -8,6 +8,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap/smooth.hpp"
 #include "tools/wrap_training/train.hpp"
 
@@ -45,7 +46,7 @@ std::vector<WrapCompareRow> compareWrapModels(const WrapCompareOptions& o) {
     if (cn.net.inputs() != wrapInputSize(type) || cn.net.outputs() != 3)
       throw std::invalid_argument("compareWrapModels: " + cn.name + " is not a " + wrapTypeName(type) + " wrap network");
 
-  // muscles: end points from the default box (valid ones), velocities random, 20 mass points each
+  // muscles: end points from the default box (valid ones), velocities random, `points` mass points each
   const WrapOracle oracle = makeExactWrapOracle(type);
   std::mt19937_64 rng(o.seed);
   std::uniform_real_distribution<double> u01(0.0, 1.0), uv(-1.0, 1.0);
