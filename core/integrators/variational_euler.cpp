@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -21,20 +20,17 @@ VecX VariationalEuler::momentum(const System& sys, const State& s, double h, Dyn
   return ws.M * s.qdot;
 }
 
-VariationalEulerScratch& VariationalEuler::scratchOf(const System& sys, DynamicsWorkspace& ws) {
-  sys.bind(ws);
-  auto* c = dynamic_cast<VariationalEulerScratch*>(ws.integrator.get());
-  if (!c) {
-    auto made = std::make_unique<VariationalEulerScratch>();
-    c = made.get();
-    ws.integrator = std::move(made);
+VariationalEulerWorkspace& VariationalEuler::cacheFor(const System& sys) {
+  if (cache_.system_id != sys.id()) {
+    cache_ = VariationalEulerWorkspace{};
+    cache_.system_id = sys.id();
   }
-  return *c;
+  return cache_;
 }
 
 const VecX& VariationalEuler::momentumOf(const System& sys, const State& s, double h, DynamicsWorkspace& ws) {
-  VariationalEulerScratch& c = scratchOf(sys, ws);
-  // the cached momentum belongs to exactly the state a step with ws returned last
+  VariationalEulerWorkspace& c = cacheFor(sys);
+  // the cached momentum belongs to exactly the state this integrator returned last
   const bool same = c.have_state && c.q_end.size() == s.q.size() && c.v_end.size() == s.qdot.size();
   const bool hit = same && ((c.q_end == s.q && c.v_end == s.qdot) || liftThroughChartSwitch(sys, s, c));
   if (!hit) {
@@ -53,7 +49,7 @@ void VariationalEuler::setMomentum(const System& sys, const State& s, const VecX
   if (s.q.size() != n || s.qdot.size() != n || p.size() != n)
     throw std::invalid_argument("symplectic: setMomentum: state or momentum does not have " + std::to_string(n) +
                                 " entries");
-  VariationalEulerScratch& c = scratchOf(sys, workspace(sys));
+  VariationalEulerWorkspace& c = cacheFor(sys);
   c.have_state = true;
   c.q_end = s.q;
   c.v_end = s.qdot;
@@ -63,7 +59,7 @@ void VariationalEuler::setMomentum(const System& sys, const State& s, const VecX
 
 void VariationalEuler::step(const System& sys, State& s, double h, DynamicsWorkspace& ws) {
   VecX p = momentumOf(sys, s, h, ws);  // a copy: the cache stays valid if the step throws
-  VariationalEulerScratch& c = scratchOf(sys, ws);
+  VariationalEulerWorkspace& c = cacheFor(sys);
   // linear extrapolation of the velocity predicts v_k+1 to O(h^2) (one or two iterations fewer)
   VecX guess;
   const VecX* guess_ptr = nullptr;
@@ -80,7 +76,7 @@ void VariationalEuler::step(const System& sys, State& s, double h, DynamicsWorks
   c.have_prev = true;
 }
 
-bool VariationalEuler::liftThroughChartSwitch(const System& sys, const State& s, VariationalEulerScratch& c) {
+bool VariationalEuler::liftThroughChartSwitch(const System& sys, const State& s, VariationalEulerWorkspace& c) {
   // is s the chart switch of the state we returned?
   State sw;
   sw.t = s.t;
@@ -114,7 +110,7 @@ void VariationalEuler::stepMomentum(const System& sys, State& s, VecX& p, double
   const int nc = sys.numConstraintRows();
   if (p.size() != n || s.q.size() != n || s.qdot.size() != n)
     throw std::invalid_argument("symplectic: momentum or state does not have ndof entries");
-  VariationalEulerScratch& c = scratchOf(sys, ws);
+  VariationalEulerWorkspace& c = cacheFor(sys);
   MatX& Jg = c.Jg;
   const VecX q_k = s.q;
   const VecX v_k = s.qdot;
