@@ -34,7 +34,7 @@
 #include <vector>
 
 #include "core/joints/functions.hpp"
-#include "core/muscles/wrap/wrap_surface.hpp"
+#include "core/geometry/wrap_surface.hpp"
 #include "core/skeleton/model.hpp"
 
 namespace redmax {

@@ -46,7 +46,7 @@
 //   Smooth (default)  core/muscles/wrap/smooth.hpp: exact wrapped path away from the contact
 //                     change, C2 blend across it; J and Jdot exact (dual numbers). The mass matrix
 //                     is continuous, so the energy is conserved to integrator error.
-//   Exact             the exact library (core/muscles/wrap/wrap_surface.hpp). Origin -> one
+//   Exact             the exact library (core/geometry/wrap_surface.hpp). Origin -> one
 //                     surface -> insertion: J by central differences on the end points and Jdot by
 //                     central differences of that J along (p1dot, p2dot) (the dissertation's route,
 //                     [D Eq. 5.58]). Any other shape: the whole path as OpenSim computes it

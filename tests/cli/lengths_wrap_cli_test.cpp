@@ -24,7 +24,7 @@
 #include "converter/storage.hpp"
 #include "core/muscles/path_kinematics.hpp"
 #include "core/muscles/wrap/smooth.hpp"
-#include "core/muscles/wrap/wrap_surface.hpp"
+#include "core/geometry/wrap_surface.hpp"
 #include "core/muscles/wrap_muscle.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "core/spatial/se3.hpp"

@@ -1,5 +1,6 @@
 // Dependencies point down only (STYLE.md): this test fails on any upward or forbidden #include.
 //   core/spatial <- core/joints <- core/skeleton <- core/muscles <- core/dynamics <- core/integrators
+//   core/spatial <- core/geometry <- core/muscles   (surface geometry: wrap surfaces, dual numbers)
 //   core/dynamics <- core/model (the musculoskeletal aggregate, beside core/integrators)
 //   converter/, plugin/ -> core/ (plugin may also read the converter's description)
 //   tools/ -> core/ (offline work the engine never runs: wrap-network training, wrap benchmarks)
@@ -50,7 +51,7 @@ std::vector<Include> scan(const fs::path& root, const std::string& dir) {
 // the project folder an include names ("core/joints/joint.hpp" -> "core/joints"), or "" if external
 std::string layerOf(const std::string& inc) {
   static const std::vector<std::string> layers = {
-      "core/spatial", "core/joints", "core/skeleton", "core/muscles", "core/dynamics",
+      "core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles", "core/dynamics",
       "core/integrators", "core/model", "converter", "plugin", "tools", "validation", "cli"};
   for (const auto& l : layers)
     if (inc.rfind(l + "/", 0) == 0) return l;
@@ -70,13 +71,18 @@ bool isSundials(const std::string& inc) {
 std::map<std::string, std::set<std::string>> layerRules() {
   std::map<std::string, std::set<std::string>> rules = {
       {"core/spatial", {"core/spatial"}},
+      {"core/geometry", {"core/spatial", "core/geometry"}},
       {"core/joints", {"core/spatial", "core/joints"}},
       {"core/skeleton", {"core/spatial", "core/joints", "core/skeleton"}},
-      {"core/muscles", {"core/spatial", "core/joints", "core/skeleton", "core/muscles"}},
-      {"core/dynamics", {"core/spatial", "core/joints", "core/skeleton", "core/muscles", "core/dynamics"}},
+      {"core/muscles", {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles"}},
+      {"core/dynamics",
+       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles", "core/dynamics"}},
       {"core/integrators",
-       {"core/spatial", "core/joints", "core/skeleton", "core/muscles", "core/dynamics", "core/integrators"}},
-      {"core/model", {"core/spatial", "core/joints", "core/skeleton", "core/muscles", "core/dynamics", "core/model"}},
+       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles", "core/dynamics",
+        "core/integrators"}},
+      {"core/model",
+       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles", "core/dynamics",
+        "core/model"}},
   };
   std::set<std::string> core_all = rules.at("core/integrators");
   core_all.insert("core/model");
@@ -136,8 +142,14 @@ TEST(Layering, DetectsAViolation) {
   EXPECT_TRUE(mayInclude("converter", "core/model/musculoskeletal_model.hpp"));
   EXPECT_EQ(layerOf("Eigen/Core"), "");
   EXPECT_EQ(layerOf("tools/wrap_training/train.hpp"), "tools");
+  EXPECT_EQ(layerOf("core/geometry/wrap_surface.hpp"), "core/geometry");
   // and the rules must refuse upward includes
   EXPECT_FALSE(mayInclude("core/muscles", "core/dynamics/system.hpp"));
+  EXPECT_FALSE(mayInclude("core/geometry", "core/muscles/path.hpp"));  // geometry sits below muscles
+  EXPECT_FALSE(mayInclude("core/geometry", "core/joints/joint.hpp"));  // and depends on spatial only
+  EXPECT_FALSE(mayInclude("core/spatial", "core/geometry/dual.hpp"));
+  EXPECT_TRUE(mayInclude("core/geometry", "core/spatial/types.hpp"));
+  EXPECT_TRUE(mayInclude("core/muscles", "core/geometry/wrap_surface.hpp"));
   EXPECT_FALSE(mayInclude("core/muscles", "tools/wrap_training/train.hpp"));
   EXPECT_FALSE(mayInclude("validation", "tools/wrap_training/train.hpp"));
   EXPECT_FALSE(mayInclude("tools", "validation/report/csv.hpp"));

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "core/muscles/wrap/network.hpp"
-#include "core/muscles/wrap/wrap_surface.hpp"
+#include "core/geometry/wrap_surface.hpp"
 
 namespace redmax {
 

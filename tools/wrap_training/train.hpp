@@ -17,7 +17,7 @@
 
 #include "core/muscles/wrap/network.hpp"
 #include "core/muscles/wrap/network_model.hpp"
-#include "core/muscles/wrap/wrap_surface.hpp"
+#include "core/geometry/wrap_surface.hpp"
 
 namespace redmax {
 

@@ -6,90 +6,18 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "core/geometry/constructions.hpp"
+#include "core/geometry/dual.hpp"
+
 namespace redmax {
 namespace {
+
+using namespace detail;  // dual numbers and the shared constructions
 
 constexpr double kPi = 3.14159265358979323846;
 // quadrant cylinders: the band narrows where the line's point nearest the axis is closer than
 // this many radii to the quadrant plane (see smoothPoint)
 constexpr double kQuadrantBlend = 0.25;
-
-// ---------------------------------------------------------------------------------------------
-// dual numbers: x = a + b eps with eps^2 = 0; nesting Dual<Dual<double>> gives a second
-// (mixed) directional derivative in b.b
-
-template <class T>
-struct Dual {
-  T a{}, b{};
-  Dual() = default;
-  Dual(double v) : a(v), b(0.0) {}  // a constant
-  Dual(const T& a_, const T& b_) : a(a_), b(b_) {}
-};
-
-inline double value(double x) { return x; }
-template <class T>
-double value(const Dual<T>& x) { return value(x.a); }
-
-template <class T> Dual<T> operator+(const Dual<T>& x, const Dual<T>& y) { return {x.a + y.a, x.b + y.b}; }
-template <class T> Dual<T> operator-(const Dual<T>& x, const Dual<T>& y) { return {x.a - y.a, x.b - y.b}; }
-template <class T> Dual<T> operator-(const Dual<T>& x) { return {-x.a, -x.b}; }
-template <class T> Dual<T> operator*(const Dual<T>& x, const Dual<T>& y) { return {x.a * y.a, x.a * y.b + x.b * y.a}; }
-template <class T> Dual<T> operator/(const Dual<T>& x, const Dual<T>& y) {
-  const T inv = 1.0 / y.a;
-  const T q = x.a * inv;
-  return {q, (x.b - q * y.b) * inv};
-}
-template <class T> Dual<T> operator+(const Dual<T>& x, double y) { return {x.a + y, x.b}; }
-template <class T> Dual<T> operator+(double y, const Dual<T>& x) { return {x.a + y, x.b}; }
-template <class T> Dual<T> operator-(const Dual<T>& x, double y) { return {x.a - y, x.b}; }
-template <class T> Dual<T> operator-(double y, const Dual<T>& x) { return {y - x.a, -x.b}; }
-template <class T> Dual<T> operator*(const Dual<T>& x, double y) { return {x.a * y, x.b * y}; }
-template <class T> Dual<T> operator*(double y, const Dual<T>& x) { return {x.a * y, x.b * y}; }
-template <class T> Dual<T> operator/(const Dual<T>& x, double y) { return {x.a / y, x.b / y}; }
-template <class T> Dual<T> operator/(double y, const Dual<T>& x) { return Dual<T>{T(y), T(0.0)} / x; }
-
-// elementary functions for double and, recursively, for duals
-inline double dsqrt(double x) { return std::sqrt(x); }
-inline double dsin(double x) { return std::sin(x); }
-inline double dcos(double x) { return std::cos(x); }
-inline double dacos(double x) { return std::acos(x); }
-inline double dasin(double x) { return std::asin(x); }
-inline double datan2(double y, double x) { return std::atan2(y, x); }
-template <class T> Dual<T> dsqrt(const Dual<T>& x) {
-  const T s = dsqrt(x.a);
-  return {s, x.b / (2.0 * s)};
-}
-template <class T> Dual<T> dsin(const Dual<T>& x) { return {dsin(x.a), dcos(x.a) * x.b}; }
-template <class T> Dual<T> dcos(const Dual<T>& x) { return {dcos(x.a), -(dsin(x.a) * x.b)}; }
-template <class T> Dual<T> dacos(const Dual<T>& x) { return {dacos(x.a), -(x.b / dsqrt(1.0 - x.a * x.a))}; }
-template <class T> Dual<T> dasin(const Dual<T>& x) { return {dasin(x.a), x.b / dsqrt(1.0 - x.a * x.a)}; }
-template <class T> Dual<T> datan2(const Dual<T>& y, const Dual<T>& x) {
-  return {datan2(y.a, x.a), (x.a * y.b - y.a * x.b) / (x.a * x.a + y.a * y.a)};
-}
-
-// 3-vectors of any scalar
-template <class T> using V3 = std::array<T, 3>;
-template <class T> V3<T> operator+(const V3<T>& u, const V3<T>& v) { return {u[0] + v[0], u[1] + v[1], u[2] + v[2]}; }
-template <class T> V3<T> operator-(const V3<T>& u, const V3<T>& v) { return {u[0] - v[0], u[1] - v[1], u[2] - v[2]}; }
-template <class T, class S> V3<T> operator*(const S& s, const V3<T>& v) { return {s * v[0], s * v[1], s * v[2]}; }
-template <class T> T dot(const V3<T>& u, const V3<T>& v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; }
-template <class T> V3<T> cross(const V3<T>& u, const V3<T>& v) {
-  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-}
-template <class T> T norm(const V3<T>& v) { return dsqrt(dot(v, v)); }
-template <class T> V3<T> normalize(const V3<T>& v) {
-  const T n = norm(v);
-  return (1.0 / n) * v;
-}
-template <class T> Vec3 values(const V3<T>& v) { return Vec3(value(v[0]), value(v[1]), value(v[2])); }
-template <class T> V3<T> constant(const Vec3& v) { return {T(v[0]), T(v[1]), T(v[2])}; }
-template <class T> V3<T> zAxis() { return {T(0.0), T(0.0), T(1.0)}; }
-
-// rotation of v by angle phi about the unit axis k (Rodrigues)
-template <class T> V3<T> rotate(const V3<T>& k, const T& phi, const V3<T>& v) {
-  const T c = dcos(phi), s = dsin(phi);
-  return c * v + s * cross(k, v) + (dot(k, v) * (1.0 - c)) * k;
-}
 
 // alpha may be a constant or carry derivatives of its own (the same scalar type as the points)
 template <class T> using Alpha = std::type_identity_t<T>;
@@ -156,167 +84,46 @@ T penetration(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// the exact library's unconstrained cylinder, single wrap (wrap_cylinder.cpp), over any scalar.
-// Returns false when the library would not wrap for a reason other than penetration (both
-// tangent points beyond the cylinder's ends).
-
-template <class T>
-void cylinderCandidates(double R, const V3<T>& p, V3<T>& pa, V3<T>& a, V3<T>& b, T& rho) {
-  // tangent candidates in the plane through p normal to the axis
-  pa = {T(0.0), T(0.0), p[2]};
-  const V3<T> radial{p[0], p[1], T(0.0)};
-  rho = norm(radial);
-  const V3<T> vv = (1.0 / rho) * radial;
-  const T dist = R * (R / rho);
-  const V3<T> pp = pa + dist * vv;
-  const T dist2 = dsqrt(R * R - dist * dist);
-  const V3<T> uu = cross(zAxis<T>(), vv);
-  a = pp + dist2 * uu;
-  b = pp - dist2 * uu;
-}
-
+// the exact library's cylinder, single wrap, over any scalar: its tangent points
+// (core/geometry/constructions.hpp, the code the library runs on double) and the helix. Returns
+// false when the library would not wrap for a reason other than penetration (both tangent points
+// beyond the cylinder's ends).
 template <class T>
 bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, const Alpha<T>& alpha, V3<T>& x,
                    T* total_out = nullptr) {
-  const double R = surf.radius;
-  V3<T> p11, p22, r1a, r1b, r2a, r2b, r1, r2;
-  T rho1, rho2;
-  cylinderCandidates(R, p1, p11, r1a, r1b, rho1);
-  cylinderCandidates(R, p2, p22, r2a, r2b, rho2);
-  bool far_side_wrap = false, long_wrap = false;
-  if (surf.quadrant_sign == 0) {
-    // the candidate pair whose radial directions agree best (decided on values)
-    const Vec3 u1a = (values(r1a) - values(p11)).normalized(), u1b = (values(r1b) - values(p11)).normalized();
-    const Vec3 u2a = (values(r2a) - values(p22)).normalized(), u2b = (values(r2b) - values(p22)).normalized();
-    const double d1 = u1a.dot(u2a), d2 = u1a.dot(u2b), d3 = u1b.dot(u2a), d4 = u1b.dot(u2b);
-    if (d1 > d2 && d1 > d3 && d1 > d4) r1 = r1a, r2 = r2a;
-    else if (d2 > d3 && d2 > d4) r1 = r1a, r2 = r2b;
-    else if (d3 > d4) r1 = r1b, r2 = r2a;
-    else r1 = r1b, r2 = r2b;
-  } else {
-    // the library's candidate table for a quadrant (decided on values)
-    const int axis = surf.quadrant_axis, sign = surf.quadrant_sign;
-    auto dsign = [](double v) { return v >= 0.0 ? 1 : -1; };
-    const Vec3 r1am = values(r1a) - values(p11), r1bm = values(r1b) - values(p11);
-    const Vec3 r2am = values(r2a) - values(p22), r2bm = values(r2b) - values(p22);
-    const double al = std::acos(r1am.dot(r2bm) / (r1am.norm() * r2bm.norm()));
-    const double be = std::acos(r1bm.dot(r2am) / (r1bm.norm() * r2am.norm()));
-    const bool a1 = dsign(value(r1a[axis])) == sign, b1 = dsign(value(r1b[axis])) == sign;
-    const bool a2 = dsign(value(r2a[axis])) == sign, b2 = dsign(value(r2b[axis])) == sign;
-    auto pick_ba = [&](bool far_if) { r1 = r1b, r2 = r2a, far_side_wrap = (al > be) == far_if; };
-    auto pick_ab = [&](bool far_if) { r1 = r1a, r2 = r2b, far_side_wrap = (al > be) == far_if; };
-    if (a1 && b1) {
-      if (a2) pick_ba(false);
-      else pick_ab(true);
-    } else if (a1 && !b1) {
-      pick_ab(true);
-    } else if (!a1 && b1) {
-      pick_ba(false);
-    } else if (a2) {
-      pick_ba(false);
-    } else if (b2) {
-      pick_ab(true);
-    } else {
-      if (al > be) r1 = r1a, r2 = r2b;
-      else r1 = r1b, r2 = r2a;
-      far_side_wrap = true;
-    }
-    const Vec3 sum_musc = (values(r1) - values(p1)) + (values(r2) - values(p2));
-    const Vec3 sum_r = (values(r1) - values(p11)) + (values(r2) - values(p22));
-    long_wrap = sum_r.dot(sum_musc) < 0.0;
-  }
-  // apex on the near side of the axis-normal plane through the muscle line's point at fraction
-  // rho1 / (rho1 + rho2)
-  const T t = rho1 / (rho1 + rho2);
-  const V3<T> mpt = p1 + t * (p2 - p1);
-  const V3<T> axispt{T(0.0), T(0.0), mpt[2]};
-  const V3<T> l1 = normalize(p1 - axispt), l2 = normalize(p2 - axispt);
-  const V3<T> n = normalize(cross(l1, l2));
-  const V3<T> apex1 = axispt + R * normalize(cross(zAxis<T>(), n));
-  const V3<T> apex2 = axispt + R * normalize(cross(n, zAxis<T>()));
-  const double dist1 = (values(mpt) - values(apex1)).squaredNorm(), dist2 = (values(mpt) - values(apex2)).squaredNorm();
-  const V3<T> apex = far_side_wrap ? (dist1 < dist2 ? apex2 : apex1) : (dist1 < dist2 ? apex1 : apex2);
-  // slide r1, r2 along the axis into the plane through p1, p2 and the apex (each only when that
-  // moves it toward the other end; the library's tests, decided on values)
-  const V3<T> pn = normalize(cross(normalize(p1 - apex), normalize(p2 - apex)));
-  const T dplane = -dot(p1, pn);
-  auto slide = [&](const V3<T>& r, V3<T>& out) {
-    const T dp = 20.0 * pn[2];
-    if (!(std::abs(value(dp)) >= 1e-5)) return false;
-    const T s = (-dplane - (dot(pn, r) - 10.0 * pn[2])) / dp;
-    if (value(s) < -1e-5 || value(s) > 1.0 + 1e-5) return false;
-    out = {r[0], r[1], r[2] - 10.0 + 20.0 * s};
-    return true;
-  };
-  // the library's closest point on the line through p11 with direction p22 (as OpenSim does)
-  auto closestOnP11Line = [&](const Vec3& pt) {
-    const Vec3 a = values(p11), dir = values(p22).normalized();
-    return Vec3(a + (pt - a).dot(dir) * dir);
-  };
-  V3<T> r1p, r2p;
-  const bool r1_inter = slide(r1, r1p), r2_inter = slide(r2, r2p);
-  const Vec3 p11v = values(p11), p22v = values(p22);
-  if (r1_inter && (closestOnP11Line(values(r1p)) - p22v).squaredNorm() < (p11v - p22v).squaredNorm()) r1 = r1p;
-  if (r2_inter && (closestOnP11Line(values(r2p)) - p11v).squaredNorm() < (p22v - p11v).squaredNorm()) r2 = r2p;
-  const double half = 0.5 * surf.length;
-  const double z1 = value(r1[2]), z2 = value(r2[2]);
-  if ((z1 < -half || z1 > half) && (z2 < -half || z2 > half)) return false;
+  V3<T> r1, r2;
+  bool long_wrap = false;
+  if (!cylinderTangentPoints(surf.radius, surf.length, surf.quadrant_axis, surf.quadrant_sign, p1, p2, r1, r2,
+                             long_wrap))
+    return false;
   // helix about the axis
-  T theta = datan2(r1[0] * r2[1] - r1[1] * r2[0], r1[0] * r2[0] + r1[1] * r2[1]);
-  if (long_wrap) theta = -(2.0 * kPi - theta);  // the long way round, turning the other way
+  const T theta = cylinderHelixAngle(r1, r2, long_wrap);
   x = pathPoint(p1, p2, r1, r2, zAxis<T>(), theta, r2[2] - r1[2], alpha, total_out);
   return true;
 }
 
-// the exact library's unconstrained sphere (wrap_sphere.cpp), over any scalar
-template <class T>
-void sphereTangents(double R, const V3<T>& p, const V3<T>& n, V3<T>& a, V3<T>& b) {
-  const V3<T> y = normalize((-1.0) * p);
-  const V3<T> z = cross(n, y);
-  const T pn = norm(p);
-  const T ang = dasin(R / pn);
-  const T c = dcos(ang), s = dsin(ang);
-  a = p + (pn * c) * (c * y - s * z);
-  b = p + (pn * c) * (c * y + s * z);
-}
-
+// the exact library's unconstrained sphere over any scalar (constructions.hpp, as core/geometry/sphere.cpp)
 template <class T>
 bool spherePoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, const Alpha<T>& alpha, V3<T>& x,
                  T* total_out = nullptr) {
   const double R = surf.radius;
-  const V3<T> p1p2 = normalize(p1 - p2);
-  V3<T> hp2 = cross(p1p2, normalize(p2));
-  if (values(hp2).norm() < 1e-5) {
-    // the library's history-free choice for a line through the centre
-    const Vec3 d = values(p1p2);
-    int k = 0;
-    for (int i = 1; i < 3; ++i)
-      if (std::abs(d[i]) < std::abs(d[k])) k = i;
-    hp2 = cross(p1p2, constant<T>(Vec3::Unit(k)));
-  }
-  const V3<T> n = normalize(hp2);
-  V3<T> r1a, r1b, r2a, r2b, r1, r2;
-  sphereTangents(R, p1, n, r1a, r1b);
-  sphereTangents(R, p2, n, r2a, r2b);
-  {
-    const Vec3 u1a = values(r1a).normalized(), u1b = values(r1b).normalized();
-    const Vec3 u2a = values(r2a).normalized(), u2b = values(r2b).normalized();
-    const double j1 = u1a.dot(u2a), j2 = u1a.dot(u2b), j3 = u1b.dot(u2a), j4 = u1b.dot(u2b);
-    if (j1 > j2 && j1 > j3 && j1 > j4) r1 = r1a, r2 = r2a;
-    else if (j2 > j3 && j2 > j4) r1 = r1a, r2 = r2b;
-    else if (j3 > j4) r1 = r1b, r2 = r2a;
-    else r1 = r1b, r2 = r2b;
-  }
-  const V3<T> r1n = normalize(r1), r2n = normalize(r2);
-  const T angle = dacos(dot(r1n, r2n));
-  const V3<T> c = cross(r1n, r2n);
-  const V3<T> ax = values(c).squaredNorm() > 0.0 ? normalize(c) : n;
+  const V3<T> n = sphereWrapPlaneNormal(p1, p2);
+  V3<T> r1a, r1b, r2a, r2b;
+  sphereTangentPoints(R, p1, n, r1a, r1b);
+  sphereTangentPoints(R, p2, n, r2a, r2b);
+  const int k = closestCandidatePair(values(r1a).normalized(), values(r1b).normalized(), values(r2a).normalized(),
+                                     values(r2b).normalized());
+  const V3<T>& r1 = k < 2 ? r1a : r1b;
+  const V3<T>& r2 = k % 2 == 0 ? r2a : r2b;
+  T angle;
+  V3<T> ax;
+  sphereArc(r1, r2, n, angle, ax);
   x = pathPoint(p1, p2, r1, r2, ax, angle, T(0.0), alpha, total_out);
   return true;
 }
 
 // ---------------------------------------------------------------------------------------------
-// the exact library's ellipsoid (wrap_ellipsoid.cpp), hybrid method, no quadrant, over any scalar.
+// the exact library's ellipsoid (core/geometry/ellipsoid.cpp), hybrid method, no quadrant, over any scalar.
 // The library's iterative pieces become exact-derivative ones: closest points on the ellipsoid
 // are found by the library's Newton iteration on values and refined over T by two Newton steps
 // (implicit function theorem); the tangent points, which the library approximates by damped
@@ -325,7 +132,7 @@ bool spherePoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, cons
 // replaced by its limit, the plane curve itself, with the arc length by Gauss-Legendre quadrature
 // and the point at a given arc length by Newton steps (again two over T).
 
-constexpr double kMuBlendMin = 0.7073;  // the library's constants (wrap_ellipsoid.cpp)
+constexpr double kMuBlendMin = 0.7073;  // the library's constants (core/geometry/ellipsoid.cpp)
 constexpr double kMuBlendMax = 0.9;
 constexpr int kFanSamples = 300;
 constexpr double kSvBoundaryBlend = 0.3;
@@ -695,87 +502,20 @@ bool ellipsoidPoint(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, c
 }
 
 // ---------------------------------------------------------------------------------------------
-// the exact library's torus (wrap_torus.cpp): the centre-circle point nearest the line anchors a
+// the exact library's torus (core/geometry/torus.cpp, constructions.hpp): the centre-circle point nearest the line anchors a
 // quadrant "+x" cylinder of the tube radius; over any scalar
 
-// OpenSim's residual along the line p + u n (the library's circleResidual) and its first and
-// (if asked) second u-derivatives
-template <class T>
-void torusResidual(const V3<T>& p, const V3<T>& n, double r, const T& u, T& f, T& fu, T* fuu = nullptr) {
-  const T c2 = 2.0 * dot(p, n);
-  const T c3 = p[0] * n[0] + p[1] * n[1];
-  const T c4 = n[0] * n[0] + n[1] * n[1];
-  const T c5 = p[0] * p[0] + p[1] * p[1];
-  const T q = u * u * c4 + 2.0 * c3 * u + c5;
-  const T sq = dsqrt(q);
-  const T qu = 2.0 * c4 * u + 2.0 * c3;
-  f = c2 + 2.0 * u - 2.0 * r * qu / sq;
-  fu = 2.0 - 2.0 * r * (2.0 * c4 / sq - qu * qu / (2.0 * q * sq));
-  if (fuu) {
-    const T s3 = q * sq;
-    *fuu = -2.0 * r * (-3.0 * c4 * qu / s3 + 0.75 * qu * qu * qu / (s3 * q));
-  }
-}
-
-// the library's damped Newton search from u = 0 (same steps, so the same root)
-double torusSolveFromStart(const Vec3& p, const Vec3& n, double r) {
-  const V3<double> pv{p[0], p[1], p[2]}, nv{n[0], n[1], n[2]};
-  auto res = [&](double u) {
-    double f, fu;
-    torusResidual(pv, nv, r, u, f, fu);
-    return f;
-  };
-  double u = 0.0, f = res(u), bound = 0.2;
-  for (int it = 0; it < 500 && std::isfinite(f); ++it) {
-    const double h = 1e-7 * (1.0 + std::abs(u));
-    const double df = (res(u + h) - res(u - h)) / (2 * h);
-    double step = (df != 0.0 && std::isfinite(df)) ? -f / df : (f > 0 ? -bound : bound);
-    if (std::abs(step) > bound) step = step > 0 ? bound : -bound;
-    bool accepted = false;
-    for (int k = 0; k < 60; ++k) {
-      const double fn = res(u + step);
-      if (std::isfinite(fn) && std::abs(fn) < std::abs(f)) {
-        u += step;
-        f = fn;
-        accepted = true;
-        break;
-      }
-      step *= 0.5;
-    }
-    if (!accepted) break;
-    bound = std::max(bound, 2.0 * std::abs(step));
-    if (std::abs(step) < 1e-13 * (1.0 + std::abs(u)) || std::abs(f) < 1e-14) break;
-  }
-  return u;
-}
-
-// the local cylinder's frame k at the circle point c (x toward the torus centre, y = -z, z = x
-// cross y) and the end points in it; false when the library does not wrap (a quadrant excludes
-// both candidates, or a degenerate anchor)
-template <class T>
-struct TorusFrame {
-  V3<T> c, xk, yk, zk, q1, q2;
-  V3<T> toTorus(const V3<T>& q) const { return c + q[0] * xk + q[1] * yk + q[2] * zk; }
-};
-
+// the anchor of the torus's local cylinder and the end points in its frame, the library's search
+// on values refined over T; false when the library does not wrap (a quadrant excludes both
+// candidates, or a degenerate anchor)
 template <class T>
 bool torusFrame(const WrapSurface& s, const V3<T>& p1, const V3<T>& p2, TorusFrame<T>& f) {
   const double radius = s.outer_radius;
   const Vec3 a = values(p1), b = values(p2);
   const Vec3 n12 = (b - a).normalized();
-  const double u1 = torusSolveFromStart(a, n12, radius), u2 = torusSolveFromStart(b, -n12, radius);
-  const Vec3 a1 = a + u1 * n12, a2 = b - u2 * n12;
-  auto dist = [&](const Vec3& x) {
-    return std::sqrt(x.squaredNorm() + radius * radius - 2.0 * radius * std::hypot(x[0], x[1]));
-  };
-  const double d1 = dist(a1), d2 = dist(a2);
-  bool first = d1 < d2;
-  if (s.quadrant_sign != 0) {
-    auto dsign = [](double v) { return v >= 0.0 ? 1 : -1; };
-    const bool ok1 = dsign(a1[s.quadrant_axis]) == s.quadrant_sign, ok2 = dsign(a2[s.quadrant_axis]) == s.quadrant_sign;
-    if (!ok1 && !ok2) return false;
-    if (ok1 != ok2) first = ok1;
-  }
+  double u1, u2;
+  bool first;
+  if (!torusAnchorSearch(s, a, b, u1, u2, first)) return false;
   // the chosen solution refined over T: from the converged value, each Newton step doubles the
   // order of the correct Taylor terms, so two give exact first and second derivatives (implicit
   // function theorem). The library's search minimises |residual|: it ends at a root, or (7% of
@@ -808,24 +548,8 @@ bool torusFrame(const WrapSurface& s, const V3<T>& p1, const V3<T>& p2, TorusFra
       u = root ? u - r / ru : u - ru / ruu;
     }
   }
-  const V3<T> x = p + u * dir;
-  const T m = dsqrt(x[0] * x[0] + x[1] * x[1]);
-  if (!(value(m) > 0.0) || !std::isfinite(value(m))) return false;
-  f.c = {x[0] * (radius / m), x[1] * (radius / m), T(0.0)};
-  f.xk = normalize((-1.0) * f.c);
-  f.yk = {T(0.0), T(0.0), T(-1.0)};
-  f.zk = cross(f.xk, f.yk);
-  auto toK = [&](const V3<T>& q) {
-    const V3<T> r = q - f.c;
-    return V3<T>{dot(f.xk, r), dot(f.yk, r), dot(f.zk, r)};
-  };
-  f.q1 = toK(p1);
-  f.q2 = toK(p2);
-  return true;
+  return makeTorusFrame(radius, p + u * dir, p1, p2, f);
 }
-
-// the torus's local cylinder (the library's: radius inner_radius, length 1e4, quadrant +x)
-WrapSurface torusCylinder(const WrapSurface& s) { return WrapSurface::makeCylinder(s.inner_radius, 10000.0, 0, +1); }
 
 // the blended point over any scalar; length_out (if given) receives the blended segment length
 // L = L_straight + w (L_wrapped - L_straight), the exact wrapped length outside the band

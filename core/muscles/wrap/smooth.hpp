@@ -14,10 +14,11 @@
 // straight path (what the exact library gives); for d >= width it is the exact wrapped path; in
 // between it moves smoothly from one to the other (the error is at most |x_wrapped - x_straight|
 // inside the band, which is O(width)).
-// Wrapped path: the same construction as the exact library (core/muscles/wrap/wrap_surface.hpp),
-// re-derived as a function template and evaluated on nested dual numbers, so J = dx/d(p1, p2) and
-// Jdot = dJ/dt along (p1dot, p2dot) are exact to round-off (forward-over-forward differentiation,
-// 6 passes: one per input direction, each also carrying the velocity direction).
+// Wrapped path: the exact library's own construction for cylinders, spheres and tori (the function
+// templates of core/geometry/constructions.hpp, which the library runs on double) evaluated on
+// nested dual numbers (core/geometry/dual.hpp), so J = dx/d(p1, p2) and Jdot = dJ/dt along (p1dot,
+// p2dot) are exact to round-off (forward-over-forward differentiation, 6 passes: one per input
+// direction, each also carrying the velocity direction); ellipsoids below.
 //
 // Supported: Cylinder (also with a quadrant), Sphere and Ellipsoid without a quadrant, and Torus,
 // single wrap (OpenSim's algorithms as the exact library reproduces them).
@@ -74,7 +75,7 @@
 #include <string>
 #include <vector>
 
-#include "core/muscles/wrap/wrap_surface.hpp"
+#include "core/geometry/wrap_surface.hpp"
 
 namespace redmax {
 

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "core/muscles/path.hpp"
-#include "core/muscles/wrap/wrap_surface.hpp"
+#include "core/geometry/wrap_surface.hpp"
 
 namespace redmax {
 

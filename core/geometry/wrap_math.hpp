@@ -1,13 +1,11 @@
 #pragma once
-// Internal helpers of the exact wrap library (core/muscles/wrap/): OpenSim's WrapMath primitives
+// Internal helpers of the exact wrap library (core/geometry/): OpenSim's WrapMath primitives
 // re-derived, and one routine per surface type. All in the surface frame. Not a public API: use
 // calcWrap() from wrap_surface.hpp.
-#include "core/muscles/wrap/wrap_surface.hpp"
+#include "core/geometry/constructions.hpp"
+#include "core/geometry/wrap_surface.hpp"
 
 namespace redmax::detail {
-
-/// OpenSim's DSIGN: +1 for v >= 0, -1 otherwise
-inline int dsign(double v) { return v >= 0.0 ? 1 : -1; }
 
 /// out = v / |v| (zero when |v| < machine epsilon); returns |v|
 double normalizeOrZero(const Vec3& v, Vec3& out);

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/muscles/wrap/wrap_geometry.hpp"
+#include "core/geometry/wrap_math.hpp"
 
 namespace redmax::detail {
 namespace {

@@ -1,4 +1,4 @@
-#include "core/muscles/wrap/wrap_geometry.hpp"
+#include "core/geometry/wrap_math.hpp"
 
 #include <cmath>
 #include <limits>

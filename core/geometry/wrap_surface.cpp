@@ -1,11 +1,11 @@
-#include "core/muscles/wrap/wrap_surface.hpp"
+#include "core/geometry/wrap_surface.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-#include "core/muscles/wrap/wrap_geometry.hpp"
+#include "core/geometry/wrap_math.hpp"
 
 namespace redmax {
 

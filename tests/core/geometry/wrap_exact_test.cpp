@@ -9,8 +9,8 @@
 #include <cstdio>
 #include <random>
 
-#include "core/muscles/wrap/wrap_geometry.hpp"
-#include "core/muscles/wrap/wrap_surface.hpp"
+#include "core/geometry/wrap_math.hpp"
+#include "core/geometry/wrap_surface.hpp"
 
 namespace {
 
