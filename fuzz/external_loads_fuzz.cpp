@@ -64,11 +64,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } else {
     std::remove((dir + "/data.mot").c_str());
   }
-  try {
+  redmax::fuzz::acceptingProjectErrors([&] {
     redmax::osim::ExternalLoads loads = redmax::osim::readExternalLoads(xml_path, dir);
     if (model()) redmax::osim::checkExternalLoads(loads, *model());
-  } catch (const std::exception& e) {
-    redmax::fuzz::acceptError(e);
-  }
+  });
   return 0;
 }

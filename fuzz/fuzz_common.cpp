@@ -6,11 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <set>
-#include <typeinfo>
 
-#include "converter/error.hpp"
-#include "core/skeleton/model.hpp"
 
 namespace redmax::fuzz {
 
@@ -55,15 +51,6 @@ void acceptError(const std::exception& e) {
   // REDMAX_FUZZ_VERBOSE=1: every message (to check that seeds read)
   static const bool verbose = std::getenv("REDMAX_FUZZ_VERBOSE") != nullptr;
   if (verbose) std::fprintf(stderr, "fuzz: %s\n", what);
-  // REDMAX_FUZZ_REPORT_OTHER=1: list (once each) errors that are not ConvertError/ModelError,
-  // i.e. messages without FILE:LINE that a user would find hard to act on
-  static const bool report = std::getenv("REDMAX_FUZZ_REPORT_OTHER") != nullptr;
-  if (report && dynamic_cast<const osim::ConvertError*>(&e) == nullptr &&
-      dynamic_cast<const ModelError*>(&e) == nullptr) {
-    static std::set<std::string> seen;
-    const std::string key = std::string(typeid(e).name()) + ": " + std::string(what).substr(0, 60);
-    if (seen.insert(key).second) std::fprintf(stderr, "fuzz: other error %s\n", key.c_str());
-  }
 }
 
 }  // namespace redmax::fuzz

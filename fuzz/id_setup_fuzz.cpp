@@ -11,18 +11,11 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = redmax::fuzz::writeInput("setup.xml", data, size);
-  try {
-    (void)redmax::osim::readInverseDynamicsSetup(path);
-  } catch (const std::exception& e) {
-    redmax::fuzz::acceptError(e);
-    return 0;
-  }
-  try {
+  if (!redmax::fuzz::acceptingProjectErrors([&] { (void)redmax::osim::readInverseDynamicsSetup(path); })) return 0;
+  redmax::fuzz::acceptingProjectErrors([&] {
     redmax::osim::IdToolSettings s;
     s.setup_file = path;
     (void)redmax::osim::resolveIdSettings(s);
-  } catch (const std::exception& e) {
-    redmax::fuzz::acceptError(e);
-  }
+  });
   return 0;
 }

@@ -12,19 +12,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string path =
       redmax::fuzz::writeInput(size % 2 ? "input.mot" : "input.sto", data, size);
   redmax::osim::Storage s;
-  try {
-    s = redmax::osim::readStorage(path);
-  } catch (const std::exception& e) {
-    redmax::fuzz::acceptError(e);
-    return 0;
-  }
-  try {
+  if (!redmax::fuzz::acceptingProjectErrors([&] { s = redmax::osim::readStorage(path); })) return 0;
+  redmax::fuzz::acceptingProjectErrors([&] {
     const std::string text = redmax::osim::formatStorage(s);
     const std::string again = redmax::fuzz::writeInput(
         "again.sto", reinterpret_cast<const std::uint8_t*>(text.data()), text.size());
     (void)redmax::osim::readStorage(again);
-  } catch (const std::exception& e) {
-    redmax::fuzz::acceptError(e);
-  }
+  });
   return 0;
 }

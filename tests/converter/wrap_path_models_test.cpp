@@ -210,8 +210,12 @@ TEST(WrapPathModels, SmoothMusclesAtRandomPosesStayOnOpenSimsPath) {
                 "(max %.1e m), %d errors\n",
                 rel, total, on, band, far, worst, errors);
     EXPECT_EQ(errors, 0);
-    EXPECT_GT(on, 0.8 * total);
-    EXPECT_LE(far, 0.01 * total);
+    EXPECT_GT(total, 0);
+    // measured: 93.8% / 92.3% on the path, none farther than 1 mm, max 7.2e-4 m (both models);
+    // 1% of poses used to be allowed arbitrarily far away
+    EXPECT_GT(on, 0.9 * total);
+    EXPECT_EQ(far, 0);
+    EXPECT_LE(worst, 1e-3);
   }
 }
 

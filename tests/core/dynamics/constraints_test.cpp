@@ -112,7 +112,8 @@ TEST_P(ConstraintFd, WeldMatchesFiniteDifferences) {
   expectDerivativesMatch(to_world, m, s, a, true);
 }
 
-INSTANTIATE_TEST_SUITE_P(Seeds, ConstraintFd, ::testing::Range(0, 4));
+INSTANTIATE_TEST_SUITE_P(Seeds, ConstraintFd, ::testing::Range(0, 4),
+                         [](const ::testing::TestParamInfo<int>& i) { return "seed" + std::to_string(i.param); });
 
 TEST(FourBar, ClosedConfigurationSatisfiesBothVersions) {
   const FourBar fb;

@@ -177,7 +177,8 @@ TEST_P(MappedVsConstrained, SameAccelerationsEnergiesAndForces) {
   EXPECT_TRUE(nearRel(tauR, VecX(wm.J_rR.transpose() * taur_rnea), 1e-9));
 }
 
-INSTANTIATE_TEST_SUITE_P(Seeds, MappedVsConstrained, ::testing::Range(0, 4));
+INSTANTIATE_TEST_SUITE_P(Seeds, MappedVsConstrained, ::testing::Range(0, 4),
+                         [](const ::testing::TestParamInfo<int>& i) { return "seed" + std::to_string(i.param); });
 
 TEST(MappedVsConstrained, SameTrajectoryAndTheCoupledCoordinateFollowsF) {
   // 8-link 3D chain, RK4 h = 1e-3 for 2 s: constrained (Baumgarte) vs hyper-reduced

@@ -116,7 +116,8 @@ TEST_P(Hybrid, FreeCoordinatesFollowForwardDynamicsUnderTheComputedTorques) {
   EXPECT_TRUE(nearRel(plain.inverseDynamics(s, qdd, wp), tau, 1e-9));
 }
 
-INSTANTIATE_TEST_SUITE_P(Seeds, Hybrid, ::testing::Range(0, 5));
+INSTANTIATE_TEST_SUITE_P(Seeds, Hybrid, ::testing::Range(0, 5),
+                         [](const ::testing::TestParamInfo<int>& i) { return "seed" + std::to_string(i.param); });
 
 TEST(Locked, HoldingTorqueHasTheDocumentedSign) {
   // a 1 m, 1 kg rod hinged about z, hanging along -y; locked horizontal (q = pi/2, rod along +x):

@@ -221,7 +221,8 @@ TEST_P(MuscleTermSeeds, ForceIsLagrangianAndMassIsKineticEnergyHessian) {
   EXPECT_TRUE(nearRel(f, f_lagrange, 1e-6)) << (f - f_lagrange).norm() << " vs " << f_lagrange.norm();
 }
 
-INSTANTIATE_TEST_SUITE_P(Seeds, MuscleTermSeeds, ::testing::Range(0, 4));
+INSTANTIATE_TEST_SUITE_P(Seeds, MuscleTermSeeds, ::testing::Range(0, 4),
+                         [](const ::testing::TestParamInfo<int>& i) { return "seed" + std::to_string(i.param); });
 
 TEST(MuscleTerm, DroppingTheQuadraticVelocityVector) {
   const Model m = scenes::randomTree(5, 9, scenes::TreeJoints::SimbodyComparable);

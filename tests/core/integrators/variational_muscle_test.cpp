@@ -243,7 +243,10 @@ TEST_P(VariationalViaPointCrossing, ConvergesToTheMomentumContinuousSolution) {
   EXPECT_LT(eu_last, 0.25 * gap);
 }
 
-INSTANTIATE_TEST_SUITE_P(Alpha, VariationalViaPointCrossing, ::testing::Values(0.5, 0.55));
+INSTANTIATE_TEST_SUITE_P(Alpha, VariationalViaPointCrossing, ::testing::Values(0.5, 0.55),
+                         [](const ::testing::TestParamInfo<double>& i) {
+                           return "alpha" + std::to_string(static_cast<int>(std::lround(i.param * 100))) + "pct";
+                         });
 
 }  // namespace
 }  // namespace redmax

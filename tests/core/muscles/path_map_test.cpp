@@ -138,7 +138,8 @@ TEST_P(PathMapFd, PositionsJacobianAndBiasMatchDifferences) {
   EXPECT_GE(checked, 4) << "too many draws had a mass point on a via point";
 }
 
-INSTANTIATE_TEST_SUITE_P(TypesIAndII, PathMapFd, ::testing::Values(0, 1, 2, 3, 4, 5));
+INSTANTIATE_TEST_SUITE_P(TypesIAndII, PathMapFd, ::testing::Values(0, 1, 2, 3, 4, 5),
+                         [](const ::testing::TestParamInfo<int>& i) { return std::to_string(i.param) + "_via_points"; });
 
 TEST(PathMap, BadInputThrows) {
   const MassPoints mp = makeMassPoints({0.5}, {1.0});

@@ -97,7 +97,8 @@ TEST_P(EolRandom, J_sxMatchesEqualStrainDifferences) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(InternalPoints, EolRandom, ::testing::Range(1, 6));
+INSTANTIATE_TEST_SUITE_P(InternalPoints, EolRandom, ::testing::Range(1, 6),
+                         [](const ::testing::TestParamInfo<int>& i) { return std::to_string(i.param) + "_via_points"; });
 
 // x_a(z) of one segment, z = (x0, x1, s0, s1), for a fixed material coordinate s_a
 Vec3 massPointOfZ(const Eigen::Matrix<double, 8, 1>& z, double s_a) {

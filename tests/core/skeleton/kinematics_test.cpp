@@ -68,7 +68,8 @@ TEST_P(KinematicsFd, JmrZeroOutsideAncestors) {
       }
 }
 
-INSTANTIATE_TEST_SUITE_P(Seeds, KinematicsFd, ::testing::Range(0, 5));
+INSTANTIATE_TEST_SUITE_P(Seeds, KinematicsFd, ::testing::Range(0, 5),
+                         [](const ::testing::TestParamInfo<int>& i) { return "seed" + std::to_string(i.param); });
 
 TEST(Kinematics, DoublePendulumTipPosition) {
   const Model m = scenes::doublePendulum(1.0, 1.0);
