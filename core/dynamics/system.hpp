@@ -72,9 +72,9 @@ struct DynamicsWorkspace {
   VecX rhs_r;                // (nc)
 
   // scratch owned for others (System::bind): one slot per ForceTerm of the bound system, in
-  // System::terms() order (null where the term needs none), and one for the integrator that
-  // drives this workspace (e.g. the variational integrator's momentum). All are dropped when the
-  // workspace is bound to another system (or the system changed).
+  // System::terms() order (null where the term needs none), and one for an integrator that keeps
+  // state per workspace (the built-in ones need none: VariationalEulerWorkspace is the
+  // integrator's). All are dropped when the workspace is bound to another system (or it changed).
   std::vector<std::unique_ptr<TermScratch>> term_scratch;  // (number of terms)
   std::unique_ptr<TermScratch> integrator;
   std::uint64_t system_id = 0;  // System::id() the slots belong to; 0 = none
