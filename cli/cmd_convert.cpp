@@ -1,5 +1,5 @@
 // `redmax convert`: read an OpenSim model, print a summary, optionally write the intermediate
-// description as JSON. Errors are `error: FILE:LINE: what` with exit code 2 (DESIGN.md §3).
+// description as JSON. Errors are `error: FILE:LINE: what` with exit code 2 (docs/commands.md §1).
 #include <iostream>
 
 #include "cli/args.hpp"

@@ -1,5 +1,5 @@
-// `redmax id`: inverse dynamics as OpenSim's InverseDynamicsTool computes it (DESIGN.md §3,
-// OPENSIM_SEMANTICS.md §7). converter/id/ does the input processing; the engine is the core or
+// `redmax id`: inverse dynamics as OpenSim's InverseDynamicsTool computes it (docs/commands.md §1,
+// docs/opensim_compatibility.md §7). converter/id/ does the input processing; the engine is the core or
 // Simbody (plugin/simbody/id_engine.hpp). Errors are `error: FILE[:LINE]: what` with exit code 2
 // for bad input, 1 for a frame that cannot be solved.
 #include <chrono>

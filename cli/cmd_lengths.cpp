@@ -1,5 +1,5 @@
 // `redmax lengths`: musculotendon path lengths along a coordinates file, as OpenSim's
-// GeometryPath::getLength gives them (DESIGN.md §3; OPENSIM_SEMANTICS.md §1.5, §6). Exact wrapping
+// GeometryPath::getLength gives them (docs/commands.md §1; docs/opensim_compatibility.md §1.5, §6). Exact wrapping
 // over cylinders, spheres, ellipsoids and tori (core/muscles/wrap/). Coordinates absent from the
 // file keep their defaults; Rotational columns of a degrees file are converted; constraints are not
 // enforced (the file's coupled coordinates are used as written).

@@ -1,4 +1,4 @@
-// `redmax simulate`: forward simulation of an OpenSim model in the REDMAX core (DESIGN.md section 3).
+// `redmax simulate`: forward simulation of an OpenSim model in the REDMAX core (docs/commands.md §1).
 // The driver is validation/simulate (a library, so that studies call the same code); this file
 // parses flags, prints the summary and writes the states atomically. Exit codes: 0 success,
 // 1 the run diverged (nothing written), 2 bad input or usage.

@@ -1,5 +1,5 @@
 // `redmax validate`: the inputs of `redmax id`, solved by the core and by Simbody, compared with
-// each other and with reference results, written as a report directory (DESIGN.md §3). The work
+// each other and with reference results, written as a report directory (docs/commands.md §1). The work
 // is validation/id_validation.hpp; this file parses flags and maps errors to exit codes:
 // 0 every comparison passed, 1 one failed (or a frame could not be solved, or the report could
 // not be written), 2 bad input or usage.

@@ -1,6 +1,6 @@
 #pragma once
 // Subcommands of the `redmax` executable. Each lives in its own cli/cmd_*.cpp and registers
-// itself with a static CommandRegistration; main.cpp dispatches. Exit codes (DESIGN.md §3):
+// itself with a static CommandRegistration; main.cpp dispatches. Exit codes (docs/commands.md §1):
 // 0 success, 1 the run failed (e.g. diverged), 2 bad input or usage.
 #include <functional>
 #include <string>

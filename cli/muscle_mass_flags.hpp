@@ -1,5 +1,5 @@
 #pragma once
-// The MUSCLE-MASS OPTIONS of DESIGN.md section 3, shared by every command that builds a model with
+// The MUSCLE-MASS OPTIONS of docs/commands.md §1, shared by every command that builds a model with
 // muscle mass (`redmax id`, `simulate`, `validate`, ...):
 //   --muscle-mass none|physiological|transfer   (default none)
 //   --muscles all|REGEX|top:K   --mass-points N   --mass-region fibre|whole

@@ -14,7 +14,7 @@
 // The finger (osim_models/finger.osim, FDP and FDS 0.2 kg each) is sensitive: a 1e-10 rad change of
 // q0 grows to 1.6e-6 rad in 1 s, so agreeing with the core to 1e-6 there needs local errors near
 // 1e-12. RungeKuttaFeldberg with the infinity norm reaches it with the fewest realizations (each
-// assembles G M^-1 G^T over the 30 constraint rows): README, "Simbody plugin", has the comparison.
+// assembles G M^-1 G^T over the 30 constraint rows): docs/simbody.md has the comparison.
 #include <string>
 #include <vector>
 

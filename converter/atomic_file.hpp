@@ -1,6 +1,6 @@
 #pragma once
 // Atomic file output: write everything to a temporary file beside the target, then rename it,
-// so that a failed or interrupted write never leaves a half-written output (DESIGN.md §3).
+// so that a failed or interrupted write never leaves a half-written output (docs/commands.md §1).
 #include <string>
 
 namespace redmax::osim {

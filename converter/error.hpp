@@ -1,6 +1,6 @@
 #pragma once
 // Errors raised while reading OpenSim files. The message carries the file and, where known, the
-// line, so that the command line prints `error: FILE:LINE: what is wrong` (DESIGN.md §3).
+// line, so that the command line prints `error: FILE:LINE: what is wrong` (docs/commands.md §1).
 #include <stdexcept>
 #include <string>
 

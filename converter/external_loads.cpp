@@ -1,4 +1,4 @@
-// ExternalLoads and InverseDynamicsTool setup files (OPENSIM_SEMANTICS §7).
+// ExternalLoads and InverseDynamicsTool setup files (docs/opensim_compatibility.md §7).
 #include "converter/external_loads.hpp"
 
 #include <filesystem>

@@ -1,6 +1,6 @@
 #pragma once
 // OpenSim ExternalLoads files (.xml holding ExternalForce objects and a data file), read as
-// OpenSim 4.x reads them (OPENSIM_SEMANTICS §7 step 8).
+// OpenSim 4.x reads them (docs/opensim_compatibility.md §7.8).
 #include <array>
 #include <string>
 #include <vector>

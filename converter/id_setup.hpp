@@ -1,6 +1,6 @@
 #pragma once
 // OpenSim InverseDynamicsTool setup files, with paths resolved relative to the setup file's
-// folder as OpenSim does (OPENSIM_SEMANTICS §7).
+// folder as OpenSim does (docs/opensim_compatibility.md §7).
 #include <limits>
 #include <string>
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
 // The intermediate model description: an OpenSim model as plain data, after the legacy upgrades
-// of OPENSIM_SEMANTICS.md §1.4 and with every socket resolved. No simulation state lives here.
+// of docs/opensim_compatibility.md §1.4 and with every socket resolved. No simulation state lives here.
 //
 // Frames follow the OpenSim/Simbody monogram notation: X_AB is the pose of frame B in frame A
 // (a 4x4 homogeneous matrix, x_A = X_AB * x_B). For a joint, P is the parent body, F the joint

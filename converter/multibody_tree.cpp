@@ -1,4 +1,4 @@
-// The multibody tree OpenSim builds from its joints (OPENSIM_SEMANTICS §3.1): a restatement of
+// The multibody tree OpenSim builds from its joints (docs/opensim_compatibility.md §3.1): a restatement of
 // Simbody's MultibodyGraphMaker (breadth-first by level in JointSet order, reversed joints,
 // massless bodies extended to a massful one, loops cut by welds or slave bodies) and of
 // Model::createMultibodyTree / extendConnectToModel, which fix the q order.

@@ -1,5 +1,5 @@
 // .osim reader: wrap objects on frames, the ForceSet, and the GeometryPath of every path force
-// (points, conditional and moving points, wraps), OPENSIM_SEMANTICS §6.
+// (points, conditional and moving points, wraps), docs/opensim_compatibility.md §6.
 #include <algorithm>
 #include <cmath>
 #include <map>

@@ -1,6 +1,6 @@
 // .osim reader: model layout, frames, bodies, joints, coordinates, constraints and markers.
 // Wrap objects and forces are in osim_forces.cpp; the multibody tree in multibody_tree.cpp.
-// Each legacy upgrade below restates OpenSim's updateFromXMLNode rules (OPENSIM_SEMANTICS §1.4).
+// Each legacy upgrade below restates OpenSim's updateFromXMLNode rules (docs/opensim_compatibility.md §1.4).
 #include "converter/osim_reader.hpp"
 
 #include <algorithm>

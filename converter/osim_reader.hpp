@@ -1,6 +1,6 @@
 #pragma once
 // Reader for OpenSim model files (.osim): the 4.0 layout (Version 40000 and later) and the legacy
-// layouts 10901 ... 30000, upgraded as OpenSim upgrades them (OPENSIM_SEMANTICS.md §1).
+// layouts 10901 ... 30000, upgraded as OpenSim upgrades them (docs/opensim_compatibility.md §1).
 #include <string>
 
 #include "converter/error.hpp"

@@ -1,5 +1,5 @@
 // Storage (.sto/.mot) reading and writing, restating OpenSim's Storage(file) and printResult
-// behaviour (OPENSIM_SEMANTICS §1.5).
+// behaviour (docs/opensim_compatibility.md §1.5).
 #include "converter/storage.hpp"
 
 #include <cctype>

@@ -1,6 +1,6 @@
 #pragma once
 // OpenSim Storage files (.sto, .mot): reading every header variant OpenSim reads, deciding
-// degrees vs radians as OpenSim's Storage(file) does (OPENSIM_SEMANTICS §1.5), and writing
+// degrees vs radians as OpenSim's Storage(file) does (docs/opensim_compatibility.md §1.5), and writing
 // OpenSim-readable version-1 files atomically.
 #include <string>
 #include <utility>

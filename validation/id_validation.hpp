@@ -1,5 +1,5 @@
 #pragma once
-// `redmax validate` as a library function (DESIGN.md §3): one inverse-dynamics trial, processed
+// `redmax validate` as a library function (docs/commands.md §1): one inverse-dynamics trial, processed
 // once by converter/id's InverseDynamicsTool, solved by both engines (core and Simbody), and
 // compared:
 //   core_vs_simbody       every column, every frame: |core - simbody| <= engine_rel * column peak

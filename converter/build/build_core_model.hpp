@@ -5,7 +5,7 @@
 // the REDMAX core, plus the bookkeeping that ties it to the description.
 //
 // Bodies. Core bodies are created in the description's mobilizer order (tree.mobilizers, the
-// order Simbody creates MobilizedBodies, OPENSIM_SEMANTICS.md 3.1), so parents precede children
+// order Simbody creates MobilizedBodies, docs/opensim_compatibility.md §3.1), so parents precede children
 // and the core's q vector is the description's coordinate list, i.e. OpenSim's multibody-tree
 // order (ID columns come out in OpenSim's order). Mass, COM and inertia (about the COM, products
 // as matrix entries) are taken as given; a massless body keeps zero inertia (Simbody zeroes the

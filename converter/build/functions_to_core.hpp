@@ -1,6 +1,6 @@
 #pragma once
 // OpenSim functions (plain data, FunctionDesc) -> core functions (AxisFunction: value, exact
-// gradient and Hessian), with the evaluation rules of OPENSIM_SEMANTICS.md section 4.
+// gradient and Hessian), with the evaluation rules of docs/opensim_compatibility.md §4.
 //
 //   Constant                 c, any number of arguments (the caller's count), derivatives 0
 //   LinearFunction           [slopes..., intercept], one argument per slope

@@ -1,5 +1,5 @@
 #pragma once
-// OpenSim's fallback for an invalid body inertia (OPENSIM_SEMANTICS.md section 2: OpenSim's
+// OpenSim's fallback for an invalid body inertia (docs/opensim_compatibility.md §2: OpenSim's
 // Body::getInertia). When SimTK::Inertia rejects the tensor about the centre of mass (negative
 // moment, broken triangle inequality, a product larger than half a moment), OpenSim replaces it by
 // an isotropic tensor diag = |(Ixx, Iyy, Izz)| / sqrt(3) with zero products. Only builds of

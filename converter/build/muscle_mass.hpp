@@ -1,5 +1,5 @@
 #pragma once
-// Where muscle mass comes from (DESIGN.md, MUSCLE-MASS OPTIONS; [D Sec. 6.2.8-6.2.9]). No body mass
+// Where muscle mass comes from (docs/muscle_mass.md, MUSCLE-MASS OPTIONS; [D Sec. 6.2.8-6.2.9]). No body mass
 // is created or lost: every kilogram given to a muscle's mass points is taken from a body.
 //
 //   none           the model as OpenSim sees it (muscles lumped into the bones).
@@ -35,7 +35,7 @@
 
 namespace redmax::osim {
 
-/// Rajagopal et al. 2016 (60 N/cm^2) and Ward & Lieber 2005 (1059.7 kg/m^3); see README
+/// Rajagopal et al. 2016 (60 N/cm^2) and Ward & Lieber 2005 (1059.7 kg/m^3); see docs/muscle_mass.md
 inline constexpr double kDefaultSpecificTension = 0.6e6;  // Pa
 inline constexpr double kDefaultMuscleDensity = 1059.7;   // kg/m^3
 

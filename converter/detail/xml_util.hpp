@@ -65,7 +65,7 @@ bool childBool(const XmlDocument& doc, const XMLElement* parent, const char* tag
 std::string childText(const XMLElement* parent, const char* tag, const std::string& fallback = "");
 
 /// round to 6 significant digits, as a default std::ostringstream writes a double
-/// (OpenSim's legacy upgrades pass some values through such a stream, OPENSIM_SEMANTICS §1.4)
+/// (OpenSim's legacy upgrades pass some values through such a stream, docs/opensim_compatibility.md §1.4)
 double roundLikeOstream(double x);
 
 }  // namespace redmax::osim::detail

@@ -1,5 +1,5 @@
 #pragma once
-// OpenSim's InverseDynamicsTool as a library (OPENSIM_SEMANTICS.md section 7), engine-agnostic:
+// OpenSim's InverseDynamicsTool as a library (docs/opensim_compatibility.md §7), engine-agnostic:
 //
 //   settings (setup file, overridden by flags)  -> resolveIdSettings -> IdToolConfig
 //   IdToolConfig -> InverseDynamicsTool: model read and built (constraints ignored, muscles left

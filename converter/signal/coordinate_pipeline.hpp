@@ -1,5 +1,5 @@
 #pragma once
-// The InverseDynamicsTool's processing of the coordinates file (OPENSIM_SEMANTICS §7, steps 3-6):
+// The InverseDynamicsTool's processing of the coordinates file (docs/opensim_compatibility.md §7.3-7.6):
 //   3. if the cutoff is >= 0: pad every column and the time column by N/2 (odd reflection);
 //      if the time steps are not uniform, fit quintic natural splines to the padded data and
 //      resample on the accumulated grid t_first, t_first+dt, ... (dt = the minimum step);

@@ -1,5 +1,5 @@
 #pragma once
-// Time interpolation of external-load data (OPENSIM_SEMANTICS §7.8, ExternalForce): the data
+// Time interpolation of external-load data (docs/opensim_compatibility.md §7.8, ExternalForce): the data
 // is not filtered; one row gives a constant, two or three rows OpenSim's PiecewiseLinearFunction,
 // four or more a natural cubic spline (GCVSpline degree 3, error variance 0).
 #include <span>

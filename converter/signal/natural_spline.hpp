@@ -1,7 +1,7 @@
 #pragma once
 // Natural interpolating splines of odd degree 2m-1 (m = 1..4: linear, cubic, quintic, septic).
 //
-// This is what OpenSim's GCVSpline with error variance 0 evaluates (OPENSIM_SEMANTICS §4): GCVSPL
+// This is what OpenSim's GCVSpline with error variance 0 evaluates (docs/opensim_compatibility.md §4): GCVSPL
 // in mode 3 stops at a smoothing parameter so small that the fit interpolates to ~1e-13, and a
 // natural smoothing spline tends to the natural interpolating spline as p -> 0. We compute the
 // p = 0 limit directly:

@@ -1,6 +1,6 @@
 #pragma once
-// OpenSim's signal primitives as the InverseDynamicsTool uses them (OPENSIM_SEMANTICS §7, steps 3
-// and 7, "The low-pass filter"): odd-reflection padding (Signal::Pad), the minimum time step and
+// OpenSim's signal primitives as the InverseDynamicsTool uses them (docs/opensim_compatibility.md §7.3
+// and 7.7, and §7.10 the low-pass filter): odd-reflection padding (Signal::Pad), the minimum time step and
 // uniformity test, resampling on an accumulated time grid (Storage::resample), the zero-phase
 // third-order Butterworth IIR (Signal::LowpassIIR) and Storage::findIndex. The floating-point
 // operations are done in OpenSim's order, so time grids come out bit-identical.

@@ -1,7 +1,7 @@
 #pragma once
 // Errors of the signal-processing layer (splines, filters, resampling). They are input errors:
 // too few samples, times that do not increase, mismatched lengths. The command line maps them
-// to exit code 2 (DESIGN.md §3).
+// to exit code 2 (docs/commands.md §1).
 #include <stdexcept>
 #include <string>
 

@@ -8,7 +8,7 @@
 // Velocity convention. Every core joint has qdot = dq/dt. OpenSim's ID puts the coordinate
 // splines' first and second derivatives into Simbody's u and udot for every mobility, and for
 // Ball, Free, Ellipsoid (and the ellipsoid part of Scapulothoracic) joints Simbody reads those
-// Euler-angle rates as the angular velocity of M in F, expressed in F (OPENSIM_SEMANTICS.md 3.2,
+// Euler-angle rates as the angular velocity of M in F, expressed in F (docs/opensim_compatibility.md §3.2,
 // 7 step 7). IdEngineOptions::rates_as_u marks such joints: for them the engine receives u
 // and udot (the data's rates, taken as OpenSim takes them) and returns the generalized force
 // conjugate to u, as OpenSim writes it. Unmarked joints get (qdot, qddot) and return the force

@@ -1,4 +1,4 @@
-// WrapEllipsoid as OpenSim computes it (OPENSIM_SEMANTICS.md 6). In coordinates scaled by
+// WrapEllipsoid as OpenSim computes it (docs/opensim_compatibility.md §6). In coordinates scaled by
 // f = 3 / sum(dimensions): the segment must cross the ellipsoid; a point c1 on the surface fixes
 // the wrapping plane (the "fan" of closest points along the chord, the "axial" (Frans) cross
 // section, a blend of the two (hybrid), or the chord midpoint); r1 and r2 are found in that plane

@@ -1,4 +1,4 @@
-// WrapSphere as OpenSim computes it (OPENSIM_SEMANTICS.md 6): tangent points in the plane through
+// WrapSphere as OpenSim computes it (docs/opensim_compatibility.md §6): tangent points in the plane through
 // P1, P2 and the centre, a great-circle arc between them (constructions.hpp, shared with the
 // smooth model), and OpenSim's quadrant handling (including the negative length of far-side
 // wraps).

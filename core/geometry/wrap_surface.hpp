@@ -1,6 +1,6 @@
 #pragma once
 // Exact wrapping over one surface, as OpenSim 4.x computes it (the dissertation's "existing
-// library" [D Sec. 5.3.3]; semantics in OPENSIM_SEMANTICS.md section 6). Everything here is in the
+// library" [D Sec. 5.3.3]; semantics in docs/opensim_compatibility.md §6). Everything here is in the
 // surface frame s: the wrap object's own frame, whose pose in its body is WrapObject's
 // (xyz_body_rotation, translation). Units are metres and radians.
 //

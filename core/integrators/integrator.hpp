@@ -1,13 +1,17 @@
 #pragma once
 // Forward-dynamics integrators behind one interface [D Eq. 4.20, 4.21, 4.82].
-// SUNDIALS appears only in core/integrators/*.cpp, never in a header (STYLE.md).
+// SUNDIALS appears only in core/integrators/*.cpp, never in a header (docs/design.md §3).
 //
-//   name    method                                            step      constraints
-//   euler   symplectic (semi-implicit) Euler [D Eq. 4.20]     fixed     velocity-level KKT [D Eq. 4.102, 4.110]
-//   bdf1    linearly implicit backward Euler [D Eq. 4.80-4.82] fixed    velocity-level KKT
-//   sdirk2  2-stage L-stable SDIRK, order 2, Newton           fixed     KKT accelerations + Baumgarte
-//   rk45    Dormand-Prince 5(4), SUNDIALS ARKODE ERKStep      adaptive  KKT accelerations + Baumgarte
-//   cvode   variable-order BDF, SUNDIALS CVODE, dense Newton  adaptive  KKT accelerations + Baumgarte
+//   name        method                                            step      constraints
+//   euler       semi-implicit Euler [D Eq. 4.20] (SymplecticEuler)  fixed   velocity-level KKT [D Eq. 4.102, 4.110]
+//   symplectic  variational Euler, implicit in v (VariationalEuler) fixed   velocity-level KKT
+//   bdf1        linearly implicit backward Euler [D Eq. 4.80-4.82] fixed  velocity-level KKT
+//   sdirk2      2-stage L-stable SDIRK, order 2, Newton           fixed     KKT accelerations + Baumgarte
+//   rk45        Dormand-Prince 5(4), SUNDIALS ARKODE ERKStep      adaptive  KKT accelerations + Baumgarte
+//   cvode       variable-order BDF, SUNDIALS CVODE, dense Newton  adaptive  KKT accelerations + Baumgarte
+//
+// euler is symplectic only when M is constant; with M(q) its energy error grows linearly in time,
+// while symplectic keeps it bounded (docs/notes.md).
 //
 // Every method treats q and qdot as independent coordinates with dq/dt = qdot (true for every
 // joint type, see core/joints/joint.hpp). After each internal step the joints get a chance to

@@ -1,6 +1,6 @@
 // SUNDIALS 6.4 back ends of rk45 (ARKODE ERKStep, Dormand-Prince 5(4)) and cvode (CVODE BDF,
 // dense Newton). The only translation unit that includes SUNDIALS headers; the static SUNDIALS
-// archives are linked into libredmax_integrators with their symbols hidden (BUILD_NOTES trap 2).
+// archives are linked into libredmax_integrators with their symbols hidden (docs/build.md trap 2).
 #include "core/integrators/sundials_integrators.hpp"
 
 #include <arkode/arkode_erkstep.h>

@@ -1,7 +1,7 @@
 #pragma once
 // Adaptive integrators from SUNDIALS 6.4 (ARKODE ERKStep and CVODE). SUNDIALS types stay in
-// sundials_integrators.cpp: this header only sees an opaque implementation (STYLE.md, and
-// BUILD_NOTES trap 2: its symbols are hidden inside libredmax_integrators).
+// sundials_integrators.cpp: this header only sees an opaque implementation (docs/design.md §3, and
+// docs/build.md trap 2: its symbols are hidden inside libredmax_integrators).
 #include <memory>
 
 #include "core/integrators/integrator.hpp"

@@ -65,7 +65,7 @@
 // ODE M qddot = f that the other integrators solve keeps qdot continuous. Both are consistent
 // limits of different jump rules (their kinetic-energy jumps are +-1/2 v^T (M+ - M-) v to first
 // order), so on such scenes "symplectic" converges at order 1 to another trajectory
-// (tests/core/integrators/variational_muscle_test.cpp; README, notes a researcher should know).
+// (tests/core/integrators/variational_muscle_test.cpp; docs/notes.md).
 //
 // Constraints: enforced at the velocity level as in "euler" [D Eq. 4.102, 4.110]: every linear
 // solve is the KKT system [A G^T; G 0] [v; lambda] = [A v_n - R(v_n); G v_k + h rhs - vel_err]

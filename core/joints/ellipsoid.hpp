@@ -1,6 +1,6 @@
 #pragma once
 // Ellipsoid joint: Simbody's MobilizedBody::Ellipsoid as OpenSim uses it (EllipsoidJoint, and the
-// first stage of ScapulothoracicJoint; OPENSIM_SEMANTICS.md section 3.2). The child frame M
+// first stage of ScapulothoracicJoint; docs/opensim_compatibility.md §3.2). The child frame M
 // slides on an ellipsoid fixed in F while it turns, its z axis kept along the ellipsoid's
 // position-dependent "normal" n:
 //   R = Rx(q1) Ry(q2) Rz(q3)  (body-fixed XYZ, as SphericalEuler XYZ),   n = R e_z,

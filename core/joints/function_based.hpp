@@ -1,5 +1,5 @@
 #pragma once
-// OpenSim CustomJoint / Simbody FunctionBased mobilizer (OPENSIM_SEMANTICS.md section 3.3).
+// OpenSim CustomJoint / Simbody FunctionBased mobilizer (docs/opensim_compatibility.md §3.3).
 //
 // Six transform axes: rotation1..3 then translation1..3. Axis k has a unit direction, a list of
 // coordinate indices into this joint's q (the function's arguments, in order) and a function:

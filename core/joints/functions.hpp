@@ -1,6 +1,6 @@
 #pragma once
 // Functions of joint coordinates for the function-based (OpenSim CustomJoint) joint, with exact
-// first and second derivatives (OPENSIM_SEMANTICS.md section 4).
+// first and second derivatives (docs/opensim_compatibility.md §4).
 //
 // Interface for new function types (the converter adds OpenSim's others against it):
 //   - derive from AxisFunction (any number of arguments, at most 6) or, for one argument, from
@@ -107,7 +107,7 @@ class NaturalCubicSpline : public UnivariateFunction {
   std::vector<double> x_, y_, m_;  // m_: second derivatives at the knots
 };
 
-/// OpenSim SimmSpline (Forsythe-Malcolm-Moler cubic spline, OPENSIM_SEMANTICS.md section 4):
+/// OpenSim SimmSpline (Forsythe-Malcolm-Moler cubic spline, docs/opensim_compatibility.md §4):
 ///  - intervals h_i = max(1e-7, x_{i+1} - x_i);
 ///  - n = 2: the straight line; n = 3: the parabola through the points (equal second derivatives
 ///    on both intervals); n >= 4: the third derivative on the first (last) interval equals that

@@ -1,5 +1,5 @@
 #pragma once
-// The closed set of joint types as a std::variant (STYLE.md "Joints: std::variant, not virtual").
+// The closed set of joint types as a std::variant (docs/design.md §5).
 // Each alternative is a plain struct with
 //   int nq() const;                                        number of coordinates (= velocities)
 //   void calc(const VecJ& q, const VecJ& qdot, JointKinematics& out) const;   Q, S, Sdot

@@ -1,6 +1,6 @@
 #pragma once
 // A joint used in the opposite direction (Simbody's Direction::Reverse, which OpenSim applies when
-// the multibody tree reaches a joint's child before its parent; OPENSIM_SEMANTICS.md 3.1). The
+// the multibody tree reaches a joint's child before its parent; docs/opensim_compatibility.md §3.1). The
 // coordinates keep their meaning; the tree's inboard body carries the joint's M frame and the
 // outboard body its F frame, so the joint transform is inverted:
 //   Q'(q) = Q(q)^-1.

@@ -1,5 +1,5 @@
 #pragma once
-// The musculoskeletal model as one immutable aggregate (STYLE.md Model/State/Workspace): the
+// The musculoskeletal model as one immutable aggregate (docs/design.md §4): the
 // skeleton Model, its muscles, the constraints and the coordinate map that act on it, extra force
 // elements (ForceTerms such as springs), and the settings that define the model. It is built once
 // by a MusculoskeletalModelBuilder and read through const accessors afterwards; every edit (a

@@ -3,7 +3,7 @@
 // coordinate alpha in [0, 1] (fraction of the path's arc length, the "texture coordinate"), and a
 // muscle (path + fibre/tendon lengths + mass points) as plain data.
 //
-// Placement convention (DESIGN.md: mass only in the fibre portion, tendons massless by default):
+// Placement convention (docs/design.md §2: mass only in the fibre portion, tendons massless by default):
 //   - fibre share   phi = l_opt / (l_opt + l_ts)  (optimal fibre length, tendon slack length),
 //     taken as a constant fraction of the path;
 //   - the tendon share 1 - phi is split equally between the two ends, so the fibre occupies

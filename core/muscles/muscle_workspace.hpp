@@ -1,6 +1,6 @@
 #pragma once
 // Everything derived from (Model, State, Muscle) for one musculotendon, grouped by stage
-// (STYLE.md Model/State/Workspace). Written by the algorithms in path_kinematics.hpp,
+// (docs/design.md §4). Written by the algorithms in path_kinematics.hpp,
 // via_point.hpp, straight.hpp and muscle_kinematics.hpp, in that order.
 //
 // Sizes: P active path points (changes only when a conditional point switches), n = P - 2 internal

@@ -3,7 +3,7 @@
 // origin (first) through via points to the insertion (last). Algorithms that evaluate a path live
 // in core/muscles/path_kinematics.hpp; this header only describes it.
 //
-// Point kinds (OpenSim's GeometryPath, OPENSIM_SEMANTICS.md section 6):
+// Point kinds (OpenSim's GeometryPath, docs/opensim_compatibility.md §6):
 //   Fixed        a location fixed in a body frame (or the world, body = -1).
 //   Conditional  a Fixed point that belongs to the path only while its coordinate q_k satisfies
 //                lo - 1e-5 <= q_k <= hi + 1e-5 (inclusive, OpenSim's tolerance). Without a
@@ -11,7 +11,7 @@
 //   Moving       each location component is a function of one coordinate, x_b = f(q_k), in the
 //                body frame; a component without a function keeps `location`'s value. Its velocity
 //                gains a term through q_k, so J_xr gets a column that does not go through J_mr.
-// Path types (DESIGN.md): I = two fixed points, III = any wrap object, II = everything else.
+// Path types (docs/design.md §2): I = two fixed points, III = any wrap object, II = everything else.
 // Wrap objects: `wraps` lists the path's PathWraps (surface, body, pose, range) in OpenSim's
 // order; core/muscles/wrap/wrap_path.hpp computes the wrapped path. `num_wraps` marks Type III
 // paths (it equals wraps.size() when the converter fills both; a path may carry only the count).
@@ -75,7 +75,7 @@ PathPoint makeConditionalPoint(int body, const Vec3& location, int coordinate, d
 PathPoint makeMovingPoint(int body, int coordinate, std::array<AxisFunctionPtr, 3> functions,
                           const Vec3& location = Vec3::Zero(), std::string name = "");
 
-/// OpenSim's activity tolerance of conditional path points (OPENSIM_SEMANTICS.md section 6)
+/// OpenSim's activity tolerance of conditional path points (docs/opensim_compatibility.md §6)
 inline constexpr double kConditionalTolerance = 1e-5;
 
 /// true if the point is in the path at configuration q (Fixed and Moving: always)

@@ -1,5 +1,5 @@
 #pragma once
-// The immutable skeleton model (STYLE.md Model/State/Workspace): bodies, the joint tree, the
+// The immutable skeleton model (docs/design.md §4): bodies, the joint tree, the
 // reduced coordinates q_r and their index ranges. Built with ModelBuilder; algorithms in
 // core/skeleton/kinematics.hpp and core/dynamics/ read it and write a Workspace.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Simulation state: time and reduced coordinates, nothing derived (STYLE.md).
+// Simulation state: time and reduced coordinates, nothing derived (docs/design.md).
 #include "core/spatial/types.hpp"
 
 namespace redmax {

@@ -58,7 +58,7 @@ Mat3 rotationAxisAngle(const Vec3& unit_axis, double angle);
 /// 3x3 inertia tensor about the COM in body axes: [[I_c + m[c][c]^T, m[c]], [m[c]^T, m I]]
 Mat6 spatialInertia(double mass, const Vec3& com, const Mat3& inertia_com);
 
-/// relative comparison that also works against a zero reference (STYLE.md):
+/// relative comparison that also works against a zero reference (docs/design.md §8):
 /// |a - b| <= tol * (1 + |b|)
 template <class A, class B>
 bool nearRel(const A& a, const B& b, double tol) {

@@ -109,7 +109,7 @@ bool RedmaxInverseDynamicsTool::run() {
   if (_jointsForReportingBodyForces.getSize() > 0)
     OpenSim::log_warn("RedmaxInverseDynamicsTool: joints_to_report_body_forces is not supported; no body forces are written");
 
-  // paths relative to the setup file's folder (OPENSIM_SEMANTICS.md §7), for every file
+  // paths relative to the setup file's folder (docs/opensim_compatibility.md §7), for every file
   const std::string base = setupFolder(setup);
   const std::string model_file = resolveAgainst(base, _modelFileName);
   const std::string coordinates_file = resolveAgainst(base, _coordinatesFileName);

@@ -1,5 +1,5 @@
 #pragma once
-// RedmaxInverseDynamicsTool: OpenSim's InverseDynamicsTool with muscle mass (DESIGN.md
+// RedmaxInverseDynamicsTool: OpenSim's InverseDynamicsTool with muscle mass (docs/muscle_mass.md,
 // MUSCLE-MASS OPTIONS), as an OpenSim object type that `opensim-cmd -L libredmax_opensim.so
 // run-tool SETUP.xml` runs.
 //
@@ -16,7 +16,7 @@
 //   transfer_fraction  in [0, 1) (transfer only)
 //   full_precision     write %.16e instead of OpenSim's %16.8lf    (default false)
 //
-// What run() computes, per output frame t (OPENSIM_SEMANTICS.md §7 for OpenSim's part):
+// What run() computes, per output frame t (docs/opensim_compatibility.md §7 for OpenSim's part):
 //   1. OpenSim's own input processing and solver on the OpenSim model: the coordinates file
 //      padded, filtered, converted to radians and splined as OpenSim does; q, u, udot from the
 //      splines; tau_osim = InverseDynamicsSolver::solve (calcResidualForceIgnoringConstraints).

@@ -1,6 +1,6 @@
 #pragma once
 // A core AxisFunction seen as a SimTK::Function, for Simbody's FunctionBased mobilizer (the way
-// OpenSim hands its CustomJoint functions to Simbody, OPENSIM_SEMANTICS.md section 3.3).
+// OpenSim hands its CustomJoint functions to Simbody, docs/opensim_compatibility.md §3.3).
 // Include through plugin/ only (it pulls in Simbody).
 #include "plugin/simbody/simbody_include.hpp"
 

@@ -13,7 +13,7 @@
 // index), so the one implementation serves plugin/simbody's own systems (MuscleInertia builds the
 // map from its SimbodyModel) and OpenSim's (plugin/opensim builds it from the OpenSim model).
 // Frames: path points are stations in the core bodies' frames, which are the mobilized bodies'
-// frames B (DESIGN.md §2).
+// frames B (docs/design.md §2).
 //
 // Path points: conditional points only change the active set (isPathPointActive on q). A moving
 // point x_b(q_c) in body b adds through its coordinate c velocity R x_b' qdot_c and acceleration

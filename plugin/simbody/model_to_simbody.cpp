@@ -84,7 +84,7 @@ MobilizerChoice chooseMobilizer(const Joint& joint, const std::string& name, con
                                     "X_FM = (R, p in F)) maps to Simbody's Free mobilizer");
           c.kind = MobilizerKind::Free;
         } else if constexpr (std::is_same_v<T, FunctionBased>) {
-          // Simbody's FunctionBased has the approximate Hdot of OPENSIM_SEMANTICS 3.3; the core
+          // Simbody's FunctionBased has the approximate Hdot of docs/opensim_compatibility.md §3.3; the core
           // joint matches it only with simbody_compat (exact mode differs for coupled rotations)
           c.kind = MobilizerKind::FunctionBased;
           c.function_based = &j;

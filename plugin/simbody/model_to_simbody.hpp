@@ -18,7 +18,7 @@
 // converts between the two spaces: M_core = T^T M_u T, tau_core = T^T f_u. Its blocks for Ball,
 // Free and Ellipsoid are the core's speed map (core/dynamics/speed_map.hpp).
 //
-// Only TUs that need Simbody include this header (BUILD_NOTES: ~15 s and 700 MB per TU; every such
+// Only TUs that need Simbody include this header (docs/build.md, compile time: ~15 s and 700 MB per TU; every such
 // TU must be compiled with -UNDEBUG, which the SimTKcommon target propagates).
 #include <memory>
 #include <string>

@@ -9,7 +9,7 @@
 // A constrained operator== taking two index values exactly is a better match than both and
 // restores the C++17 meaning (compare the stored ints); `!=` follows by C++20 rewriting.
 // Include this header instead of <Simbody.h>, and only in plugin/ and validation/ sources
-// (compile with -UNDEBUG: BUILD_NOTES trap 1, propagated by the SimTKcommon target).
+// (compile with -UNDEBUG: docs/build.md trap 1, propagated by the SimTKcommon target).
 #include <concepts>
 #include <type_traits>
 

@@ -4,7 +4,7 @@
 // in the band (L = L_straight + w (L_wrapped - L_straight), smooth.hpp). The band is found here
 // from the library (calcSegmentWraps and the smooth model's blend weight at the test's own
 // configurations), not from the command. Models: subject_walk_armless_18musc (OpenSim's test
-// motion, 40 WrapCylinders; skipped without /work/shared), the wrapping double pendulum of
+// motion, 40 WrapCylinders; skipped without ../shared, docs/shared_data.md), the wrapping double pendulum of
 // osim_models/ over a q2 sweep written here; neural with cylinder_6x256 on a pendulum whose
 // cylinder is scaled so the end points lie inside the network's training box; bad values.
 #include <gtest/gtest.h>

@@ -14,7 +14,7 @@
 //     points), 0.3 s.
 // The energies of the two engines agree to 1e-6 J, the muscle mass changes the trajectory by more
 // than the tolerance, and each summary states its CPU time. Also: CPodes (--integrator cvode)
-// runs inside the redmax executable (BUILD_NOTES trap 2) and agrees to 1e-5; a core-only integrator,
+// runs inside the redmax executable (docs/build.md trap 2) and agrees to 1e-5; a core-only integrator,
 // an unknown engine, --no-qvv, a bad --simbody-method or --simbody-norm, and either of those without
 // --engine simbody exit 2 with a message and write nothing.
 #include <gtest/gtest.h>
@@ -152,7 +152,7 @@ TEST_F(SimulateEngineCli, SummaryStatesEngineAndCpuAndCvodeRuns) {
   ASSERT_EQ(sb.code, 0) << sb.err;
   EXPECT_NE(sb.out.find("engine simbody"), std::string::npos) << sb.out;
   EXPECT_GE(summaryCpu(sb.out), 0.0) << sb.out;
-  // CPodes inside the executable that also links SUNDIALS (BUILD_NOTES trap 2)
+  // CPodes inside the executable that also links SUNDIALS (docs/build.md trap 2)
   const CmdResult cv = run(common + " --engine simbody --integrator cvode --rtol 1e-9 --atol 1e-11 --out " +
                            path("c.sto"));
   ASSERT_EQ(cv.code, 0) << cv.err;

@@ -179,7 +179,7 @@ TEST_F(WrapFlagsCli, PhysiologicalWrapMassConservesEnergy) {
 // about 70 deg; tight rk45 for 1 s as the work-precision running-leg scene. With the gastrocnemii
 // carrying mass (--muscles), the smooth model keeps the drift at integrator error (bound 1e-9;
 // the exact model's jump at the event is orders larger). With every muscle the tibialis anterior's
-// via point adds its own sliding-point drift (Type II, README), printed only.
+// via point adds its own sliding-point drift (Type II, docs/notes.md), printed only.
 TEST_F(WrapFlagsCli, RunningLegGastrocnemiiCarryMassAndConserveEnergy) {
   std::ofstream(path("init.sto")) << "initial\nversion=1\nnRows=1\nnColumns=4\ninDegrees=no\nendheader\n"
                                      "time\thip_flexion_r_u\tknee_angle_r_u\tankle_angle_r_u\n0\t3\t-4\t2\n";

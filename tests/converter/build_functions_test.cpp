@@ -1,5 +1,5 @@
 // FunctionDesc -> core AxisFunction (converter/build/functions_to_core.hpp): every OpenSim function
-// type against values worked out by hand from OPENSIM_SEMANTICS.md section 4, gradients and
+// type against values worked out by hand from docs/opensim_compatibility.md §4, gradients and
 // Hessians against central differences of the values (h = 1e-6, relative 1e-6 in nearRel's
 // sense), and the errors (file:line and owner in the message).
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // Joints for converted OpenSim models: the Ellipsoid and Reversed core joints (S against
 // differences of Q, Sdot against differences of S, central differences h = 1e-6, relative 1e-6),
 // and makeCoreJoint's X_FM for every OpenSim joint type against the table of
-// OPENSIM_SEMANTICS.md 3.2 written out independently here (to 1e-14).
+// docs/opensim_compatibility.md §3.2 written out independently here (to 1e-14).
 #include <gtest/gtest.h>
 
 #include <numbers>

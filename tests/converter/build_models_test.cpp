@@ -1,9 +1,9 @@
 // Converted OpenSim models in the core (converter/build/build_core_model.hpp):
-//  - every model of ../shared/opensim/README.md's table builds (exact, Simbody-compatible, with
+//  - every model of docs/shared_data.md's table builds (exact, Simbody-compatible, with
 //    couplers eliminated), with the description's coordinates in the same order;
 //  - body poses at the default and at random configurations within the coordinate ranges equal
 //    an independent composition X_G,child = X_G,parent X_PF X_FM(q) X_BM^-1 through the tree
-//    written here from OPENSIM_SEMANTICS.md 3.2-3.3 (reversed joints inverted), to 1e-12;
+//    written here from docs/opensim_compatibility.md §3.2-3.3 (reversed joints inverted), to 1e-12;
 //  - J_mr against differences of the body poses and Jdot_mr against differences of J_mr along
 //    qdot (central, h = 1e-6, relative 1e-6 in nearRel's sense) at random configurations;
 //  - synthetic models with every joint type, offset frames, reversed joints and a loop.
@@ -30,7 +30,7 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kH = 1e-6;
 constexpr double kFdTol = 1e-6;
 
-// the README's models table, and the models of the published inverse-dynamics sets
+// the models table of docs/shared_data.md, and the models of the published inverse-dynamics sets
 const std::vector<std::string>& sharedModels() {
   static const std::vector<std::string> m = {
       "opensim-models/Models/Arm26/arm26.osim",
@@ -432,7 +432,7 @@ TEST(BuildSynthetic, LoopIsCutBySlaveBodyWithHalfTheMassAndAWeld) {
 namespace redmax::osim {
 namespace {
 
-// The OpenSim-compatibility switch (DESIGN.md 2) on CustomJoints: poses are the same; Simbody's
+// The OpenSim-compatibility switch (docs/design.md §2) on CustomJoints: poses are the same; Simbody's
 // velocity-product terms are exact for pelvis/hip-like joints (gait2392: identical Jdot_mr, so
 // identical inverse dynamics) and differ where one coordinate drives several rotations
 // (Rajagopal's knees): the difference is measured and must be nonzero there.

@@ -1,5 +1,5 @@
 // ExternalLoads files with their data, and InverseDynamicsTool setups with paths resolved from
-// the setup file's folder (OPENSIM_SEMANTICS §7), on the shared files and generated ones.
+// the setup file's folder (docs/opensim_compatibility.md §7), on the shared files and generated ones.
 #include <gtest/gtest.h>
 
 #include <filesystem>

@@ -170,7 +170,7 @@ TEST(IdTool, DoublePendulumMatchesClosedForm) {
 
 TEST(IdTool, DegreesConvertOnlyRotationalColumns) {
   // cart-pole: a SliderJoint (x, metres) and a PinJoint (theta); the file says inDegrees=yes and
-  // gives x in metres, theta in degrees: only theta is converted (OPENSIM_SEMANTICS 3.4, 7)
+  // gives x in metres, theta in degrees: only theta is converted (docs/opensim_compatibility.md §3.4, 7)
   TempDir dir;
   const double M = 2.0, m = 0.7, c = 0.4, I = 0.03;
   const Sine sx{0.1, 0.3, 2 * M_PI * 0.6, 0.2}, sth{0.3, 0.8, 2 * M_PI * 0.9, 1.0};

@@ -1,4 +1,4 @@
-// Legacy .osim upgrades on generated files (OPENSIM_SEMANTICS §1.3-1.4): ground body to Ground,
+// Legacy .osim upgrades on generated files (docs/opensim_compatibility.md §1.3-1.4): ground body to Ground,
 // joints out of bodies in BodySet order, offset frames with 6-digit rounding, inertia defaults,
 // reverse=true, isDisabled, pennation_angle, MusclePointSet without GeometryPath, aliases.
 #include <gtest/gtest.h>

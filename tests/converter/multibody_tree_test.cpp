@@ -1,4 +1,4 @@
-// Multibody-tree order on synthetic models whose answers follow from OPENSIM_SEMANTICS §3.1:
+// Multibody-tree order on synthetic models whose answers follow from docs/opensim_compatibility.md §3.1:
 // breadth-first by level in JointSet order, reversed joints, massless bodies extended at once,
 // loops cut by slave bodies or weld constraints, FreeJoints for unconnected bodies.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Every model of ../shared/opensim/README.md's table loads with the table's numbers; the
+// Every model of docs/shared_data.md's table loads with the table's numbers; the
 // multibody-tree coordinate order matches OpenSim 4.6's inverse-dynamics column order; legacy
 // files read with OpenSim's upgrades equal the copies OpenSim itself upgraded.
 #include <gtest/gtest.h>
@@ -29,7 +29,7 @@ struct Expected {
   std::vector<std::string> joint_types;
 };
 
-// numbers from ../shared/opensim/README.md's models table; path-type counts from an
+// numbers from docs/shared_data.md's models table; path-type counts from an
 // independent ElementTree count of PathPointSet/PathWrapSet contents
 const std::vector<Expected>& expectedModels() {
   static const std::vector<Expected> e = {
@@ -344,7 +344,7 @@ TEST(LegacyUpgrade, Gait2392Version20303EqualsTheCurrentCopyExceptTheToes) {
       "opensim-models@a26e12c/Pipelines/Gait2392_Simbody/OutputReference/subject01_simbody.osim"));
   const auto b = readOsimModel(
       sharedOpenSim("opensim-models/Pipelines/Gait2392_Simbody/OutputReference/subject01_simbody.osim"));
-  // README: the toes' Iyy changed in 2024; everything else is the upgrade of the same data
+  // docs/shared_data.md: the toes' Iyy changed in 2024; everything else is the upgrade of the same data
   expectSameGeometry(a, b, {"toes_r", "toes_l"});
   const int t = a.findBody("toes_r");
   EXPECT_NE(a.bodies[t].inertia[1], b.bodies[t].inertia[1]);

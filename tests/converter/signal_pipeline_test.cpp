@@ -1,7 +1,7 @@
 // The InverseDynamicsTool's coordinate processing (converter/signal/coordinate_pipeline.hpp) on
 // OpenSim's own inputs: the processed time grid and window must reproduce, as printed, the time
 // column OpenSim 4.6 wrote for sets A (filtered and unfiltered), E and F
-// (../shared/opensim/README.md). Filtered values are checked on a synthetic signal whose
+// (docs/shared_data.md). Filtered values are checked on a synthetic signal whose
 // filtered form is known in closed form; unfiltered splines must pass through the raw data.
 #include <gtest/gtest.h>
 

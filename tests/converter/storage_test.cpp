@@ -1,5 +1,5 @@
 // Storage (.sto/.mot) reading on every shared header variant and on generated edge cases,
-// degrees vs radians as OpenSim decides (OPENSIM_SEMANTICS §1.5), and the atomic writer.
+// degrees vs radians as OpenSim decides (docs/opensim_compatibility.md §1.5), and the atomic writer.
 #include <gtest/gtest.h>
 
 #include <cmath>

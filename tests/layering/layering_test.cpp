@@ -1,4 +1,4 @@
-// Dependencies point down only (STYLE.md): this test fails on any upward or forbidden #include.
+// Dependencies point down only (docs/design.md §3): this test fails on any upward or forbidden #include.
 //   core/spatial <- core/joints <- core/skeleton <- core/muscles <- core/dynamics <- core/integrators
 //   core/spatial <- core/geometry <- core/muscles   (surface geometry: wrap surfaces, dual numbers)
 //   core/dynamics <- core/model (the musculoskeletal aggregate, beside core/integrators)

@@ -1,5 +1,5 @@
 // The OpenSim plugin (plugin/opensim) on the real inverse-dynamics set F (Gait10dof18musc,
-// /work/shared/opensim/README.md): at zero muscle mass it must be OpenSim's own InverseDynamicsTool
+// docs/shared_data.md): at zero muscle mass it must be OpenSim's own InverseDynamicsTool
 // (same process, same inputs); at 80% tibia transfer it must agree with `redmax id` (the converter's
 // InverseDynamicsTool with the core engine), which computes the same mass points with the core's
 // kinematics instead of OpenSim's Simbody system. Built only when OpenSim is found.
@@ -29,7 +29,7 @@ namespace fs = std::filesystem;
 
 std::string shared(const std::string& rel) { return std::string(REDMAX_SHARED_DIR) + "/opensim/" + rel; }
 
-// the inverse-dynamics sets of /work/shared/opensim/README.md (A filtered, E, F) and the body whose
+// the inverse-dynamics sets of docs/shared_data.md (A filtered, E, F) and the body whose
 // mass moves into its muscles in the transfer runs (arm26 has no tibia: its humerus, spanned by the
 // one muscle without wrap objects, BICshort)
 struct IdSet {

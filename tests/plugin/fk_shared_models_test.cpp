@@ -166,7 +166,7 @@ TEST(FkSharedModels, CoreAndSimbodyAgreeOnEveryBodyPose) {
 // Legacy vs 4.0 copies of the same model: the 2017 files (opensim-models@a26e12c) and the current
 // ones give the same body poses, body by body (by name), at the default pose and 100 random
 // coordinate vectors (by coordinate name, within the current file's ranges). The current files
-// were written by OpenSim 4 with 6 significant digits (OPENSIM_SEMANTICS 1.4), and the reader
+// were written by OpenSim 4 with 6 significant digits (docs/opensim_compatibility.md §1.4), and the reader
 // applies the same 6-digit rounding to the legacy offsets, so the trees agree to round-off except
 // where the newer file was edited afterwards (arm26's massless base body; gait2392 re-rounded).
 struct LegacyPair {

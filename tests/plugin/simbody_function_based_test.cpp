@@ -363,7 +363,7 @@ TEST_P(SharedModels, CoreMatchesSimbody) {
   Model m = r.model;
   // gait2392's toes break the inertia triangle inequality, which this Simbody build (checks on)
   // rejects; both sides get OpenSim's debug-build replacement, isotropic |(Ixx, Iyy, Izz)|/sqrt 3
-  // (OPENSIM_SEMANTICS 2), so the joints are still compared on the full model
+  // (docs/opensim_compatibility.md §2), so the joints are still compared on the full model
   int replaced = replaceUnphysicalInertias(m);
   std::printf("  %d body inertias replaced\n", replaced);
   if (std::string(GetParam()).find("Gait2392") != std::string::npos) {

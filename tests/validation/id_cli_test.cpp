@@ -146,7 +146,7 @@ TEST_F(IdCli, SetEMatchesOpenSim46ThroughTheCommandLine) {
   const std::string model = sh + "opensim-models@a26e12c/Pipelines/Gait2392_Simbody/OutputReference/subject01_simbody.osim";
   if (!fs::exists(model) || !fs::exists(sh + "opensim-4.6-results/E.sto"))
     GTEST_SKIP() << "shared OpenSim data not found under " << sh;
-  // the setup names the current (2024) model; the 2017 model is given by flag, as README's table
+  // the setup names the current (2024) model; the 2017 model is given by flag, as docs/shared_data.md's table
   const CmdResult r = run("id --setup " + e + "subject01_Setup_InverseDynamics.xml --model " + model +
                           " --out e.sto");
   ASSERT_EQ(r.code, 0) << r.err;

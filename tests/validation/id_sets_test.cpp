@@ -1,11 +1,11 @@
-// `redmax id` on the shared OpenSim inverse-dynamics sets (../shared/opensim/README.md): A (arm26,
+// `redmax id` on the shared OpenSim inverse-dynamics sets (docs/shared_data.md): A (arm26,
 // filtered and unfiltered), E (gait2392 with ground reactions) and F (gait10dof18musc), all with
 // the 2017 models. Checks, per column and frame:
 //   - core (OpenSim-compatible) vs OpenSim 4.6's own output: RMS <= 1e-6 of the column's peak;
 //   - core vs the Simbody engine on identical inputs: every frame within 1e-9 of the peak (where
 //     Debian's Simbody rejects an inertia, set E, both engines get OpenSim's isotropic fallback);
 //   - against the published (OpenSim 3.x-era) results: A and F agree as OpenSim 4.6 does; E differs
-//     by up to ~5.5% (README), which is reported, and bounded;
+//     by up to ~5.5% (docs/shared_data.md), which is reported, and bounded;
 //   - exact vs OpenSim-compatible kinematics: the difference per column is reported.
 // Skipped with a message when ../shared is absent. Credits: OpenSim (opensim-org/opensim-models)
 // and the model authors (arm26: Holzbaur/Delp et al.; gait2392: Delp et al.; gait10dof18musc).
@@ -223,7 +223,7 @@ TEST_P(IdSets, PublishedResultsAndExactKinematics) {
 
 // A model whose knees are CustomJoints with one coordinate driving several rotations (the
 // Rajagopal-style walking model of OpenSim's Moco tests): there the OpenSim-compatible velocity
-// terms differ from exact kinematics (OPENSIM_SEMANTICS 3.3). No OpenSim ID result exists for it;
+// terms differ from exact kinematics (docs/opensim_compatibility.md §3.3). No OpenSim ID result exists for it;
 // the difference is reported and must be visible in the knee columns, absent in the lumbar ones
 // (a pelvis-like joint, where Simbody's formula is exact).
 TEST(IdCoupledKnee, ExactAndCompatibleDiffer) {

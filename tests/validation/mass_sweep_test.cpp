@@ -506,7 +506,7 @@ TEST_F(MassSweep, CommandLineSweepAndBadValues) {
 }
 
 // ------------------------------------------------------------------------------------------------
-// set F (gait10dof18musc), ../shared/opensim/README.md
+// set F (gait10dof18musc), docs/shared_data.md
 
 TEST_F(MassSweep, SetFTibiaTransferSweep) {
   const std::string base = std::string(REDMAX_SHARED_DIR) + "/opensim/";

@@ -97,7 +97,7 @@ TEST(Simulate, MuscleMassConservesEnergyOnlyWithItsQuadraticVelocityVector) {
 
 TEST(Simulate, ViaPointOnAMovingBodyLeavesOnlyThePassageJumps) {
   // double_pendulum_via.osim's via point rides on link1: mass points sliding past it change
-  // velocity abruptly, so the energy jumps at each passage (README, conditional points) even with
+  // velocity abruptly, so the energy jumps at each passage (docs/notes.md, conditional path points) even with
   // the QVV; dropping the QVV adds the smooth drift on top, several times larger
   SimulationModelOptions mo;
   mo.explicit_masses = {{"via_muscle", 1.0}};

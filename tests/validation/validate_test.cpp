@@ -198,7 +198,7 @@ TEST_F(Validate, CoreOnlyIsRecordedAndStillPasses) {
   EXPECT_NE(redmax::validation::formatIdValidationSummary(r).find("engine simbody: skipped"), std::string::npos);
 }
 
-// set F (gait10dof18musc, ../shared/opensim/README.md) through its setup file, the 2017 model
+// set F (gait10dof18musc, docs/shared_data.md) through its setup file, the 2017 model
 // given by flag, against OpenSim 4.6's own ID result
 TEST_F(Validate, SetFPassesAgainstOpenSim46) {
   const std::string base = std::string(REDMAX_SHARED_DIR) + "/opensim/";

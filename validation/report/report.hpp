@@ -1,5 +1,5 @@
 #pragma once
-// The validation report (`redmax validate ... --report DIR`, DESIGN.md §3): a builder that
+// The validation report (`redmax validate ... --report DIR`, docs/commands.md §1): a builder that
 // collects comparisons, overlays, tables, plots, wall times, checks and free-form sections, and
 // writes them into DIR:
 //   summary.json            machine-readable: inputs, per-comparison per-column metrics,

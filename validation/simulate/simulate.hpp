@@ -1,6 +1,6 @@
 #pragma once
 // Forward simulation of an OpenSim model in the REDMAX core: the driver behind `redmax simulate`
-// (DESIGN.md section 3), reusable by studies (finger flick, work-precision reports).
+// (docs/commands.md §1), reusable by studies (finger flick, work-precision reports).
 //
 //   .osim --readOsimModel--> description --(muscle mass)--> buildCoreModel (constraints on)
 //         --> System: skeleton (gravity from the model) + MuscleTerm (muscles with mass points)

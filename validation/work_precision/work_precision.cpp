@@ -427,7 +427,7 @@ WorkPrecisionResult runWorkPrecision(const std::string& report_dir, const WorkPr
        << " J/s); energy scale (max kinetic energy) " << fmt(sr.energy_scale) << " J.";
     if (sr.reference_energy_drift > 1e-6 * std::max(1.0, sr.energy_scale))
       md << " The reference itself does not conserve energy: mass points of a Type II muscle slide past via "
-            "points on moving bodies, where the mass matrix jumps (README, conditional path points), so the "
+            "points on moving bodies, where the mass matrix jumps (docs/notes.md, conditional path points), so the "
             "motion is only piecewise smooth, orders degrade, and the variational `symplectic` method (which "
             "keeps momentum continuous across a jump while the others keep velocity continuous) converges to "
             "a different solution.";
@@ -449,7 +449,7 @@ WorkPrecisionResult runWorkPrecision(const std::string& report_dir, const WorkPr
             "mass point crosses a via point, M(q) jumps; the ODE solvers keep qdot continuous, the variational "
             "step keeps p = M qdot continuous (v+ = M+^-1 M- v-), and it converges at order 1 to that other "
             "solution (event-located references for both rules in "
-            "tests/core/integrators/variational_muscle_test.cpp; README, notes a researcher should know).\n";
+            "tests/core/integrators/variational_muscle_test.cpp; docs/notes.md).\n";
     md << "\n" << markdownTable(sr);
     scene_md.emplace_back("Scene " + name, md.str());
 

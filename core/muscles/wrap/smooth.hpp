@@ -64,7 +64,7 @@
 // Cost: ellipsoids and tori keep their alpha-independent construction (anchor and frame; plane,
 // tangent points and arc-length table) per thread for the last 8 end-point pairs, keyed by the
 // points with all their dual parts, so a muscle's mass points share it; results never depend on
-// the cache. Measured by `redmax train-wrap --compare` (README, Type III smooth model).
+// the cache. Measured by `redmax train-wrap --compare` (docs/wrapping.md, smooth model).
 // Penetration of an ellipsoid: 1 - the line's distance from the centre in coordinates divided by
 // the semi-axes, times the smallest semi-axis (> 0 exactly when the library wraps).
 // Not supported (smoothWrapUnsupportedReason() says why): spheres and ellipsoids with a quadrant.

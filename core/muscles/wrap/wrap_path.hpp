@@ -1,6 +1,6 @@
 #pragma once
 // A whole musculotendon path with wrap objects, as OpenSim's GeometryPath computes it
-// (computePath + applyWrapObjects + calcLengthAfterPathComputation; OPENSIM_SEMANTICS.md 6):
+// (computePath + applyWrapObjects + calcLengthAfterPathComputation; docs/opensim_compatibility.md §6):
 //   1. the active path points, in order;
 //   2. each PathWrap in order: its previous tangent points are removed; every segment of the
 //      current path between the first active point at/after range_begin and the last active point

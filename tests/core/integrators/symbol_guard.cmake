@@ -1,4 +1,4 @@
-# BUILD_NOTES trap 2 guard: Simbody's libSimTKmath exports C symbols with the same names as
+# docs/build.md trap 2 guard: Simbody's libSimTKmath exports C symbols with the same names as
 # SUNDIALS 6.4, so no binary that can share a process with Simbody may export or import SUNDIALS
 # symbols dynamically. Run as
 #   cmake -DNM=<nm> -DFILES="<lib>;<exe>;..." -P symbol_guard.cmake
@@ -41,5 +41,5 @@ foreach(f IN LISTS FILES)
 endforeach()
 if(_bad)
   message(FATAL_ERROR "symbol_guard: SUNDIALS symbols visible in the dynamic symbol table "
-                      "(they would clash with Simbody's bundled CPodes, BUILD_NOTES trap 2):\n${_bad}")
+                      "(they would clash with Simbody's bundled CPodes, docs/build.md trap 2):\n${_bad}")
 endif()

@@ -1,5 +1,5 @@
 #pragma once
-// Finite-difference helpers shared by the joint tests (STYLE.md: central differences, h ~ 1e-6,
+// Finite-difference helpers shared by the joint tests (docs/design.md §8: central differences, h ~ 1e-6,
 // compared with nearRel).
 #include <random>
 

@@ -1,5 +1,5 @@
 // J_mr against forward kinematics and Jdot_mr against J_mr, by central differences
-// (STYLE.md: every analytic derivative gets an FD test).
+// (docs/design.md §8: every analytic derivative gets an FD test).
 #include "core/skeleton/kinematics.hpp"
 
 #include <gtest/gtest.h>
