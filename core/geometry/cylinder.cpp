@@ -1,4 +1,4 @@
-// WrapCylinder as OpenSim computes it (OPENSIM_SEMANTICS.md 6): candidate tangent points in the
+// WrapCylinder as OpenSim computes it (docs/opensim_compatibility.md §6): candidate tangent points in the
 // planes through P1 and P2 normal to the axis, OpenSim's choice among them, a slide along the axis
 // into the plane through P1, P2 and the apex (constructions.hpp, shared with the smooth model),
 // then a helix between r1 and r2.

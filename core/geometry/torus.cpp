@@ -1,4 +1,4 @@
-// WrapTorus as OpenSim computes it (OPENSIM_SEMANTICS.md 6): the point of the centre circle
+// WrapTorus as OpenSim computes it (docs/opensim_compatibility.md §6): the point of the centre circle
 // nearest the muscle line (searched from each end, the better of the two, quadrant-aware) carries
 // a long cylinder of the tube radius, tangent to the circle, with quadrant "+x" toward the torus
 // centre; the cylinder code does the rest. The search and the frame are constructions.hpp's,
