@@ -1,15 +1,14 @@
 // `redmax train-wrap`: train the Type III wrap network on samples of the exact wrapping library
 // [D Sec. 5.3.3.1], or (--compare) time networks, the smooth model and the exact library per mass
-// point (position + Jacobian + Jdot) against their position error.
+// point (position + Jacobian + Jdot) against their position error. The work is done by
+// tools/wrap_training/ (train.hpp, compare.hpp, study.hpp); this file parses, calls and prints.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <iostream>
 #include <memory>
-#include <random>
 #include <sstream>
 #include <optional>
 #include <string>
@@ -18,8 +17,9 @@
 #include "cli/flags.hpp"
 #include "converter/atomic_file.hpp"
 #include "core/muscles/wrap/network_model.hpp"
-#include "core/muscles/wrap/smooth.hpp"
-#include "core/muscles/wrap/train.hpp"
+#include "tools/wrap_training/compare.hpp"
+#include "tools/wrap_training/study.hpp"
+#include "tools/wrap_training/train.hpp"
 #include "validation/report/csv.hpp"
 #include "validation/report/plot.hpp"
 #include "validation/scenes/wrap_pendulums.hpp"
@@ -128,7 +128,7 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
   net.meta["threshold"] = num(threshold, 6);
   net.meta["test_rms_m"] = num(err.rms, 6);
   net.meta["test_max_m"] = num(err.max, 6);
-  net.meta["box"] = "core/muscles/wrap/train.hpp makeDefaultWrapBox (units of the surface size)";
+  net.meta["box"] = "tools/wrap_training/train.hpp makeDefaultWrapBox (units of the surface size)";
   net.save(*out);
   std::cout << "trained " << net.architecture() << " (" << net.parameterCount() << " parameters) on "
             << wrapTypeName(type) << ": " << history.size() << " epochs, " << history.back().steps << " steps, "
@@ -170,254 +170,38 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
 // ---------------------------------------------------------------------------------------------
 // speed against error
 
-struct CompareRow {
-  std::string method;
-  long parameters = 0;
-  double us_per_point = 0.0;
-  double rms = NAN, max = NAN;
-  std::string note;
-};
-
 int runCompare(const FlagValues& a) {
-  const WrapType type = parseWrapType(a.get("surface", "cylinder"));
+  WrapCompareOptions o;
+  o.type = parseWrapType(a.get("surface", "cylinder"));
+  const WrapType type = o.type;
   const std::optional<std::string> report = optionalFlag(a, "report");
   if (!report) throw UsageError{"--compare needs --report DIR"};
   requireFolder(*report);
-  const long muscles = a.getInt("muscles", 200);
-  const int points = static_cast<int>(a.getInt("mass-points", 20));
+  o.muscles = a.getInt("muscles", 200);
+  o.points = static_cast<int>(a.getInt("mass-points", 20));
+  const long muscles = o.muscles;
+  const int points = o.points;
   if (muscles < 1 || points < 1) throw UsageError{"--muscles and --mass-points must be positive"};
-  const unsigned long long seed = static_cast<unsigned long long>(a.getInt("seed", 1));
-  const double width = a.getDouble("width", 0.05);
-  const WrapInputBox box = makeDefaultWrapBox(type);
-  std::vector<std::pair<std::string, Mlp>> nets;
+  o.seed = static_cast<unsigned long long>(a.getInt("seed", 1));
+  o.width = a.getDouble("width", 0.05);
   for (const auto& f : splitList(a.get("nets", ""))) {
+    Mlp n;
     try {
-      nets.emplace_back(std::filesystem::path(f).stem().string(), Mlp::load(f));
+      n = Mlp::load(f);
     } catch (const NetworkFormatError& e) {
       throw UsageError{e.what()};
     } catch (const std::runtime_error& e) {
       throw UsageError{e.what()};
     }
-    const Mlp& n = nets.back().second;
     if (n.inputs() != wrapInputSize(type) || n.outputs() != 3 || (n.meta.count("surface") && n.meta.at("surface") != wrapTypeName(type)))
       throw UsageError{f + ": not a " + wrapTypeName(type) + " wrap network"};
+    o.nets.push_back({std::filesystem::path(f).stem().string(), std::move(n), false});
   }
   const std::string untrained = a.get("untrained", "6x256");
-  for (const auto& spec : untrained == "none" ? std::vector<std::string>{} : splitList(untrained)) {
-    // timing only: the cost of a network does not depend on its weights
-    Mlp n(wrapInputSize(type), parseHidden(spec), 3, seed);
-    n.input_min = box.lo;
-    n.input_max = box.hi;
-    nets.emplace_back(spec + " (untrained, timing only)", n);
-  }
+  for (const auto& spec : untrained == "none" ? std::vector<std::string>{} : splitList(untrained))
+    o.nets.push_back({spec + " (untrained, timing only)", makeTimingWrapNetwork(type, parseHidden(spec), o.seed), true});
 
-  // muscles: end points from the default box (valid ones), velocities random, 20 mass points each
-  const WrapOracle oracle = makeExactWrapOracle(type);
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u01(0.0, 1.0), uv(-1.0, 1.0);
-  std::vector<VecX> inputs;  // one per muscle (alpha slot unused)
-  std::vector<Vec3> v1s, v2s;
-  while (static_cast<long>(inputs.size()) < muscles) {
-    VecX x(box.lo.size());
-    for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = box.lo[i] + (box.hi[i] - box.lo[i]) * u01(rng);
-    x[6] = 0.5;
-    if (!oracle(x).valid) continue;
-    inputs.push_back(x);
-    v1s.emplace_back(uv(rng), uv(rng), uv(rng));
-    v2s.emplace_back(uv(rng), uv(rng), uv(rng));
-  }
-  std::vector<double> alphas(points);
-  for (int k = 0; k < points; ++k) alphas[k] = (k + 0.5) / points;
-  const long total_points = muscles * points;
-
-  // exact positions (the reference)
-  std::vector<Vec3> exact(total_points);
-  for (long m = 0; m < muscles; ++m) {
-    const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
-    const Vec3 p1 = inputs[m].segment<3>(0), p2 = inputs[m].segment<3>(3);
-    const WrapResult r = calcWrap(s, p1, p2);
-    for (int k = 0; k < points; ++k) exact[m * points + k] = calcWrappedPathPoint(s, r, p1, p2, alphas[k]);
-  }
-  auto errors = [&](const std::vector<Vec3>& x, CompareRow& row) {
-    double se = 0.0, mx = 0.0;
-    for (long i = 0; i < total_points; ++i) {
-      const double e = (x[i] - exact[i]).norm();
-      se += e * e;
-      mx = std::max(mx, e);
-    }
-    row.rms = std::sqrt(se / total_points);
-    row.max = mx;
-  };
-  // repeat a timed loop until it has run 0.3 s; microseconds per mass point
-  auto timePerPoint = [&](const std::function<void()>& all_points) {
-    long reps = 0;
-    const auto t0 = Clock::now();
-    do {
-      all_points();
-      ++reps;
-    } while (secondsSince(t0) < 0.3);
-    return 1e6 * secondsSince(t0) / (static_cast<double>(reps) * total_points);
-  };
-  std::vector<CompareRow> rows;
-  volatile double sink = 0.0;
-
-  // exact library: position, then J and Jdot by central differences, one wrap per perturbed pair
-  // of end points shared by the muscle's mass points, as the runtime does (calcExactWrapPointsFd:
-  // 1 + 12 + 24 wraps per muscle)
-  {
-    CompareRow row;
-    row.method = "exact library + central differences";
-    const double h = 1e-6;
-    std::vector<Vec3> xp(points), xm(points);
-    auto evalAll = [&](const WrapSurface& s, const Vec3& p1, const Vec3& p2, std::vector<Vec3>& xs) {
-      const WrapResult r = calcWrap(s, p1, p2);
-      for (int k = 0; k < points; ++k) xs[k] = calcWrappedPathPoint(s, r, p1, p2, alphas[k]);
-    };
-    std::vector<Eigen::Matrix<double, 3, 6>> J(points), Jp(points), Jm(points);
-    auto jac = [&](const WrapSurface& s, const Vec3& p1, const Vec3& p2, std::vector<Eigen::Matrix<double, 3, 6>>& Js) {
-      for (int i = 0; i < 6; ++i) {
-        Vec3 a1 = p1, a2 = p2, b1 = p1, b2 = p2;
-        (i < 3 ? a1 : a2)[i % 3] += h;
-        (i < 3 ? b1 : b2)[i % 3] -= h;
-        evalAll(s, a1, a2, xp);
-        evalAll(s, b1, b2, xm);
-        for (int k = 0; k < points; ++k) Js[k].col(i) = (xp[k] - xm[k]) / (2 * h);
-      }
-    };
-    std::vector<Vec3> x(points);
-    row.us_per_point = timePerPoint([&] {
-      for (long m = 0; m < muscles; ++m) {
-        const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
-        const Vec3 p1 = inputs[m].segment<3>(0), p2 = inputs[m].segment<3>(3);
-        evalAll(s, p1, p2, x);
-        jac(s, p1, p2, J);
-        jac(s, p1 + h * v1s[m], p2 + h * v2s[m], Jp);
-        jac(s, p1 - h * v1s[m], p2 - h * v2s[m], Jm);
-        for (int k = 0; k < points; ++k) {
-          const Eigen::Matrix<double, 3, 6> Jdot = (Jp[k] - Jm[k]) / (2 * h);
-          sink = sink + x[k][0] + J[k](0, 0) + Jdot(0, 0);
-        }
-      }
-    });
-    row.rms = row.max = 0.0;
-    row.note = "reference; J, Jdot jump at contact changes";
-    rows.push_back(row);
-  }
-
-  // smooth model
-  {
-    CompareRow row;
-    row.method = "smooth model (width " + num(width, 3) + " size)";
-    std::vector<Vec3> x(total_points);
-    // the band in units of the surface's size (radius, tube radius, smallest semi-axis)
-    auto bandOf = [&](const WrapSurface& s) {
-      const double size = type == WrapType::Torus       ? s.inner_radius
-                          : type == WrapType::Ellipsoid ? s.dimensions.minCoeff()
-                                                        : s.radius;
-      return SmoothWrapOptions{width * size};
-    };
-    for (long m = 0; m < muscles; ++m) {
-      const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
-      for (int k = 0; k < points; ++k)
-        x[m * points + k] = calcSmoothWrapPoint(s, inputs[m].segment<3>(0), inputs[m].segment<3>(3), alphas[k], bandOf(s));
-    }
-    errors(x, row);
-    row.us_per_point = timePerPoint([&] {
-      for (long m = 0; m < muscles; ++m) {
-        const WrapSurface s = makeWrapSurfaceFromInput(type, inputs[m]);
-        for (int k = 0; k < points; ++k) {
-          const auto sp = calcSmoothWrapPointDerivatives(s, inputs[m].segment<3>(0), inputs[m].segment<3>(3), alphas[k],
-                                                         v1s[m], v2s[m], bandOf(s));
-          sink = sink + sp.x[0] + sp.J(0, 0) + sp.Jdot(0, 0);
-        }
-      }
-    });
-    row.note = type == WrapType::Ellipsoid ? "exact J, Jdot (dual numbers); a muscle's points share the plane construction"
-                                           : "exact J, Jdot (dual numbers)";
-    rows.push_back(row);
-  }
-
-  // networks: one batch per muscle (all its mass points), exact Jdot and the forward difference
-  for (const auto& [name, net] : nets) {
-    std::vector<MatX> X(muscles), Xdot(muscles);
-    for (long m = 0; m < muscles; ++m) {
-      X[m].resize(net.inputs(), points);
-      Xdot[m] = MatX::Zero(net.inputs(), points);
-      for (int k = 0; k < points; ++k) {
-        X[m].col(k) = inputs[m];
-        X[m](6, k) = alphas[k];
-        Xdot[m].col(k).segment<3>(0) = v1s[m];
-        Xdot[m].col(k).segment<3>(3) = v2s[m];
-      }
-    }
-    MlpWorkspace ws;
-    MatX Y, J, Jdot, Yf, Jf, Jdot_fd;
-    std::vector<Vec3> x(total_points);
-    double jd_diff = 0.0, jd_norm = 0.0;
-    long outside = 0;
-    for (long m = 0; m < muscles; ++m) {
-      net.calcJacobianDot(X[m], Xdot[m], Y, J, Jdot, ws);
-      net.calcJacobianDotFd(X[m], Xdot[m], 1e-6, Yf, Jf, Jdot_fd, ws);
-      jd_diff += (Jdot_fd - Jdot).squaredNorm();
-      jd_norm += Jdot.squaredNorm();
-      for (int k = 0; k < points; ++k) {
-        x[m * points + k] = Y.col(k);
-        if (!net.insideBox(X[m].col(k))) ++outside;
-      }
-    }
-    const bool untrained = name.find("untrained") != std::string::npos;
-    CompareRow row;
-    row.method = "network " + name;
-    row.parameters = net.parameterCount();
-    if (!untrained) errors(x, row);
-    row.us_per_point = timePerPoint([&] {
-      for (long m = 0; m < muscles; ++m) {
-        net.calcJacobianDot(X[m], Xdot[m], Y, J, Jdot, ws);
-        sink = sink + Y(0, 0) + J(0, 0) + Jdot(0, 0);
-      }
-    });
-    const double fd_us = timePerPoint([&] {
-      for (long m = 0; m < muscles; ++m) {
-        net.calcJacobianDotFd(X[m], Xdot[m], 1e-6, Y, J, Jdot, ws);
-        sink = sink + Y(0, 0) + J(0, 0) + Jdot(0, 0);
-      }
-    });
-    // the same network as a run-time wrap model (network_model.hpp: scaling by the radius, the box
-    // test on every input, the smooth model where it fails)
-    const bool as_model = networkWrapUnsupportedReason(net).empty() && (type == WrapType::Cylinder || type == WrapType::Sphere);
-    std::vector<WrapSurface> surfs;
-    for (long m = 0; m < muscles && as_model; ++m) surfs.push_back(makeWrapSurfaceFromInput(type, inputs[m]));
-    NetworkWrapWorkspace nws;
-    WrapMassPoints wmp;
-    std::vector<long> on_net;  // muscles whose scaled inputs stay in the box (timed: the network's cost)
-    for (long m = 0; m < muscles && as_model; ++m)
-      if (calcNetworkWrapModel(&net, surfs[m], inputs[m].segment<3>(0), inputs[m].segment<3>(3), v1s[m], v2s[m], alphas,
-                               true, wmp, nws)
-              .usedNetwork())
-        on_net.push_back(m);
-    double model_us = NAN;
-    if (!on_net.empty()) {
-      long reps = 0;
-      const auto t0 = Clock::now();
-      do {
-        for (long m : on_net) {
-          calcNetworkWrapModel(&net, surfs[m], inputs[m].segment<3>(0), inputs[m].segment<3>(3), v1s[m], v2s[m], alphas,
-                               true, wmp, nws);
-          sink = sink + wmp.x[0][0] + wmp.J[0](0, 0) + wmp.Jdot[0](0, 0);
-        }
-        ++reps;
-      } while (secondsSince(t0) < 0.3);
-      model_us = 1e6 * secondsSince(t0) / (static_cast<double>(reps) * on_net.size() * points);
-    }
-    const long fell_back = muscles - static_cast<long>(on_net.size());
-    row.note = "exact Jdot; Eq. 5.58 FD Jdot (eps 1e-6): " + num(fd_us, 3) + " us/point, rel. diff " +
-               num(std::sqrt(jd_diff / std::max(jd_norm, 1e-300)), 2);
-    if (as_model)
-      row.note += "; as a wrap model (scaling, box test, " + std::to_string(fell_back) + " of " + std::to_string(muscles) +
-                  " muscles leave the box at radius 0.5-1.5, timed on the others): " + num(model_us, 3) + " us/point";
-    if (outside) row.note += "; " + std::to_string(outside) + " points outside the training box";
-    rows.push_back(row);
-  }
+  const std::vector<WrapCompareRow> rows = compareWrapModels(o);
 
   // table, CSV, plot
   validation::CsvTable t;
@@ -446,11 +230,10 @@ int runCompare(const FlagValues& a) {
                                                    "RMS position error (surface size units)", lines));
   const auto gp = validation::findGnuplot();
   if (gp.available) {
-    const auto o = validation::renderPlot(gp, validation::PlotFormat::Auto, fig, *report + "/speed_error");
-    if (!o.ok) std::cerr << "note: plot not drawn: " << o.error << "\n";
+    const auto drawn = validation::renderPlot(gp, validation::PlotFormat::Auto, fig, *report + "/speed_error");
+    if (!drawn.ok) std::cerr << "note: plot not drawn: " << drawn.error << "\n";
   }
   std::cout << "wrote " << *report << "/speed_error.csv and the plot\n";
-  (void)sink;
   return 0;
 }
 
@@ -461,87 +244,64 @@ int runStudy(const FlagValues& a) {
   const std::optional<std::string> report = optionalFlag(a, "report");
   if (!report) throw UsageError{"--study needs --report DIR"};
   requireFolder(*report);
-  std::vector<double> thresholds;
+  WrapStudyOptions o;
+  o.thresholds.clear();
   for (const auto& t : splitList(a.get("thresholds", "0.01,0.05,0.1"))) {
     char* end = nullptr;
     const double v = std::strtod(t.c_str(), &end);
     if (*end != '\0' || !(v >= 0.0 && v < 1.0)) throw UsageError{"--thresholds: '" + t + "' is not in [0, 1)"};
-    thresholds.push_back(v);
+    o.thresholds.push_back(v);
   }
-  std::vector<std::string> archs = splitList(a.get("architectures", "1x32,3x32"));
-  for (const auto& h : archs) parseHidden(h);  // validate before training
-  const long samples = a.getInt("samples", 10000);
-  if (samples < 10) throw UsageError{"--samples must be at least 10"};
-  TrainOptions opt;
+  o.architectures = splitList(a.get("architectures", "1x32,3x32"));
+  for (const auto& h : o.architectures) parseHidden(h);  // validate before training
+  o.samples = a.getInt("samples", 10000);
+  if (o.samples < 10) throw UsageError{"--samples must be at least 10"};
+  TrainOptions& opt = o.train;
   opt.epochs = static_cast<int>(a.getInt("epochs", 60));
   opt.batch = static_cast<int>(a.getInt("batch", 64));
   opt.learning_rate = a.getDouble("lr", 1e-3);
   opt.seed = static_cast<unsigned long long>(a.getInt("seed", 1));
   if (opt.epochs < 1 || opt.batch < 1) throw UsageError{"--epochs and --batch must be positive"};
 
-  // Fig. 6.8's scene: unit cylinder, origin fixed, the insertion moves along x through the contact
-  // change (the straight line touches the cylinder at ins_x = -0.33)
-  const WrapType type = WrapType::Cylinder;
-  const WrapSurface surf = WrapSurface::makeCylinder(1.0, 1000.0);
-  const Vec3 ori(-2.0, 1.2, 0.3);
-  const double alpha = 0.5;
-  const int n = 251;
-  std::vector<double> xs(n), x_exact(n), j_exact(n);
-  auto exactPoint = [&](double x) {
-    const Vec3 ins(x, -1.3, -0.2);
-    return calcWrappedPathPoint(surf, calcWrap(surf, ori, ins), ori, ins, alpha);
-  };
-  for (int k = 0; k < n; ++k) {
-    xs[k] = -1.5 + 2.5 * k / (n - 1);
-    x_exact[k] = exactPoint(xs[k])[0];
-    const double h = 1e-7;  // one-sided near the kink would mix branches: central, tiny step
-    j_exact[k] = (exactPoint(xs[k] + h)[0] - exactPoint(xs[k] - h)[0]) / (2 * h);
-  }
-  const WrapInputBox box = makeDefaultWrapBox(type);
-  const WrapOracle oracle = makeExactWrapOracle(type);
+  const WrapStudy study = runWrapThresholdStudy(o, [](const WrapStudyCurve& c) {
+    std::cerr << "train-wrap --study: threshold " << c.threshold << ", " << c.architecture << ": validation rms "
+              << c.val_rms << " (size units)\n";
+  });
+
+  // CSV: the sweep, the exact library, then x and its derivative per network; a plot per threshold
+  const std::vector<double>& xs = study.ins_x;
   validation::CsvTable t;
   t.header = {"ins_x", "x_exact", "dxdins_exact"};
-  std::vector<std::vector<double>> cols;
   validation::PlotFigure fig;
   fig.title = "x_alpha (alpha 0.5) and d x_alpha / d ins_x near the contact change, by threshold and network";
   fig.columns = 2;
-  for (double thr : thresholds) {
-    const WrapTrainingSet data = makeWrapTrainingSet(box, oracle, samples, thr, opt.seed);
-    std::vector<validation::PlotLine> lx{validation::makePlotLine("exact library", xs, x_exact)},
-        lj{validation::makePlotLine("exact library (differences)", xs, j_exact)};
-    for (const auto& arch : archs) {
-      opt.hidden = parseHidden(arch);
-      const Mlp net = trainWrapNetwork(data, box, opt);
-      MlpWorkspace ws;
-      MatX X(8, n), Y, J;
-      for (int k = 0; k < n; ++k) X.col(k) << ori, Vec3(xs[k], -1.3, -0.2), alpha, 1.0;
-      net.calcJacobian(X, Y, J, ws);
-      std::vector<double> xn(n), jn(n);
-      for (int k = 0; k < n; ++k) xn[k] = Y(0, k), jn[k] = J(0, 8 * k + 3);
-      const std::string name = arch + " thr " + num(thr, 3);
+  const size_t na = o.architectures.size();  // curves: threshold-major
+  for (size_t i = 0; i < o.thresholds.size(); ++i) {
+    const double thr = o.thresholds[i];
+    std::vector<validation::PlotLine> lx{validation::makePlotLine("exact library", xs, study.x_exact)},
+        lj{validation::makePlotLine("exact library (differences)", xs, study.dxdins_exact)};
+    for (size_t j = 0; j < na; ++j) {
+      const WrapStudyCurve& c = study.curves[i * na + j];
+      const std::string name = c.architecture + " thr " + num(thr, 3);
       t.header.push_back("x_" + name);
       t.header.push_back("dxdins_" + name);
-      cols.push_back(xn);
-      cols.push_back(jn);
-      lx.push_back(validation::makePlotLine(arch, xs, xn));
-      lj.push_back(validation::makePlotLine(arch, xs, jn));
-      std::cerr << "train-wrap --study: threshold " << thr << ", " << arch << ": validation rms "
-                << net.meta.at("final_val_rms_m") << " (size units)\n";
+      lx.push_back(validation::makePlotLine(c.architecture, xs, c.x));
+      lj.push_back(validation::makePlotLine(c.architecture, xs, c.dxdins));
     }
     fig.panels.push_back(validation::makeXYPanel("x_alpha.x, threshold " + num(100 * thr, 3) + "%", "ins_x", "x_alpha.x", lx));
     fig.panels.push_back(validation::makeXYPanel("d x_alpha.x / d ins_x, threshold " + num(100 * thr, 3) + "%", "ins_x",
                                                  "Jacobian entry", lj));
   }
-  for (int k = 0; k < n; ++k) {
-    std::vector<double> row{xs[k], x_exact[k], j_exact[k]};
-    for (const auto& c : cols) row.push_back(c[k]);
+  for (size_t k = 0; k < xs.size(); ++k) {
+    std::vector<double> row{xs[k], study.x_exact[k], study.dxdins_exact[k]};
+    for (const auto& c : study.curves) row.push_back(c.x[k]), row.push_back(c.dxdins[k]);
     t.addRow(row);
   }
   osim::writeFileAtomic(*report + "/study.csv", validation::formatCsv(t));
   const auto gp = validation::findGnuplot();
   if (gp.available) {
-    const auto o = validation::renderPlot(gp, validation::PlotFormat::Auto, fig, *report + "/study");
-    if (!o.ok) std::cerr << "note: plot not drawn: " << o.error << "\n";
+    const auto drawn = validation::renderPlot(gp, validation::PlotFormat::Auto, fig, *report + "/study");
+    if (!drawn.ok) std::cerr << "note: plot not drawn: " << drawn.error << "\n";
   }
   std::cout << "wrote " << *report << "/study.csv and the plot\n";
   return 0;
@@ -710,7 +470,7 @@ CommandRegistration reg(
      "       redmax train-wrap --pendulums NET.txt [--count 8] [--duration 2] [--tol 1e-12] [--seed S] [--fd-jdot]\n"
      "                         [--report DIR]\n"
      "Training [D Sec. 5.3.3.1]: N samples (default 30000) drawn uniformly from the surface type's box\n"
-     "(core/muscles/wrap/train.hpp makeDefaultWrapBox; units of the surface size) and labelled by the exact\n"
+     "(tools/wrap_training/train.hpp makeDefaultWrapBox; units of the surface size) and labelled by the exact\n"
      "library; samples with 0 < l/L < threshold are discarded. A tanh MLP (--hidden DEPTHxWIDTH or W1-W2-...,\n"
      "default 6x256) is trained with Adam (--lr, default 1e-4; --batch default 256) on the mean squared error\n"
      "for E epochs (default 100) or until --time-limit. Deterministic for a seed. The network file records\n"

@@ -399,6 +399,10 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
     so.simbody_check = sb_run.ran;
     so.engine_rel = opt.engine_rel;
     so.engine_abs = opt.engine_abs;
+    // the value 0 against the same references as the zero-mass core, at their tolerance
+    for (size_t i = 0; i < refs.size(); ++i) so.references.push_back({ref_labels[i], refs[i]});
+    so.reference_tolerance = {opt.reference_abs, opt.reference_rms_rel, opt.reference_abs, opt.reference_max_rel};
+    so.interpolation = opt.interpolation;
     r.mass_sweep = runMassSweep(tool, core_result, so, mass_factory);
     double secs = 0;
     for (const auto& p : r.mass_sweep.points) secs += p.seconds;

@@ -18,10 +18,11 @@
 // difference from the zero-mass core is reported per column as the "inertial effect"
 // (summary.inertial_effect, inertial_effect.csv, an overlay, core_mass_id.sto): a measurement,
 // never a failure. With mass_sweep values, the core is solved once per value instead
-// (validation/mass_sweep.hpp; summary.mass_sweep); of the sweep only its zero check (the value 0
-// reproduces the zero-mass result) can fail. In both cases, when the Simbody engine runs, Simbody
+// (validation/mass_sweep.hpp; summary.mass_sweep); of the sweep, its zero check (the value 0,
+// massless points, reproduces the zero-mass result), the value 0 against each reference, and
+// Simbody at every value can fail. In both cases, when the Simbody engine runs, Simbody
 // with muscle inertia (plugin/simbody, the same model and mass points) solves the muscle-mass
-// trial (the sweep's largest value) too: core_mass_vs_simbody_mass at the engine tolerance, a
+// trial (every sweep value) too: core_mass_vs_simbody_mass at the engine tolerance, a
 // check in the verdict (summary.simbody_mass_check), recorded only when wrapping muscles carry
 // mass over the exact wrap model (simbodyMassCheckNotCountedReason).
 #include <limits>

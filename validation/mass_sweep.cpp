@@ -76,14 +76,37 @@ MassSweepEngineFactory makeCoreMassEngineFactory(const osim::InverseDynamicsTool
         samples.push_back(q);
       }
     }
-    osim::MuscleMassModel mm = osim::applyMuscleMass(t->description(), bo, o, samples);
+    MassSweepEngine e;
+    osim::MuscleMassModel mm;
+    if (hasZeroMuscleMass(o)) {
+      // zero mass still runs the mass-point code: the points a small positive value places (their
+      // fractions of the path do not depend on the mass), each massless, on the unchanged bodies
+      osim::MuscleMassOptions layout = o;
+      if (isTransfer(o)) layout.transfer_fraction = 1e-6;
+      else layout.density = 1e-6 * osim::kDefaultMuscleDensity;
+      const osim::MuscleMassModel points = osim::applyMuscleMass(t->description(), bo, layout, samples);
+      osim::MuscleMassOptions none = layout;  // the options are checked whatever the source
+      none.source = Source::None;
+      mm = osim::applyMuscleMass(t->description(), bo, none);
+      mm.build.muscles = points.build.muscles;
+      int n_points = 0;
+      for (Muscle& mu : mm.build.muscles) {
+        for (double& m_a : mu.mass_points.mass) m_a = 0.0;
+        e.muscles_with_mass += mu.mass_points.size() > 0;
+        n_points += mu.mass_points.size();
+      }
+      e.wrap = osim::countWrapMass(points.plan);
+      e.description = "muscle mass 0: " + std::to_string(e.muscles_with_mass) + " muscles carry " +
+                      std::to_string(n_points) + " mass points of zero mass; every body keeps its mass\n";
+    } else {
+      mm = osim::applyMuscleMass(t->description(), bo, o, samples);
+      for (const auto& me : mm.plan.muscles) e.muscles_with_mass += me.mass > 0.0;
+      e.description = osim::describeMuscleMass(mm.plan);
+      e.wrap = osim::countWrapMass(mm.plan);
+    }
     if (mm.build.model.nr() != t->model().nr())
       throw osim::ConvertError(t->config().model_file, 0, "the model with muscle mass has other coordinates");
-    MassSweepEngine e;
     e.muscle_mass = mm.plan.total_muscle_mass;
-    for (const auto& me : mm.plan.muscles) e.muscles_with_mass += me.mass > 0.0;
-    e.description = osim::describeMuscleMass(mm.plan);
-    e.wrap = osim::countWrapMass(mm.plan);
     e.model = std::make_shared<const Model>(mm.build.model);
     e.muscles = mm.build.muscles;
     // the core with the muscles' mass points as a MuscleTerm (core_id_engine.hpp)
@@ -94,15 +117,14 @@ MassSweepEngineFactory makeCoreMassEngineFactory(const osim::InverseDynamicsTool
 
 osim::MuscleMassOptions massOptionsForValue(const osim::MuscleMassOptions& base, double value) {
   osim::MuscleMassOptions o = base;
-  if (isTransfer(base)) {
-    o.transfer_fraction = value;
-  } else if (value == 0.0) {
-    // a density of 0 is not a physical option: scale 0 is the model without muscle mass
-    o.source = Source::None;
-  } else {
-    o.density = base.density * value;  // every physiological mass scales with the density
-  }
+  if (isTransfer(base)) o.transfer_fraction = value;
+  else o.density = base.density * value;  // every physiological mass scales with the density (0 at 0)
   return o;
+}
+
+bool hasZeroMuscleMass(const osim::MuscleMassOptions& o) {
+  return (o.source == Source::Physiological && o.density == 0.0) ||
+         (o.source == Source::Transfer && o.transfer_fraction == 0.0);
 }
 
 std::vector<double> checkMassSweepValues(const osim::MuscleMassOptions& base, std::vector<double> values) {
@@ -252,37 +274,39 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
   std::vector<MatX> tau;
   for (double v : r.options.values) {
     MassSweepEngine e = factory(massOptionsForValue(options.base, v));
-    // Simbody with muscle inertia at the largest value: the same model and mass points
-    if (options.simbody_check && v == r.options.values.back()) {
-      r.simbody.value = v;
+    // Simbody with muscle inertia at every value: the same model and mass points
+    if (options.simbody_check) {
+      MassSweepSimbodyCheck c;
+      c.value = v;
       if (!e.model) {
-        r.simbody.skipped = "the engine factory gave no model";
+        c.skipped = "the engine factory gave no model";
       } else {
         SimbodyCrossCheckEngine sb;
         try {
           sb = makeSimbodyCrossCheckEngine(*e.model, e.muscles, tool.engineOptions());
         } catch (const std::exception& ex) {
-          r.simbody.skipped = std::string("the Simbody engine cannot build this model: ") + ex.what();
+          c.skipped = std::string("the Simbody engine cannot build this model: ") + ex.what();
         }
         if (sb.engine) {
           try {
-            r.simbody.result = tool.run(*sb.engine);
-            r.simbody.result.name = osim::kIdStorageName;
-            r.simbody.ran = true;
+            c.result = tool.run(*sb.engine);
+            c.result.name = osim::kIdStorageName;
+            c.ran = true;
             if (sb.usedFallback()) {
               // the same model for both: the core again, with the fallback inertia
               osim::CoreIdEngine core_fallback(*sb.fallback_model, e.muscles, tool.engineOptions());
-              r.simbody.core_result = tool.run(core_fallback);
-              r.simbody.core_result.name = osim::kIdStorageName;
-              r.simbody.note = describeInertiaFallback(sb);
+              c.core_result = tool.run(core_fallback);
+              c.core_result.name = osim::kIdStorageName;
+              c.note = describeInertiaFallback(sb);
             }
           } catch (const std::exception& ex) {
             // an engine that fails where the core succeeds is a disagreement
-            r.simbody.failed = true;
-            r.simbody.skipped = std::string("the Simbody engine failed: ") + ex.what();
+            c.failed = true;
+            c.skipped = std::string("the Simbody engine failed: ") + ex.what();
           }
         }
       }
+      r.simbody_values.push_back(std::move(c));
     }
     if (!e.engine) throw std::invalid_argument("mass sweep: the engine factory made no engine");
     ProgressOptions po;
@@ -303,15 +327,56 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
     tau.push_back(s.data);
     r.torques.push_back(std::move(s));
   }
-  if (r.simbody.ran) {
+  if (options.simbody_check) {
     CompareOptions co;
     co.tolerance = {options.engine_abs, options.engine_rel, options.engine_abs, options.engine_rel};
     co.align.grid_table = 0;
     co.missing_columns_fail = true;
-    r.simbody.comparison = compareTables("core_mass_vs_simbody_mass", r.simbody.coreTorques(r.torques.back()),
-                                         "core_mass", r.simbody.result, "simbody_mass", co);
-    r.simbody.not_counted = simbodyMassCheckNotCountedReason(massOptionsForValue(options.base, r.simbody.value),
-                                                             r.points.back().wrap);
+    const size_t z = 0;  // checkMassSweepValues puts 0 first
+    MassSweepSimbodyCheck& c0 = r.simbody_values[z];
+    for (size_t j = 0; j < r.simbody_values.size(); ++j) {
+      MassSweepSimbodyCheck& c = r.simbody_values[j];
+      if (!c.ran) continue;
+      const osim::Storage& core_j = c.coreTorques(r.torques[j]);
+      c.comparison = compareTables("core_mass_vs_simbody_mass", core_j, "core_mass", c.result, "simbody_mass", co);
+      c.not_counted = simbodyMassCheckNotCountedReason(massOptionsForValue(options.base, c.value), r.points[j].wrap);
+      // the inertial effect of each engine against its own value 0 (same model pair at both ends:
+      // the fallback inertia, when used, is the same at every value)
+      if (!c0.ran) continue;
+      const osim::Storage& core_0 = c0.coreTorques(r.torques[z]);
+      if (core_j.data.rows() != core_0.data.rows() || c.result.data.rows() != c0.result.data.rows() ||
+          core_j.data.cols() != c.result.data.cols() || core_j.data.rows() != c.result.data.rows())
+        continue;
+      const MatX eff_core = core_j.data - core_0.data, eff_sb = c.result.data - c0.result.data;
+      double worst_peak = 0, worst_eff = 0;
+      bool any_effect = false;
+      for (int col = 0; col < eff_core.cols(); ++col) {
+        const double d = (eff_core.col(col) - eff_sb.col(col)).cwiseAbs().maxCoeff();
+        const double peak = core_0.data.col(col).cwiseAbs().maxCoeff();
+        const double eff = eff_core.col(col).cwiseAbs().maxCoeff();
+        worst_peak = std::max(worst_peak, peak > 0 ? d / peak : d);
+        if (eff > 1e-12 * peak) {
+          any_effect = true;
+          worst_eff = std::max(worst_eff, d / eff);
+        }
+      }
+      c.effect_max_rel = worst_peak;
+      if (any_effect) c.effect_rel_to_effect = worst_eff;
+    }
+    r.simbody = r.simbody_values.back();
+  }
+  // the value 0 (massless points) against results computed elsewhere (OpenSim's own ID)
+  for (const MassSweepOptions::Reference& ref : options.references) {
+    CompareOptions co;
+    co.tolerance = options.reference_tolerance;
+    co.align.grid_table = 1;
+    co.align.interpolation = options.interpolation;
+    try {
+      r.zero_vs_references.push_back(compareTables("mass_sweep_zero_vs_" + ref.label, r.torques.front(), "core_zero_points",
+                                                   ref.table, ref.label, co));
+    } catch (const CompareError& ex) {
+      throw CompareError(ref.label + ": " + ex.what());
+    }
   }
   r.analysis = analyzeMassSweep(r.options.values, tau, zero_mass.data, options.zero_tolerance);
   for (size_t c = 0; c < r.analysis.columns.size(); ++c) r.analysis.columns[c].name = labels[c];
@@ -411,7 +476,44 @@ void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_ma
     addSimbodyMassCheck(r.simbody.comparison, r.simbody.coreTorques(r.torques.back()), r.simbody.result, report,
                         r.simbody.not_counted);
 
-  // the zero check: the only sweep result that can fail
+  // Simbody at every value: engines and their inertial effects, the degradation toward s = 0
+  if (!r.simbody_values.empty()) {
+    CsvTable t;
+    t.header = {"value", "ran", "worst_column", "max_rel", "agrees", "effect_max_rel", "effect_rel_to_effect", "counted"};
+    bool all_agree = true, any_counted = false;
+    std::string worst_detail;
+    double worst = -1;
+    for (const MassSweepSimbodyCheck& c : r.simbody_values) {
+      const bool counted = c.not_counted.empty();
+      std::string col;
+      double max_rel = std::numeric_limits<double>::quiet_NaN();
+      if (c.ran && c.comparison.worst >= 0) {
+        const ColumnMetrics& w = c.comparison.metrics[static_cast<size_t>(c.comparison.worst)];
+        col = w.name;
+        max_rel = w.max_rel;
+      }
+      t.addRow({formatNumber(c.value), c.ran ? "1" : "0", col, formatNumber(max_rel),
+                c.ran ? (c.comparison.passed ? "PASS" : "DIFFERS") : (c.failed ? "FAILED" : "skipped"),
+                formatNumber(c.effect_max_rel), formatNumber(c.effect_rel_to_effect), counted ? "1" : "0"});
+      if (!counted) continue;
+      if (c.failed || (c.ran && !c.comparison.passed)) all_agree = false;
+      if (c.ran || c.failed) any_counted = true;
+      if (c.ran && max_rel > worst) {
+        worst = max_rel;
+        worst_detail = "worst at " + valueLabel(base, c.value) + ": `" + col + "` max/peak " + fmtG("%.3g", max_rel);
+      }
+    }
+    report.addTable("mass_sweep_simbody", t,
+                    "per sweep value: core vs Simbody with muscle inertia (max |d| / column peak), and the two "
+                    "engines' inertial effects tau(s) - tau(0) against each other (relative to the zero-mass peak "
+                    "and to the core's largest effect)");
+    if (any_counted)
+      report.addCheck("mass sweep: core equals Simbody with muscle inertia at every value", all_agree, worst_detail);
+  }
+  // the value 0 against OpenSim's own result (and any other reference)
+  for (const Comparison& c : r.zero_vs_references) report.addComparison(c, "generalized force [N m or N]");
+
+  // the zero check: the value 0 (massless points) against the plain zero-mass run
   if (an.zero_index >= 0)
     report.addCheck("mass sweep: the zero value reproduces the zero-mass result", an.zero_passed,
                     "max |tau(0) - tau_zero_mass| / peak = " + fmtG("%.3g", an.zero_max_rel) + " (tolerance " +
@@ -460,6 +562,36 @@ void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_ma
   sbj["value"] = r.simbody.value;
   if (!r.simbody.note.empty()) sbj["inertia_fallback"] = r.simbody.note;
   js["simbody_check"] = sbj;
+  JsonValue sbv = JsonValue::array();
+  for (const MassSweepSimbodyCheck& c : r.simbody_values) {
+    JsonValue o = JsonValue::object();
+    o["value"] = c.value;
+    o["ran"] = c.ran;
+    if (!c.skipped.empty()) o["skipped"] = c.skipped;
+    if (c.ran) {
+      o["agrees"] = c.comparison.passed;
+      if (c.comparison.worst >= 0) o["worst_max_rel"] = num(c.comparison.metrics[static_cast<size_t>(c.comparison.worst)].max_rel);
+    }
+    o["effect_max_rel"] = num(c.effect_max_rel);
+    o["effect_rel_to_effect"] = num(c.effect_rel_to_effect);
+    o["counted_in_verdict"] = c.not_counted.empty();
+    sbv.push(o);
+  }
+  js["simbody_values"] = sbv;
+  JsonValue zr = JsonValue::array();
+  for (const Comparison& c : r.zero_vs_references) {
+    JsonValue o = JsonValue::object();
+    o["name"] = c.name;
+    o["reference"] = c.label_b;
+    o["passed"] = c.passed;
+    if (c.worst >= 0) {
+      o["worst_column"] = c.metrics[static_cast<size_t>(c.worst)].name;
+      o["worst_rms_rel"] = num(c.metrics[static_cast<size_t>(c.worst)].rms_rel);
+      o["worst_max_rel"] = num(c.metrics[static_cast<size_t>(c.worst)].max_rel);
+    }
+    zr.push(o);
+  }
+  js["zero_vs_references"] = zr;
   JsonValue zc = JsonValue::object();
   zc["present"] = an.zero_index >= 0;
   zc["max_rel"] = num(an.zero_max_rel);
@@ -504,7 +636,26 @@ void addMassSweepToReport(const MassSweepResult& r, const osim::Storage& zero_ma
             << fmtG("%+.2f%%", 100 * col.peak_change_rel[last]) << " | " << fmtG("%.2f%%", 100 * col.max_diff_rel[last])
             << " | " << (col.has_effect ? fmtG("%.12f", col.r2) : std::string("no effect")) << " | "
             << fmtG("%.2g", col.nonlinearity_rel) << " |\n";
-  md_text << "\nZero check (the value 0 against the zero-mass run): max |diff| / peak = "
+  if (!r.simbody_values.empty()) {
+    md_text << "\nSimbody with muscle inertia (plugin/simbody's own mass-point kinematics) at every value; the "
+               "inertial effect tau(s) - tau(0) of each engine against the other's:\n\n| value | core vs Simbody "
+               "max / peak | effect difference / peak | effect difference / effect |\n|---|---|---|---|\n";
+    for (const MassSweepSimbodyCheck& c : r.simbody_values) {
+      const double mr = c.ran && c.comparison.worst >= 0
+                            ? c.comparison.metrics[static_cast<size_t>(c.comparison.worst)].max_rel
+                            : std::numeric_limits<double>::quiet_NaN();
+      md_text << "| " << valueLabel(base, c.value) << " | "
+              << (c.ran ? fmtG("%.3g", mr) : std::string(c.failed ? "failed" : "skipped")) << " | "
+              << fmtG("%.3g", c.effect_max_rel) << " | " << fmtG("%.3g", c.effect_rel_to_effect) << " |\n";
+    }
+  }
+  for (const Comparison& c : r.zero_vs_references)
+    if (c.worst >= 0)
+      md_text << "\nThe value 0 (massless points) against " << c.label_b << ": worst `"
+              << c.metrics[static_cast<size_t>(c.worst)].name << "` RMS / peak "
+              << fmtG("%.3g", c.metrics[static_cast<size_t>(c.worst)].rms_rel) << " -> "
+              << (c.passed ? "PASS" : "FAIL") << ".\n";
+  md_text << "\nZero check (the value 0, massless points, against the plain zero-mass run): max |diff| / peak = "
           << fmtG("%.3g", an.zero_max_rel) << " -> " << (an.zero_passed ? "PASS" : "FAIL") << ".\n\n"
           << "Linear by construction: inverse dynamics is linear in the body inertias and the mass-point "
              "masses at fixed (q, qdot, qddot), and the sweep changes those affinely while the mass points "
@@ -625,6 +776,23 @@ std::string formatMassSweepSummary(const MassSweepResult& r) {
     std::istringstream wl(formatWrapMassCount(r.points.back().wrap));
     for (std::string line; std::getline(wl, line);) os << "  " << line << "\n";
   }
+  if (r.simbody_values.size() > 1) {
+    os << "  simbody with muscle inertia per value (max/peak; effect difference / effect):";
+    for (const MassSweepSimbodyCheck& c : r.simbody_values) {
+      os << " " << valueLabel(base, c.value) << " ";
+      if (!c.ran) os << (c.failed ? "failed" : "skipped");
+      else if (c.comparison.worst >= 0)
+        os << fmtG("%.2g", c.comparison.metrics[static_cast<size_t>(c.comparison.worst)].max_rel) << "; "
+           << fmtG("%.2g", c.effect_rel_to_effect);
+      os << ",";
+    }
+    os << "\n";
+  }
+  for (const Comparison& c : r.zero_vs_references)
+    if (c.worst >= 0)
+      os << "  value 0 vs " << c.label_b << ": worst " << c.metrics[static_cast<size_t>(c.worst)].name << " rms/peak "
+         << fmtG("%.3g", c.metrics[static_cast<size_t>(c.worst)].rms_rel) << " -> " << (c.passed ? "PASS" : "FAIL")
+         << "\n";
   if (r.simbody.ran) os << "  " << formatSimbodyMassCheck(r.simbody.comparison, r.simbody.not_counted);
   else if (!r.simbody.skipped.empty()) os << "  simbody with muscle inertia: " << r.simbody.skipped << "\n";
   os << "  zero check: max |diff| / peak " << fmtG("%.3g", r.analysis.zero_max_rel) << " -> "

@@ -8,7 +8,11 @@
 //   transfer        s is the fraction of the transfer body's mass moved into the muscles that span
 //                   it (MuscleMassOptions::transfer_fraction = s), e.g. 0, 0.2, ..., 0.8
 //   physiological   s scales every muscle's physiological mass (the density is s * density), e.g.
-//                   0, 0.25, 0.5, 1
+//                   0, 1e-3, 0.01, 0.1, 1
+// Every value runs the muscle-mass code path, s = 0 included: there the muscles keep the mass
+// points a positive value gives them, each with zero mass, and the bodies keep their masses
+// (makeCoreMassEngineFactory). So the zero check compares two different computations (the
+// MuscleTerm with massless points against the plain skeleton), not a run with itself.
 //
 // Analysis per output column c (tau_0 = the zero-mass core result, y_k(s) = tau_s(k) - tau_0(k)):
 //   peak(s)            max_k |tau_s(k)|; peak_change_rel(s) = (peak(s) - peak(0)) / peak(0)
@@ -18,7 +22,17 @@
 //                        R^2 = 1 - sum (y - b_k s)^2 / sum (y - mean_s y_k)^2
 //                      and nonlinearity_rel = max |y - b_k s| / peak(0)
 //   zero check         a value s = 0 must reproduce tau_0: max_k |y_k(0)| <= zero_tolerance * peak(0)
-//                      for every column (the only part of a sweep that can fail)
+//                      for every column
+//
+// Independent references (MassSweepOptions::simbody_check, references), which is what shows the
+// graceful degradation; the core's own fit below is linear by construction and shows nothing:
+//   Simbody            every value solved by SimbodyIdEngine with plugin/simbody's MuscleInertia
+//                      (its own mass-point kinematics on Simbody stations, not the core's
+//                      MuscleTerm): core vs Simbody at each value (engine tolerance of the column
+//                      peak), and the inertial effect tau(s) - tau(0) of each engine against the
+//                      other's, so the effect's decay toward s = 0 is seen by both
+//   OpenSim            the value 0 (massless points) against OpenSim's own inverse-dynamics result
+//                      of the trial where one is given, at the reference tolerance
 //
 // Linearity by construction. The masses the sweep moves (transfer: (1 - s) m_body and s m_body
 // split over the muscles; physiological: s times each muscle's mass, removed from the bodies by
@@ -51,14 +65,27 @@ struct MassSweepOptions {
   double zero_tolerance = 1e-12;  ///< the zero check, relative to each column's zero-mass peak
   double r2_min = 0.999;          ///< the acceptance R^2 (reported per column, not pass/fail)
   bool progress = false;          ///< progress lines on stderr
-  /// also solve the largest value with Simbody's muscle inertia (SimbodyIdEngine with muscles)
+  /// also solve every value with Simbody's muscle inertia (SimbodyIdEngine with muscles)
   bool simbody_check = false;
   double engine_rel = 1e-9, engine_abs = 1e-10;  ///< its tolerance against the core (as core_vs_simbody)
+  /// results of the trial computed elsewhere (OpenSim's own ID): the value 0 is compared with each
+  /// (columns by name, the reference's rows as the grid) at reference_tolerance, a check in the verdict
+  struct Reference {
+    std::string label;  ///< "opensim"
+    osim::Storage table;
+  };
+  std::vector<Reference> references;
+  Tolerance reference_tolerance{1e-9, 1e-6, 1e-9, std::numeric_limits<double>::infinity()};
+  Interpolation interpolation = Interpolation::Linear;
 };
 
 /// The muscle-mass options of one sweep value: transfer_fraction = value, or density * value
-/// (physiological scale 0 is Source::None: the muscle-mass step refuses a zero density).
+/// (physiological scale 0 is density 0, which osim::applyMuscleMass refuses: engine factories give
+/// it the points of a positive density with zero mass, see hasZeroMuscleMass).
 osim::MuscleMassOptions massOptionsForValue(const osim::MuscleMassOptions& base, double value);
+
+/// Options that move no mass: physiological with density 0 or transfer of fraction 0.
+bool hasZeroMuscleMass(const osim::MuscleMassOptions& options);
 
 /// Sort, check and complete sweep values: finite, distinct, in [0, 1) for transfer and >= 0 for
 /// physiological, 0 added when absent. Throws std::invalid_argument naming the bad value, or when
@@ -92,7 +119,9 @@ struct MassSweepEngine {
 using MassSweepEngineFactory = std::function<MassSweepEngine(const osim::MuscleMassOptions&)>;
 
 /// The default factory: osim::applyMuscleMass on the tool's description (its build options), the
-/// core engine over the resulting model with the muscles' mass points.
+/// core engine over the resulting model with the muscles' mass points. Options with zero mass
+/// (hasZeroMuscleMass) give the tool's bodies unchanged and the muscles the mass points that a
+/// positive value would place, each with mass 0, so the mass-point code still runs.
 MassSweepEngineFactory makeCoreMassEngineFactory(const osim::InverseDynamicsTool& tool);
 
 /// Per column results (see the file comment for the definitions).
@@ -151,6 +180,12 @@ struct MassSweepSimbodyCheck {
   osim::Storage core_result;
   std::string note;
   std::string not_counted;  ///< simbodyMassCheckNotCountedReason at this value ("" = counted)
+  /// the inertial effects tau(s) - tau(0) of both engines (each against its own value 0), worst
+  /// column max_k |effect_core - effect_simbody| / zero-mass peak; NaN until filled (both values ran)
+  double effect_max_rel = std::numeric_limits<double>::quiet_NaN();
+  /// the same difference relative to the core's largest effect at this value (NaN at s = 0 or when
+  /// there is no effect)
+  double effect_rel_to_effect = std::numeric_limits<double>::quiet_NaN();
   /// the core torques this check compares with: core_result, or the sweep's own at this value
   const osim::Storage& coreTorques(const osim::Storage& sweep_value) const {
     return core_result.numRows() > 0 ? core_result : sweep_value;
@@ -163,7 +198,11 @@ struct MassSweepResult {
   std::vector<osim::Storage> torques;  ///< per value, the tool's output table
   std::vector<std::string> main_columns;
   MassSweepAnalysis analysis;
-  MassSweepSimbodyCheck simbody;  ///< filled when MassSweepOptions::simbody_check
+  MassSweepSimbodyCheck simbody;  ///< the largest value's Simbody check (simbody_values.back())
+  /// MassSweepOptions::simbody_check: one Simbody check per value, in value order
+  std::vector<MassSweepSimbodyCheck> simbody_values;
+  /// the value 0 against each MassSweepOptions::references entry ("mass_sweep_zero_vs_<label>")
+  std::vector<Comparison> zero_vs_references;
 };
 
 /// Run the sweep on the tool's processed inputs (the tool is not re-run: the same splines and
@@ -175,6 +214,8 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
                              const MassSweepOptions& options, const MassSweepEngineFactory& factory = {});
 
 /// Everything into the report: per value mass_sweep_tau_<v>.csv (time and every column),
+/// mass_sweep_simbody.csv (per value: core vs Simbody and the effects' agreement; a check in the
+/// verdict unless not counted), the comparisons of the value 0 with the references (checks),
 /// mass_sweep_peaks.csv, mass_sweep_fit.csv, figures mass_sweep_torques (the main columns, one
 /// line per value) and mass_sweep_peak_change (change of peak and largest change against the
 /// swept mass, Figs. 6.16-6.17), summary.json "mass_sweep", a report.md section, and the zero

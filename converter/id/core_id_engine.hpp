@@ -1,6 +1,7 @@
 #pragma once
 // The core (REDMAX) engine of the inverse-dynamics tool: tau = M qddot - f [D Eq. 4.18] with
-// gravity and the external loads as a BodyLoads term, constraints ignored (OpenSim's
+// gravity and the external loads as an input of the evaluation (DynamicsWorkspace::loads),
+// constraints ignored (OpenSim's
 // calcResidualForceIgnoringConstraints).
 //
 // OpenSim compatibility for Ball/Free/Ellipsoid joints (IdEngineOptions::rates_as_u). OpenSim puts
@@ -18,21 +19,30 @@
 #include <vector>
 
 #include "converter/id/id_engine.hpp"
+#include "core/dynamics/speed_map.hpp"
 #include "core/dynamics/system.hpp"
 #include "core/muscles/mass_points.hpp"
 #include "core/joints/joint.hpp"
 
 namespace redmax::osim {
 
-/// OpenSim's speed map of one joint marked rates_as_u: u = T(q) qdot (nu x nq; nu = 6 for a free
-/// joint, 3 for ball and ellipsoid, nq for a Composite whose first part is such a joint, the rest
-/// identity) and, if Tdot is given, its time derivative along qdot. A Reversed joint uses its inner
-/// joint's map (u keeps its meaning under Simbody's Direction::Reverse). Throws IdEngineError for
-/// any other joint type.
-void calcOpenSimSpeedMap(const Joint& joint, const VecJ& q, const VecJ& qdot, MatJ& T, MatJ* Tdot);
+using redmax::calcOpenSimSpeedMap;
+using redmax::hasOpenSimSpeedMap;
 
-/// true if calcOpenSimSpeedMap accepts the joint
-bool hasOpenSimSpeedMap(const Joint& joint);
+/// Everything one frame of a CoreIdEngine writes; one per thread. The engine itself is not
+/// changed by solving with a workspace, so threads that share one engine (and its System) each
+/// solve their frames with their own CoreIdWorkspace, bit-identically to a serial run.
+struct CoreIdWorkspace {
+  explicit CoreIdWorkspace(const System& system);
+  // inputs of the frame in the core's convention (equal to (v, vdot) without marked joints)
+  State state;               // t, q, qdot                                      (nr)
+  VecX qddot;                //                                                 (nr)
+  // position stage: poses for the loads, speed maps of the marked joints
+  std::vector<Mat4> E_wi;    // body poses                                      (nb)
+  std::vector<MatJ> T;       // u = T qdot per marked joint (mapping tau back)  (marked)
+  // the System's evaluation; dyn.loads holds the frame's resolved external loads
+  DynamicsWorkspace dyn;
+};
 
 class CoreIdEngine final : public IdEngine {
  public:
@@ -46,29 +56,29 @@ class CoreIdEngine final : public IdEngine {
   /// unchanged. Also throws ModelError for a muscle that does not fit the model.
   CoreIdEngine(Model model, std::vector<Muscle> muscles, IdEngineOptions options = {});
   std::string name() const override { return "core"; }
+  /// one frame with the engine's own workspace (lastState(), lastQddot())
   void calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,
                              const std::vector<IdLoadSample>& loads, VecX& tau) override;
+  /// one frame with the caller's workspace (made as CoreIdWorkspace(system())); const, so any
+  /// number of threads may share the engine, each with its own workspace
+  void calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,
+                             const std::vector<IdLoadSample>& loads, VecX& tau, CoreIdWorkspace& ws) const;
 
   const Model& model() const { return system_.model(); }
   const System& system() const { return system_; }
   /// sum of the muscles' mass points (kg); 0 without muscle mass
   double muscleMass() const { return muscle_mass_; }
-  /// (qdot, qddot) in the core's own convention for the last frame solved (equal to (v, vdot)
-  /// without marked joints)
-  const State& lastState() const { return state_; }
-  const VecX& lastQddot() const { return qddot_; }
+  /// (qdot, qddot) in the core's own convention for the last frame solved with the engine's own
+  /// workspace (equal to (v, vdot) without marked joints)
+  const State& lastState() const { return ws_.state; }
+  const VecX& lastQddot() const { return ws_.qddot; }
 
  private:
   System system_;
-  std::shared_ptr<BodyLoads> loads_;
-  DynamicsWorkspace ws_;
   IdEngineOptions options_;
   std::vector<int> marked_;  // marked joint slots
-  std::vector<Mat4> E_wi_;
-  State state_;
-  VecX qddot_;
-  std::vector<MatJ> T_;  // per marked joint (for mapping tau back)
   double muscle_mass_ = 0.0;
+  CoreIdWorkspace ws_;       // for the IdEngine interface (one caller at a time)
 };
 
 }  // namespace redmax::osim

@@ -12,14 +12,14 @@ void addBodyWrench(const Model& model, const SkeletonWorkspace& ws, int body, co
 }
 }  // namespace
 
-void BodyLoads::addForce(const Model& model, const State&, const SkeletonWorkspace& ws, VecX& f) const {
-  for (const PointForce& p : point_forces) {
+void addExternalLoads(const Model& model, const SkeletonWorkspace& ws, const ExternalLoads& loads, VecX& f) {
+  for (const PointForce& p : loads.point_forces) {
     if (p.body < 0) continue;  // force on the world does nothing
     const Mat3 R = ws.E_wi[p.body].topLeftCorner<3, 3>();
     const Vec6 w = Gamma(p.point_i).transpose() * (R.transpose() * p.force_w);
     addBodyWrench(model, ws, p.body, w, f);
   }
-  for (const BodyWrench& b : wrenches) {
+  for (const BodyWrench& b : loads.wrenches) {
     if (b.body < 0) continue;
     const Mat3 R = ws.E_wi[b.body].topLeftCorner<3, 3>();
     Vec6 w;
@@ -28,11 +28,19 @@ void BodyLoads::addForce(const Model& model, const State&, const SkeletonWorkspa
   }
 }
 
-double BodyLoads::potentialEnergy(const Model&, const State&, const SkeletonWorkspace& ws) const {
+double externalLoadsPotential(const SkeletonWorkspace& ws, const ExternalLoads& loads) {
   double V = 0.0;
-  for (const PointForce& p : point_forces)
+  for (const PointForce& p : loads.point_forces)
     if (p.body >= 0) V -= p.force_w.dot(transformPoint(ws.E_wi[p.body], p.point_i));
   return V;
+}
+
+void BodyLoads::addForce(const Model& model, const State&, const TermContext& ctx, VecX& f) const {
+  addExternalLoads(model, ctx.sk, *this, f);
+}
+
+double BodyLoads::potentialEnergy(const Model&, const State&, const TermContext& ctx) const {
+  return externalLoadsPotential(ctx.sk, *this);
 }
 
 }  // namespace redmax

@@ -3,6 +3,15 @@
 // deformables) add to the reduced mass matrix and force without touching joint code [D Eq. 4.76,
 // 4.82, 5.7]: each ForceTerm adds its share of
 //   M_r qddot = f_r,    and for linearly implicit integrators K_r = -df_r/dq, D_r = -df_r/dqdot.
+//
+// Terms are immutable once built and may be shared by any number of threads: everything a term
+// computes at a state lives in its scratch (TermScratch, made by makeScratch()), which each
+// DynamicsWorkspace owns one of per term (MuJoCo's mjData, Pinocchio's Data). A term sees its
+// scratch and the evaluation counter through TermContext; the counter tells it whether the scratch
+// already holds this state's results, so that addMass, addForce and the energies of one state
+// share one evaluation without comparing states.
+#include <cstdint>
+#include <memory>
 #include <string>
 
 #include "core/skeleton/kinematics.hpp"
@@ -11,17 +20,41 @@
 
 namespace redmax {
 
+/// Per-workspace scratch of one ForceTerm (or of an integrator, DynamicsWorkspace::integrator).
+/// `evaluation` is the TermContext::evaluation its cached results belong to (0: none).
+struct TermScratch {
+  virtual ~TermScratch() = default;
+  std::uint64_t evaluation = 0;
+};
+
+/// What a term sees of one evaluation: the skeleton kinematics at the state (Stage::Velocity),
+/// its own scratch slot, and the evaluation counter of the workspace (equal for every call at the
+/// same kinematics, different after the kinematics were recomputed; 0: unknown, do not reuse).
+/// Built implicitly from a SkeletonWorkspace for direct calls outside a System: no scratch, no
+/// reuse (a term then evaluates into temporaries).
+struct TermContext {
+  TermContext(const SkeletonWorkspace& sk) : sk(sk) {}  // NOLINT: implicit on purpose (see above)
+  TermContext(const SkeletonWorkspace& sk, TermScratch* scratch, std::uint64_t evaluation)
+      : sk(sk), scratch(scratch), evaluation(evaluation) {}
+  const SkeletonWorkspace& sk;
+  TermScratch* scratch = nullptr;
+  std::uint64_t evaluation = 0;
+  /// the same kinematics without the scratch (e.g. for evaluations at other states)
+  TermContext withoutScratch() const { return TermContext(sk); }
+};
+
 class ForceTerm {
  public:
   virtual ~ForceTerm() = default;
   virtual std::string name() const = 0;
+  /// this term's per-workspace scratch (null: the term needs none); called once per workspace
+  virtual std::unique_ptr<TermScratch> makeScratch(const Model&) const { return nullptr; }
   /// add this term's inertia to M (ndof x ndof); needs Stage::Velocity
-  virtual void addMass(const Model&, const State&, const SkeletonWorkspace&, MatX& M) const {}
+  virtual void addMass(const Model&, const State&, const TermContext&, MatX& M) const {}
   /// add this term's generalized force (including its quadratic-velocity part) to f (ndof)
-  virtual void addForce(const Model&, const State&, const SkeletonWorkspace&, VecX& f) const = 0;
+  virtual void addForce(const Model&, const State&, const TermContext&, VecX& f) const = 0;
   /// add K = -df/dq and D = -df/dqdot (ndof x ndof); default: explicit term (adds nothing)
-  virtual void addStiffnessDamping(const Model&, const State&, const SkeletonWorkspace&, MatX& K,
-                                   MatX& D) const {}
+  virtual void addStiffnessDamping(const Model&, const State&, const TermContext&, MatX& K, MatX& D) const {}
   /// add Mdot(q, qdot) qdot of this term's inertia to Mdot_v (ndof), where Mdot = sum_j dM/dq_j
   /// qdot_j; needs Stage::Velocity at s. Used by the variational (symplectic) integrator, whose
   /// momentum equation needs dL/dq = f + Mdot qdot. Default: a central difference of addMass along
@@ -29,11 +62,11 @@ class ForceTerm {
   /// cbrt(machine epsilon): relative error ~1e-10), evaluated in a scratch SkeletonWorkspace; a
   /// term whose addMass adds nothing at s costs one addMass call. Override it analytically where
   /// the mass matrix is known in closed form.
-  virtual void addMassDotTimesVelocity(const Model& model, const State& s, const SkeletonWorkspace& sk,
+  virtual void addMassDotTimesVelocity(const Model& model, const State& s, const TermContext& ctx,
                                        VecX& Mdot_v) const {
     const int n = static_cast<int>(Mdot_v.size());
     MatX M = MatX::Zero(n, n);
-    addMass(model, s, sk, M);
+    addMass(model, s, ctx, M);
     const double vmax = s.qdot.size() > 0 ? s.qdot.lpNorm<Eigen::Infinity>() : 0.0;
     if (M.isZero(0.0) || !(vmax > 0.0)) return;
     const double e = 6e-6 / vmax;
@@ -42,14 +75,15 @@ class ForceTerm {
     sp.q += e * s.qdot;
     sm.q -= e * s.qdot;
     MatX Mp = MatX::Zero(n, n), Mm = MatX::Zero(n, n);
+    // other states: no reuse of the scratch's results for s
     calcKinematics(model, sp, scratch);
-    addMass(model, sp, scratch, Mp);
+    addMass(model, sp, TermContext(scratch), Mp);
     calcKinematics(model, sm, scratch);
-    addMass(model, sm, scratch, Mm);
+    addMass(model, sm, TermContext(scratch), Mm);
     Mdot_v.noalias() += ((Mp - Mm) * s.qdot) / (2.0 * e);
   }
-  virtual double kineticEnergy(const Model&, const State&, const SkeletonWorkspace&) const { return 0.0; }
-  virtual double potentialEnergy(const Model&, const State&, const SkeletonWorkspace&) const { return 0.0; }
+  virtual double kineticEnergy(const Model&, const State&, const TermContext&) const { return 0.0; }
+  virtual double potentialEnergy(const Model&, const State&, const TermContext&) const { return 0.0; }
 };
 
 }  // namespace redmax

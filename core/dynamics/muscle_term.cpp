@@ -10,7 +10,11 @@ MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTe
     validateMuscle(model, m);
     if (m.mass_points.size() > 0) massive_.push_back(m);
   }
-  ws_ = MuscleWorkspace(model, massive_);
+}
+
+std::unique_ptr<TermScratch> MuscleTerm::makeScratch(const Model& model) const {
+  if (massive_.empty()) return nullptr;
+  return std::make_unique<MuscleTermScratch>(model, massive_);
 }
 
 double MuscleTerm::totalMass() const {
@@ -19,100 +23,101 @@ double MuscleTerm::totalMass() const {
   return m;
 }
 
-void MuscleTerm::update(const Model& model, const State& s, const SkeletonWorkspace& sk) const {
+MuscleTermScratch& MuscleTerm::evaluate(const Model& model, const State& s, const TermContext& ctx,
+                                        MuscleTermScratch& local) const {
   if (model.nr() != nr_)
     throw std::logic_error("MuscleTerm: built for a model with " + std::to_string(nr_) +
                            " coordinates, used with one with " + std::to_string(model.nr()));
-  // one evaluation serves addMass, addForce and the energies of the same state
-  if (cache_valid_ && q_cache_.size() == s.q.size() && qdot_cache_.size() == s.qdot.size() &&
-      q_cache_ == s.q && qdot_cache_ == s.qdot)
-    return;
-  cache_valid_ = false;
-  calcMuscleKinematics(model, s, sk, massive_, ws_, true);
-  q_cache_ = s.q;
-  qdot_cache_ = s.qdot;
-  cache_valid_ = true;
+  auto* slot = dynamic_cast<MuscleTermScratch*>(ctx.scratch);
+  MuscleTermScratch& sc = slot ? *slot : local;
+  // one evaluation serves addMass, addForce, Mdot qdot and the energies of the same state
+  if (slot && ctx.evaluation != 0 && sc.evaluation == ctx.evaluation) return sc;
+  sc.evaluation = 0;  // stays 0 if the evaluation throws
+  if (sc.ws.muscles.size() != massive_.size()) sc.ws = MuscleWorkspace(model, massive_);
+  calcMuscleKinematics(model, s, ctx.sk, massive_, sc.ws, true);
+  sc.evaluation = slot ? ctx.evaluation : 0;
+  return sc;
 }
 
-void MuscleTerm::addMass(const Model& model, const State& s, const SkeletonWorkspace& sk, MatX& M) const {
+void MuscleTerm::addMass(const Model& model, const State& s, const TermContext& ctx, MatX& M) const {
   if (massive_.empty()) return;
-  std::lock_guard<std::mutex> lock(mutex_);
-  update(model, s, sk);
+  MuscleTermScratch local;
+  MuscleTermScratch& sc = evaluate(model, s, ctx, local);
   // J_ar^T M_a J_ar, M_a diagonal [D Eq. 5.7b]
   // one product per muscle on sqrt(m_a)-scaled rows, (W^1/2 J)^T (W^1/2 J) = J^T W J, in the
   // muscle's compact columns, then scattered into M
   for (size_t m = 0; m < massive_.size(); ++m) {
     const MassPoints& mp = massive_[m].mass_points;
-    const MuscleKinematics& mk = ws_.muscles[m];
+    const MuscleKinematics& mk = sc.ws.muscles[m];
     const MatX& J = mk.J_ar;
-    scratch_.resize(J.rows(), J.cols());
-    for (int a = 0; a < mp.size(); ++a) scratch_.middleRows<3>(3 * a) = std::sqrt(mp.mass[a]) * J.middleRows<3>(3 * a);
-    Mc_.noalias() = scratch_.transpose() * scratch_;
+    sc.scaled_J.resize(J.rows(), J.cols());
+    for (int a = 0; a < mp.size(); ++a) sc.scaled_J.middleRows<3>(3 * a) = std::sqrt(mp.mass[a]) * J.middleRows<3>(3 * a);
+    sc.Mc.noalias() = sc.scaled_J.transpose() * sc.scaled_J;
     const int k = static_cast<int>(mk.cols.size());
     for (int j = 0; j < k; ++j)
-      for (int i = 0; i < k; ++i) M(mk.cols[i], mk.cols[j]) += Mc_(i, j);
+      for (int i = 0; i < k; ++i) M(mk.cols[i], mk.cols[j]) += sc.Mc(i, j);
   }
 }
 
-void MuscleTerm::addForce(const Model& model, const State& s, const SkeletonWorkspace& sk, VecX& f) const {
+void MuscleTerm::addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const {
   if (massive_.empty()) return;
-  std::lock_guard<std::mutex> lock(mutex_);
-  update(model, s, sk);
+  MuscleTermScratch local;
+  MuscleTermScratch& sc = evaluate(model, s, ctx, local);
   // J_ar^T (f_a - M_a Jdot_ar qdot), f_a = m_a g [D Eq. 5.6, 5.7c], in compact columns
   for (size_t m = 0; m < massive_.size(); ++m) {
     const MassPoints& mp = massive_[m].mass_points;
-    const MuscleKinematics& mk = ws_.muscles[m];
-    gatherColumns(s.qdot, mk, qdot_c_);
-    fc_.setZero(qdot_c_.size());
+    const MuscleKinematics& mk = sc.ws.muscles[m];
+    gatherColumns(s.qdot, mk, sc.qdot_c);
+    sc.fc.setZero(sc.qdot_c.size());
     for (int a = 0; a < mp.size(); ++a) {
       Vec3 fa = mp.mass[a] * model.gravity;
-      if (options_.quadratic_velocity) fa.noalias() -= mp.mass[a] * (mk.Jdot_ar.middleRows<3>(3 * a) * qdot_c_);
-      fc_.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * fa;
+      if (options_.quadratic_velocity) fa.noalias() -= mp.mass[a] * (mk.Jdot_ar.middleRows<3>(3 * a) * sc.qdot_c);
+      sc.fc.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * fa;
     }
-    scatterAddColumns(fc_, mk, f);
+    scatterAddColumns(sc.fc, mk, f);
   }
 }
 
-void MuscleTerm::addMassDotTimesVelocity(const Model& model, const State& s, const SkeletonWorkspace& sk,
+void MuscleTerm::addMassDotTimesVelocity(const Model& model, const State& s, const TermContext& ctx,
                                          VecX& Mdot_v) const {
   if (massive_.empty()) return;
-  std::lock_guard<std::mutex> lock(mutex_);
-  update(model, s, sk);
+  MuscleTermScratch local;
+  MuscleTermScratch& sc = evaluate(model, s, ctx, local);
   // d/dt (J_ar^T M_a J_ar) qdot with M_a constant [D Eq. 5.7b], in compact columns
   for (size_t m = 0; m < massive_.size(); ++m) {
     const MassPoints& mp = massive_[m].mass_points;
-    const MuscleKinematics& mk = ws_.muscles[m];
-    gatherColumns(s.qdot, mk, qdot_c_);
-    fc_.setZero(qdot_c_.size());
+    const MuscleKinematics& mk = sc.ws.muscles[m];
+    gatherColumns(s.qdot, mk, sc.qdot_c);
+    sc.fc.setZero(sc.qdot_c.size());
     for (int a = 0; a < mp.size(); ++a) {
       const auto J = mk.J_ar.middleRows<3>(3 * a);
       const auto Jd = mk.Jdot_ar.middleRows<3>(3 * a);
-      const Vec3 m_xdot = mp.mass[a] * (J * qdot_c_);
-      const Vec3 m_Jdv = mp.mass[a] * (Jd * qdot_c_);
-      fc_.noalias() += Jd.transpose() * m_xdot;
-      fc_.noalias() += J.transpose() * m_Jdv;
+      const Vec3 m_xdot = mp.mass[a] * (J * sc.qdot_c);
+      const Vec3 m_Jdv = mp.mass[a] * (Jd * sc.qdot_c);
+      sc.fc.noalias() += Jd.transpose() * m_xdot;
+      sc.fc.noalias() += J.transpose() * m_Jdv;
     }
-    scatterAddColumns(fc_, mk, Mdot_v);
+    scatterAddColumns(sc.fc, mk, Mdot_v);
   }
 }
 
-double MuscleTerm::kineticEnergy(const Model& model, const State& s, const SkeletonWorkspace& sk) const {
+double MuscleTerm::kineticEnergy(const Model& model, const State& s, const TermContext& ctx) const {
   if (massive_.empty()) return 0.0;
-  std::lock_guard<std::mutex> lock(mutex_);
-  update(model, s, sk);
+  MuscleTermScratch local;
+  MuscleTermScratch& sc = evaluate(model, s, ctx, local);
   double T = 0.0;
   for (size_t m = 0; m < massive_.size(); ++m)
-    T += muscleKineticEnergy(massive_[m].mass_points, ws_.muscles[m], s.qdot);
+    T += muscleKineticEnergy(massive_[m].mass_points, sc.ws.muscles[m], s.qdot);
   return T;
 }
 
-double MuscleTerm::potentialEnergy(const Model& model, const State& s, const SkeletonWorkspace& sk) const {
+double MuscleTerm::potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const {
   if (massive_.empty()) return 0.0;
-  std::lock_guard<std::mutex> lock(mutex_);
-  update(model, s, sk);
+  MuscleTermScratch local;
+  MuscleTermScratch& sc = evaluate(model, s, ctx, local);
   double V = 0.0;
   for (size_t m = 0; m < massive_.size(); ++m)
-    V += musclePotentialEnergy(massive_[m].mass_points, ws_.muscles[m], model.gravity);
+    V += musclePotentialEnergy(massive_[m].mass_points, sc.ws.muscles[m], model.gravity);
   return V;
 }
 

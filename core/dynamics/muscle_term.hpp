@@ -10,10 +10,12 @@
 // Implicit integrators: addStiffnessDamping is not overridden, so bdf1/sdirk2 treat the muscle
 // inertia's forces (gravity on the points, QVV) explicitly in K and D; M is still exact.
 //
-// Thread safety: the term caches the muscle kinematics of the last (q, qdot) it saw, so that
-// addMass, addForce and the energies of one state share one evaluation; a mutex guards the
-// cache, so one term may be shared, but concurrent callers then take turns.
-#include <mutex>
+// Thread safety: the term itself is immutable. The muscle kinematics of a state live in its
+// scratch (MuscleTermScratch, one per DynamicsWorkspace), valid for one evaluation of the
+// workspace (TermContext::evaluation), so that addMass, addForce, Mdot qdot and the energies of
+// one state share one muscle evaluation; threads with their own workspaces share one term without
+// waiting on each other. Only the muscles with mass points are evaluated (no Jdot of massless
+// muscles), at the velocity stage.
 #include <vector>
 
 #include "core/dynamics/force_term.hpp"
@@ -27,6 +29,18 @@ struct MuscleTermOptions {
   bool quadratic_velocity = true;
 };
 
+/// Scratch of a MuscleTerm in one workspace (ForceTerm::makeScratch).
+struct MuscleTermScratch final : TermScratch {
+  MuscleTermScratch() = default;
+  MuscleTermScratch(const Model& model, const std::vector<Muscle>& massive) : ws(model, massive) {}
+  // velocity stage: calcMuscleKinematics of the muscles with mass, at evaluation `evaluation`
+  MuscleWorkspace ws;               // one MuscleKinematics per muscle with mass points   (n_massive)
+  // per-muscle temporaries of addMass / addForce (k = that muscle's compact columns)
+  MatX scaled_J;                    // sqrt(m_a)-scaled J_ar (addMass)                     (3N x k)
+  MatX Mc;                          // its J^T W J                                         (k x k)
+  VecX qdot_c, fc;                  // qdot and force in the muscle's columns              (k)
+};
+
 class MuscleTerm final : public ForceTerm {
  public:
   /// Validates every muscle against `model` (validateMuscle; throws ModelError). Muscles without
@@ -34,13 +48,15 @@ class MuscleTerm final : public ForceTerm {
   MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options = {});
 
   std::string name() const override { return "muscle_mass"; }
-  void addMass(const Model& model, const State& s, const SkeletonWorkspace& sk, MatX& M) const override;
-  void addForce(const Model& model, const State& s, const SkeletonWorkspace& sk, VecX& f) const override;
+  /// a MuscleTermScratch sized for the muscles with mass (null when there are none)
+  std::unique_ptr<TermScratch> makeScratch(const Model& model) const override;
+  void addMass(const Model& model, const State& s, const TermContext& ctx, MatX& M) const override;
+  void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   /// analytic Mdot qdot of the mass points: sum_a m_a (Jdot_ar^T J_ar + J_ar^T Jdot_ar) qdot
-  void addMassDotTimesVelocity(const Model& model, const State& s, const SkeletonWorkspace& sk,
+  void addMassDotTimesVelocity(const Model& model, const State& s, const TermContext& ctx,
                                VecX& Mdot_v) const override;
-  double kineticEnergy(const Model& model, const State& s, const SkeletonWorkspace& sk) const override;
-  double potentialEnergy(const Model& model, const State& s, const SkeletonWorkspace& sk) const override;
+  double kineticEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
+  double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
 
   const std::vector<Muscle>& muscles() const { return muscles_; }
   const MuscleTermOptions& options() const { return options_; }
@@ -48,21 +64,15 @@ class MuscleTerm final : public ForceTerm {
   double totalMass() const;
 
  private:
-  // evaluate (or reuse) the kinematics of the muscles with mass at this state; caller holds mutex_
-  void update(const Model& model, const State& s, const SkeletonWorkspace& sk) const;
+  // the scratch holding the muscle kinematics at this evaluation: ctx's slot, evaluated unless it
+  // already holds this evaluation, or (direct calls without a slot) `local`, evaluated now
+  MuscleTermScratch& evaluate(const Model& model, const State& s, const TermContext& ctx,
+                              MuscleTermScratch& local) const;
 
   std::vector<Muscle> muscles_;
   std::vector<Muscle> massive_;        // the muscles with at least one mass point
   MuscleTermOptions options_;
   int nr_ = 0;
-
-  mutable std::mutex mutex_;
-  mutable MuscleWorkspace ws_;         // kinematics of massive_
-  mutable VecX q_cache_, qdot_cache_;
-  mutable bool cache_valid_ = false;
-  mutable MatX scratch_;               // sqrt(m_a)-scaled J_ar of one muscle (addMass)  (3N x k)
-  mutable MatX Mc_;                    // its J^T W J                                     (k x k)
-  mutable VecX qdot_c_, fc_;           // qdot and force in one muscle's columns          (k)
 };
 
 }  // namespace redmax

@@ -1,5 +1,6 @@
 #include "core/dynamics/system.hpp"
 
+#include <atomic>
 #include <cmath>
 
 #include <Eigen/Dense>
@@ -16,11 +17,41 @@ DynamicsWorkspace::DynamicsWorkspace(const Model& model) : sk(model) {
   D.setZero(n, n);
 }
 
+DynamicsWorkspace::DynamicsWorkspace(const System& system) : DynamicsWorkspace(system.model()) {
+  const int n = system.ndof();
+  M.setZero(n, n);
+  f.setZero(n);
+  K.setZero(n, n);
+  D.setZero(n, n);
+  system.bind(*this);
+}
+
+std::uint64_t System::Id::next() {
+  // a counter, not a lock: ids only have to differ
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
+
 System::System(Model model) : model_(std::move(model)), ndof_(model_.nr()) {}
+
+void System::bind(DynamicsWorkspace& ws) const {
+  if (ws.system_id == id_.value) return;
+  ws.term_scratch.clear();
+  ws.integrator.reset();
+  for (const auto& t : terms_) ws.term_scratch.push_back(t->makeScratch(model_));
+  ws.system_id = id_.value;
+}
+
+void System::calcSkeletonKinematics(const State& s, DynamicsWorkspace& ws) const {
+  bind(ws);
+  calcKinematics(model_, s, ws.sk);
+  ++ws.evaluation;
+}
 
 void System::addConstraint(std::shared_ptr<const Constraint> c) {
   if (!c) throw ModelError("System::addConstraint: null constraint");
   nc_ += c->rows();
+  id_.renew();
   constraints_.push_back(std::move(c));
 }
 
@@ -30,6 +61,7 @@ int System::addExtraCoordinates(int n) {
   const int first = ndof_;
   ndof_ += n;
   n_extra_ += n;
+  id_.renew();
   return first;
 }
 
@@ -40,6 +72,7 @@ void System::setCoordinateMap(std::shared_ptr<const CoordinateMap> map) {
     throw ModelError("System::setCoordinateMap: map built for " + std::to_string(map->nr()) +
                      " coordinates, model has " + std::to_string(model_.nr()));
   map_ = std::move(map);
+  id_.renew();
   ndof_ = map_ ? map_->nR() : model_.nr();
 }
 
@@ -107,7 +140,7 @@ int System::reparameterize(State& s) const {
 
 void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
   if (!map_) {
-    calcKinematics(model_, s, ws.sk);
+    calcSkeletonKinematics(s, ws);
     if (n_extra_ == 0) {
       calcSkeletonMass(model_, ws.sk, ws.M);
       calcSkeletonForce(model_, s, ws.sk, ws.f);
@@ -122,20 +155,24 @@ void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
       ws.M.topLeftCorner(nr, nr) = ws.M_r;
       ws.f.head(nr) = ws.f_r;
     }
-    for (const auto& t : terms_) {
-      t->addMass(model_, s, ws.sk, ws.M);
-      t->addForce(model_, s, ws.sk, ws.f);
+    if (!ws.loads.empty()) addExternalLoads(model_, ws.sk, ws.loads, ws.f);
+    for (size_t i = 0; i < terms_.size(); ++i) {
+      const TermContext ctx = context(ws, i);
+      terms_[i]->addMass(model_, s, ctx, ws.M);
+      terms_[i]->addForce(model_, s, ctx, ws.f);
     }
     return;
   }
   // skeleton and terms in q_r at the expanded state, then chained through J_rR [D Eq. 4.86]
   expandInto(s, ws);
-  calcKinematics(model_, ws.s_r, ws.sk);
+  calcSkeletonKinematics(ws.s_r, ws);
   calcSkeletonMass(model_, ws.sk, ws.M_r);
   calcSkeletonForce(model_, ws.s_r, ws.sk, ws.f_r);
-  for (const auto& t : terms_) {
-    t->addMass(model_, ws.s_r, ws.sk, ws.M_r);
-    t->addForce(model_, ws.s_r, ws.sk, ws.f_r);
+  if (!ws.loads.empty()) addExternalLoads(model_, ws.sk, ws.loads, ws.f_r);
+  for (size_t i = 0; i < terms_.size(); ++i) {
+    const TermContext ctx = context(ws, i);
+    terms_[i]->addMass(model_, ws.s_r, ctx, ws.M_r);
+    terms_[i]->addForce(model_, ws.s_r, ctx, ws.f_r);
   }
   const MatX MJ = ws.M_r * ws.J_rR;
   ws.M.noalias() = ws.J_rR.transpose() * MJ;
@@ -170,7 +207,8 @@ void System::calcMassDotTimesVelocity(const State& s, DynamicsWorkspace& ws, Vec
   VecX Mdot_r;
   skeletonMassDotTimesVelocity(model_, s_sk, ws.sk, Mdot_r);
   if (n_extra_ > 0) Mdot_r.conservativeResizeLike(VecX::Zero(ndof_));
-  for (const auto& t : terms_) t->addMassDotTimesVelocity(model_, s_sk, ws.sk, Mdot_r);
+  bind(ws);
+  for (size_t i = 0; i < terms_.size(); ++i) terms_[i]->addMassDotTimesVelocity(model_, s_sk, context(ws, i), Mdot_r);
   if (!map_) {
     Mdot_v = std::move(Mdot_r);
     return;
@@ -186,7 +224,8 @@ void System::calcStiffnessDamping(const State& s, DynamicsWorkspace& ws) const {
     ws.K.setZero(ndof(), ndof());
     ws.D.setZero(ndof(), ndof());
     addJointStiffnessDamping(model_, ws.K, ws.D);
-    for (const auto& t : terms_) t->addStiffnessDamping(model_, s, ws.sk, ws.K, ws.D);
+    bind(ws);
+    for (size_t i = 0; i < terms_.size(); ++i) terms_[i]->addStiffnessDamping(model_, s, context(ws, i), ws.K, ws.D);
     return;
   }
   // K_R = J^T K_r J, D_R = J^T D_r J. The derivatives of J_rR and Jdot_rR themselves are left
@@ -197,7 +236,9 @@ void System::calcStiffnessDamping(const State& s, DynamicsWorkspace& ws) const {
   ws.K_r.setZero(nr, nr);
   ws.D_r.setZero(nr, nr);
   addJointStiffnessDamping(model_, ws.K_r, ws.D_r);
-  for (const auto& t : terms_) t->addStiffnessDamping(model_, ws.s_r, ws.sk, ws.K_r, ws.D_r);
+  bind(ws);
+  for (size_t i = 0; i < terms_.size(); ++i)
+    terms_[i]->addStiffnessDamping(model_, ws.s_r, context(ws, i), ws.K_r, ws.D_r);
   ws.K.noalias() = ws.J_rR.transpose() * (ws.K_r * ws.J_rR);
   ws.D.noalias() = ws.J_rR.transpose() * (ws.D_r * ws.J_rR);
 }
@@ -320,9 +361,9 @@ double System::kineticEnergy(const State& s, DynamicsWorkspace& ws) const {
     expandInto(s, ws);
     sk_state = &ws.s_r;
   }
-  calcKinematics(model_, *sk_state, ws.sk);
+  calcSkeletonKinematics(*sk_state, ws);
   double T = skeletonKineticEnergy(model_, ws.sk);
-  for (const auto& t : terms_) T += t->kineticEnergy(model_, *sk_state, ws.sk);
+  for (size_t i = 0; i < terms_.size(); ++i) T += terms_[i]->kineticEnergy(model_, *sk_state, context(ws, i));
   return T;
 }
 
@@ -332,9 +373,10 @@ double System::potentialEnergy(const State& s, DynamicsWorkspace& ws) const {
     expandInto(s, ws);
     sk_state = &ws.s_r;
   }
-  calcKinematics(model_, *sk_state, ws.sk);
+  calcSkeletonKinematics(*sk_state, ws);
   double V = skeletonPotentialEnergy(model_, *sk_state, ws.sk);
-  for (const auto& t : terms_) V += t->potentialEnergy(model_, *sk_state, ws.sk);
+  if (!ws.loads.empty()) V += externalLoadsPotential(ws.sk, ws.loads);
+  for (size_t i = 0; i < terms_.size(); ++i) V += terms_[i]->potentialEnergy(model_, *sk_state, context(ws, i));
   return V;
 }
 

@@ -15,9 +15,11 @@
 //   M = J_rR^T M_r J_rR,  f = J_rR^T (f_r - M_r Jdot_rR qdot_R),  G = G_r J_rR,
 //   rhs = rhs_r - G_r Jdot_rR qdot_R                                 [D Eq. 4.84-4.86, 4.105]
 // Without a map (the default) nothing changes: q = q_r and ndof = nr.
+#include <cstdint>
 #include <memory>
 #include <vector>
 
+#include "core/dynamics/body_loads.hpp"
 #include "core/dynamics/constraint.hpp"
 #include "core/dynamics/coordinate_map.hpp"
 #include "core/dynamics/force_term.hpp"
@@ -25,10 +27,32 @@
 
 namespace redmax {
 
-/// Scratch for one evaluation of the dynamics; one per thread.
+class System;
+
+/// Everything one evaluation of a System writes, and the inputs that change per evaluation; one
+/// per thread (MuJoCo's mjData, Pinocchio's Data). A System is immutable while it is evaluated
+/// and may be shared by threads that each own a DynamicsWorkspace. Stages are computed in order
+/// and only as far as the caller asks:
+///   position   ws.sk (poses, J_mr): calcKinematics
+///   velocity   ws.sk (twists, Jdot_mr), the terms' scratch (e.g. the muscles' J_ar, Jdot_ar)
+///   dynamics   M, f (calcMassAndForce), then K, D, G, rhs, lambda as asked
+/// Energies stop at the velocity stage (no M); ID of a term without mass adds none of its work.
 struct DynamicsWorkspace {
+  /// sized for the model's nr; the term slots are made on the first evaluation by a System
   explicit DynamicsWorkspace(const Model& model);
+  /// sized for the system (ndof) with its term slots made now
+  explicit DynamicsWorkspace(const System& system);
+  DynamicsWorkspace(DynamicsWorkspace&&) = default;
+  DynamicsWorkspace& operator=(DynamicsWorkspace&&) = default;
+
+  // inputs of the next evaluation (set by the caller with the State; never written by the System)
+  ExternalLoads loads;       // external point forces and torques (measured GRF)  (any count)
+
+  // position and velocity stage
   SkeletonWorkspace sk;
+  std::uint64_t evaluation = 0;  // bumped whenever sk is recomputed (TermContext::evaluation)
+
+  // dynamics stage
   MatX M;          // mass matrix                      (ndof x ndof)
   VecX f;          // generalized force                (ndof)
   MatX K, D;       // -df/dq, -df/dqdot (implicit use) (ndof x ndof)
@@ -46,6 +70,14 @@ struct DynamicsWorkspace {
   MatX K_r, D_r;             // (nr x nr)
   MatX G_r;                  // constraint Jacobian in q_r                       (nc x nr)
   VecX rhs_r;                // (nc)
+
+  // scratch owned for others (System::bind): one slot per ForceTerm of the bound system, in
+  // System::terms() order (null where the term needs none), and one for the integrator that
+  // drives this workspace (e.g. the variational integrator's momentum). All are dropped when the
+  // workspace is bound to another system (or the system changed).
+  std::vector<std::unique_ptr<TermScratch>> term_scratch;  // (number of terms)
+  std::unique_ptr<TermScratch> integrator;
+  std::uint64_t system_id = 0;  // System::id() the slots belong to; 0 = none
 };
 
 /// Baumgarte stabilisation for acceleration-level constraints: rhs -= 2 alpha verr + beta^2 perr.
@@ -59,6 +91,13 @@ class System {
   explicit System(Model model);
 
   const Model& model() const { return model_; }
+  /// Identity of this system and its terms, constraints and map: unique in the process, new for
+  /// a copy and after every change (addTerm, addConstraint, setCoordinateMap,
+  /// addExtraCoordinates); workspaces key their scratch on it.
+  std::uint64_t id() const { return id_.value; }
+  /// Make ws's scratch slots for this system unless they are already (a no-op then). Every
+  /// evaluation below does it; integrators call it before using ws.integrator.
+  void bind(DynamicsWorkspace& ws) const;
   /// number of system coordinates: nr, or the map's nR with hyper-reduced coordinates
   int ndof() const { return ndof_; }
   /// Append n coordinates that the skeleton does not own (e.g. free nodes of a deformable body
@@ -69,7 +108,10 @@ class System {
   int numExtraCoordinates() const { return n_extra_; }
   int numConstraintRows() const { return nc_; }
 
-  void addTerm(std::shared_ptr<const ForceTerm> term) { terms_.push_back(std::move(term)); }
+  void addTerm(std::shared_ptr<const ForceTerm> term) {
+    terms_.push_back(std::move(term));
+    id_.renew();
+  }
   void addConstraint(std::shared_ptr<const Constraint> c);
   const std::vector<std::shared_ptr<const ForceTerm>>& terms() const { return terms_; }
   const std::vector<std::shared_ptr<const Constraint>>& constraints() const { return constraints_; }
@@ -102,7 +144,7 @@ class System {
   /// remaining max |Cdot| predicted by the linear step.
   double projectVelocities(State& s, DynamicsWorkspace& ws) const;
 
-  /// kinematics, M and f (skeleton + terms) [D Eq. 4.76]
+  /// kinematics, M and f (skeleton + ws.loads + terms) [D Eq. 4.76]
   void calcMassAndForce(const State& s, DynamicsWorkspace& ws) const;
   /// K and D (joint springs/dampers + terms), after calcMassAndForce [D Eq. 4.82]
   void calcStiffnessDamping(const State& s, DynamicsWorkspace& ws) const;
@@ -125,6 +167,7 @@ class System {
   /// forwardDynamics: the actuation that realises the prescribed motion [D Eq. 4.109]
   VecX prescribedForces(const DynamicsWorkspace& ws) const;
 
+  /// kinematics and energies only (no M); the potential includes ws.loads' (BodyLoads' rule)
   double kineticEnergy(const State& s, DynamicsWorkspace& ws) const;
   double potentialEnergy(const State& s, DynamicsWorkspace& ws) const;
 
@@ -135,6 +178,26 @@ class System {
   static VecX solveKKT(const MatX& M, const MatX& G, const VecX& a, const VecX& b, VecX* lambda);
 
  private:
+  // a fresh process-wide serial number on construction, copy and renew()
+  struct Id {
+    Id() : value(next()) {}
+    Id(const Id&) : value(next()) {}
+    Id& operator=(const Id&) {
+      value = next();
+      return *this;
+    }
+    void renew() { value = next(); }
+    static std::uint64_t next();
+    std::uint64_t value;
+  };
+  // kinematics of (skeleton) state s into ws.sk, as a new evaluation
+  void calcSkeletonKinematics(const State& s, DynamicsWorkspace& ws) const;
+  // what term i sees of the current evaluation of ws
+  TermContext context(const DynamicsWorkspace& ws, size_t i) const {
+    return TermContext(ws.sk, ws.term_scratch[i].get(), ws.evaluation);
+  }
+
+  Id id_;
   Model model_;
   std::vector<std::shared_ptr<const ForceTerm>> terms_;
   std::vector<std::shared_ptr<const Constraint>> constraints_;

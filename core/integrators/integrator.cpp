@@ -78,6 +78,11 @@ void checkAdvanceArguments(const System& sys, const State& s, double t_out, cons
   }
 }
 
+DynamicsWorkspace& FixedStepIntegrator::workspace(const System& sys) {
+  if (!ws_ || ws_->system_id != sys.id()) ws_ = std::make_unique<DynamicsWorkspace>(sys);
+  return *ws_;
+}
+
 void FixedStepIntegrator::advance(const System& sys, State& s, double t_out) {
   const std::string who = name();
   checkAdvanceArguments(sys, s, t_out, who.c_str());
@@ -96,7 +101,7 @@ void FixedStepIntegrator::advance(const System& sys, State& s, double t_out) {
   const double h = span / static_cast<double>(n);
   const double t0 = s.t;
   checkFinite(s, h, who.c_str());
-  DynamicsWorkspace ws(sys.model());
+  DynamicsWorkspace& ws = workspace(sys);
   State last_good = s;
   for (long k = 0; k < n; ++k) {
     try {

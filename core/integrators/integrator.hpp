@@ -85,7 +85,9 @@ void checkAdvanceArguments(const System& sys, const State& s, double t_out, cons
 
 /// Shared driver of the fixed-step methods: cuts [state.t, t_out] into ceil(span / dt) equal
 /// steps, calls step() for each, lets the joints switch chart after each step, checks for
-/// NaN/Inf, and sets state.t = t_out exactly at the end.
+/// NaN/Inf, and sets state.t = t_out exactly at the end. advance() steps with one workspace per
+/// integrator, kept across calls while the system stays the same (System::id), so what a method
+/// carries from step to step (DynamicsWorkspace::integrator) survives a span cut into calls.
 class FixedStepIntegrator : public Integrator {
  public:
   explicit FixedStepIntegrator(const IntegratorOptions& opt) : opt_(opt) {}
@@ -93,9 +95,14 @@ class FixedStepIntegrator : public Integrator {
   /// one step of size h from state (state.t advanced by h); no chart switch, no NaN check
   virtual void step(const System& sys, State& state, double h, DynamicsWorkspace& ws) = 0;
   const IntegratorOptions& options() const { return opt_; }
+  /// the workspace advance() uses for sys (a new one when sys is not the system of the last)
+  DynamicsWorkspace& workspace(const System& sys);
 
  protected:
   IntegratorOptions opt_;
+
+ private:
+  std::unique_ptr<DynamicsWorkspace> ws_;
 };
 
 }  // namespace redmax

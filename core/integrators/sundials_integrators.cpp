@@ -55,7 +55,7 @@ struct SundialsSolver {
   bool valid = false;
   double t_cur = 0.0;
   bool pending_chart_check = false;
-  const System* last_sys = nullptr;
+  std::uint64_t last_sys = 0;  // System::id() of the system last integrated (0: none)
   State last_out;
 
   // counters already folded into the stats
@@ -342,7 +342,7 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
   Binding bind(S, sys, ws);
   try {
     // resume from the internal solution only if the caller did not touch the returned state
-    const bool resume = S.valid && S.last_sys == &sys && S.N == 2 * n && s.t == S.last_out.t &&
+    const bool resume = S.valid && S.last_sys == sys.id() && S.N == 2 * n && s.t == S.last_out.t &&
                         s.q == S.last_out.q && s.qdot == S.last_out.qdot;
     if (!resume) {
       checkFinite(s, 0.0, who.c_str());
@@ -392,7 +392,7 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
     s.q = out.q;
     s.qdot = out.qdot;
     S.last_out = out;
-    S.last_sys = &sys;
+    S.last_sys = sys.id();
   } catch (...) {
     S.valid = false;
     S.syncStats(stats_);

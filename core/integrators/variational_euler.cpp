@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -20,19 +21,31 @@ VecX VariationalEuler::momentum(const System& sys, const State& s, double h, Dyn
   return ws.M * s.qdot;
 }
 
-const VecX& VariationalEuler::momentumOf(const System& sys, const State& s, double h, DynamicsWorkspace& ws) {
-  // the cached momentum belongs to exactly the state this integrator returned last
-  const bool same_sys = sys_ == &sys && q_end_.size() == s.q.size() && v_end_.size() == s.qdot.size();
-  const bool hit = same_sys && ((q_end_ == s.q && v_end_ == s.qdot) || liftThroughChartSwitch(sys, s));
-  if (!hit) {
-    p_ = momentum(sys, s, h, ws);
-    ++stats_.rhs_evals;
-    sys_ = &sys;
-    q_end_ = s.q;
-    v_end_ = s.qdot;
-    have_prev_ = false;
+VariationalEulerScratch& VariationalEuler::scratchOf(const System& sys, DynamicsWorkspace& ws) {
+  sys.bind(ws);
+  auto* c = dynamic_cast<VariationalEulerScratch*>(ws.integrator.get());
+  if (!c) {
+    auto made = std::make_unique<VariationalEulerScratch>();
+    c = made.get();
+    ws.integrator = std::move(made);
   }
-  return p_;
+  return *c;
+}
+
+const VecX& VariationalEuler::momentumOf(const System& sys, const State& s, double h, DynamicsWorkspace& ws) {
+  VariationalEulerScratch& c = scratchOf(sys, ws);
+  // the cached momentum belongs to exactly the state a step with ws returned last
+  const bool same = c.have_state && c.q_end.size() == s.q.size() && c.v_end.size() == s.qdot.size();
+  const bool hit = same && ((c.q_end == s.q && c.v_end == s.qdot) || liftThroughChartSwitch(sys, s, c));
+  if (!hit) {
+    c.p = momentum(sys, s, h, ws);
+    ++stats_.rhs_evals;
+    c.have_state = true;
+    c.q_end = s.q;
+    c.v_end = s.qdot;
+    c.have_prev = false;
+  }
+  return c.p;
 }
 
 void VariationalEuler::setMomentum(const System& sys, const State& s, const VecX& p) {
@@ -40,37 +53,39 @@ void VariationalEuler::setMomentum(const System& sys, const State& s, const VecX
   if (s.q.size() != n || s.qdot.size() != n || p.size() != n)
     throw std::invalid_argument("symplectic: setMomentum: state or momentum does not have " + std::to_string(n) +
                                 " entries");
-  sys_ = &sys;
-  q_end_ = s.q;
-  v_end_ = s.qdot;
-  p_ = p;
-  have_prev_ = false;
+  VariationalEulerScratch& c = scratchOf(sys, workspace(sys));
+  c.have_state = true;
+  c.q_end = s.q;
+  c.v_end = s.qdot;
+  c.p = p;
+  c.have_prev = false;
 }
 
 void VariationalEuler::step(const System& sys, State& s, double h, DynamicsWorkspace& ws) {
   VecX p = momentumOf(sys, s, h, ws);  // a copy: the cache stays valid if the step throws
+  VariationalEulerScratch& c = scratchOf(sys, ws);
   // linear extrapolation of the velocity predicts v_k+1 to O(h^2) (one or two iterations fewer)
   VecX guess;
   const VecX* guess_ptr = nullptr;
-  if (have_prev_) {
-    guess = 2.0 * s.qdot - v_prev_;
+  if (c.have_prev) {
+    guess = 2.0 * s.qdot - c.v_prev;
     guess_ptr = &guess;
   }
   const VecX v_k = s.qdot;
   stepMomentum(sys, s, p, h, ws, guess_ptr);
-  p_ = std::move(p);
-  q_end_ = s.q;
-  v_end_ = s.qdot;
-  v_prev_ = v_k;
-  have_prev_ = true;
+  c.p = std::move(p);
+  c.q_end = s.q;
+  c.v_end = s.qdot;
+  c.v_prev = v_k;
+  c.have_prev = true;
 }
 
-bool VariationalEuler::liftThroughChartSwitch(const System& sys, const State& s) {
+bool VariationalEuler::liftThroughChartSwitch(const System& sys, const State& s, VariationalEulerScratch& c) {
   // is s the chart switch of the state we returned?
   State sw;
   sw.t = s.t;
-  sw.q = q_end_;
-  sw.qdot = v_end_;
+  sw.q = c.q_end;
+  sw.qdot = c.v_end;
   if (sys.reparameterize(sw) == 0 || sw.q != s.q || sw.qdot != s.qdot) return false;
   // the switch q' = phi(q) maps velocities linearly, qdot' = Dphi(q) qdot; its cotangent lift
   // p' = Dphi^-T p is a symplectic change of coordinates, so the composed map stays symplectic.
@@ -80,16 +95,16 @@ bool VariationalEuler::liftThroughChartSwitch(const System& sys, const State& s)
   State e;
   e.t = s.t;
   for (int j = 0; j < n; ++j) {
-    e.q = q_end_;
+    e.q = c.q_end;
     e.qdot = VecX::Unit(n, j);
     sys.reparameterize(e);
     Dphi.col(j) = e.qdot;
   }
   const Eigen::PartialPivLU<MatX> lu(Dphi.transpose());
-  p_ = lu.solve(p_);
-  if (have_prev_) v_prev_ = Dphi * v_prev_;
-  q_end_ = s.q;
-  v_end_ = s.qdot;
+  c.p = lu.solve(c.p);
+  if (c.have_prev) c.v_prev = Dphi * c.v_prev;
+  c.q_end = s.q;
+  c.v_end = s.qdot;
   return true;
 }
 
@@ -99,6 +114,8 @@ void VariationalEuler::stepMomentum(const System& sys, State& s, VecX& p, double
   const int nc = sys.numConstraintRows();
   if (p.size() != n || s.q.size() != n || s.qdot.size() != n)
     throw std::invalid_argument("symplectic: momentum or state does not have ndof entries");
+  VariationalEulerScratch& c = scratchOf(sys, ws);
+  MatX& Jg = c.Jg;
   const VecX q_k = s.q;
   const VecX v_k = s.qdot;
   State sv;
@@ -136,16 +153,16 @@ void VariationalEuler::stepMomentum(const System& sys, State& s, VecX& p, double
   auto jacobian = [&]() {
     const VecX g0 = g;
     VecX vp;
-    Jg_.resize(n, n);
+    Jg.resize(n, n);
     for (int j = 0; j < n; ++j) {
       const double d = 1e-7 * (1.0 + std::abs(v[j]));
       vp = v;
       vp[j] += d;
       evalG(vp);
-      Jg_.col(j) = (g - g0) / d;
+      Jg.col(j) = (g - g0) / d;
     }
     g = g0;
-    jac_sys_ = &sys;
+    c.have_jacobian = true;
     ++stats_.jacobian_evals;
   };
 
@@ -157,8 +174,8 @@ void VariationalEuler::stepMomentum(const System& sys, State& s, VecX& p, double
     A = std::move(Anew);
     if (nc == 0) lu.compute(A);
   };
-  if (jac_sys_ != &sys || Jg_.rows() != n) jacobian();
-  setMatrix(M_k - h * Jg_);
+  if (!c.have_jacobian || Jg.rows() != n) jacobian();
+  setMatrix(M_k - h * Jg);
 
   // residual R(v) = M_k v - h g(v) - p; every solve is A v+ = A v - R(v) with constraint rows
   int iters = 0, since = 0, refreshes = 0;
@@ -178,7 +195,7 @@ void VariationalEuler::stepMomentum(const System& sys, State& s, VecX& p, double
       evalG(v);
       jacobian();
       ++refreshes;
-      setMatrix(M_k - h * Jg_);
+      setMatrix(M_k - h * Jg);
       since = 0;
       dv = 0.0;
       continue;
@@ -208,14 +225,14 @@ void VariationalEuler::stepMomentum(const System& sys, State& s, VecX& p, double
       }
       jacobian();
       ++refreshes;
-      setMatrix(M_k - h * Jg_);
+      setMatrix(M_k - h * Jg);
       since = 0;
     } else if (dv > 1e-8 * (1.0 + v.norm())) {
-      // Broyden's rank-one update keeps Jg_ current along the trajectory at no extra evaluation
+      // Broyden's rank-one update keeps Jg current along the trajectory at no extra evaluation
       // (skipped once dv is so small that g's round-off would dominate the secant)
       const VecX dvec = v - v_prev;
-      Jg_ += ((g - g_old) - Jg_ * dvec) * (dvec.transpose() / dvec.squaredNorm());
-      setMatrix(M_k - h * Jg_);
+      Jg += ((g - g_old) - Jg * dvec) * (dvec.transpose() / dvec.squaredNorm());
+      setMatrix(M_k - h * Jg);
     }
   }
   iterations_ += iters;

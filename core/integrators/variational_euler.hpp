@@ -24,10 +24,12 @@
 // constant and f independent of v it reduces to "euler".
 //
 // Momentum and the state. State stores q and qdot only; the step needs p_k, which is not
-// M(q_k) qdot_k but M(q_k-1) qdot_k. The integrator therefore caches p after each step, keyed by
-// the System's address and the exact bits of the (q, qdot) it returned (as the SUNDIALS
-// integrators keep their internal state). A state that does not match (a new initial condition,
-// a state modified by the caller) is given
+// M(q_k) qdot_k but M(q_k-1) qdot_k. The integrator therefore keeps p after each step in the
+// workspace it steps with (DynamicsWorkspace::integrator, a VariationalEulerScratch; advance()
+// keeps one workspace per system across calls, see FixedStepIntegrator), together with the exact
+// bits of the (q, qdot) it returned (as the SUNDIALS integrators keep their internal state). A
+// workspace bound to another system has no cache. A state that does not match (a new initial
+// condition, a state modified by the caller) is given
 //   p = M(q - h qdot) qdot,
 // the momentum it would have had had it come from a step of size h (equal to the cached one up to
 // round-off for a state produced by this integrator, so results do not depend on how a span is
@@ -74,6 +76,19 @@
 
 namespace redmax {
 
+/// The variational integrator's part of a DynamicsWorkspace (DynamicsWorkspace::integrator).
+struct VariationalEulerScratch final : TermScratch {
+  // momentum cache: p belongs to the state (q_end, v_end) this integrator returned last
+  bool have_state = false;
+  VecX q_end, v_end, p;      // (ndof)
+  VecX v_prev;               // velocity of the step before, for the predictor (ndof)
+  bool have_prev = false;
+  // last difference Jacobian dg/dv, kept current by Broyden updates; reused as the iteration
+  // matrix of later steps until the contraction slows down        (ndof x ndof)
+  MatX Jg;
+  bool have_jacobian = false;
+};
+
 class VariationalEuler final : public FixedStepIntegrator {
  public:
   /// tol: relative convergence tolerance on v; max_iter: iterations per step
@@ -81,26 +96,27 @@ class VariationalEuler final : public FixedStepIntegrator {
       : FixedStepIntegrator(opt), tol_(tol), max_iter_(max_iter) {}
   std::string name() const override { return "symplectic"; }
 
-  /// one step of size h (state.t += h), with p from the cache or reconstructed (see above)
+  /// one step of size h (state.t += h), with p from ws's cache or reconstructed (see above)
   void step(const System& sys, State& state, double h, DynamicsWorkspace& ws) override;
 
   /// One step of the (q, p) map: on entry s.q = q_k, s.qdot = v_k (start of the constraint rows
   /// and first guess of v unless `guess` is given), p = p_k (ndof); on exit s.q = q_k+1,
-  /// s.qdot = v_k+1, p = p_k+1 = M(q_k) v_k+1, s.t += h. No chart switch, no cache update.
+  /// s.qdot = v_k+1, p = p_k+1 = M(q_k) v_k+1, s.t += h. No chart switch, no momentum cache
+  /// update (the difference Jacobian in ws is kept).
   void stepMomentum(const System& sys, State& s, VecX& p, double h, DynamicsWorkspace& ws,
                     const VecX* guess = nullptr);
 
   /// discrete momentum of a state reached by a step of size h: p = M(q - h qdot) qdot (ndof)
   static VecX momentum(const System& sys, const State& s, double h, DynamicsWorkspace& ws);
 
-  /// Seed the cache: the next step from exactly s (same System, same q and qdot bits) uses
-  /// momentum p (ndof), e.g. to resume from a saved (q, qdot, p). Throws std::invalid_argument on
-  /// sizes that do not match the system.
+  /// Seed the cache of advance()'s workspace for sys: the next advance from exactly s (same
+  /// System, same q and qdot bits) uses momentum p (ndof), e.g. to resume from a saved (q, qdot,
+  /// p). Throws std::invalid_argument on sizes that do not match the system.
   void setMomentum(const System& sys, const State& s, const VecX& p);
 
-  /// The momentum the next step from s will use (ndof): the cached p if s is the state this
-  /// integrator returned last, carried through a joint chart switch if s is that state switched,
-  /// else momentum(sys, s, h, ws). Updates the cache accordingly.
+  /// The momentum the next step from s with ws will use (ndof): ws's cached p if s is the state
+  /// returned last by a step with ws, carried through a joint chart switch if s is that state
+  /// switched, else momentum(sys, s, h, ws). Updates ws's cache accordingly.
   const VecX& momentumOf(const System& sys, const State& s, double h, DynamicsWorkspace& ws);
 
   /// linear solves of the implicit momentum equation over all steps, and the most in one step
@@ -109,9 +125,11 @@ class VariationalEuler final : public FixedStepIntegrator {
   int maxIterationsPerStep() const { return max_iterations_per_step_; }
 
  private:
-  // if s is the chart switch of (q_end_, v_end_), carry p_ (and the predictor) over to the new
+  // ws's VariationalEulerScratch for sys (made on first use, dropped with the binding)
+  static VariationalEulerScratch& scratchOf(const System& sys, DynamicsWorkspace& ws);
+  // if s is the chart switch of (c.q_end, c.v_end), carry c.p (and the predictor) over to the new
   // chart by the cotangent lift and return true
-  bool liftThroughChartSwitch(const System& sys, const State& s);
+  static bool liftThroughChartSwitch(const System& sys, const State& s, VariationalEulerScratch& c);
 
   static constexpr int kMaxRefreshes = 3;      // difference Jacobians per step at most
   static constexpr double kRefreshAbove = 0.1;  // contraction rate that triggers one
@@ -121,14 +139,6 @@ class VariationalEuler final : public FixedStepIntegrator {
   long iterations_ = 0;
   int max_iterations_per_step_ = 0;
 
-  // momentum cache: p_ belongs to the state (q_end_, v_end_) of system sys_
-  const System* sys_ = nullptr;
-  VecX q_end_, v_end_, v_prev_, p_;
-  bool have_prev_ = false;  // v_prev_ is the velocity of the step before (predictor)
-  // last difference Jacobian dg/dv (ndof x ndof) and the system it belongs to; reused as the
-  // iteration matrix of later steps until the contraction slows down
-  MatX Jg_;
-  const System* jac_sys_ = nullptr;
 };
 
 }  // namespace redmax

@@ -55,8 +55,13 @@
 //                     length, J by central differences in q and Jdot by mixed central differences
 //                     along qdot. Positions are continuous at a contact change but J jumps there,
 //                     so the kinetic energy jumps: the dissertation's motivation for a smooth model.
+//   Neural            a trained network (core/muscles/wrap/network_model.hpp) on the segments the
+//                     smooth model takes, scaled by the surface size: exact J and Jdot of the
+//                     network; the smooth model wherever the network cannot answer (outside its
+//                     training box, another surface type, a quadrant wrap, beyond the cylinder's
+//                     length), counted and warned about once per muscle (recordNeuralWrapEval).
 // Dispatch: calcWrapModelPoints() is the one place where a surface-frame wrap model is chosen
-// (p1, p2, fractions -> w, Jw, Jwdot); a new model (e.g. a network) hooks in there.
+// (p1, p2, fractions -> w, Jw, Jwdot) among the three.
 // Columns: a wrap surface on a body that moves no path point adds its body's coordinates to the
 // muscle's compact columns (initWrapMuscleColumns; calcMuscleKinematics calls it).
 #include <string>

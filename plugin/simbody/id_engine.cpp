@@ -25,7 +25,7 @@ Mat4 toMat4(const SimTK::Transform& X) {
 
 struct SimbodyIdEngine::Impl {
   Model model;
-  osim::IdEngineOptions options;
+  IdEngineOptions options;
   std::unique_ptr<SimbodyModel> sm;
   SimTK::State state;
   std::vector<Mat4> E_wi;
@@ -36,7 +36,7 @@ struct SimbodyIdEngine::Impl {
   SimTK::Vector f_muscles;
 };
 
-SimbodyIdEngine::SimbodyIdEngine(const Model& model, const osim::IdEngineOptions& options)
+SimbodyIdEngine::SimbodyIdEngine(const Model& model, const IdEngineOptions& options)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.model = model;
@@ -64,7 +64,7 @@ SimbodyIdEngine::SimbodyIdEngine(const Model& model, const osim::IdEngineOptions
 }
 
 SimbodyIdEngine::SimbodyIdEngine(const Model& model, std::vector<Muscle> muscles,
-                                 const osim::IdEngineOptions& options)
+                                 const IdEngineOptions& options)
     : SimbodyIdEngine(model, options) {
   bool any = false;
   for (const Muscle& mu : muscles) any = any || mu.mass_points.size() > 0;
@@ -74,12 +74,12 @@ SimbodyIdEngine::SimbodyIdEngine(const Model& model, std::vector<Muscle> muscles
 SimbodyIdEngine::~SimbodyIdEngine() = default;
 
 void SimbodyIdEngine::calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,
-                                            const std::vector<osim::IdLoadSample>& loads, VecX& tau) {
+                                            const std::vector<IdLoadSample>& loads, VecX& tau) {
   Impl& m = *impl_;
   const SimbodyModel& sm = *m.sm;
   const int nr = m.model.nr();
   if (q.size() != nr || v.size() != nr || vdot.size() != nr)
-    throw osim::IdEngineError("inverse dynamics needs " + std::to_string(nr) +
+    throw IdEngineError("inverse dynamics needs " + std::to_string(nr) +
                               " coordinates, speeds and accelerations");
 
   // u and udot: the given rates as they are for marked joints (OpenSim), T qdot elsewhere
@@ -109,7 +109,7 @@ void SimbodyIdEngine::calcGeneralizedForces(double t, const VecX& q, const VecX&
   SimTK::Vector_<SimTK::SpatialVec> body_forces = sm.system.getRigidBodyForces(sb, SimTK::Stage::Dynamics);
   const SimTK::Vector& mobility_forces = sm.system.getMobilityForces(sb, SimTK::Stage::Dynamics);
   for (int i = 0; i < m.model.nb(); ++i) m.E_wi[i] = toMat4(sm.mobods[i].getBodyTransform(sb));
-  osim::resolveLoads(loads, m.E_wi, m.point_forces, m.wrenches);
+  resolveLoads(loads, m.E_wi, m.point_forces, m.wrenches);
   for (const PointForce& f : m.point_forces)
     sm.matter.addInStationForce(sb, sm.mobods[f.body].getMobilizedBodyIndex(),
                                 SimTK::Vec3(f.point_i.x(), f.point_i.y(), f.point_i.z()),
@@ -131,7 +131,7 @@ void SimbodyIdEngine::calcGeneralizedForces(double t, const VecX& q, const VecX&
       m.muscles->calcGeneralizedForces(sb, udot_sb, m.f_muscles);
     } catch (const MuscleError& e) {
       // a degenerate path at this frame: the frame cannot be solved (IdEngine contract)
-      throw osim::IdEngineError("at t = " + std::to_string(t) + ": " + e.what());
+      throw IdEngineError("at t = " + std::to_string(t) + ": " + e.what());
     }
     f_u += m.f_muscles;
   }

@@ -1,5 +1,6 @@
 #pragma once
-// The Simbody engine of the inverse-dynamics tool (converter/id/inverse_dynamics_tool.hpp): the
+// The Simbody engine (core/dynamics/id_engine.hpp) of the inverse-dynamics tool
+// (converter/id/inverse_dynamics_tool.hpp): the
 // core model rebuilt as a Simbody system (model_to_simbody.hpp) and solved as OpenSim's
 // InverseDynamicsSolver does, with SimbodyMatterSubsystem::calcResidualForceIgnoringConstraints:
 //   tau_u = M udot + c(q, u) - (gravity + external loads as station forces and body torques).
@@ -13,30 +14,30 @@
 #include <string>
 #include <vector>
 
-#include "converter/id/id_engine.hpp"
+#include "core/dynamics/id_engine.hpp"
 #include "core/muscles/mass_points.hpp"
 #include "core/skeleton/model.hpp"
 
 namespace redmax::simbody {
 
-class SimbodyIdEngine final : public osim::IdEngine {
+class SimbodyIdEngine final : public IdEngine {
  public:
   /// Builds the Simbody system (Ball mobilizers for spherical joints when any of them is marked,
   /// Gimbal otherwise). Throws SimbodyBuildError (simbody_options.hpp) when the model has a joint
   /// without a Simbody counterpart, or a marked joint whose mobilizer has u = qdot (not Ball/Free).
-  explicit SimbodyIdEngine(const Model& model, const osim::IdEngineOptions& options = {});
+  explicit SimbodyIdEngine(const Model& model, const IdEngineOptions& options = {});
   /// The same, plus the inertia and weight of the mass points of `muscles` (muscles without mass
   /// points add nothing). Throws ModelError for a muscle that does not fit the model (validateMuscle);
   /// calcGeneralizedForces throws IdEngineError naming the muscle when its path degenerates at a frame
   /// (e.g. coincident consecutive path points).
-  SimbodyIdEngine(const Model& model, std::vector<Muscle> muscles, const osim::IdEngineOptions& options = {});
+  SimbodyIdEngine(const Model& model, std::vector<Muscle> muscles, const IdEngineOptions& options = {});
   ~SimbodyIdEngine() override;
   SimbodyIdEngine(const SimbodyIdEngine&) = delete;
   SimbodyIdEngine& operator=(const SimbodyIdEngine&) = delete;
 
   std::string name() const override { return "simbody"; }
   void calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,
-                             const std::vector<osim::IdLoadSample>& loads, VecX& tau) override;
+                             const std::vector<IdLoadSample>& loads, VecX& tau) override;
 
  private:
   struct Impl;

@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include "core/dynamics/speed_map.hpp"
 #include "plugin/simbody/function_adapter.hpp"
 
 namespace redmax::simbody {
@@ -279,7 +280,7 @@ void calcVelocityMap(const SimbodyModel& sm, const Model& model, const State& s,
   const int n = model.nr();
   T.setZero(n, n);
   if (Tdot) Tdot->setZero(n, n);
-  JointKinematics jk;
+  MatJ Tj, Tdj;
   for (int i = 0; i < model.nb(); ++i) {
     const MobilizerMap& m = sm.map[i];
     if (m.nq == 0) continue;
@@ -287,24 +288,12 @@ void calcVelocityMap(const SimbodyModel& sm, const Model& model, const State& s,
       T.block(m.simbody_u, m.q_index, m.nq, m.nq).setIdentity();
       continue;
     }
-    // Ball/Free/Ellipsoid: u = (w_FM; v_FM) in F (Ellipsoid: w_FM only) = diag(R_FM, R_FM) S qdot,
-    // S being the twist of M in F expressed in M; its time derivative adds diag(R [w], R [w]) S
-    // with w = (S qdot)_w in M
-    const auto q = s.q.segment(m.q_index, m.nq);
-    const auto qd = s.qdot.segment(m.q_index, m.nq);
-    model.joints[i].joint.calc(q, qd, jk);
-    const Mat3 R = jk.Q.topLeftCorner<3, 3>();
-    Eigen::Matrix<double, 6, 6> D = Eigen::Matrix<double, 6, 6>::Zero();
-    D.topLeftCorner<3, 3>() = R;
-    D.bottomRightCorner<3, 3>() = R;
-    T.block(m.simbody_u, m.q_index, m.nq, m.nq) = (D * jk.S).topRows(m.nq);
-    if (Tdot) {
-      const Vec3 w = (jk.S * qd).head<3>();
-      Eigen::Matrix<double, 6, 6> Dd = Eigen::Matrix<double, 6, 6>::Zero();
-      Dd.topLeftCorner<3, 3>() = R * skew(w);
-      Dd.bottomRightCorner<3, 3>() = R * skew(w);
-      Tdot->block(m.simbody_u, m.q_index, m.nq, m.nq) = (Dd * jk.S + D * jk.Sdot).topRows(m.nq);
-    }
+    // Ball/Free/Ellipsoid: u = (w_FM; v_FM) in F (Ellipsoid, Ball: w_FM only), the core's speed map
+    const VecJ q = s.q.segment(m.q_index, m.nq);
+    const VecJ qd = s.qdot.segment(m.q_index, m.nq);
+    calcOpenSimSpeedMap(model.joints[i].joint, q, qd, Tj, Tdot ? &Tdj : nullptr);
+    T.block(m.simbody_u, m.q_index, m.nq, m.nq) = Tj;
+    if (Tdot) Tdot->block(m.simbody_u, m.q_index, m.nq, m.nq) = Tdj;
   }
 }
 

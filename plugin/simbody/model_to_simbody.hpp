@@ -15,7 +15,8 @@
 // Simbody's q equals the core q for every joint. Simbody's generalized speeds u equal qdot except
 // for Ball and Ellipsoid (u = w_FM expressed in F) and Free (u = [w_FM; v_FM], both in F). The velocity map
 //   u = T(q) qdot,   udot = T qddot + Tdot qdot        (T block diagonal, nu x nr)
-// converts between the two spaces: M_core = T^T M_u T, tau_core = T^T f_u.
+// converts between the two spaces: M_core = T^T M_u T, tau_core = T^T f_u. Its blocks for Ball,
+// Free and Ellipsoid are the core's speed map (core/dynamics/speed_map.hpp).
 //
 // Only TUs that need Simbody include this header (BUILD_NOTES: ~15 s and 700 MB per TU; every such
 // TU must be compiled with -UNDEBUG, which the SimTKcommon target propagates).

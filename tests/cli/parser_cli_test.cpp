@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +23,7 @@ class ParserCli : public ::testing::Test {
     if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to cli_tests (build target redmax)";
     dir_ = fs::temp_directory_path() / ("redmax_parser_cli_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
+    std::ofstream(dir_ / "q.mot") << "";  // exists: the parse errors below come before reading it
   }
   void TearDown() override {
     if (!dir_.empty()) fs::remove_all(dir_);
@@ -65,6 +67,8 @@ TEST_F(ParserCli, ParseErrorsExitTwoWithErrorAndWriteNothing) {
       {"simulate stray --model " + model + " --duration 1 --out s.sto", "simulate takes no positional arguments (got 'stray')"},
       {"convert " + model + " " + model, "convert takes one MODEL.osim"},
       {"nosuchcommand", "unknown command 'nosuchcommand'"},
+      // a file that must exist, named first
+      {"id --model " + model + " --coordinates missing.mot --out s.sto", "missing.mot: no such file (--coordinates)"},
   };
   for (const Case& c : cases) {
     const CmdResult r = run(c.args);

@@ -153,7 +153,7 @@ TEST(HardCases, NanStopsTheRunNamingTimeCoordinateStep) {
 class NanForce final : public ForceTerm {
  public:
   std::string name() const override { return "nan_force"; }
-  void addForce(const Model&, const State& s, const SkeletonWorkspace&, VecX& f) const override {
+  void addForce(const Model&, const State& s, const TermContext&, VecX& f) const override {
     if (s.t >= 0.1) f[0] = std::numeric_limits<double>::quiet_NaN();
   }
 };

@@ -10,6 +10,12 @@
 //     of the peak, R^2 >= 1 - 1e-9), the ankle moment changes, and a physiological scale sweep
 //     has R^2 >= 0.999; Simbody with muscle inertia agrees with the core at 80% (1e-9 of the
 //     peak); the single-value inertial effect equals the sweep at the same fraction;
+//   - toward zero (physiological scales 0, 1e-3, 0.01, 0.1, 1; running leg everywhere, set F with
+//     ../shared): the value 0 runs the mass-point code with massless points; Simbody with
+//     plugin/simbody's own muscle inertia agrees with the core at every value (1e-13 of the peak,
+//     measured <= 4.9e-15), so do the two engines' inertial effects tau(s) - tau(0), and each
+//     engine's effect is s times its effect at 1 (|ratio / s - 1| <= 1e-10, measured 1.4e-11); set
+//     F's value 0 equals OpenSim 4.6's own ID result (RMS 1e-9 of the peak, measured 7.6e-11);
 //   - the command line: a sweep through `redmax validate` exits 0 and fills summary.json; its 80%
 //     torques equal `redmax id --muscle-mass transfer --transfer-fraction 0.8` (1e-12 of the peak);
 //     bad sweep values and flags exit 2;
@@ -192,7 +198,13 @@ TEST(MassSweepValues, ParsedCheckedSortedAndZeroAdded) {
   // the options of one value
   EXPECT_EQ(redmax::validation::massOptionsForValue(t, 0.6).transfer_fraction, 0.6);
   EXPECT_DOUBLE_EQ(redmax::validation::massOptionsForValue(p, 0.5).density, 0.5 * p.density);
-  EXPECT_EQ(redmax::validation::massOptionsForValue(p, 0.0).source, Source::None);
+  // scale 0 stays physiological (massless points), not "no muscle mass"
+  EXPECT_EQ(redmax::validation::massOptionsForValue(p, 0.0).source, Source::Physiological);
+  EXPECT_EQ(redmax::validation::massOptionsForValue(p, 0.0).density, 0.0);
+  EXPECT_TRUE(redmax::validation::hasZeroMuscleMass(redmax::validation::massOptionsForValue(p, 0.0)));
+  EXPECT_TRUE(redmax::validation::hasZeroMuscleMass(redmax::validation::massOptionsForValue(t, 0.0)));
+  EXPECT_FALSE(redmax::validation::hasZeroMuscleMass(redmax::validation::massOptionsForValue(p, 1e-3)));
+  EXPECT_FALSE(redmax::validation::hasZeroMuscleMass(redmax::validation::massOptionsForValue(t, 0.2)));
 }
 
 TEST(MassSweepValues, MainColumnsFollowTheTransferSide) {
@@ -291,6 +303,102 @@ TEST_F(MassSweep, RunningLegPhysiologicalScaleSweepIsLinear) {
   EXPECT_NEAR(sw.points[1].muscle_mass, 0.25 * sw.points.back().muscle_mass, 1e-12);
   std::printf("[ measured ] running leg, physiological scale 0-1 (%.3f kg): R^2 min %.15f\n",
               sw.points.back().muscle_mass, sw.analysis.r2_min_observed);
+}
+
+// graceful degradation toward zero mass, against references that share nothing with the core's
+// muscle code: Simbody with plugin/simbody's MuscleInertia solves every value (its own station
+// kinematics of the mass points), and the two engines' inertial effects tau(s) - tau(0) must agree
+// at every value while shrinking in proportion to s
+const std::vector<double> kToZero = {0.0, 1e-3, 0.01, 0.1, 1.0};
+
+// max_k |x(k)| over every column, of a - b
+double maxAbsDiff(const MatX& a, const MatX& b) { return (a - b).cwiseAbs().maxCoeff(); }
+
+// per sweep value, of the table pairs (zero, value): the effect's size over every column and frame
+std::vector<double> effectSizes(const std::vector<MatX>& tau) {
+  std::vector<double> out;
+  for (const MatX& t : tau) out.push_back(maxAbsDiff(t, tau.front()));
+  return out;
+}
+
+// what both engine checks assert on a sweep over kToZero; returns the worst effect ratio defect
+// |effect(s) / (s effect(1)) - 1| over s > 0 of both engines
+double checkDegradation(const redmax::validation::MassSweepResult& sw, const redmax::osim::Storage& zero_mass,
+                        const char* what) {
+  EXPECT_EQ(sw.options.values, kToZero);
+  EXPECT_EQ(sw.points.front().muscle_mass, 0.0);
+  // the value 0 ran the mass-point code: the muscles carry points, massless
+  EXPECT_GT(sw.points.front().muscles_with_mass, 0);
+  EXPECT_EQ(sw.points.front().muscles_with_mass, sw.points.back().muscles_with_mass);
+  EXPECT_NE(sw.points.front().description.find("zero mass"), std::string::npos) << sw.points.front().description;
+  EXPECT_TRUE(sw.analysis.zero_passed) << sw.analysis.zero_max_rel;
+  EXPECT_NEAR(sw.points[1].muscle_mass, 1e-3 * sw.points.back().muscle_mass, 1e-12 * sw.points.back().muscle_mass);
+  EXPECT_EQ(sw.simbody_values.size(), kToZero.size());
+  if (sw.simbody_values.size() != kToZero.size()) return 1.0;
+  std::vector<MatX> core, sb;
+  for (size_t j = 0; j < kToZero.size(); ++j) {
+    const auto& c = sw.simbody_values[j];
+    SCOPED_TRACE(std::string(what) + " value " + std::to_string(kToZero[j]));
+    EXPECT_EQ(c.value, kToZero[j]);
+    EXPECT_TRUE(c.ran) << c.skipped;
+    if (!c.ran) return 1.0;
+    EXPECT_TRUE(c.not_counted.empty()) << c.not_counted;
+    EXPECT_TRUE(c.comparison.passed);
+    const auto& w = c.comparison.metrics[static_cast<size_t>(c.comparison.worst)];
+    // the engine tolerance is 1e-9 of the peak; measured 1.6e-15 (running leg) and 4.9e-15 (set F)
+    EXPECT_LE(w.max_rel, 1e-13) << w.name;
+    // the effects agree to the engines' round-off, relative to the column peak (measured <= 3.6e-15)
+    if (j > 0) EXPECT_LE(c.effect_max_rel, 1e-13);
+    core.push_back(c.coreTorques(sw.torques[j]).data);
+    sb.push_back(c.result.data);
+  }
+  // Simbody with massless points equals the plain zero-mass core (an engine with no muscle code)
+  const Eigen::VectorXd pk = peaks(zero_mass.data);
+  if (sw.simbody_values.front().core_result.numRows() == 0)
+    for (int c = 0; c < zero_mass.data.cols(); ++c)
+      EXPECT_LE((sb.front().col(c) - zero_mass.data.col(c)).cwiseAbs().maxCoeff(), 1e-9 * pk(c)) << zero_mass.labels[c];
+  // linear in s toward zero, seen by each engine: effect(s) = s effect(1) per frame and column
+  const std::vector<double> ec = effectSizes(core), es = effectSizes(sb);
+  EXPECT_GT(ec.back(), 1e-6 * pk.maxCoeff()) << "the muscles must matter at s = 1";
+  double worst = 0;
+  for (size_t j = 1; j < kToZero.size(); ++j) {
+    const double s = kToZero[j];
+    worst = std::max({worst, std::abs(ec[j] / (s * ec.back()) - 1), std::abs(es[j] / (s * es.back()) - 1)});
+    // per frame too, for the Simbody side (the core is affine by construction)
+    EXPECT_LE(maxAbsDiff(sb[j] - sb.front(), s * (sb.back() - sb.front())), 1e-9 * pk.maxCoeff()) << s;
+  }
+  std::printf("[ measured ] %s: effect at s = 1e-3 / effect at 1: core %.6g, simbody %.6g (x 1e-3); worst "
+              "|ratio / s - 1| %.2g; core vs simbody worst %.2g of the peak, effects %.2g of the peak\n",
+              what, ec[1] / ec.back() * 1e3, es[1] / es.back() * 1e3, worst,
+              [&] {
+                double m = 0;
+                for (const auto& c : sw.simbody_values)
+                  m = std::max(m, c.comparison.metrics[static_cast<size_t>(c.comparison.worst)].max_rel);
+                return m;
+              }(),
+              [&] {
+                double m = 0;
+                for (size_t j = 1; j < sw.simbody_values.size(); ++j) m = std::max(m, sw.simbody_values[j].effect_max_rel);
+                return m;
+              }());
+  return worst;
+}
+
+TEST_F(MassSweep, RunningLegPhysiologicalSweepTowardZeroAgreesWithSimbodyAtEveryValue) {
+  auto opt = legOptions("leg_to_zero");
+  opt.gnuplot = "none";
+  opt.muscle_mass.source = Source::Physiological;
+  opt.mass_sweep = {1.0, 0.1, 0.01, 1e-3};  // 0 is added
+  const auto r = redmax::validation::runIdValidation(opt);
+  ASSERT_TRUE(r.has_mass_sweep);
+  EXPECT_TRUE(r.passed);
+  const redmax::osim::Storage zero = redmax::osim::readStorage((dir_ / "leg_to_zero" / "core_id.sto").string());
+  const double worst = checkDegradation(r.mass_sweep, zero, "running leg, physiological 0-1");
+  // measured 1.4e-11: linear to round-off in both engines (the effect at 1e-3 is 1e-3 of the one at 1)
+  EXPECT_LE(worst, 1e-10);
+  EXPECT_TRUE(fs::exists(dir_ / "leg_to_zero" / "mass_sweep_simbody.csv"));
+  const JsonValue s = JsonValue::parse(slurp(dir_ / "leg_to_zero" / "summary.json"));
+  EXPECT_EQ(s.at("mass_sweep").at("simbody_values").size(), kToZero.size());
 }
 
 TEST_F(MassSweep, InertialEffectEqualsTheSweepAtTheSameFraction) {
@@ -414,9 +522,19 @@ TEST_F(MassSweep, SetFTibiaTransferSweep) {
   opt.muscle_mass.source = Source::Transfer;
   opt.muscle_mass.transfer_body = "tibia_r";
   opt.mass_sweep = kFractions;
+  opt.references = {{base + "opensim-4.6-results/F.sto", "opensim"}};
   const auto r = redmax::validation::runIdValidation(opt);
   ASSERT_TRUE(r.has_mass_sweep);
   const auto& sw = r.mass_sweep;
+  // the value 0 (massless points) against OpenSim 4.6's own result, as the zero-mass core is
+  ASSERT_EQ(sw.zero_vs_references.size(), 1u);
+  EXPECT_TRUE(sw.zero_vs_references[0].passed);
+  // Simbody at every fraction
+  ASSERT_EQ(sw.simbody_values.size(), kFractions.size());
+  for (const auto& c : sw.simbody_values) {
+    EXPECT_TRUE(c.ran && c.comparison.passed) << c.value << ": " << c.skipped;
+    if (c.value > 0) EXPECT_LE(c.effect_max_rel, 1e-9) << c.value;
+  }
   // the zero-mass engines agree, and so does Simbody with muscle inertia at 80% (MovingPathPoints
   // included: their terms come from Simbody's own mobilizer kinematics, muscle_inertia.hpp)
   EXPECT_TRUE(r.passed);
@@ -487,6 +605,39 @@ TEST_F(MassSweep, SetETibiaTransferSweep) {
               "peak; R^2 min %.15f\n",
               sw.points.back().muscle_mass, sw.points.back().muscles_with_mass,
               100 * sw.analysis.columns[static_cast<size_t>(ankle)].max_diff_rel.back(), sw.analysis.r2_min_observed);
+}
+
+// set F toward zero mass: both engines at every value, and the value 0 against OpenSim 4.6's result
+TEST_F(MassSweep, SetFPhysiologicalSweepTowardZeroAgainstSimbodyAndOpenSim) {
+  const std::string base = std::string(REDMAX_SHARED_DIR) + "/opensim/";
+  const std::string setup = base + "opensim-models/Pipelines/Gait10dof18musc/OutputReference/ID/walk_Setup_ID.xml";
+  const std::string model = base + "opensim-models@a26e12c/Pipelines/Gait10dof18musc/OutputReference/subject01.osim";
+  const std::string opensim = base + "opensim-4.6-results/F.sto";
+  for (const auto& f : {setup, model, opensim})
+    if (!fs::exists(f)) GTEST_SKIP() << "shared OpenSim data not found: " << f << " (needs ../shared/opensim)";
+  redmax::validation::IdValidationOptions opt;
+  opt.settings.setup_file = setup;
+  opt.settings.model_file = model;
+  opt.report_dir = (dir_ / "setF_to_zero").string();
+  opt.gnuplot = "none";
+  opt.muscle_mass.source = Source::Physiological;
+  opt.mass_sweep = {1.0, 0.1, 0.01, 1e-3};
+  opt.references = {{opensim, "opensim"}};
+  const auto r = redmax::validation::runIdValidation(opt);
+  ASSERT_TRUE(r.has_mass_sweep);
+  EXPECT_TRUE(r.passed);
+  const auto& sw = r.mass_sweep;
+  ASSERT_EQ(sw.zero_vs_references.size(), 1u);
+  const auto& zc = sw.zero_vs_references[0];
+  EXPECT_TRUE(zc.passed);
+  const auto& zw = zc.metrics[static_cast<size_t>(zc.worst)];
+  // measured 7.6e-11 of the peak (RMS, lumbar_extension_moment), as the zero-mass core
+  EXPECT_LE(zw.rms_rel, 1e-9) << zw.name;
+  const redmax::osim::Storage zero = redmax::osim::readStorage((dir_ / "setF_to_zero" / "core_id.sto").string());
+  const double worst = checkDegradation(sw, zero, "set F, physiological 0-1");
+  EXPECT_LE(worst, 1e-10);  // measured 1.1e-11
+  std::printf("[ measured ] set F, value 0 (massless points) vs OpenSim 4.6: worst %s RMS/peak %.3g\n", zw.name.c_str(),
+              zw.rms_rel);
 }
 
 // the muscles' share of inverse dynamics, tau_m = tau(with mass points) - tau(skeleton alone) on

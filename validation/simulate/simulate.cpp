@@ -109,13 +109,13 @@ bool ImpulseLoads::active(double t) const {
   return false;
 }
 
-void ImpulseLoads::addForce(const Model& model, const State& s, const SkeletonWorkspace& sk, VecX& f) const {
+void ImpulseLoads::addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const {
   // the switch-off is a step in time; 1e-12 s of slack keeps a step that starts at t_end (up to
   // round-off in t) out of the impulse
   BodyLoads on;
   for (const Load& l : loads_)
     if (s.t < l.t_end - 1e-12) on.point_forces.push_back({l.body, l.point_i, l.force_w});
-  if (!on.point_forces.empty()) on.addForce(model, s, sk, f);
+  if (!on.point_forces.empty()) on.addForce(model, s, ctx, f);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -75,7 +75,7 @@ class ImpulseLoads final : public ForceTerm {
   };
   explicit ImpulseLoads(std::vector<Load> loads) : loads_(std::move(loads)) {}
   std::string name() const override { return "impulse_loads"; }
-  void addForce(const Model& model, const State& s, const SkeletonWorkspace& sk, VecX& f) const override;
+  void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   const std::vector<Load>& loads() const { return loads_; }
   /// true while any load acts at time t
   bool active(double t) const;

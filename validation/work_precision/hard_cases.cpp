@@ -57,7 +57,7 @@ class NanAfter final : public ForceTerm {
  public:
   explicit NanAfter(double t_nan) : t_nan_(t_nan) {}
   std::string name() const override { return "nan_after"; }
-  void addForce(const Model&, const State& s, const SkeletonWorkspace&, VecX& f) const override {
+  void addForce(const Model&, const State& s, const TermContext&, VecX& f) const override {
     if (s.t >= t_nan_) f[0] += std::numeric_limits<double>::quiet_NaN();
   }
 

@@ -8,7 +8,6 @@
 
 #include "core/muscles/mass_points.hpp"
 #include "core/muscles/path.hpp"
-#include "core/muscles/wrap/train.hpp"
 
 namespace redmax {
 
@@ -46,6 +45,26 @@ void checkEndPoints(const WrapSurface& s, const Vec3& p1, const Vec3& p2) {
 }
 
 }  // namespace
+
+int wrapInputSize(WrapType type) {
+  switch (type) {
+    case WrapType::Cylinder:
+    case WrapType::Sphere: return 8;
+    case WrapType::Ellipsoid: return 10;
+    case WrapType::Torus: return 9;
+  }
+  return 0;
+}
+
+WrapSurface makeWrapSurfaceFromInput(WrapType type, const VecX& in) {
+  switch (type) {
+    case WrapType::Cylinder: return WrapSurface::makeCylinder(in[7], 1000.0 * in[7]);
+    case WrapType::Sphere: return WrapSurface::makeSphere(in[7]);
+    case WrapType::Ellipsoid: return WrapSurface::makeEllipsoid(Vec3(in[7], in[8], in[9]));
+    case WrapType::Torus: return WrapSurface::makeTorus(in[7], in[8]);
+  }
+  return {};
+}
 
 std::string toString(NetworkWrapFallback why) {
   switch (why) {

@@ -159,6 +159,15 @@ NetworkWrapEval calcNeuralWrapModelPoints(const WrapMassOptions& options, const 
 /// to the sink). No-op otherwise.
 void recordNeuralWrapEval(const Muscle& muscle, const PathWrap& w);
 
+/// Input layout of the network of a surface type: origin (3), insertion (3), alpha, then the
+/// size parameters: radius (cylinder, sphere), semi-axes a b c (ellipsoid), inner and outer
+/// radius (torus).
+int wrapInputSize(WrapType type);
+
+/// The surface described by the size part of an input vector (no quadrant; the cylinder's length
+/// is 1000 radii, i.e. effectively infinite).
+WrapSurface makeWrapSurfaceFromInput(WrapType type, const VecX& input);
+
 /// A wrap network from a file (Mlp::load), checked by networkWrapUnsupportedReason.
 /// NetworkFormatError (FILE:LINE: ...) for a bad file, std::runtime_error for I/O or an unusable
 /// network (naming the file).

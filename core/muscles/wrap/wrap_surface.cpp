@@ -3,10 +3,29 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "core/muscles/wrap/wrap_geometry.hpp"
 
 namespace redmax {
+
+WrapType parseWrapType(const std::string& name) {
+  if (name == "cylinder") return WrapType::Cylinder;
+  if (name == "sphere") return WrapType::Sphere;
+  if (name == "ellipsoid") return WrapType::Ellipsoid;
+  if (name == "torus") return WrapType::Torus;
+  throw std::invalid_argument("unknown surface '" + name + "' (expected cylinder, sphere, ellipsoid or torus)");
+}
+
+std::string wrapTypeName(WrapType type) {
+  switch (type) {
+    case WrapType::Cylinder: return "cylinder";
+    case WrapType::Sphere: return "sphere";
+    case WrapType::Ellipsoid: return "ellipsoid";
+    case WrapType::Torus: return "torus";
+  }
+  return "?";
+}
 
 using namespace detail;
 

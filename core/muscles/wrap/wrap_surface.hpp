@@ -41,6 +41,7 @@
 // the torus's closest point is found to 1e-12 by Newton/bisection instead of MINPACK's lmdif with
 // tolerance 1e-4 (differences below lmdif's tolerance); when the torus's inner cylinder gives no
 // wrap OpenSim still reports "wrapped" with no points (which inserts nothing); we report NoWrap.
+#include <string>
 #include <vector>
 
 #include "core/spatial/types.hpp"
@@ -48,6 +49,10 @@
 namespace redmax {
 
 enum class WrapType { Cylinder, Sphere, Ellipsoid, Torus };
+
+/// "cylinder", "sphere", "ellipsoid", "torus" (std::invalid_argument for anything else) and back.
+WrapType parseWrapType(const std::string& name);
+std::string wrapTypeName(WrapType type);
 
 /// OpenSim PathWrap `method` (ellipsoids only)
 enum class WrapMethod { Hybrid, Midpoint, Axial };

@@ -18,10 +18,11 @@ class SpringParticle final : public ForceTerm {
   SpringParticle(int first, int body, Vec3 x_tip, double m, double k, Vec3 g)
       : first_(first), body_(body), x_tip_(x_tip), m_(m), k_(k), g_(g) {}
   std::string name() const override { return "spring_particle"; }
-  void addMass(const Model&, const State&, const SkeletonWorkspace&, MatX& M) const override {
+  void addMass(const Model&, const State&, const TermContext&, MatX& M) const override {
     M.block<3, 3>(first_, first_) += m_ * Mat3::Identity();
   }
-  void addForce(const Model& model, const State& s, const SkeletonWorkspace& ws, VecX& f) const override {
+  void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override {
+    const SkeletonWorkspace& ws = ctx.sk;
     const Vec3 x = s.q.segment<3>(first_);
     const Vec3 tip = transformPoint(ws.E_wi[body_], x_tip_);
     const Vec3 F = k_ * (tip - x);  // pulls the particle towards the tip
@@ -30,10 +31,11 @@ class SpringParticle final : public ForceTerm {
     pointJacobian(model, ws, body_, x_tip_, J);
     f.head(model.nr()) -= J.transpose() * F;
   }
-  double kineticEnergy(const Model&, const State& s, const SkeletonWorkspace&) const override {
+  double kineticEnergy(const Model&, const State& s, const TermContext&) const override {
     return 0.5 * m_ * s.qdot.segment<3>(first_).squaredNorm();
   }
-  double potentialEnergy(const Model&, const State& s, const SkeletonWorkspace& ws) const override {
+  double potentialEnergy(const Model&, const State& s, const TermContext& ctx) const override {
+    const SkeletonWorkspace& ws = ctx.sk;
     const Vec3 x = s.q.segment<3>(first_);
     const Vec3 tip = transformPoint(ws.E_wi[body_], x_tip_);
     return 0.5 * k_ * (tip - x).squaredNorm() - m_ * g_.dot(x);

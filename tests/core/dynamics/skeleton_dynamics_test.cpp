@@ -33,16 +33,27 @@ TEST_P(DynamicsSeeds, RecursiveNewtonEulerMatchesRedmaxRoute) {
 }
 
 TEST_P(DynamicsSeeds, ForwardInvertsInverse) {
+  // System::forwardDynamics (REDMAX M and f, factorised) against the O(n) Newton-Euler pass, which
+  // shares neither M nor f: the unactuated accelerations need zero generalized force
   const Model m = scenes::randomTree(12, 600 + GetParam());
   System sys(m);
   std::mt19937 rng(GetParam());
   const State s = randomState(m.nr(), rng);
-  const VecX qddot = randomState(m.nr(), rng).qdot;
   DynamicsWorkspace ws(m);
-  const VecX tau = sys.inverseDynamics(s, qddot, ws);
-  // apply tau as a generalized force and solve forward dynamics
-  VecX qddot_fd = ws.M.ldlt().solve(ws.f + tau);
-  EXPECT_TRUE(nearRel(qddot_fd, qddot, 1e-10));
+  const VecX qddot = sys.forwardDynamics(s, ws);
+  const VecX tau = inverseDynamicsRecursive(m, s, qddot);
+  // the scale: what the accelerations balance (gravity and velocity products, -f)
+  const VecX tau_rest = inverseDynamicsRecursive(m, s, VecX::Zero(m.nr()));
+  ASSERT_GT(tau_rest.norm(), 1e-3);
+  EXPECT_LE(tau.norm(), 1e-10 * tau_rest.norm());
+  // and the REDMAX route's own inverse dynamics at those accelerations
+  EXPECT_LE(sys.inverseDynamics(s, qddot, ws).norm(), 1e-10 * tau_rest.norm());
+  // the mass matrix forwardDynamics factorised, column by column from the recursive pass
+  MatX M_rnea(m.nr(), m.nr());
+  for (int i = 0; i < m.nr(); ++i)
+    M_rnea.col(i) = inverseDynamicsRecursive(m, s, VecX::Unit(m.nr(), i)) - tau_rest;
+  sys.calcMassAndForce(s, ws);
+  EXPECT_LE((ws.M - M_rnea).norm(), 1e-10 * M_rnea.norm());
 }
 
 TEST_P(DynamicsSeeds, MassMatrixIsKineticEnergyHessian) {
@@ -77,7 +88,8 @@ TEST_P(DynamicsSeeds, ForceIsLagrangian) {
   EXPECT_NEAR(dEdt, 0.0, 1e-6 * (1 + std::abs(E(s))));
 }
 
-INSTANTIATE_TEST_SUITE_P(Seeds, DynamicsSeeds, ::testing::Range(0, 5));
+INSTANTIATE_TEST_SUITE_P(Seeds, DynamicsSeeds, ::testing::Range(0, 5),
+                         [](const ::testing::TestParamInfo<int>& i) { return "seed" + std::to_string(i.param); });
 
 TEST(SkeletonDynamics, SinglePendulumAnalytic) {
   // rod of length L hinged at one end: I qddot = -m g (L/2) sin q

@@ -115,7 +115,7 @@ class LambdaForce final : public ForceTerm {
   using Fn = std::function<void(const State&, VecX&)>;
   explicit LambdaForce(Fn fn) : fn_(std::move(fn)) {}
   std::string name() const override { return "lambda_force"; }
-  void addForce(const Model&, const State& s, const SkeletonWorkspace&, VecX& f) const override { fn_(s, f); }
+  void addForce(const Model&, const State& s, const TermContext&, VecX& f) const override { fn_(s, f); }
 
  private:
   Fn fn_;

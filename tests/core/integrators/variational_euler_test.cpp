@@ -581,11 +581,11 @@ TEST(MassDotTimesVelocity, MuscleTermAnalyticAndDefault) {
 class QuadraticMassTerm final : public ForceTerm {
  public:
   std::string name() const override { return "quadratic_mass"; }
-  void addMass(const Model&, const State& s, const SkeletonWorkspace&, MatX& M) const override {
+  void addMass(const Model&, const State& s, const TermContext&, MatX& M) const override {
     M(0, 0) += 1.0 + s.q[0] * s.q[0];
     M(1, 1) += 2.0 + std::sin(s.q[1]);
   }
-  void addForce(const Model&, const State&, const SkeletonWorkspace&, VecX&) const override {}
+  void addForce(const Model&, const State&, const TermContext&, VecX&) const override {}
 };
 
 TEST(MassDotTimesVelocity, ForceTermDefaultIsCentralDifference) {

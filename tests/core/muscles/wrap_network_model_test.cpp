@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "core/muscles/wrap/network_model.hpp"
-#include "core/muscles/wrap/train.hpp"
+#include "tools/wrap_training/train.hpp"
 #include "core/muscles/wrap_muscle.hpp"
 #include "core/spatial/se3.hpp"
 #include "tests/core/muscles/muscle_test_util.hpp"

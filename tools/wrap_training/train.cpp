@@ -1,4 +1,4 @@
-#include "core/muscles/wrap/train.hpp"
+#include "tools/wrap_training/train.hpp"
 
 #include <barrier>
 #include <chrono>
@@ -51,44 +51,6 @@ void runParallel(int T, const std::function<void(int)>& f) {
 }
 
 }  // namespace
-
-WrapType parseWrapType(const std::string& name) {
-  if (name == "cylinder") return WrapType::Cylinder;
-  if (name == "sphere") return WrapType::Sphere;
-  if (name == "ellipsoid") return WrapType::Ellipsoid;
-  if (name == "torus") return WrapType::Torus;
-  throw std::invalid_argument("unknown surface '" + name + "' (expected cylinder, sphere, ellipsoid or torus)");
-}
-
-std::string wrapTypeName(WrapType type) {
-  switch (type) {
-    case WrapType::Cylinder: return "cylinder";
-    case WrapType::Sphere: return "sphere";
-    case WrapType::Ellipsoid: return "ellipsoid";
-    case WrapType::Torus: return "torus";
-  }
-  return "?";
-}
-
-int wrapInputSize(WrapType type) {
-  switch (type) {
-    case WrapType::Cylinder:
-    case WrapType::Sphere: return 8;
-    case WrapType::Ellipsoid: return 10;
-    case WrapType::Torus: return 9;
-  }
-  return 0;
-}
-
-WrapSurface makeWrapSurfaceFromInput(WrapType type, const VecX& in) {
-  switch (type) {
-    case WrapType::Cylinder: return WrapSurface::makeCylinder(in[7], 1000.0 * in[7]);
-    case WrapType::Sphere: return WrapSurface::makeSphere(in[7]);
-    case WrapType::Ellipsoid: return WrapSurface::makeEllipsoid(Vec3(in[7], in[8], in[9]));
-    case WrapType::Torus: return WrapSurface::makeTorus(in[7], in[8]);
-  }
-  return {};
-}
 
 WrapInputBox makeDefaultWrapBox(WrapType type) {
   WrapInputBox b;

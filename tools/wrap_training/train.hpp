@@ -1,5 +1,6 @@
 #pragma once
-// Training the wrap network [D Sec. 5.3.3.1, 6.2.6]: samples drawn uniformly from a stated box of
+// Training the wrap network (a tool, not part of the engine: the engine only evaluates networks,
+// core/muscles/wrap/network.hpp) [D Sec. 5.3.3.1, 6.2.6]: samples drawn uniformly from a stated box of
 // inputs (origin, insertion in the surface frame, alpha, surface size), labelled by an exact
 // wrapping oracle; samples whose wrapped length l is a small nonzero fraction of the path length L
 // (0 < l/L < threshold) are discarded, so the network never sees the contact change's kink.
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "core/muscles/wrap/network.hpp"
+#include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap/wrap_surface.hpp"
 
 namespace redmax {
@@ -36,19 +38,6 @@ struct WrapInputBox {
   std::vector<std::string> names;
   VecX lo, hi;
 };
-
-/// "cylinder", "sphere", "ellipsoid", "torus" (std::invalid_argument for anything else) and back.
-WrapType parseWrapType(const std::string& name);
-std::string wrapTypeName(WrapType type);
-
-/// Input layout of the network of a surface type: origin (3), insertion (3), alpha, then the
-/// size parameters: radius (cylinder, sphere), semi-axes a b c (ellipsoid), inner and outer
-/// radius (torus).
-int wrapInputSize(WrapType type);
-
-/// The surface described by the size part of an input vector (no quadrant; the cylinder's length
-/// is 1000 radii, i.e. effectively infinite).
-WrapSurface makeWrapSurfaceFromInput(WrapType type, const VecX& input);
 
 /// The default training box of a surface type, in units of the surface size (wrapping is
 /// scale-equivariant: scale inputs by 1/size at run time for other scales):

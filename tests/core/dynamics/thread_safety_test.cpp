@@ -1,0 +1,145 @@
+// Workspaces own all scratch (issue 15): one System with inertial muscles (a MuscleTerm) and
+// per-evaluation external loads (DynamicsWorkspace::loads), shared by 4 threads that each own a
+// DynamicsWorkspace, gives bit-identical (==) inverse dynamics, forward dynamics and energies to a
+// serial run; states are dealt round-robin and solved backwards. The term's scratch holds one
+// evaluation: after calcMassAndForce it is tagged with the workspace's evaluation counter, a new
+// state moves the counter on, and a workspace bound to another system gets new slots.
+// (The real-model version, sets E and F, is tests/validation/thread_safety_test.cpp.)
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/dynamics/muscle_term.hpp"
+#include "core/dynamics/system.hpp"
+#include "tests/core/muscles/muscle_test_util.hpp"
+#include "validation/scenes/scenes.hpp"
+
+namespace redmax {
+namespace {
+
+// Type II muscle: origin anywhere, a fixed and a moving via point, insertion on a body
+Muscle viaMuscle(const Model& m, std::mt19937& rng, double mass, const std::string& name) {
+  auto body = [&](bool world) {
+    const int lo = world ? -1 : 0;
+    return lo + static_cast<int>(rng() % static_cast<unsigned>(m.nb() - lo));
+  };
+  Muscle mu;
+  mu.name = name;
+  auto cubic = std::make_shared<PolynomialFunction>(std::vector<double>{0.05, -0.1, 0.2, 0.1});
+  mu.path.points = {makeFixedPoint(body(true), test::randomVec(rng, 0.3)),
+                    makeFixedPoint(body(false), test::randomVec(rng, 0.3)),
+                    makeMovingPoint(body(false), static_cast<int>(rng() % m.nr()), {cubic, nullptr, cubic},
+                                    Vec3(0, 0.1, 0)),
+                    makeFixedPoint(body(false), test::randomVec(rng, 0.3))};
+  mu.optimal_fiber_length = 0.3;
+  mu.tendon_slack_length = 0.2;
+  MassPointOptions opt;
+  opt.count = 8;
+  mu.mass_points = makeMassPoints(mass, 0.3, 0.2, opt);
+  return mu;
+}
+
+struct Sample {
+  State s;
+  VecX qddot;
+  ExternalLoads loads;
+};
+
+struct Result {
+  VecX tau, qddot;
+  double T = 0.0, V = 0.0;
+};
+
+Result evaluate(const System& sys, const Sample& x, DynamicsWorkspace& ws) {
+  Result r;
+  ws.loads = x.loads;
+  r.tau = sys.inverseDynamics(x.s, x.qddot, ws);
+  r.qddot = sys.forwardDynamics(x.s, ws);
+  r.T = sys.kineticEnergy(x.s, ws);
+  r.V = sys.potentialEnergy(x.s, ws);
+  return r;
+}
+
+TEST(ThreadSafety, FourThreadsOnOneSystemEqualTheSerialRunBitForBit) {
+  const Model m = scenes::randomTree(8, 31, scenes::TreeJoints::SimbodyComparable);
+  std::mt19937 rng(11);
+  std::vector<Muscle> muscles;
+  for (int k = 0; k < 4; ++k) muscles.push_back(viaMuscle(m, rng, 0.2 + 0.1 * k, "m" + std::to_string(k)));
+  muscles.push_back(viaMuscle(m, rng, 0.0, "massless"));
+  System sys(m);
+  sys.addTerm(std::make_shared<MuscleTerm>(m, muscles));
+  std::vector<Sample> samples(48);
+  for (Sample& x : samples) {
+    x.s = test::randomState(m.nr(), rng);
+    x.qddot = test::randomState(m.nr(), rng).qdot;
+    const int body = static_cast<int>(rng() % static_cast<unsigned>(m.nb()));
+    x.loads.point_forces.push_back({body, test::randomVec(rng, 0.2), test::randomVec(rng, 50.0)});
+    x.loads.wrenches.push_back({body, test::randomVec(rng, 5.0), Vec3::Zero()});
+  }
+
+  std::vector<Result> serial;
+  DynamicsWorkspace ws(sys);
+  for (const Sample& x : samples) serial.push_back(evaluate(sys, x, ws));
+
+  constexpr int kThreads = 4;
+  std::vector<Result> parallel(samples.size());
+  std::vector<std::thread> pool;
+  for (int j = 0; j < kThreads; ++j)
+    pool.emplace_back([&, j] {
+      DynamicsWorkspace own(sys.model());  // slots made on first use
+      for (long k = static_cast<long>(samples.size()) - 1; k >= 0; --k)
+        if (k % kThreads == j) parallel[static_cast<size_t>(k)] = evaluate(sys, samples[static_cast<size_t>(k)], own);
+    });
+  for (auto& th : pool) th.join();
+
+  for (size_t k = 0; k < samples.size(); ++k) {
+    EXPECT_TRUE(parallel[k].tau == serial[k].tau) << "sample " << k;
+    EXPECT_TRUE(parallel[k].qddot == serial[k].qddot) << "sample " << k;
+    EXPECT_EQ(parallel[k].T, serial[k].T) << "sample " << k;
+    EXPECT_EQ(parallel[k].V, serial[k].V) << "sample " << k;
+  }
+  // the loads are an input: they change tau (the check above compares something)
+  DynamicsWorkspace bare(sys);
+  EXPECT_FALSE(sys.inverseDynamics(samples[0].s, samples[0].qddot, bare) == serial[0].tau);
+}
+
+TEST(ThreadSafety, TermScratchHoldsOneEvaluationOfItsSystem) {
+  const Model m = scenes::randomTree(5, 7, scenes::TreeJoints::SimbodyComparable);
+  std::mt19937 rng(3);
+  System sys(m);
+  sys.addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{viaMuscle(m, rng, 0.5, "a")}));
+  DynamicsWorkspace ws(m);
+  EXPECT_EQ(ws.system_id, 0u);
+  const State s = test::randomState(m.nr(), rng);
+  sys.calcMassAndForce(s, ws);
+  EXPECT_EQ(ws.system_id, sys.id());
+  ASSERT_EQ(ws.term_scratch.size(), 1u);
+  ASSERT_NE(ws.term_scratch[0], nullptr);
+  const std::uint64_t e1 = ws.evaluation;
+  EXPECT_EQ(ws.term_scratch[0]->evaluation, e1);
+  // Mdot qdot at the same state reuses the evaluation; a new state moves the counter on
+  VecX Mdv;
+  sys.calcMassDotTimesVelocity(s, ws, Mdv);
+  EXPECT_EQ(ws.evaluation, e1);
+  sys.calcMassAndForce(test::randomState(m.nr(), rng), ws);
+  EXPECT_GT(ws.evaluation, e1);
+  EXPECT_EQ(ws.term_scratch[0]->evaluation, ws.evaluation);
+  // a copy of the system is another system; so is the system after a change
+  const System copy = sys;
+  EXPECT_NE(copy.id(), sys.id());
+  const std::uint64_t before = sys.id();
+  System changed = sys;
+  const std::uint64_t copied = changed.id();
+  changed.addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{viaMuscle(m, rng, 0.1, "b")}));
+  EXPECT_NE(changed.id(), copied);
+  EXPECT_EQ(sys.id(), before);
+  changed.calcMassAndForce(s, ws);
+  EXPECT_EQ(ws.system_id, changed.id());
+  EXPECT_EQ(ws.term_scratch.size(), 2u);
+}
+
+}  // namespace
+}  // namespace redmax
