@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/args.hpp"
+#include "cli/flags.hpp"
 #include "converter/error.hpp"
 #include "plugin/simbody/speed_comparison.hpp"
 #include "validation/id_speed.hpp"
@@ -34,20 +34,21 @@ Model makeScene(const std::string& name) {
 }
 
 
-int runBench(const std::vector<std::string>& argv) {
-  Args a(argv, {"scene", "repeats", "batches", "json", "integrators", "spherical", "dt", "id-setup", "id-model"}, {});
-  if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
-  const long repeats = a.getInt("repeats", 200);
-  const long batches = a.getInt("batches", 5);
-  if (repeats < 1 || repeats > 100000000) throw UsageError{"--repeats must be between 1 and 1e8"};
-  if (batches < 1 || batches > 1000) throw UsageError{"--batches must be between 1 and 1000"};
+struct BenchFlags {
+  std::string scene = "all", json, integrators, spherical = "gimbal", id_setup, id_model;
+  long repeats = 200, batches = 5;
+  double dt = 1e-3;
+};
+
+int runBench(const BenchFlags& f, const CLI::App& app) {
+  const long repeats = f.repeats, batches = f.batches;
 
   // inverse dynamics on a real trial, both engines (validation/id_speed.hpp)
-  if (a.has("id-model") && !a.has("id-setup")) throw UsageError{"--id-model needs --id-setup"};
-  if (auto setup = a.get("id-setup")) {
+  if (given(app, "--id-model") && !given(app, "--id-setup")) throw UsageError{"--id-model needs --id-setup"};
+  if (given(app, "--id-setup")) {
     validation::IdSpeedOptions o;
-    o.settings.setup_file = *setup;
-    if (auto m = a.get("id-model")) o.settings.model_file = *m;
+    o.settings.setup_file = f.id_setup;
+    if (given(app, "--id-model")) o.settings.model_file = f.id_model;
     o.batches = static_cast<int>(batches);
     try {
       std::cout << validation::formatIdSpeed(validation::timeIdEngines(o));
@@ -55,26 +56,22 @@ int runBench(const std::vector<std::string>& argv) {
       std::cerr << "error: " << e.what() << "\n";
       return 2;
     }
-    if (!a.has("scene")) return 0;
+    if (!given(app, "--scene")) return 0;
   }
 
   simbody::SpeedOptions opt;
-  opt.dt = a.getDouble("dt", 1e-3);
-  if (!(opt.dt > 0.0)) throw UsageError{"--dt must be positive"};
-  const std::string sph = a.get("spherical", "gimbal");
-  if (sph == "gimbal") opt.spherical = simbody::SphericalAs::Gimbal;
-  else if (sph == "ball") opt.spherical = simbody::SphericalAs::Ball;
-  else throw UsageError{"--spherical expects gimbal or ball, got '" + sph + "'"};
-  if (auto list = a.get("integrators")) {
-    opt.integrators = splitList(*list);
-    if (*list == "none") opt.integrators.clear();
+  opt.dt = f.dt;
+  opt.spherical = f.spherical == "ball" ? simbody::SphericalAs::Ball : simbody::SphericalAs::Gimbal;
+  if (given(app, "--integrators")) {
+    opt.integrators = splitList(f.integrators);
+    if (f.integrators == "none") opt.integrators.clear();
     for (const auto& name : opt.integrators)
       if (name != "euler" && name != "bdf1" && name != "sdirk2" && name != "rk45" && name != "cvode")
         throw UsageError{"unknown integrator '" + name + "' in --integrators (expected euler, bdf1, sdirk2, rk45, cvode or none)"};
   }
 
   // scenes first, so that bad names fail before any timing
-  const std::string scene_arg = a.get("scene", "all");
+  const std::string& scene_arg = f.scene;
   std::vector<std::string> names = scene_arg == "all"
       ? std::vector<std::string>{"chain5", "chain10", "chain20", "chain40", "humanoid"}
       : splitList(scene_arg);
@@ -83,7 +80,7 @@ int runBench(const std::vector<std::string>& argv) {
   for (const auto& n : names) models.emplace_back(n, makeScene(n));
 
   // the output folder must exist before minutes of timing are spent
-  const auto json = a.get("json");
+  const std::string* json = given(app, "--json") ? &f.json : nullptr;
   if (json) {
     const auto parent = std::filesystem::path(*json).parent_path();
     if (!parent.empty() && !std::filesystem::is_directory(parent))
@@ -108,11 +105,45 @@ int runBench(const std::vector<std::string>& argv) {
 }
 
 CommandRegistration reg(
-    {"bench", "time the core against Simbody on built-in scenes (ratios)",
-     "usage: redmax bench [--scene NAME[,NAME...]|all] [--repeats N] [--batches B] [--json OUT]\n"
-     "                    [--integrators LIST|none] [--spherical gimbal|ball] [--dt S]\n"
-     "       redmax bench --id-setup ID_SETUP.xml [--id-model M.osim] [--batches B] [--scene ...]\n"
-     "Times, on the same tree and state, each core operation next to Simbody's equivalent:\n"
+    {"bench", "time the core against Simbody on built-in scenes (ratios)", [](CLI::App& app) {
+       auto f = std::make_shared<BenchFlags>();
+       app.add_option("--scene", f->scene,
+                      "chain<N>: serial chain of N hinges (scenes::limbChain), e.g. chain5, chain40;\n"
+                      "humanoid (37 DoF tree); all (default) = chain5,chain10,chain20,chain40,humanoid;\n"
+                      "or a comma-separated list")
+           ->type_name("NAME[,NAME...]|all");
+       app.add_option("--repeats", f->repeats, "calls per timed batch (default 200)")
+           ->type_name("N")
+           ->check(between(1, 1e8, true, "1", "1e8"));
+       app.add_option("--batches", f->batches, "timed batches; the fastest is kept (default 5)")
+           ->type_name("B")
+           ->check(between(1, 1000, true));
+       app.add_option("--json", f->json, "also write the rows as JSON (atomically: temporary file, then rename)")
+           ->type_name("OUT");
+       app.add_option("--integrators", f->integrators,
+                      "comma-separated subset of euler,bdf1,sdirk2,rk45,cvode (default all), or none")
+           ->type_name("LIST|none");
+       app.add_option("--spherical", f->spherical,
+                      "map spherical joints to Simbody Gimbal (u = qdot, default) or Ball (Euler angles)")
+           ->type_name("gimbal|ball")
+           ->check(oneOf({"gimbal", "ball"}));
+       app.add_option("--dt", f->dt, "integrator step / reporting interval in seconds (default 0.001)")
+           ->type_name("S")
+           ->check(positive());
+       app.add_option("--id-setup", f->id_setup,
+                      "time inverse dynamics on a real trial instead (an InverseDynamicsTool setup):\n"
+                      "microseconds per frame of each engine on the same processed inputs (fastest\n"
+                      "of --batches passes over all frames), the ratio, and the wall time of a whole\n"
+                      "`redmax id` run against its frame count. Where Debian's Simbody rejects an\n"
+                      "inertia (gait2392's toes) both engines are timed with OpenSim's isotropic\n"
+                      "fallback for it. Scenes run too only if --scene is given")
+           ->type_name("ID_SETUP.xml");
+       app.add_option("--id-model", f->id_model, "with --id-setup: overrides its model")->type_name("M.osim");
+       app.footer(
+           "usage: redmax bench [--scene NAME[,NAME...]|all] [--repeats N] [--batches B] [--json OUT]\n"
+           "                    [--integrators LIST|none] [--spherical gimbal|ball] [--dt S]\n"
+           "       redmax bench --id-setup ID_SETUP.xml [--id-model M.osim] [--batches B] [--scene ...]\n"
+           "Times, on the same tree and state, each core operation next to Simbody's equivalent:\n"
      "  kinematics        calcKinematics                     vs realize(Velocity)\n"
      "  mass_matrix       calcSkeletonMass                   vs calcM\n"
      "  id_redmax         System::inverseDynamics            vs realize(Dynamics) + calcResidualForceIgnoringConstraints\n"
@@ -122,21 +153,9 @@ CommandRegistration reg(
      "                    (euler, bdf1: SemiExplicitEuler; sdirk2: SemiExplicitEuler2; rk45: RungeKuttaMerson;\n"
      "                    cvode: CPodes; adaptive ones at accuracy 1e-6)\n"
      "and prints: scene, DoF, operation, redmax us, Simbody us, ratio (redmax / Simbody).\n"
-     "  --scene       chain<N>: serial chain of N hinges (scenes::limbChain), e.g. chain5, chain40;\n"
-     "                humanoid (37 DoF tree); all (default) = chain5,chain10,chain20,chain40,humanoid\n"
-     "  --repeats     calls per timed batch (default 200); the fastest of --batches (default 5) is kept\n"
-     "  --json OUT    also write the rows as JSON (atomically: temporary file, then rename)\n"
-     "  --integrators comma-separated subset of euler,bdf1,sdirk2,rk45,cvode (default all), or none\n"
-     "  --spherical   map spherical joints to Simbody Gimbal (u = qdot, default) or Ball (Euler angles)\n"
-     "  --dt          integrator step / reporting interval in seconds (default 0.001)\n"
-     "  --id-setup    time inverse dynamics on a real trial instead (an InverseDynamicsTool setup;\n"
-     "                --id-model overrides its model): microseconds per frame of each engine on the\n"
-     "                same processed inputs (fastest of --batches passes over all frames), the ratio,\n"
-     "                and the wall time of a whole `redmax id` run against its frame count. Where\n"
-     "                Debian's Simbody rejects an inertia (gait2392's toes) both engines are timed\n"
-     "                with OpenSim's isotropic fallback for it. Scenes run too only if --scene is given.\n"
-     "Timing only: nothing here is checked for correctness (see plugin_tests for the cross-checks).\n",
-     runBench});
+     "Timing only: nothing here is checked for correctness (see plugin_tests for the cross-checks).");
+       return [f, &app] { return runBench(*f, app); };
+     }});
 
 }  // namespace
 }  // namespace redmax::cli

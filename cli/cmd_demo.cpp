@@ -3,23 +3,28 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
+#include <string>
 
-#include "cli/args.hpp"
+#include "cli/flags.hpp"
 #include "core/integrators/integrator.hpp"
 #include "validation/scenes/scenes.hpp"
 
 namespace redmax::cli {
 namespace {
 
-int runDemo(const std::vector<std::string>& argv) {
-  Args a(argv, {"integrator", "dt", "duration", "rtol", "atol"}, {});
+struct DemoFlags {
+  std::string integrator = "euler";
+  double dt = 1e-3, duration = 5.0, rtol = 1e-8, atol = 1e-10;
+};
+
+int runDemo(const DemoFlags& f) {
   IntegratorOptions opt;
-  opt.dt = a.getDouble("dt", 1e-3);
-  opt.rtol = a.getDouble("rtol", 1e-8);
-  opt.atol = a.getDouble("atol", 1e-10);
-  const double T = a.getDouble("duration", 5.0);
-  if (!(opt.dt > 0) || !(T > 0)) throw UsageError{"--dt and --duration must be positive"};
-  const std::string name = a.get("integrator", "euler");
+  opt.dt = f.dt;
+  opt.rtol = f.rtol;
+  opt.atol = f.atol;
+  const double T = f.duration;
+  const std::string& name = f.integrator;
 
   System sys(scenes::doublePendulum());
   State s = sys.defaultState();
@@ -41,12 +46,28 @@ int runDemo(const std::vector<std::string>& argv) {
   return 0;
 }
 
-CommandRegistration reg({"demo", "run the built-in double pendulum and print its energy",
-                         "usage: redmax demo [--integrator euler|symplectic|bdf1|sdirk2|rk45|cvode]\n"
-                         "                   [--dt S] [--duration S] [--rtol R] [--atol A]\n"
-                         "Integrates a double pendulum released from rest at q = (1, 0.5) rad and prints q and the\n"
-                         "kinetic, potential and total energy at 10 instants.\n",
-                         runDemo});
+CommandRegistration reg({"demo", "run the built-in double pendulum and print its energy", [](CLI::App& app) {
+                           auto f = std::make_shared<DemoFlags>();
+                           app.add_option("--integrator", f->integrator, "integrator (default euler)")
+                               ->type_name("euler|symplectic|bdf1|sdirk2|rk45|cvode")
+                               ->check(oneOf({"euler", "symplectic", "bdf1", "sdirk2", "rk45", "cvode"}));
+                           app.add_option("--dt", f->dt, "step in seconds (default 0.001)")
+                               ->type_name("S")
+                               ->check(positive());
+                           app.add_option("--duration", f->duration, "simulated seconds (default 5)")
+                               ->type_name("S")
+                               ->check(positive());
+                           app.add_option("--rtol", f->rtol, "relative tolerance of rk45/cvode (default 1e-8)")
+                               ->type_name("R")
+                               ->check(number());
+                           app.add_option("--atol", f->atol, "absolute tolerance of rk45/cvode (default 1e-10)")
+                               ->type_name("A")
+                               ->check(number());
+                           app.footer(
+                               "Integrates a double pendulum released from rest at q = (1, 0.5) rad and prints q and the\n"
+                               "kinetic, potential and total energy at 10 instants.");
+                           return [f] { return runDemo(*f); };
+                         }});
 
 }  // namespace
 }  // namespace redmax::cli

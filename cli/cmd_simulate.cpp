@@ -15,12 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "cli/args.hpp"
 #include "cli/muscle_mass_flags.hpp"
-#include "cli/simulate_simbody.hpp"
 #include "core/muscles/wrap/network_model.hpp"
 #include "validation/report/progress.hpp"
 #include "validation/simulate/simulate.hpp"
+#include "validation/simulate/simulate_simbody.hpp"
 
 namespace redmax::cli {
 namespace {
@@ -49,91 +48,67 @@ std::vector<std::pair<std::string, double>> parseMassList(const std::string& tex
   return out;
 }
 
-// the value flags: simulate's own, the muscle-mass ones and the Simbody engine's (simulate_simbody.hpp)
-std::set<std::string> simulateFlags() {
-  std::set<std::string> names = withMuscleMassFlags({"model", "duration", "integrator", "dt", "rtol", "atol",
-                                                     "max-step", "initial", "initial-time", "wrap", "output-dt", "out",
-                                                     "muscle-mass-kg", "impulse", "engine"});
-  for (const std::string& n : simbodyEngineFlagNames()) names.insert(n);
-  return names;
-}
+const std::vector<std::string> kIntegrators = {"euler", "symplectic", "bdf1", "sdirk2", "rk45", "cvode"};
 
-int runSimulate(const std::vector<std::string>& argv) {
-  const Args a(argv, simulateFlags(), {"no-qvv", "progress", "quiet", "full-precision"});
-  if (!a.positionals().empty())
-    throw UsageError{"simulate takes no positional arguments (got '" + a.positionals().front() + "')"};
-  if (!a.has("model")) throw UsageError{"simulate needs --model M.osim"};
-  if (!a.has("duration")) throw UsageError{"simulate needs --duration S"};
-  if (!a.has("out")) throw UsageError{"simulate needs --out STATES.sto"};
-  const std::string model_path = *a.get("model"), out_path = *a.get("out");
-  const std::string engine = a.get("engine", "core");
-  if (engine != "core" && engine != "simbody") throw UsageError{"--engine must be core or simbody, got '" + engine + "'"};
-  const SimbodyEngineFlags simbody_flags = parseSimbodyEngineFlags(a, engine);
-
+struct SimulateFlags {
+  std::string model, out, initial, muscle_mass_kg, impulse, engine = "core";
   validation::SimulateOptions so;
-  so.duration = a.getDouble("duration", 0.0);
-  if (!(so.duration > 0.0)) throw UsageError{"--duration must be positive"};
-  so.integrator = a.get("integrator", "rk45");
+  double initial_time = 0.0;
+  bool no_qvv = false, progress = false, quiet = false, full_precision = false;
+  MuscleMassFlags mm;
+  std::string simbody_method, simbody_norm = "rms";
+};
+
+int runSimulate(SimulateFlags& f, const CLI::App& app) {
+  if (!given(app, "--model")) throw UsageError{"simulate needs --model M.osim"};
+  if (!given(app, "--duration")) throw UsageError{"simulate needs --duration S"};
+  if (!given(app, "--out")) throw UsageError{"simulate needs --out STATES.sto"};
+  const std::string &model_path = f.model, &out_path = f.out, &engine = f.engine;
+  for (const char* n : {"--simbody-method", "--simbody-norm"})
+    if (given(app, n) && engine != "simbody") throw UsageError{std::string(n) + " needs --engine simbody"};
+  validation::SimbodyEngineOptions simbody_flags;
+  simbody_flags.method = f.simbody_method;
+  simbody_flags.infinity_norm = f.simbody_norm == "inf";
+
+  validation::SimulateOptions& so = f.so;
   IntegratorOptions& io = so.integrator_options;
-  io.dt = a.getDouble("dt", 1e-3);
-  io.rtol = a.getDouble("rtol", 1e-6);
-  io.atol = a.getDouble("atol", 1e-8);
-  io.max_step = a.getDouble("max-step", 0.0);
-  if (!(io.dt > 0.0)) throw UsageError{"--dt must be positive"};
-  if (!(io.rtol > 0.0) || !(io.atol > 0.0)) throw UsageError{"--rtol and --atol must be positive"};
-  if (io.max_step < 0.0) throw UsageError{"--max-step must not be negative"};
-  so.output_dt = a.getDouble("output-dt", 0.0);
-  if (a.has("output-dt") && !(so.output_dt > 0.0)) throw UsageError{"--output-dt must be positive"};
-  {
-    const auto names = {"euler", "symplectic", "bdf1", "sdirk2", "rk45", "cvode"};
-    bool known = false;
-    for (const char* n : names) known = known || so.integrator == n;
-    if (!known)
-      throw UsageError{"--integrator must be euler, symplectic, bdf1, sdirk2, rk45 or cvode, got '" +
-                       so.integrator + "'"};
-  }
   // --wrap and friends (muscle_mass_flags.hpp) choose how wrapping muscles with mass move; with no
   // mass at all they would do nothing
-  if (hasWrapFlags(a) && !a.has("muscle-mass-kg") && a.get("muscle-mass", "none") == "none")
-    throw UsageError{std::string("--") + (a.has("wrap") ? "wrap" : a.has("wrap-width") ? "wrap-width" : "wrap-network") +
+  if (f.mm.wrap.any() && !given(app, "--muscle-mass-kg") && f.mm.source == "none")
+    throw UsageError{f.mm.wrap.firstGiven() +
                      " needs muscle mass (--muscle-mass physiological|transfer or --muscle-mass-kg)"};
 
   validation::SimulationModelOptions mo;
-  mo.quadratic_velocity = !a.has("no-qvv");
-  if (auto v = a.get("muscle-mass-kg")) {
+  mo.quadratic_velocity = !f.no_qvv;
+  if (given(app, "--muscle-mass-kg")) {
     // explicit masses take the point count and region from --mass-points / --mass-region; the
     // flags that choose or size a mass source do not apply
-    if (a.get("muscle-mass", "none") != "none")
-      throw UsageError{"--muscle-mass-kg excludes --muscle-mass " + a.get("muscle-mass", "")};
-    for (const char* f : {"muscles", "specific-tension", "muscle-density", "transfer-body", "transfer-fraction"})
-      if (a.has(f)) throw UsageError{std::string("--") + f + " needs --muscle-mass physiological or transfer"};
-    mo.explicit_masses = parseMassList(*v);
-    parseWrapFlags(a, mo.muscle_mass);
-    const long n = a.getInt("mass-points", 20);
-    if (n < 1 || n > 100000) throw UsageError{"--mass-points must be between 1 and 100000"};
-    mo.muscle_mass.mass_points = static_cast<int>(n);
-    const std::string region = a.get("mass-region", "fibre");
-    if (region == "whole") mo.muscle_mass.region = MassPointOptions::Region::WholePath;
-    else if (region != "fibre" && region != "fiber") throw UsageError{"--mass-region must be fibre or whole"};
+    if (f.mm.source != "none") throw UsageError{"--muscle-mass-kg excludes --muscle-mass " + f.mm.source};
+    for (const char* n : {"--muscles", "--specific-tension", "--muscle-density", "--transfer-body", "--transfer-fraction"})
+      if (given(app, n)) throw UsageError{std::string(n) + " needs --muscle-mass physiological or transfer"};
+    mo.explicit_masses = parseMassList(f.muscle_mass_kg);
+    parseWrapFlags(f.mm.wrap, mo.muscle_mass);
+    mo.muscle_mass.mass_points = static_cast<int>(f.mm.mass_points);
+    if (f.mm.region == "whole") mo.muscle_mass.region = MassPointOptions::Region::WholePath;
   } else {
-    mo.muscle_mass = parseMuscleMassFlags(a);
+    mo.muscle_mass = parseMuscleMassFlags(f.mm);
   }
-  if (auto v = a.get("impulse"))
-    for (const std::string& item : splitList(*v, ";")) mo.impulses.push_back(validation::parseImpulse(item));
-  const bool quiet = a.has("quiet");
+  if (given(app, "--impulse"))
+    for (const std::string& item : splitList(f.impulse, ";")) mo.impulses.push_back(validation::parseImpulse(item));
+  const bool quiet = f.quiet;
 
   // model and initial state: every problem here is the user's input (exit 2)
   validation::SimulationModel model;
   State initial;
   try {
     model = validation::loadSimulationModel(model_path, mo);
-    if (auto init = a.get("initial")) {
-      const osim::Storage table = osim::readStorage(*init);
-      initial = validation::initialStateFromStorage(model, table, *init,
-                                                    a.has("initial-time") ? a.getDouble("initial-time", 0.0)
-                                                                          : std::numeric_limits<double>::quiet_NaN());
+    if (given(app, "--initial")) {
+      const osim::Storage table = osim::readStorage(f.initial);
+      initial = validation::initialStateFromStorage(
+          model, table, f.initial,
+          given(app, "--initial-time") ? f.initial_time : std::numeric_limits<double>::quiet_NaN());
     } else {
-      if (a.has("initial-time")) throw UsageError{"--initial-time needs --initial STATE.sto"};
+      if (given(app, "--initial-time")) throw UsageError{"--initial-time needs --initial STATE.sto"};
       initial = validation::defaultInitialState(model);
     }
   } catch (const osim::ConvertError& e) {
@@ -162,10 +137,10 @@ int runSimulate(const std::vector<std::string>& argv) {
   const auto t_start = std::chrono::steady_clock::now();
   const long total_ms = std::lround(so.duration * 1000.0);
   so.on_row = [&](double t) {
-    if (quiet && !a.has("progress")) return;
+    if (quiet && !f.progress) return;
     if (!progress) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-      if (!a.has("progress") && wall < 2.0) return;
+      if (!f.progress && wall < 2.0) return;
       validation::ProgressOptions po;
       po.log_interval_s = 5.0;
       progress = std::make_unique<validation::Progress>("simulate (ms simulated)", total_ms, po);
@@ -173,16 +148,16 @@ int runSimulate(const std::vector<std::string>& argv) {
     progress->set(std::lround((t - initial.t) * 1000.0));
   };
 
-  // the engine: the core, or Simbody with one particle per mass point (cli/simulate_simbody.hpp)
+  // the engine: the core, or Simbody with one particle per mass point (validation/simulate/simulate_simbody.hpp)
   if (engine == "simbody") {
-    const std::string why = simbodyEngineUnsupportedReason(model, so, mo.quadratic_velocity);
+    const std::string why = validation::simbodyEngineUnsupportedReason(model, so, mo.quadratic_velocity);
     if (!why.empty()) throw UsageError{why};
   }
   const std::clock_t cpu_start = std::clock();
   validation::SimulationResult res;
   if (engine == "simbody") {
     try {
-      res = simulateSimbody(model, initial, so, simbody_flags);
+      res = validation::simulateSimbody(model, initial, so, simbody_flags);
     } catch (const std::invalid_argument& e) {
       std::cerr << "error: " << model_path << ": --engine simbody: " << e.what() << "\n";
       return 2;
@@ -206,14 +181,6 @@ int runSimulate(const std::vector<std::string>& argv) {
   }
 
   try {
-    const std::filesystem::path parent = std::filesystem::path(out_path).parent_path();
-    std::error_code ec;
-    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-    osim::StorageWriteOptions wo;
-    if (a.has("full-precision")) {
-      wo.scientific = true;
-      wo.decimals = 16;
-    }
     std::ostringstream desc;
     desc << "redmax simulate: model " << model_path << ", engine " << engine << ", integrator " << so.integrator;
     if (!simbody_flags.method.empty() || simbody_flags.infinity_norm)
@@ -225,8 +192,7 @@ int runSimulate(const std::vector<std::string>& argv) {
       desc << " (dt " << io.dt << " s)";
     desc << ", muscle mass " << model.muscle_mass << " kg" << (mo.quadratic_velocity ? "" : ", no muscle QVV")
          << "\n";
-    wo.description = desc.str();
-    osim::writeStorage(out_path, res.states, wo);
+    osim::writeResultStorage(out_path, res.states, f.full_precision, desc.str());
   } catch (const osim::ConvertError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
@@ -247,47 +213,106 @@ int runSimulate(const std::vector<std::string>& argv) {
 }
 
 CommandRegistration reg(
-    {"simulate", "forward simulation of an OpenSim model (states, energies)",
-     "usage: redmax simulate --model M.osim --duration S --out STATES.sto\n"
-     "                       [--integrator euler|symplectic|bdf1|sdirk2|rk45|cvode] [--dt S]\n"
-     "                       [--rtol R] [--atol A] [--max-step S] [--output-dt S]\n"
-     "                       [--initial STATE.sto [--initial-time T]]\n"
-     "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
-     "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
-     "                       [--engine core|simbody [--simbody-method M] [--simbody-norm rms|inf]]\n"
-     "                       [--progress] [--quiet] [--full-precision]\n"
-     "Integrates the model under gravity from its default pose (each coordinate's default_value and\n"
-     "default_speed_value) with its constraints (locked, coupled and prescribed coordinates, welds).\n"
-     "  --integrator NAME    euler (semi-implicit, fixed step), symplectic (variational Euler), bdf1\n"
-     "                       (linearly implicit), sdirk2, rk45 (Dormand-Prince, adaptive, default), cvode\n"
-     "  --dt S               fixed step (default 0.001); --rtol, --atol for rk45/cvode (1e-6, 1e-8)\n"
-     "  --output-dt S        time between output rows (default 0.01, or dt if larger; fixed-step\n"
-     "                       methods round it to whole steps)\n"
-     "  --initial FILE       start from a states or motion file: the row at t = 0 (or the first row;\n"
-     "                       --initial-time T picks another and starts there); columns named by\n"
-     "                       coordinate, /jointset/J/C/value and /speed, or C_u; degrees if the header\n"
-     "                       says inDegrees=yes; absent coordinates keep their defaults\n"
-     "  --muscle-mass-kg NAME=KG,...  give these muscles KG each in mass points, ADDED to the model\n"
-     "                       (no body gives mass; e.g. the finger's 0.2 kg flexors of [D 6.2.5]);\n"
-     "                       --mass-points, --mass-region and --wrap apply; excludes --muscle-mass\n"
-     "  --no-qvv             drop the muscles' quadratic velocity vector (energy experiment [D 6.2.4])\n"
-     "  --impulse TARGET:FX,FY,FZ:DURATION  a force (N, ground frame) while t < DURATION (s) on a\n"
-     "                       body's origin, a marker, or BODY@X,Y,Z (m, body frame); ';' separates several\n"
-     "  --engine core|simbody  the REDMAX core (default) or Simbody: the skeleton rebuilt as a Simbody\n"
-     "                       system, each muscle mass point a particle held on its path (a Constraint::Custom\n"
-     "                       per muscle); --integrator rk45 (RungeKuttaMerson) or cvode (CPodes), --rtol is\n"
-     "                       Simbody's accuracy, --atol its constraint tolerance; no core constraints,\n"
-     "                       --impulse or --no-qvv; same output columns (Simbody's energies)\n"
-     + std::string(simbodyEngineFlagsUsage()) +
-     "  --progress           progress on stderr (otherwise shown once a run takes over 2 s)\n"
-     "  --full-precision     write %.16e instead of %16.8lf (restarts from the file are then exact)\n"
-     "Output: time, /jointset/<joint>/<coord>/value and .../speed for every coordinate (radians, SI),\n"
-     "kinetic_energy, potential_energy, total_energy (J; gravity potential relative to the origin).\n"
-     "A NaN or divergence stops the run: exit 1, the time, coordinate and step are named, and nothing\n"
-     "is written. The summary gives steps, rhs evaluations, wall time and the energy drift\n"
-     "max|E(t) - E(0)| relative to max(|E(0)|, max kinetic energy).\n"
-     "\n" + std::string(muscleMassUsage()),
-     runSimulate});
+    {"simulate", "forward simulation of an OpenSim model (states, energies)", [](CLI::App& app) {
+       auto f = std::make_shared<SimulateFlags>();
+       validation::SimulateOptions& so = f->so;
+       IntegratorOptions& io = so.integrator_options;
+       so.integrator = "rk45";
+       io.dt = 1e-3;
+       io.rtol = 1e-6;
+       io.atol = 1e-8;
+       io.max_step = 0.0;
+       so.output_dt = 0.0;
+       app.add_option("--model", f->model, "the OpenSim model (.osim); required")
+           ->type_name("M.osim")
+           ->check(existingFile());
+       app.add_option("--duration", so.duration, "simulated seconds; required")->type_name("S")->check(positive());
+       app.add_option("--out", f->out, "the states file (.sto); required")->type_name("STATES.sto");
+       app.add_option("--integrator", so.integrator,
+                      "euler (semi-implicit, fixed step), symplectic (variational Euler), bdf1\n"
+                      "(linearly implicit), sdirk2, rk45 (Dormand-Prince, adaptive, default), cvode")
+           ->type_name("euler|symplectic|bdf1|sdirk2|rk45|cvode")
+           ->check(oneOf(kIntegrators));
+       app.add_option("--dt", io.dt, "fixed step (default 0.001)")->type_name("S")->check(positive());
+       app.add_option("--rtol", io.rtol, "relative tolerance of rk45/cvode (default 1e-6)")
+           ->type_name("R")
+           ->check(positive());
+       app.add_option("--atol", io.atol, "absolute tolerance of rk45/cvode (default 1e-8)")
+           ->type_name("A")
+           ->check(positive());
+       app.add_option("--max-step", io.max_step, "largest adaptive step (default 0: no limit)")
+           ->type_name("S")
+           ->check(nonNegative());
+       app.add_option("--output-dt", so.output_dt,
+                      "time between output rows (default 0.01, or dt if larger; fixed-step\n"
+                      "methods round it to whole steps)")
+           ->type_name("S")
+           ->check(positive());
+       app.add_option("--initial", f->initial,
+                      "start from a states or motion file: the row at t = 0 (or the first row;\n"
+                      "--initial-time T picks another and starts there); columns named by\n"
+                      "coordinate, /jointset/J/C/value and /speed, or C_u; degrees if the header\n"
+                      "says inDegrees=yes; absent coordinates keep their defaults")
+           ->type_name("STATE.sto")
+           ->check(existingFile());
+       app.add_option("--initial-time", f->initial_time, "with --initial: the row to start from")
+           ->type_name("T")
+           ->check(number());
+       app.add_option("--muscle-mass-kg", f->muscle_mass_kg,
+                      "give these muscles KG each in mass points, ADDED to the model (no body\n"
+                      "gives mass; e.g. the finger's 0.2 kg flexors of [D 6.2.5]); --mass-points,\n"
+                      "--mass-region and --wrap apply; excludes --muscle-mass")
+           ->type_name("NAME=KG,...")
+           ->group("Muscle mass");
+       app.add_flag("--no-qvv", f->no_qvv, "drop the muscles' quadratic velocity vector (energy experiment [D 6.2.4])");
+       app.add_option("--impulse", f->impulse,
+                      "a force (N, ground frame) while t < DURATION (s) on a body's origin, a\n"
+                      "marker, or BODY@X,Y,Z (m, body frame); ';' separates several")
+           ->type_name("TARGET:FX,FY,FZ:DURATION");
+       app.add_option("--engine", f->engine,
+                      "the REDMAX core (default) or Simbody: the skeleton rebuilt as a Simbody\n"
+                      "system, each muscle mass point a particle held on its path (a\n"
+                      "Constraint::Custom per muscle); --integrator rk45 (RungeKuttaMerson) or cvode\n"
+                      "(CPodes), --rtol is Simbody's accuracy, --atol its constraint tolerance; no\n"
+                      "core constraints, --impulse or --no-qvv; same output columns (Simbody's energies)")
+           ->type_name("core|simbody")
+           ->check(oneOf({"core", "simbody"}));
+       app.add_option("--simbody-method", f->simbody_method,
+                      "with --engine simbody: merson (RungeKuttaMerson), feldberg\n"
+                      "(RungeKuttaFeldberg), rk3, verlet or cpodes instead of --integrator's")
+           ->type_name("merson|feldberg|rk3|verlet|cpodes")
+           ->check(oneOf(validation::simbodyMethodNames()));
+       app.add_option("--simbody-norm", f->simbody_norm,
+                      "Simbody's step error norm: rms over all q and over all u, the particles'\n"
+                      "included (default), or the largest component; the finger agrees with the\n"
+                      "core to 1e-6 rad over 1 s with --simbody-method feldberg --simbody-norm inf\n"
+                      "--rtol 3e-12 --atol 3e-13")
+           ->type_name("rms|inf")
+           ->check(oneOf({"rms", "inf"}));
+       app.add_flag("--progress", f->progress, "progress on stderr (otherwise shown once a run takes over 2 s)");
+       app.add_flag("--quiet", f->quiet, "no summary and no progress");
+       app.add_flag("--full-precision", f->full_precision,
+                    "write %.16e instead of %16.8lf (restarts from the file are then exact)");
+       addMuscleMassFlags(app, f->mm);
+       app.footer(std::string(
+           "usage: redmax simulate --model M.osim --duration S --out STATES.sto\n"
+           "                       [--integrator euler|symplectic|bdf1|sdirk2|rk45|cvode] [--dt S]\n"
+           "                       [--rtol R] [--atol A] [--max-step S] [--output-dt S]\n"
+           "                       [--initial STATE.sto [--initial-time T]]\n"
+           "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
+           "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
+           "                       [--engine core|simbody [--simbody-method M] [--simbody-norm rms|inf]]\n"
+           "                       [--progress] [--quiet] [--full-precision]\n"
+           "Integrates the model under gravity from its default pose (each coordinate's default_value and\n"
+           "default_speed_value) with its constraints (locked, coupled and prescribed coordinates, welds).\n"
+           "Output: time, /jointset/<joint>/<coord>/value and .../speed for every coordinate (radians, SI),\n"
+           "kinetic_energy, potential_energy, total_energy (J; gravity potential relative to the origin).\n"
+           "A NaN or divergence stops the run: exit 1, the time, coordinate and step are named, and nothing\n"
+           "is written. The summary gives steps, rhs evaluations, wall time and the energy drift\n"
+           "max|E(t) - E(0)| relative to max(|E(0)|, max kinetic energy).\n") +
+           muscleMassFooter());
+       return [f, &app] { return runSimulate(*f, app); };
+     }});
 
 }  // namespace
 }  // namespace redmax::cli

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/args.hpp"
+#include "cli/flags.hpp"
 #include "converter/atomic_file.hpp"
 #include "core/muscles/wrap/network_model.hpp"
 #include "tools/wrap_training/compare.hpp"
@@ -30,11 +30,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-std::string joinArgs(const std::vector<std::string>& argv) {
-  std::string s = "redmax train-wrap";
-  for (const auto& a : argv) s += " " + a;
-  return s;
-}
 
 
 void requireFolder(const std::string& dir) {
@@ -49,6 +44,12 @@ void requireParent(const std::string& file, const char* flag) {
     throw UsageError{std::string(flag) + " " + file + ": folder '" + parent.string() + "' does not exist"};
 }
 
+// the flag's value, or nothing when it was not given
+std::optional<std::string> optionalFlag(const FlagValues& a, const std::string& name) {
+  if (!a.has(name)) return std::nullopt;
+  return a.get(name, "");
+}
+
 std::string num(double v, int prec = 4) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*g", prec, v);
@@ -58,7 +59,7 @@ std::string num(double v, int prec = 4) {
 // ---------------------------------------------------------------------------------------------
 // training
 
-int runTrain(const Args& a, const std::vector<std::string>& argv) {
+int runTrain(const FlagValues& a, const CLI::App& app) {
   const WrapType type = parseWrapType(a.get("surface", "cylinder"));
   TrainOptions opt;
   opt.hidden = parseHidden(a.get("hidden", "6x256"));
@@ -79,11 +80,11 @@ int runTrain(const Args& a, const std::vector<std::string>& argv) {
   if (!(opt.learning_rate > 0.0 && opt.learning_rate < 1.0)) throw UsageError{"--lr must be in (0, 1)"};
   if (!(threshold >= 0.0 && threshold < 1.0)) throw UsageError{"--threshold must be in [0, 1)"};
   if (opt.time_limit_s < 0.0) throw UsageError{"--time-limit must be >= 0"};
-  const auto out = a.get("out");
+  const std::optional<std::string> out = optionalFlag(a, "out");
   if (!out) throw UsageError{"--out NET.txt is required"};
   requireParent(*out, "--out");
   std::optional<Mlp> init;
-  if (const auto f = a.get("init")) {
+  if (const auto f = optionalFlag(a, "init")) {
     init = Mlp::load(*f);  // a malformed file throws with its line
     if (init->meta.count("surface") && init->meta.at("surface") != wrapTypeName(type))
       throw UsageError{"--init " + *f + " is a " + init->meta.at("surface") + " network, not " + wrapTypeName(type)};
@@ -91,7 +92,7 @@ int runTrain(const Args& a, const std::vector<std::string>& argv) {
       throw UsageError{"--init " + *f + " is " + init->architecture() + ", --hidden asks for another architecture"};
     opt.init = &*init;
   }
-  const auto report = a.get("report");
+  const std::optional<std::string> report = optionalFlag(a, "report");
   if (report) requireFolder(*report);
 
   // samples of the exact library over the stated box [D Sec. 5.3.3.1]
@@ -123,7 +124,7 @@ int runTrain(const Args& a, const std::vector<std::string>& argv) {
     for (const char* k : {"command", "adam", "epochs", "final_val_rms_m", "train_seconds", "test_rms_m"})
       if (init->meta.count(k)) net.meta[std::string("init_") + k] = init->meta.at(k);
   net.meta["surface"] = wrapTypeName(type);
-  net.meta["command"] = joinArgs(argv);
+  net.meta["command"] = commandLine(app);
   net.meta["threshold"] = num(threshold, 6);
   net.meta["test_rms_m"] = num(err.rms, 6);
   net.meta["test_max_m"] = num(err.max, 6);
@@ -169,11 +170,11 @@ int runTrain(const Args& a, const std::vector<std::string>& argv) {
 // ---------------------------------------------------------------------------------------------
 // speed against error
 
-int runCompare(const Args& a) {
+int runCompare(const FlagValues& a) {
   WrapCompareOptions o;
   o.type = parseWrapType(a.get("surface", "cylinder"));
   const WrapType type = o.type;
-  const auto report = a.get("report");
+  const std::optional<std::string> report = optionalFlag(a, "report");
   if (!report) throw UsageError{"--compare needs --report DIR"};
   requireFolder(*report);
   o.muscles = a.getInt("muscles", 200);
@@ -239,8 +240,8 @@ int runCompare(const Args& a) {
 // ---------------------------------------------------------------------------------------------
 // the threshold and architecture study [D Sec. 6.2.6, Fig. 6.8-6.11]
 
-int runStudy(const Args& a) {
-  const auto report = a.get("report");
+int runStudy(const FlagValues& a) {
+  const std::optional<std::string> report = optionalFlag(a, "report");
   if (!report) throw UsageError{"--study needs --report DIR"};
   requireFolder(*report);
   WrapStudyOptions o;
@@ -309,8 +310,8 @@ int runStudy(const Args& a) {
 // ---------------------------------------------------------------------------------------------
 // a group of wrapping double pendulums on one network (issue 7, Results)
 
-int runPendulums(const Args& a) {
-  const std::string file = *a.get("pendulums");
+int runPendulums(const FlagValues& a) {
+  const std::string file = a.get("pendulums", "");
   std::shared_ptr<const Mlp> net;
   try {
     net = loadWrapNetwork(file);
@@ -327,7 +328,7 @@ int runPendulums(const Args& a) {
   if (count < 1 || count > 1000) throw UsageError{"--count must be between 1 and 1000"};
   if (!(duration > 0.0 && duration <= 1000.0)) throw UsageError{"--duration must be in (0, 1000] s"};
   if (!(tol > 0.0 && tol < 1.0)) throw UsageError{"--tol must be in (0, 1)"};
-  const auto report = a.get("report");
+  const std::optional<std::string> report = optionalFlag(a, "report");
   if (report) requireFolder(*report);
   WrapMassOptions wrap;
   wrap.model = WrapModel::Neural;
@@ -369,23 +370,95 @@ int runPendulums(const Args& a) {
   return 0;
 }
 
-int runTrainWrap(const std::vector<std::string>& argv) {
-  Args a(argv,
-         {"surface", "hidden", "samples", "epochs", "batch", "lr", "seed", "threshold", "time-limit", "out", "report",
-          "threads", "shards", "init", "nets", "untrained", "muscles", "mass-points", "width", "thresholds", "architectures",
-          "pendulums", "count", "duration", "tol"},
-         {"compare", "study", "fd-jdot"});
-  if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
+int runTrainWrap(const CLI::App& app) {
+  const FlagValues a(app);
   if (a.has("compare") + a.has("study") + a.has("pendulums") > 1)
     throw UsageError{"--compare, --study and --pendulums exclude each other"};
   if (a.has("pendulums")) return runPendulums(a);
   if (a.has("study")) return runStudy(a);
-  return a.has("compare") ? runCompare(a) : runTrain(a, argv);
+  return a.has("compare") ? runCompare(a) : runTrain(a, app);
+}
+
+// Defaults depend on the mode (training, --compare, --study, --pendulums), so the flags are read
+// through FlagValues with each mode's default; the validators check the form here.
+void declareTrainWrapFlags(CLI::App& app) {
+  const std::string train = "Training", compare = "--compare", study = "--study", pend = "--pendulums";
+  app.add_option("--surface", "cylinder (default), sphere, ellipsoid or torus")->type_name("SURFACE");
+  app.add_option("--hidden", "the tanh MLP's hidden layers, DEPTHxWIDTH or W1-W2-... (default 6x256)")
+      ->type_name("ARCH")
+      ->group(train);
+  app.add_option("--samples", "samples drawn from the surface type's box (default 30000; --study 10000)")
+      ->type_name("N")
+      ->check(integer())
+      ->group(train);
+  app.add_option("--epochs", "training epochs (default 100; --study 60)")->type_name("E")->check(integer())->group(train);
+  app.add_option("--batch", "mini-batch size (default 256; --study 64)")->type_name("B")->check(integer())->group(train);
+  app.add_option("--lr", "Adam's learning rate (default 1e-4; --study 1e-3)")->type_name("R")->check(number())->group(train);
+  app.add_option("--seed", "random seed (default 1); the network is deterministic for a seed")
+      ->type_name("S")
+      ->check(integer());
+  app.add_option("--threshold", "samples with 0 < l/L < threshold are discarded (default 0.01)")
+      ->type_name("F")
+      ->check(number())
+      ->group(train);
+  app.add_option("--time-limit", "stop training after this many seconds (default 0: none)")
+      ->type_name("SECONDS")
+      ->check(number())
+      ->group(train);
+  app.add_option("--threads", "label samples and compute gradients on T threads (default 1)")
+      ->type_name("T")
+      ->check(integer())
+      ->group(train);
+  app.add_option("--shards",
+                 "every mini-batch is cut into S shards (default T) summed in order, so the\n"
+                 "network depends on S and the seed, not on T (S = 1: serial)")
+      ->type_name("S")
+      ->check(integer())
+      ->group(train);
+  app.add_option("--init",
+                 "continue training from that network (same surface and --hidden; its\n"
+                 "normalisation is kept, Adam restarts); its command and losses are kept in the\n"
+                 "new file's meta as init_*")
+      ->type_name("NET.txt")
+      ->group(train);
+  app.add_option("--out", "the trained network (required for training)")->type_name("NET.txt")->group(train);
+  app.add_option("--report",
+                 "training: loss.csv and a loss plot; --compare: speed_error.csv and a plot;\n"
+                 "--study: study.csv and a plot; --pendulums: pendulums.csv")
+      ->type_name("DIR");
+  app.add_flag("--compare")->description("time networks, the smooth model and the exact library per mass point")->group(compare);
+  app.add_option("--nets", "trained networks to compare")->type_name("A.txt,B.txt")->group(compare);
+  app.add_option("--untrained", "network sizes timed only (default 6x256), or none")
+      ->type_name("6x256,...|none")
+      ->group(compare);
+  app.add_option("--muscles", "muscles with random end points and velocities (default 200)")
+      ->type_name("M")
+      ->check(integer())
+      ->group(compare);
+  app.add_option("--mass-points", "mass points per muscle (default 20)")->type_name("N")->check(integer())->group(compare);
+  app.add_option("--width", "the smooth model's band width in surface sizes (default 0.05)")
+      ->type_name("W")
+      ->check(number())
+      ->group(compare);
+  app.add_flag("--study")->description("the threshold and architecture study [D Sec. 6.2.6]")->group(study);
+  app.add_option("--thresholds", "thresholds to train with (default 0.01,0.05,0.1)")
+      ->type_name("LIST")
+      ->group(study);
+  app.add_option("--architectures", "hidden layers to train (default 1x32,3x32)")->type_name("LIST")->group(study);
+  app.add_option("--pendulums", "a group of wrapping double pendulums on this cylinder network")
+      ->type_name("NET.txt")
+      ->group(pend);
+  app.add_option("--count", "pendulums (default 8)")->type_name("N")->check(integer())->group(pend);
+  app.add_option("--duration", "simulated seconds (default 2)")->type_name("S")->check(number())->group(pend);
+  app.add_option("--tol", "rk45's rtol = atol (default 1e-12)")->type_name("TOL")->check(number())->group(pend);
+  app.add_flag("--fd-jdot")->description("Jdot by the forward difference [D Eq. 5.58] instead of exact")->group(pend);
 }
 
 CommandRegistration reg(
     {"train-wrap", "train the Type III wrap network, or compare wrap models (speed against error)",
-     "usage: redmax train-wrap --surface cylinder|sphere|ellipsoid|torus [--hidden 6x256] [--samples N]\n"
+     [](CLI::App& app) {
+       declareTrainWrapFlags(app);
+       app.footer("usage: redmax train-wrap --surface cylinder|sphere|ellipsoid|torus [--hidden 6x256] [--samples N]\n"
      "                         [--epochs E] [--batch B] [--lr 1e-4] [--seed S] [--threshold 0.01]\n"
      "                         [--time-limit SECONDS] [--threads T [--shards S]] [--init NET.txt]\n"
      "                         --out NET.txt [--report DIR]\n"
@@ -418,8 +491,9 @@ CommandRegistration reg(
      "insertion, radius and surface tilt drawn with the seed) all on one cylinder network (WrapModel::Neural),\n"
      "gravity only, rk45 at --tol for --duration s; prints each one's energy drift, contact changes, steps and\n"
      "smooth-model fallbacks (--fd-jdot: Jdot by the forward difference [D Eq. 5.58]); --report DIR writes\n"
-     "DIR/pendulums.csv.\n",
-     runTrainWrap});
+     "DIR/pendulums.csv.");
+       return [&app] { return runTrainWrap(app); };
+     }});
 
 }  // namespace
 }  // namespace redmax::cli

@@ -4,122 +4,77 @@
 // 0 every comparison passed, 1 one failed (or a frame could not be solved, or the report could
 // not be written), 2 bad input or usage.
 #include <iostream>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
 
-#include "cli/args.hpp"
-#include "cli/muscle_mass_flags.hpp"
+#include "cli/id_flags.hpp"
 #include "validation/id_validation.hpp"
 
 namespace redmax::cli {
 namespace {
 
-// --reference and --published may be repeated; Args keeps only the last value of a flag, so
-// they are taken out of argv first
-std::vector<std::string> takeReferences(const std::vector<std::string>& argv,
-                                        std::vector<validation::IdReference>& refs) {
-  std::vector<std::string> rest;
-  for (size_t i = 0; i < argv.size(); ++i) {
-    const std::string& a = argv[i];
-    bool matched = false;
-    for (const std::string flag : {"reference", "published"}) {
-      const std::string f = "--" + flag;
-      std::string value;
-      if (a == f) {
-        if (i + 1 >= argv.size()) throw UsageError{f + " needs a value"};
-        value = argv[++i];
-      } else if (a.rfind(f + "=", 0) == 0) {
-        value = a.substr(f.size() + 1);
-      } else {
-        continue;
-      }
-      if (value.empty()) throw UsageError{f + " needs a file name"};
-      refs.push_back({value, flag});
-      matched = true;
-      break;
-    }
-    if (!matched) rest.push_back(a);
+struct ValidateFlags {
+  IdInputFlags in;
+  std::vector<std::string> references, published;
+  std::string report, mass_sweep, sweep_columns, interpolation, gnuplot;
+  double tolerance = validation::IdValidationOptions{}.reference_rms_rel;
+  double max_tolerance = 0.0;
+  double engine_tolerance = validation::IdValidationOptions{}.engine_rel;
+  bool quiet = false, no_simbody = false, no_plots = false;
+};
+
+// --reference and --published in the order given (they may be repeated and mixed)
+std::vector<validation::IdReference> takeReferences(const ValidateFlags& f, const CLI::App& app) {
+  std::vector<validation::IdReference> refs;
+  size_t next_ref = 0, next_pub = 0;
+  for (const CLI::Option* o : app.parse_order()) {
+    const bool ref = o->check_name("--reference");
+    if (!ref && !o->check_name("--published")) continue;
+    const std::vector<std::string>& values = ref ? f.references : f.published;
+    size_t& next = ref ? next_ref : next_pub;
+    if (next >= values.size()) continue;
+    const std::string& value = values[next++];
+    if (value.empty()) throw UsageError{std::string(ref ? "--reference" : "--published") + " needs a file name"};
+    refs.push_back({value, ref ? "reference" : "published"});
   }
-  return rest;
+  return refs;
 }
 
-// "a,b c" -> {"a", "b", "c"}
-
-double nonNegative(const Args& a, const std::string& name, double fallback) {
-  const double x = a.getDouble(name, fallback);
-  if (x < 0) throw UsageError{"--" + name + " must be >= 0"};
-  return x;
-}
-
-int runValidate(const std::vector<std::string>& argv_in) {
+int runValidate(const ValidateFlags& f, const CLI::App& app) {
   validation::IdValidationOptions opt;
-  const std::vector<std::string> argv = takeReferences(argv_in, opt.references);
-  const std::set<std::string> value_flags =
-      withMuscleMassFlags({"setup", "model", "coordinates", "external-loads", "lowpass", "t0", "t1", "report",
-                           "forces-to-exclude", "mass-sweep", "sweep-columns", "tolerance", "max-tolerance",
-                           "engine-tolerance", "interpolation", "gnuplot"});
-  const std::set<std::string> bool_flags = {"exact", "opensim-compat", "quiet", "no-simbody", "no-plots"};
-  const Args a(argv, value_flags, bool_flags);
-  if (!a.positionals().empty())
-    throw UsageError{"validate takes no positional arguments (got '" + a.positionals().front() + "')"};
+  opt.references = takeReferences(f, app);
 
   // the same inputs as `redmax id`
+  opt.settings = parseIdInputFlags(f.in, app, "validate");
   osim::IdToolSettings& s = opt.settings;
-  s.setup_file = a.get("setup", "");
-  if (s.setup_file.empty() && (!a.has("model") || !a.has("coordinates")))
-    throw UsageError{"validate needs --setup ID_SETUP.xml, or --model M.osim and --coordinates Q.mot"};
-  if (auto v = a.get("model")) s.model_file = *v;
-  if (auto v = a.get("coordinates")) s.coordinates_file = *v;
-  if (auto v = a.get("external-loads")) s.external_loads_file = *v;
-  if (a.has("lowpass")) s.lowpass_cutoff_hz = a.getDouble("lowpass", -1.0);
-  if (a.has("t0")) s.t0 = a.getDouble("t0", 0.0);
-  if (a.has("t1")) s.t1 = a.getDouble("t1", 0.0);
-  if (s.t0 && s.t1 && *s.t0 > *s.t1) throw UsageError{"--t0 is after --t1"};
-  if (auto v = a.get("forces-to-exclude")) {
-    s.forces_to_exclude = splitList(*v, ", \t");
-  }
-  if (a.has("exact") && a.has("opensim-compat"))
-    throw UsageError{"--exact and --opensim-compat exclude each other"};
-  s.opensim_compat = !a.has("exact");
   // muscle mass: one extra core run ("inertial effect") or, with --mass-sweep, a sweep
-  if (a.has("mass-sweep")) {
-    if (!a.has("muscle-mass") || a.get("muscle-mass", "none") == "none")
+  if (given(app, "--mass-sweep")) {
+    if (f.in.muscle_mass.source == "none")
       throw UsageError{"--mass-sweep needs --muscle-mass transfer (fractions) or physiological (scales)"};
-    if (a.has("transfer-fraction"))
+    if (given(app, "--transfer-fraction"))
       throw UsageError{"--mass-sweep gives the transfer fractions; leave out --transfer-fraction"};
-    opt.mass_sweep = validation::parseMassSweepValues(*a.get("mass-sweep"));
-  } else if (a.has("sweep-columns")) {
+    opt.mass_sweep = validation::parseMassSweepValues(f.mass_sweep);
+  } else if (given(app, "--sweep-columns")) {
     throw UsageError{"--sweep-columns needs --mass-sweep"};
   }
-  if (!opt.mass_sweep.empty() && a.get("muscle-mass", "") == "transfer") {
-    // the sweep gives the fractions: the shared parser still wants one, any valid value does
-    std::vector<std::string> with_fraction = argv;
-    with_fraction.push_back("--transfer-fraction=0");
-    opt.muscle_mass = parseMuscleMassFlags(Args(with_fraction, value_flags, bool_flags));
-  } else {
-    opt.muscle_mass = parseMuscleMassFlags(a);
-  }
+  // the sweep gives the transfer fractions
+  opt.muscle_mass = parseMuscleMassFlags(f.in.muscle_mass, !opt.mass_sweep.empty());
   if (!opt.mass_sweep.empty())
     opt.mass_sweep = validation::checkMassSweepValues(opt.muscle_mass, opt.mass_sweep);
-  if (auto v = a.get("sweep-columns")) opt.sweep_columns = splitList(*v, ", \t");
+  if (given(app, "--sweep-columns")) opt.sweep_columns = splitList(f.sweep_columns, ", \t");
 
   // the report and the comparisons
-  opt.report_dir = a.get("report", "");
+  opt.report_dir = f.report;
   if (opt.report_dir.empty()) throw UsageError{"validate needs --report DIR"};
-  opt.reference_rms_rel = nonNegative(a, "tolerance", opt.reference_rms_rel);
-  if (a.has("max-tolerance")) opt.reference_max_rel = nonNegative(a, "max-tolerance", 0);
-  opt.engine_rel = nonNegative(a, "engine-tolerance", opt.engine_rel);
-  opt.run_simbody = !a.has("no-simbody");
-  if (auto v = a.get("interpolation")) {
-    try {
-      opt.interpolation = validation::parseInterpolation(*v);
-    } catch (const validation::CompareError&) {
-      throw UsageError{"--interpolation must be linear or cubic, got '" + *v + "'"};
-    }
-  }
-  opt.gnuplot = a.has("no-plots") ? "none" : a.get("gnuplot", "");
-  const bool quiet = a.has("quiet");
+  opt.reference_rms_rel = f.tolerance;
+  if (given(app, "--max-tolerance")) opt.reference_max_rel = f.max_tolerance;
+  opt.engine_rel = f.engine_tolerance;
+  opt.run_simbody = !f.no_simbody;
+  if (given(app, "--interpolation")) opt.interpolation = validation::parseInterpolation(f.interpolation);
+  opt.gnuplot = f.no_plots ? "none" : f.gnuplot;
+  const bool quiet = f.quiet;
   opt.progress = !quiet;
 
   validation::IdValidationResult r;
@@ -157,15 +112,63 @@ int runValidate(const std::vector<std::string>& argv_in) {
 
 CommandRegistration reg(
     {"validate", "inverse dynamics by core and Simbody, compared with each other and with references",
-     std::string("usage: redmax validate (--setup ID_SETUP.xml | --model M.osim --coordinates Q.mot)\n"
-     "                 [--external-loads LOADS.xml] [--lowpass HZ] [--t0 S] [--t1 S]\n"
-     "                 [--forces-to-exclude LIST] [--exact]\n"
-     "                 [--reference OPENSIM_ID.sto]... [--published ID.sto]...\n"
-     "                 [--tolerance REL] [--max-tolerance REL] [--engine-tolerance REL]\n"
-     "                 [--interpolation linear|cubic] [--no-simbody] [--no-plots] [--gnuplot PATH]\n"
-     "                 [MUSCLE-MASS OPTIONS] [--mass-sweep V1,V2,... [--sweep-columns LIST]]\n"
-     "                 [--quiet] --report DIR\n"
-     "Processes the inputs once, as `redmax id` does (see `redmax id --help` for the input flags),\n"
+     [](CLI::App& app) {
+       auto f = std::make_shared<ValidateFlags>();
+       addIdInputFlags(app, f->in);
+       const std::string g = "Comparisons";
+       app.add_option("--reference", f->references,
+                      "an OpenSim ID result (label 'reference'); may be repeated")
+           ->type_name("OPENSIM_ID.sto")
+           ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+           ->group(g);
+       app.add_option("--published", f->published, "a published ID result (label 'published'); may be repeated")
+           ->type_name("ID.sto")
+           ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+           ->group(g);
+       app.add_option("--tolerance", f->tolerance, "RMS <= REL * peak against references (default 1e-6)")
+           ->type_name("REL")
+           ->check(nonNegative())
+           ->group(g);
+       app.add_option("--max-tolerance", f->max_tolerance, "also max |diff| <= REL * peak against references")
+           ->type_name("REL")
+           ->check(nonNegative())
+           ->group(g);
+       app.add_option("--engine-tolerance", f->engine_tolerance,
+                      "|core - simbody| <= REL * column peak (default 1e-9)")
+           ->type_name("REL")
+           ->check(nonNegative())
+           ->group(g);
+       app.add_option("--interpolation", f->interpolation, "the core on the reference's rows (default linear)")
+           ->type_name("linear|cubic")
+           ->check(oneOf({"linear", "cubic"}))
+           ->group(g);
+       app.add_flag("--no-simbody", f->no_simbody, "skip the Simbody engine")->group(g);
+       app.add_option("--mass-sweep", f->mass_sweep,
+                      "solve once per value on the same processed inputs: transfer fractions\n"
+                      "in [0, 1) with --muscle-mass transfer --transfer-body BODY (e.g.\n"
+                      "0,0.2,0.4,0.6,0.8), or scales >= 0 of the physiological mass with\n"
+                      "--muscle-mass physiological (e.g. 0,0.25,0.5,1); 0 is added if absent")
+           ->type_name("V1,V2,...")
+           ->group("Muscle mass");
+       app.add_option("--sweep-columns", f->sweep_columns,
+                      "the mass_sweep_torques plot's columns (default ankle, knee and hip of\n"
+                      "the transfer side)")
+           ->type_name("LIST")
+           ->group("Muscle mass");
+       app.add_option("--report", f->report, "the report folder (required)")->type_name("DIR");
+       app.add_flag("--no-plots", f->no_plots, "no gnuplot plots");
+       app.add_option("--gnuplot", f->gnuplot, "the gnuplot executable (default: found on PATH)")->type_name("PATH");
+       app.add_flag("--quiet", f->quiet, "no progress, summary or warnings");
+       app.footer(std::string(
+           "usage: redmax validate (--setup ID_SETUP.xml | --model M.osim --coordinates Q.mot)\n"
+           "                 [--external-loads LOADS.xml] [--lowpass HZ] [--t0 S] [--t1 S]\n"
+           "                 [--forces-to-exclude LIST] [--exact]\n"
+           "                 [--reference OPENSIM_ID.sto]... [--published ID.sto]...\n"
+           "                 [--tolerance REL] [--max-tolerance REL] [--engine-tolerance REL]\n"
+           "                 [--interpolation linear|cubic] [--no-simbody] [--no-plots] [--gnuplot PATH]\n"
+           "                 [MUSCLE-MASS OPTIONS] [--mass-sweep V1,V2,... [--sweep-columns LIST]]\n"
+           "                 [--quiet] --report DIR\n"
+           "Processes the inputs once, as `redmax id` does (see `redmax id --help` for the input flags),\n"
      "solves every frame with the core engine and with the Simbody engine, and compares:\n"
      "  core_vs_simbody      every column and frame: |core - simbody| <= REL * column peak\n"
      "                       (--engine-tolerance, default 1e-9; absolute floor 1e-10)\n"
@@ -181,7 +184,7 @@ CommandRegistration reg(
      "of each engine: frames, seconds, frames per second), <cmp>_metrics.csv, <cmp>_series.csv,\n"
      "overlay and difference plots (gnuplot; skipped with a note when absent or --no-plots),\n"
      "overlay_all (every series), core_id.sto and simbody_id.sto (full precision), report.md.\n"
-     "MUSCLE-MASS OPTIONS (below). The comparisons above always use the zero-mass core and\n"
+     "With MUSCLE-MASS OPTIONS, the comparisons above always use the zero-mass core and\n"
      "Simbody (OpenSim's results have no muscle inertia). With muscle mass the core solves the\n"
      "trial again and the per-column difference from the zero-mass core is reported as the\n"
      "inertial effect (inertial_effect.csv, an overlay, core_mass_id.sto, summary.inertial_effect),\n"
@@ -201,9 +204,9 @@ CommandRegistration reg(
      "                       zero-mass result to 1e-12 of each column's peak) can fail the run.\n"
      "Prints one line per engine and per comparison (worst column, PASS/FAIL).\n"
      "Exit codes: 0 every comparison passed, 1 a comparison failed (or a frame could not be solved,\n"
-     "or the report could not be written), 2 bad input or usage.\n") +
-         muscleMassUsage(),
-     runValidate});
+     "or the report could not be written), 2 bad input or usage.\n") + muscleMassFooter());
+       return [f, &app] { return runValidate(*f, app); };
+     }});
 
 }  // namespace
 }  // namespace redmax::cli

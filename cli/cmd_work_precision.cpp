@@ -8,11 +8,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "cli/args.hpp"
+#include "cli/flags.hpp"
 #include "converter/error.hpp"
 #include "converter/id/id_engine.hpp"
 #include "validation/work_precision/work_precision.hpp"
@@ -24,8 +25,14 @@ namespace fs = std::filesystem;
 
 
 // --models, else ./osim_models, else osim_models beside an ancestor of the executable's folder
-std::string findModelsDir(const Args& a) {
-  if (auto d = a.get("models")) {
+struct WorkPrecisionFlags {
+  std::string report, models, scenes, integrators, gnuplot, studies, shared;
+  bool quick = false, no_plots = false;
+};
+
+std::string findModelsDir(const WorkPrecisionFlags& f, const CLI::App& app) {
+  if (given(app, "--models")) {
+    const std::string* d = &f.models;
     if (!fs::is_regular_file(fs::path(*d) / "double_pendulum_via.osim"))
       throw UsageError{"--models " + *d + ": no double_pendulum_via.osim there"};
     return *d;
@@ -42,8 +49,9 @@ std::string findModelsDir(const Args& a) {
 
 // --shared, else $REDMAX_SHARED_DIR, else ../shared beside the repository holding the models ("" if
 // none: the ID studies then fall back to the running leg and say so)
-std::string findSharedDir(const Args& a, const std::string& models_dir) {
-  if (auto d = a.get("shared")) {
+std::string findSharedDir(const WorkPrecisionFlags& f, const CLI::App& app, const std::string& models_dir) {
+  if (given(app, "--shared")) {
+    const std::string* d = &f.shared;
     if (!fs::is_directory(*d)) throw UsageError{"--shared " + *d + ": not a directory"};
     return *d;
   }
@@ -54,26 +62,24 @@ std::string findSharedDir(const Args& a, const std::string& models_dir) {
   return "";
 }
 
-int runWorkPrecision(const std::vector<std::string>& argv) {
-  Args a(argv, {"report", "models", "scenes", "integrators", "gnuplot", "studies", "shared"}, {"quick", "no-plots"});
-  if (!a.positionals().empty()) throw UsageError{"unexpected argument '" + a.positionals()[0] + "'"};
-  const auto dir = a.get("report");
-  if (!dir || dir->empty()) throw UsageError{"--report DIR is required"};
+int runWorkPrecision(const WorkPrecisionFlags& f, const CLI::App& app) {
+  const std::string* dir = &f.report;
+  if (dir->empty()) throw UsageError{"--report DIR is required"};
   validation::WorkPrecisionOptions opt;
-  opt.quick = a.has("quick");
-  opt.models_dir = findModelsDir(a);
-  if (auto s = a.get("scenes")) opt.scenes = splitList(*s);
-  if (auto s = a.get("integrators")) opt.integrators = splitList(*s);
-  opt.gnuplot = a.has("no-plots") ? "none" : a.get("gnuplot", "");
-  if (auto s = a.get("studies")) {
-    opt.studies = splitList(*s);
+  opt.quick = f.quick;
+  opt.models_dir = findModelsDir(f, app);
+  if (given(app, "--scenes")) opt.scenes = splitList(f.scenes);
+  if (given(app, "--integrators")) opt.integrators = splitList(f.integrators);
+  opt.gnuplot = f.no_plots ? "none" : f.gnuplot;
+  if (given(app, "--studies")) {
+    opt.studies = splitList(f.studies);
     if (opt.studies.empty()) throw UsageError{"--studies needs a list (integrators,masspoints,reduction,hard)"};
     const auto all = validation::workPrecisionStudyNames();
     for (const auto& st : opt.studies)
       if (std::find(all.begin(), all.end(), st) == all.end())
         throw UsageError{"--studies: unknown study '" + st + "' (expected integrators, masspoints, reduction, hard)"};
   }
-  opt.shared_dir = findSharedDir(a, opt.models_dir);
+  opt.shared_dir = findSharedDir(f, app, opt.models_dir);
   // the report folder must be creatable before the runs are spent
   std::error_code ec;
   fs::create_directories(*dir, ec);
@@ -130,37 +136,51 @@ int runWorkPrecision(const std::vector<std::string>& argv) {
 }
 
 CommandRegistration reg(
-    {"work-precision", "error against CPU time for every integrator on the project's scenes",
-     "usage: redmax work-precision --report DIR [--quick] [--models DIR] [--scenes LIST] [--integrators LIST]\n"
-     "                             [--studies LIST] [--shared DIR] [--gnuplot PATH|none] [--no-plots]\n"
-     "\n"
-     "Runs every integrator (euler, symplectic, bdf1, sdirk2 over fixed steps 1e-2..5e-5 s; rk45, cvode over\n"
-     "rtol 1e-3..1e-10, atol = 1e-2 rtol) on the scenes pendulum_straight, pendulum_via, pendulum_wrap, finger\n"
-     "and running_leg (osim_models/, muscle mass on their Type I/II/III muscles) and measures the state error at the end against rk45 at rtol 1e-12, CPU\n"
-     "time, right-hand-side evaluations and energy drift per simulated second. Diverged runs are marked.\n"
-     "Writes DIR/<scene>.csv, DIR/<scene>.png|svg (log-log error vs CPU time), DIR/report.md (tables and\n"
-     "the recommended integrator per scene for errors <= 1e-3 and <= 1e-6) and DIR/summary.json.\n"
-     "\n"
-     "  --quick            0.5 s per scene and 3-rung ladders (about 30 s instead of minutes)\n"
-     "  --models DIR       the osim_models folder (default: ./osim_models or the repository's)\n"
-     "  --scenes LIST      comma-separated subset of pendulum_straight,pendulum_via,pendulum_wrap,finger,\n"
-     "                     running_leg\n"
-     "  --integrators LIST comma-separated subset of euler,symplectic,bdf1,sdirk2,rk45,cvode\n"
-     "  --studies LIST     comma-separated subset of integrators,masspoints,reduction,hard (default all).\n"
-     "                     masspoints: ID torque error against 500 mass points per muscle for N = 2..100\n"
-     "                     and CPU time per frame, with the recommended N; reduction: only the top-K\n"
-     "                     muscles by inertia contribution carry mass, K = 0, 1, 2, 5, 10, all. Trial: set F\n"
-     "                     of the shared OpenSim data with physiological muscle mass (--quick, or without\n"
-     "                     the shared data: the running leg, and the report says so). Writes\n"
-     "                     id_masspoints.csv|png, id_reduction.csv|png, id_reduction_ranking.csv; hard:\n"
-     "                     stability cases (hard_cases.csv), the finger flick's largest force and impulse\n"
-     "                     survived, lumped vs inertial, per integrator and step (hard_flick.csv), the\n"
-     "                     energy jump at each wrap contact change per path model (hard_wrap_jumps.csv)\n"
-     "  --shared DIR       the shared data folder holding opensim/ (default $REDMAX_SHARED_DIR, else\n"
-     "                     ../shared beside the repository)\n"
-     "\n"
-     "exit codes: 0 report written, 1 a model could not be loaded or the report not written, 2 bad input.\n",
-     runWorkPrecision});
+    {"work-precision", "error against CPU time for every integrator on the project's scenes", [](CLI::App& app) {
+       auto f = std::make_shared<WorkPrecisionFlags>();
+       app.add_option("--report", f->report, "the report folder (required)")->type_name("DIR");
+       app.add_flag("--quick", f->quick, "0.5 s per scene and 3-rung ladders (about 30 s instead of minutes)");
+       app.add_option("--models", f->models, "the osim_models folder (default: ./osim_models or the repository's)")
+           ->type_name("DIR");
+       app.add_option("--scenes", f->scenes,
+                      "comma-separated subset of pendulum_straight,pendulum_via,pendulum_wrap,\n"
+                      "finger,running_leg")
+           ->type_name("LIST");
+       app.add_option("--integrators", f->integrators,
+                      "comma-separated subset of euler,symplectic,bdf1,sdirk2,rk45,cvode")
+           ->type_name("LIST");
+       app.add_option("--studies", f->studies,
+                      "comma-separated subset of integrators,masspoints,reduction,hard (default all).\n"
+                      "masspoints: ID torque error against 500 mass points per muscle for N = 2..100\n"
+                      "and CPU time per frame, with the recommended N; reduction: only the top-K\n"
+                      "muscles by inertia contribution carry mass, K = 0, 1, 2, 5, 10, all. Trial: set F\n"
+                      "of the shared OpenSim data with physiological muscle mass (--quick, or without\n"
+                      "the shared data: the running leg, and the report says so). Writes\n"
+                      "id_masspoints.csv|png, id_reduction.csv|png, id_reduction_ranking.csv; hard:\n"
+                      "stability cases (hard_cases.csv), the finger flick's largest force and impulse\n"
+                      "survived, lumped vs inertial, per integrator and step (hard_flick.csv), the\n"
+                      "energy jump at each wrap contact change per path model (hard_wrap_jumps.csv)")
+           ->type_name("LIST");
+       app.add_option("--shared", f->shared,
+                      "the shared data folder holding opensim/ (default $REDMAX_SHARED_DIR, else\n"
+                      "../shared beside the repository)")
+           ->type_name("DIR");
+       app.add_option("--gnuplot", f->gnuplot, "the gnuplot executable, or none (default: found on PATH)")
+           ->type_name("PATH|none");
+       app.add_flag("--no-plots", f->no_plots, "no plots");
+       app.footer(
+           "usage: redmax work-precision --report DIR [--quick] [--models DIR] [--scenes LIST] [--integrators LIST]\n"
+           "                             [--studies LIST] [--shared DIR] [--gnuplot PATH|none] [--no-plots]\n"
+           "Runs every integrator (euler, symplectic, bdf1, sdirk2 over fixed steps 1e-2..5e-5 s; rk45, cvode over\n"
+           "rtol 1e-3..1e-10, atol = 1e-2 rtol) on the scenes pendulum_straight, pendulum_via, pendulum_wrap, finger\n"
+           "and running_leg (osim_models/, muscle mass on their Type I/II/III muscles) and measures the state error\n"
+           "at the end against rk45 at rtol 1e-12, CPU time, right-hand-side evaluations and energy drift per\n"
+           "simulated second. Diverged runs are marked.\n"
+           "Writes DIR/<scene>.csv, DIR/<scene>.png|svg (log-log error vs CPU time), DIR/report.md (tables and\n"
+           "the recommended integrator per scene for errors <= 1e-3 and <= 1e-6) and DIR/summary.json.\n"
+           "exit codes: 0 report written, 1 a model could not be loaded or the report not written, 2 bad input.");
+       return [f, &app] { return runWorkPrecision(*f, app); };
+     }});
 
 }  // namespace
 }  // namespace redmax::cli

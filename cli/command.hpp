@@ -1,18 +1,24 @@
 #pragma once
 // Subcommands of the `redmax` executable. Each lives in its own cli/cmd_*.cpp and registers
-// itself with a static CommandRegistration; main.cpp dispatches. Exit codes (docs/commands.md §1):
-// 0 success, 1 the run failed (e.g. diverged), 2 bad input or usage.
+// itself with a static CommandRegistration; main.cpp makes one CLI11 subcommand per entry, lets it
+// declare its flags, parses, and runs it. Exit codes (docs/commands.md §1): 0 success, 1 the run failed
+// (e.g. diverged), 2 bad input or usage.
 #include <functional>
 #include <string>
 #include <vector>
+
+namespace CLI {
+class App;
+}
 
 namespace redmax::cli {
 
 struct Command {
   std::string name;
   std::string summary;  // one line for `redmax --help`
-  std::string usage;    // full help for `redmax NAME --help`
-  std::function<int(const std::vector<std::string>& args)> run;
+  /// Declares the command's flags (with help text and validators) on its subcommand `app` and
+  /// returns the run, called once `app` has parsed; the flags' values live in state the run owns.
+  std::function<std::function<int()>(CLI::App& app)> declare;
 };
 
 std::vector<Command>& registry();

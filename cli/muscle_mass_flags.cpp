@@ -10,25 +10,91 @@
 
 namespace redmax::cli {
 
-const std::set<std::string>& muscleMassFlagNames() {
-  static const std::set<std::string> names = {
-      "muscle-mass",      "muscles",        "mass-points",   "mass-region",
-      "specific-tension", "muscle-density", "transfer-body", "transfer-fraction",
-      "wrap",             "wrap-width",     "wrap-network"};
-  return names;
+std::string WrapFlags::firstGiven() const {
+  return hasModel() ? "--wrap" : hasWidth() ? "--wrap-width" : hasNetwork() ? "--wrap-network" : "";
 }
 
-std::set<std::string> withMuscleMassFlags(std::set<std::string> names) {
-  names.insert(muscleMassFlagNames().begin(), muscleMassFlagNames().end());
-  return names;
+void addWrapFlags(CLI::App& app, WrapFlags& f, bool with_model, const std::string& group) {
+  if (with_model)
+    f.model_opt = app.add_option("--wrap", f.model,
+                                 "wrapping (Type III) muscles with mass: smooth (default) over the analytic\n"
+                                 "smooth wrap model (C2 across contact changes, energy-consistent); exact\n"
+                                 "over OpenSim's wrapping with finite-difference Jacobians (energy jumps\n"
+                                 "at contact changes); neural over a trained network; lumped keeps them\n"
+                                 "massless. smooth takes paths with at most one wrap object per segment\n"
+                                 "over the surfaces it supports, exact any path OpenSim wraps; other\n"
+                                 "wrapping muscles stay lumped and the summary says why (\"wrapping\n"
+                                 "(Type III): W of N carry mass\"). Simbody engines take the same paths\n"
+                                 "except exact beyond origin -> one wrap -> insertion, and name the\n"
+                                 "muscles they refuse")
+                      ->type_name("smooth|exact|neural|lumped")
+                      ->check(oneOf({"smooth", "exact", "neural", "lumped"}))
+                      ->group(group);
+  f.width_opt = app.add_option("--wrap-width", f.width,
+                               "smooth (and neural's fallback): transition width in metres\n"
+                               "(default 0.05 of the surface size)")
+                    ->type_name("W")
+                    ->check(positive("number of metres"))
+                    ->group(group);
+  f.network_opt = app.add_option("--wrap-network", f.network,
+                                 "neural (required): a network of `redmax train-wrap` (e.g.\n"
+                                 "osim_models/networks/cylinder_3x64.txt); surfaces it was not trained\n"
+                                 "for and inputs outside its training box use the smooth model, with a\n"
+                                 "warning once per muscle and the count in the summary")
+                      ->type_name("FILE")
+                      ->group(group);
 }
 
-bool hasWrapFlags(const Args& a) { return a.has("wrap") || a.has("wrap-width") || a.has("wrap-network"); }
+void addMuscleMassFlags(CLI::App& app, MuscleMassFlags& f) {
+  const std::string g = "Muscle mass";
+  f.source_opt = app.add_option("--muscle-mass", f.source,
+                                "none (default: the model as OpenSim sees it, muscles lumped into the\n"
+                                "bones); physiological: each muscle gets density * (max_isometric_force /\n"
+                                "specific tension) * optimal_fiber_length, taken from the bodies it was\n"
+                                "lumped into (total mass and centre of mass unchanged); transfer: a\n"
+                                "fraction of one body's mass moves into the muscles with a path point on it")
+                     ->type_name("none|physiological|transfer")
+                     ->check(oneOf({"none", "physiological", "transfer"}))
+                     ->group(g);
+  f.muscles_opt = app.add_option("--muscles", f.muscles,
+                                 "which muscles get mass: all (default), a REGEX matching whole names,\n"
+                                 "or top:K, the K largest ||M_muscle|| / ||M_skeleton|| over the trial")
+                      ->type_name("all|REGEX|top:K")
+                      ->group(g);
+  f.mass_points_opt = app.add_option("--mass-points", f.mass_points, "points per muscle (default 20)")
+                          ->type_name("N")
+                          ->check(between(1, 100000, true))
+                          ->group(g);
+  f.region_opt = app.add_option("--mass-region", f.region,
+                                "points in the fibre part of the path (fibre, default; also 'fiber') or\n"
+                                "along all of it (whole)")
+                     ->type_name("fibre|whole")
+                     ->check(oneOf({"fibre", "fiber", "whole"}))
+                     ->group(g);
+  f.tension_opt = app.add_option("--specific-tension", f.specific_tension,
+                                 "Pa; default 600000 (60 N/cm^2, Rajagopal et al. 2016)")
+                      ->type_name("PA")
+                      ->check(positive())
+                      ->group(g);
+  f.density_opt = app.add_option("--muscle-density", f.density, "kg/m^3; default 1059.7 (Ward & Lieber 2005)")
+                      ->type_name("KG_M3")
+                      ->check(positive())
+                      ->group(g);
+  f.body_opt = app.add_option("--transfer-body", f.transfer_body, "transfer only: the body that gives mass")
+                   ->type_name("BODY")
+                   ->group(g);
+  f.fraction_opt = app.add_option("--transfer-fraction", f.transfer_fraction,
+                                  "transfer only: the fraction F in [0, 1) of its mass that moves")
+                       ->type_name("F")
+                       ->check(number())
+                       ->group(g);
+  addWrapFlags(app, f.wrap, true, g);
+}
 
-void parseWrapFlags(const Args& a, osim::MuscleMassOptions& o) {
+void parseWrapFlags(const WrapFlags& f, osim::MuscleMassOptions& o) {
   // smooth by default: the mass matrix stays continuous at contact changes, so energy is conserved
   // to integrator error; exact (finite-difference J) jumps there [D Sec. 5.3.3, 6.2.4]
-  const std::string model = a.get("wrap", "smooth");
+  const std::string& model = f.model;
   o.wrap = WrapMassOptions{};
   o.wrap_mass = model != "lumped";
   if (model == "smooth") {
@@ -37,12 +103,11 @@ void parseWrapFlags(const Args& a, osim::MuscleMassOptions& o) {
     o.wrap.model = WrapModel::Exact;
   } else if (model == "neural") {
     o.wrap.model = WrapModel::Neural;
-    if (!a.has("wrap-network") || a.get("wrap-network", "").empty())
+    if (!f.hasNetwork() || f.network.empty())
       throw UsageError{"--wrap neural needs --wrap-network FILE (a network of `redmax train-wrap`, e.g. "
                        "osim_models/networks/cylinder_3x64.txt)"};
-    const std::string file = a.get("wrap-network", "");
     try {
-      o.wrap.network = loadWrapNetwork(file);
+      o.wrap.network = loadWrapNetwork(f.network);
     } catch (const std::exception& e) {
       throw UsageError{std::string("--wrap-network: ") + e.what()};
     }
@@ -52,38 +117,40 @@ void parseWrapFlags(const Args& a, osim::MuscleMassOptions& o) {
   } else if (model != "lumped") {
     throw UsageError{"--wrap must be smooth, exact, neural or lumped, got '" + model + "'"};
   }
-  if (a.has("wrap-width")) {
+  if (f.hasWidth()) {
     if (model != "smooth" && model != "neural")
       throw UsageError{"--wrap-width needs --wrap smooth or neural (the smooth model's transition width; neural "
                        "falls back to it)"};
-    o.wrap.width = a.getDouble("wrap-width", 0.0);
-    if (!(o.wrap.width > 0.0) || !std::isfinite(o.wrap.width))
-      throw UsageError{"--wrap-width must be a positive number of metres, got '" + a.get("wrap-width", "") + "'"};
+    o.wrap.width = f.width;
   }
-  if (a.has("wrap-network") && model != "neural") throw UsageError{"--wrap-network needs --wrap neural"};
+  if (f.hasNetwork() && model != "neural") throw UsageError{"--wrap-network needs --wrap neural"};
 }
 
-osim::MuscleMassOptions parseMuscleMassFlags(const Args& a) {
+osim::MuscleMassOptions parseMuscleMassFlags(const MuscleMassFlags& f, bool fraction_from_sweep) {
   using Source = osim::MuscleMassOptions::Source;
   osim::MuscleMassOptions o;
-  const std::string source = a.get("muscle-mass", "none");
   try {
-    o.source = osim::parseMuscleMassSource(source);
+    o.source = osim::parseMuscleMassSource(f.source);
   } catch (const std::invalid_argument& e) {
     throw UsageError{e.what()};
   }
+  const std::vector<std::pair<const CLI::Option*, const char*>> needs_source = {
+      {f.muscles_opt, "--muscles"},          {f.mass_points_opt, "--mass-points"},
+      {f.region_opt, "--mass-region"},       {f.tension_opt, "--specific-tension"},
+      {f.density_opt, "--muscle-density"},   {f.body_opt, "--transfer-body"},
+      {f.fraction_opt, "--transfer-fraction"}, {f.wrap.model_opt, "--wrap"},
+      {f.wrap.width_opt, "--wrap-width"},    {f.wrap.network_opt, "--wrap-network"}};
   if (o.source == Source::None) {
-    for (const std::string& f : muscleMassFlagNames())
-      if (f != "muscle-mass" && a.has(f))
-        throw UsageError{"--" + f + " needs --muscle-mass physiological or transfer"};
+    for (const auto& [opt, name] : needs_source)
+      if (opt && opt->count() > 0) throw UsageError{std::string(name) + " needs --muscle-mass physiological or transfer"};
     return o;
   }
-  parseWrapFlags(a, o);
+  parseWrapFlags(f.wrap, o);
   if (o.source != Source::Transfer)
-    for (const char* f : {"transfer-body", "transfer-fraction"})
-      if (a.has(f)) throw UsageError{std::string("--") + f + " needs --muscle-mass transfer"};
+    for (const auto& [opt, name] : {std::pair{f.body_opt, "--transfer-body"}, std::pair{f.fraction_opt, "--transfer-fraction"}})
+      if (opt->count() > 0) throw UsageError{std::string(name) + " needs --muscle-mass transfer"};
 
-  o.muscles = a.get("muscles", "all");
+  o.muscles = f.muscles;
   if (o.muscles.empty()) throw UsageError{"--muscles needs all, top:K or a regular expression"};
   if (o.muscles.rfind("top:", 0) == 0) {
     const std::string k = o.muscles.substr(4);
@@ -97,65 +164,28 @@ osim::MuscleMassOptions parseMuscleMassFlags(const Args& a) {
       throw UsageError{"--muscles '" + o.muscles + "' is not a valid regular expression (" + e.what() + ")"};
     }
   }
-  const long n = a.getInt("mass-points", o.mass_points);
-  if (n < 1 || n > 100000) throw UsageError{"--mass-points must be between 1 and 100000, got " + std::to_string(n)};
-  o.mass_points = static_cast<int>(n);
-  const std::string region = a.get("mass-region", "fibre");
-  if (region == "fibre" || region == "fiber") {
-    o.region = MassPointOptions::Region::Fibre;
-  } else if (region == "whole") {
-    o.region = MassPointOptions::Region::WholePath;
-  } else {
-    throw UsageError{"--mass-region must be fibre or whole, got '" + region + "'"};
-  }
-  o.specific_tension = a.getDouble("specific-tension", o.specific_tension);
-  if (!(o.specific_tension > 0.0)) throw UsageError{"--specific-tension must be > 0 (Pa)"};
-  o.density = a.getDouble("muscle-density", o.density);
-  if (!(o.density > 0.0)) throw UsageError{"--muscle-density must be > 0 (kg/m^3)"};
+  o.mass_points = static_cast<int>(f.mass_points);
+  o.region = f.region == "whole" ? MassPointOptions::Region::WholePath : MassPointOptions::Region::Fibre;
+  o.specific_tension = f.specific_tension;
+  o.density = f.density;
 
   if (o.source == Source::Transfer) {
-    if (!a.has("transfer-body") || a.get("transfer-body", "").empty())
+    if (f.body_opt->count() == 0 || f.transfer_body.empty())
       throw UsageError{"--muscle-mass transfer needs --transfer-body BODY"};
-    o.transfer_body = a.get("transfer-body", "");
-    if (!a.has("transfer-fraction")) throw UsageError{"--muscle-mass transfer needs --transfer-fraction F"};
-    o.transfer_fraction = a.getDouble("transfer-fraction", 0.0);
-    if (!(o.transfer_fraction >= 0.0 && o.transfer_fraction < 1.0))
-      throw UsageError{"--transfer-fraction must be in [0, 1), got " + a.get("transfer-fraction", "")};
+    o.transfer_body = f.transfer_body;
+    if (!fraction_from_sweep) {
+      if (f.fraction_opt->count() == 0) throw UsageError{"--muscle-mass transfer needs --transfer-fraction F"};
+      o.transfer_fraction = f.transfer_fraction;
+      if (!(o.transfer_fraction >= 0.0 && o.transfer_fraction < 1.0))
+        throw UsageError{"--transfer-fraction must be in [0, 1), got " + f.fraction_opt->as<std::string>()};
+    }
   }
   return o;
 }
 
-const char* muscleMassUsage() {
-  return "Muscle mass (default none: the model as OpenSim sees it, muscles lumped into the bones):\n"
-         "  --muscle-mass none|physiological|transfer\n"
-         "                       physiological: each muscle gets density * (max_isometric_force /\n"
-         "                       specific tension) * optimal_fiber_length, taken from the bodies it was\n"
-         "                       lumped into (total mass and centre of mass unchanged); transfer: a\n"
-         "                       fraction of one body's mass moves into the muscles with a path point on it\n"
-         "  --muscles all|REGEX|top:K  which muscles get mass (REGEX matches whole names; top:K the K\n"
-         "                       largest ||M_muscle|| / ||M_skeleton|| over the trial); default all\n"
-         "  --mass-points N      points per muscle (default 20)\n"
-         "  --mass-region fibre|whole  points in the fibre part of the path (default) or along all of it\n"
-         "  --specific-tension PA  default 600000 (60 N/cm^2, Rajagopal et al. 2016)\n"
-         "  --muscle-density KG_M3 default 1059.7 (Ward & Lieber 2005)\n"
-         "  --transfer-body BODY --transfer-fraction F   transfer only: F in [0, 1)\n"
-         "  --wrap smooth|exact|neural|lumped  wrapping (Type III) muscles: smooth (default) gives them\n"
-         "                       mass over the analytic smooth wrap model (C2 across contact changes,\n"
-         "                       energy-consistent); exact over OpenSim's wrapping with finite-difference\n"
-         "                       Jacobians (energy jumps at contact changes); neural over a trained network;\n"
-         "                       lumped keeps them massless. smooth takes paths with at most one wrap\n"
-         "                       object per segment over the surfaces it supports, exact any path OpenSim\n"
-         "                       wraps; other wrapping muscles stay lumped and the summary says why\n"
-         "                       (\"wrapping (Type III): W of N carry mass\"). Simbody engines take the\n"
-         "                       same paths except exact beyond origin -> one wrap -> insertion, and name\n"
-         "                       the muscles they refuse\n"
-         "  --wrap-width W       smooth (and neural's fallback): transition width in metres (default 0.05\n"
-         "                       of the radius)\n"
-         "  --wrap-network FILE  neural (required): a network of `redmax train-wrap` (e.g.\n"
-         "                       osim_models/networks/cylinder_3x64.txt); surfaces it was not trained for\n"
-         "                       and inputs outside its training box use the smooth model, with a warning\n"
-         "                       once per muscle and the count in the summary\n"
-         "The run prints every affected body's mass before and after and every muscle's mass and point\n"
+const char* muscleMassFooter() {
+  return "Muscle mass is taken from the bodies it was lumped into, so the model's total mass never changes;\n"
+         "the run prints every affected body's mass before and after and every muscle's mass and point\n"
          "count on stderr (not with --quiet).\n";
 }
 

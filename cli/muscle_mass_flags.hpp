@@ -1,6 +1,6 @@
 #pragma once
-// The MUSCLE-MASS OPTIONS of docs/commands.md §1, shared by every command that builds a model with
-// muscle mass (`redmax id`, `simulate`, `validate`, ...):
+// The MUSCLE-MASS OPTIONS of docs/commands.md §1, declared once here and added to every command
+// that builds a model with muscle mass (`redmax id`, `simulate`, `validate`, ...):
 //   --muscle-mass none|physiological|transfer   (default none)
 //   --muscles all|REGEX|top:K   --mass-points N   --mass-region fibre|whole
 //   --specific-tension PA       --muscle-density KG_M3
@@ -11,40 +11,74 @@
 //     their mass over the smooth model (C2 across contact changes, so energy-consistent); exact and
 //     neural are the dissertation's routes; lumped keeps them massless.
 // Meanings and defaults: converter/build/muscle_mass.hpp.
-#include <set>
 #include <string>
 
-#include "cli/args.hpp"
+#include "cli/flags.hpp"
 #include "converter/build/muscle_mass.hpp"
 
 namespace redmax::cli {
 
-/// value-flag names (without dashes) of the muscle-mass options: add them to a command's Args
-const std::set<std::string>& muscleMassFlagNames();
+/// --wrap, --wrap-width, --wrap-network: values as given, and whether each was given.
+struct WrapFlags {
+  std::string model = "smooth";  ///< --wrap (`redmax lengths` declares its own, default exact)
+  double width = 0.0;            ///< --wrap-width (m)
+  std::string network;           ///< --wrap-network FILE
+  CLI::Option* model_opt = nullptr;
+  CLI::Option* width_opt = nullptr;
+  CLI::Option* network_opt = nullptr;
 
-/// `names` plus the muscle-mass flags, for building an Args
-std::set<std::string> withMuscleMassFlags(std::set<std::string> names);
+  bool hasModel() const { return model_opt && model_opt->count() > 0; }
+  bool hasWidth() const { return width_opt && width_opt->count() > 0; }
+  bool hasNetwork() const { return network_opt && network_opt->count() > 0; }
+  /// true when any of --wrap, --wrap-width, --wrap-network is given
+  bool any() const { return hasModel() || hasWidth() || hasNetwork(); }
+  /// the first of them given ("--wrap", "--wrap-width", "--wrap-network"), for messages
+  std::string firstGiven() const;
+};
 
-/// The options from the flags (defaults for those not given). Throws UsageError for a value that
-/// cannot be parsed or is out of range (N < 1, tension or density <= 0, F outside [0, 1), a bad
-/// REGEX or top:K), for transfer without --transfer-body, and for --muscles, --mass-points,
-/// --mass-region, --specific-tension, --muscle-density, --transfer-* given without a source that
-/// uses them (a flag that would do nothing is a mistake).
-osim::MuscleMassOptions parseMuscleMassFlags(const Args& args);
+/// The muscle-mass flags of one command: values as given, and whether each was given.
+struct MuscleMassFlags {
+  std::string source = "none";
+  std::string muscles = "all";
+  long mass_points = 20;
+  std::string region = "fibre";
+  double specific_tension = osim::MuscleMassOptions{}.specific_tension;
+  double density = osim::MuscleMassOptions{}.density;
+  std::string transfer_body;
+  double transfer_fraction = 0.0;
+  WrapFlags wrap;
+  CLI::Option* source_opt = nullptr;
+  CLI::Option* muscles_opt = nullptr;
+  CLI::Option* mass_points_opt = nullptr;
+  CLI::Option* region_opt = nullptr;
+  CLI::Option* tension_opt = nullptr;
+  CLI::Option* density_opt = nullptr;
+  CLI::Option* body_opt = nullptr;
+  CLI::Option* fraction_opt = nullptr;
+};
 
-/// The wrap flags alone (--wrap, --wrap-width, --wrap-network) into o.wrap_mass and o.wrap, for a
-/// source that gives mass (also `simulate --muscle-mass-kg`). Not given: wrap_mass on, smooth
-/// model, default width. lumped: wrap_mass off. Throws UsageError for an unknown model, a width
-/// that is not a positive finite number of metres or given without smooth/neural, --wrap-network
+/// Declares --wrap (when `with_model`), --wrap-width and --wrap-network on `app`, in `group`.
+void addWrapFlags(CLI::App& app, WrapFlags& f, bool with_model = true, const std::string& group = "Muscle mass");
+
+/// Declares the muscle-mass flags, the wrap flags included, on `app` (help group "Muscle mass").
+void addMuscleMassFlags(CLI::App& app, MuscleMassFlags& f);
+
+/// The options from the flags (defaults for those not given). Throws UsageError for a value out of
+/// range (F outside [0, 1), a bad REGEX or top:K), for transfer without --transfer-body, and for
+/// --muscles, --mass-points, --mass-region, --specific-tension, --muscle-density, --transfer-*
+/// given without a source that uses them (a flag that would do nothing is a mistake).
+/// `fraction_from_sweep`: --transfer-fraction is not needed (`validate --mass-sweep` gives them).
+osim::MuscleMassOptions parseMuscleMassFlags(const MuscleMassFlags& f, bool fraction_from_sweep = false);
+
+/// The wrap flags alone into o.wrap_mass and o.wrap, for a source that gives mass (also `simulate
+/// --muscle-mass-kg`). Not given: wrap_mass on, smooth model, default width. lumped: wrap_mass off.
+/// Throws UsageError for an unknown model, a width given without smooth/neural, --wrap-network
 /// without neural, neural without --wrap-network or with a file loadWrapNetwork refuses. neural
 /// sets o.wrap.network and a WrapFallbackMonitor (o.wrap.monitor) that warns on stderr once per
 /// muscle; commands print its summary().
-void parseWrapFlags(const Args& args, osim::MuscleMassOptions& o);
+void parseWrapFlags(const WrapFlags& f, osim::MuscleMassOptions& o);
 
-/// true when any of --wrap, --wrap-width, --wrap-network is given
-bool hasWrapFlags(const Args& args);
-
-/// The options' lines for a command's --help (ends with a newline)
-const char* muscleMassUsage();
+/// What the run prints about muscle mass, for the footer of a command's --help.
+const char* muscleMassFooter();
 
 }  // namespace redmax::cli

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -298,6 +299,21 @@ std::string formatStorage(const Storage& s, const StorageWriteOptions& opt) {
 
 void writeStorage(const std::string& path, const Storage& s, const StorageWriteOptions& opt) {
   writeFileAtomic(path, formatStorage(s, opt));
+}
+
+void writeResultStorage(const std::string& path, const Storage& s, bool full_precision,
+                        const std::string& description) {
+  // a folder that cannot be made shows up as the write's error, with the file named
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  StorageWriteOptions wo;
+  if (full_precision) {
+    wo.scientific = true;
+    wo.decimals = 16;
+  }
+  wo.description = description;
+  writeStorage(path, s, wo);
 }
 
 }  // namespace redmax::osim

@@ -55,5 +55,10 @@ struct StorageWriteOptions {
 std::string formatStorage(const Storage& s, const StorageWriteOptions& opt = {});
 /// formatStorage written atomically (temporary file, then rename)
 void writeStorage(const std::string& path, const Storage& s, const StorageWriteOptions& opt = {});
+/// A command's result table (`redmax id`, `lengths`, `simulate`): its folder created first, as
+/// OpenSim's tools create their results directory, then writeStorage with %.16e when
+/// full_precision (else OpenSim's %16.8lf) and the description lines.
+void writeResultStorage(const std::string& path, const Storage& s, bool full_precision,
+                        const std::string& description = "");
 
 }  // namespace redmax::osim

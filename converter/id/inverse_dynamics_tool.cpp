@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "converter/coordinates_file.hpp"
 #include "converter/osim_reader.hpp"
 #include "converter/signal/signal_error.hpp"
 
@@ -39,28 +40,7 @@ std::string bodyName(std::string n) {
   return n;
 }
 
-// label path elements, e.g. "/jointset/r_shoulder/r_shoulder_elev/value" -> {..., "value"}
-std::vector<std::string> pathElements(const std::string& label) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : label) {
-    if (c == '/') {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
-  }
-  if (!cur.empty()) out.push_back(cur);
-  return out;
-}
-
 }  // namespace
-
-double degreesToRadians() {
-  // SimTK_DEGREE_TO_RADIAN is computed in long double and used as a double
-  return static_cast<double>(3.14159265358979323846264338327950288L / 180.0L);
-}
 
 // ---------------------------------------------------------------------------------------------
 IdToolConfig resolveIdSettings(const IdToolSettings& s) {
@@ -242,8 +222,11 @@ void InverseDynamicsTool::prepareCoordinates() {
   for (const auto& w : coordinates_.warnings) warnings_.push_back(file + ": " + w);
   if (coordinates_.numRows() == 0) throw ConvertError(file, 0, "the coordinates file has no rows");
 
-  // q functions by exact column name (§7 step 6); every other column is carried and ignored
+  // q functions by exact column name (§7 step 6, converter/coordinates_file.hpp); every other
+  // column is carried and ignored
   const Model& m = model();
+  const CoordinateColumns columns =
+      matchCoordinateColumns(coordinates_, description_.coordinates, CoordinateLabels::ExactName);
   std::vector<int> used;
   std::vector<double> scale;
   std::vector<std::string> missing;
@@ -252,30 +235,20 @@ void InverseDynamicsTool::prepareCoordinates() {
     IdCoordinateSource& s = sources_[k];
     s.name = m.coordinates()[k].name;
     s.constant = m.coordinates()[k].default_value;
-    s.data_column = coordinates_.findColumn(s.name);
+    const int ci = description_.findCoordinate(s.name);
+    s.data_column = ci >= 0 ? columns.value_column[ci] : coordinates_.findColumn(s.name);
     if (s.data_column < 0) {
       missing.push_back(s.name);
       continue;
     }
     // deg -> rad only for Rotational coordinates (§3.4, §7 step 4)
-    const int ci = description_.findCoordinate(s.name);
-    s.converted = coordinates_.in_degrees && ci >= 0 &&
-                  description_.coordinates[ci].motion_type == MotionType::Rotational;
+    s.converted = ci >= 0 && columns.scale[ci] != 1.0;
     s.spline = static_cast<int>(used.size());
     used.push_back(s.data_column);
-    scale.push_back(s.converted ? degreesToRadians() : 1.0);
+    scale.push_back(s.converted ? columns.scale[ci] : 1.0);
   }
   // columns whose path names a coordinate are not matched (OpenSim matches exact names only)
-  std::vector<std::string> path_labels;
-  for (const std::string& label : coordinates_.labels) {
-    const auto el = pathElements(label);
-    if (el.size() < 2 || m.findCoordinate(label) >= 0) continue;
-    for (size_t back = 1; back <= 2 && back <= el.size(); ++back)
-      if (m.findCoordinate(el[el.size() - back]) >= 0) {
-        path_labels.push_back(label);
-        break;
-      }
-  }
+  const std::vector<std::string>& path_labels = columns.unused_path_labels;
   // OpenSim would solve with every coordinate at its default; that is almost surely not what the
   // user meant, so it is an input error here
   if (used.empty())

@@ -26,6 +26,7 @@
 
 #include "converter/build/build_core_model.hpp"
 #include "converter/build/muscle_mass.hpp"
+#include "converter/coordinates_file.hpp"
 #include "converter/external_loads.hpp"
 #include "converter/id/id_engine.hpp"
 #include "converter/id_setup.hpp"
@@ -165,9 +166,6 @@ class InverseDynamicsTool {
   void prepareCoordinates();
   void prepareLoads();
 };
-
-/// OpenSim's (double)(pi/180), the factor Rotational columns of a degrees file are multiplied by
-double degreesToRadians();
 
 /// The storage name OpenSim gives ID results
 inline constexpr const char* kIdStorageName = "Inverse Dynamics Generalized Forces";

@@ -1,4 +1,4 @@
-// `redmax simulate --engine simbody` against `--engine core` end to end (cli/simulate_simbody.hpp):
+// `redmax simulate --engine simbody` against `--engine core` end to end (validation/simulate/simulate_simbody.hpp):
 // the same STATES.sto columns, and trajectories that agree to 1e-6 (rad, rad/s) at every output row
 // with tight tolerances on both sides (core rk45 rtol 1e-11; Simbody Merson accuracy 1e-10,
 // constraint tolerance 1e-11):

@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "converter/storage.hpp"
 #include "tests/converter/converter_test_util.hpp"
@@ -252,6 +254,37 @@ TEST(Storage, WriterRoundTripsAndIsAtomic) {
   EXPECT_THROW(writeStorage(dir.file("broken.sto"), broken), ConvertError);
   EXPECT_FALSE(std::filesystem::exists(dir.file("broken.sto")));
   EXPECT_THROW(writeStorage(dir.file("no/such/dir/x.sto"), s), ConvertError);
+}
+
+TEST(Storage, ResultWriterCreatesTheFolderAndTakesFullPrecision) {
+  // the one writer of `redmax id`, `lengths` and `simulate` results
+  test::TempDir dir;
+  Storage s;
+  s.name = "states";
+  s.labels = {"a"};
+  s.time = {0.0, 1.0};
+  s.data.resize(2, 1);
+  s.data << 0.12345678901234567, -4e-12;
+  const std::string p = dir.file("new/sub/out.sto");
+  writeResultStorage(p, s, false, "made by a test");
+  const std::string text = formatStorage(s, [] {
+    StorageWriteOptions o;
+    o.description = "made by a test";
+    return o;
+  }());
+  std::ifstream in(p);
+  const std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(written, text);
+  EXPECT_NE(written.find("made by a test\n"), std::string::npos) << written;
+  EXPECT_LE((readStorage(p).data - s.data).cwiseAbs().maxCoeff(), 5e-9);
+  // full precision: %.16e, so the tiny value and all digits survive
+  writeResultStorage(p, s, true);
+  const Storage r = readStorage(p);
+  EXPECT_EQ(r.data(0, 0), s.data(0, 0));
+  EXPECT_EQ(r.data(1, 0), s.data(1, 0));
+  // a folder that cannot be made is the write's error
+  dir.write("file", "x");
+  EXPECT_THROW(writeResultStorage(dir.file("file/out.sto"), s, false), ConvertError);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "converter/coordinates_file.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/body_loads.hpp"
 
@@ -321,16 +322,14 @@ State initialStateFromStorage(const SimulationModel& m, const osim::Storage& tab
     const int i = k < m.build.coordinate_index.size() ? m.build.coordinate_index[k] : -1;
     if (i < 0) continue;
     const auto& c = m.description.coordinates[k];
-    const double scale =
-        table.in_degrees && c.motion_type == osim::MotionType::Rotational ? M_PI / 180.0 : 1.0;
-    int col = table.findColumn(m.q_labels[i]);
-    if (col < 0) col = table.findColumn(c.name);
+    // one label rule and degree constant for every coordinates reader (converter/coordinates_file.hpp)
+    const double scale = osim::coordinateScale(table, c);
+    const int col = osim::findCoordinateColumn(table, c);
     if (col >= 0) {
       s.q[i] = scale * table.data(row, col);
       ++matched;
     }
-    int ucol = table.findColumn(m.u_labels[i]);
-    if (ucol < 0) ucol = table.findColumn(c.name + "_u");
+    const int ucol = osim::findSpeedColumn(table, c);
     if (ucol >= 0) {
       s.qdot[i] = scale * table.data(row, ucol);
       ++matched;

@@ -1,4 +1,4 @@
-#include "cli/simulate_simbody.hpp"
+#include "validation/simulate/simulate_simbody.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -6,12 +6,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "cli/command.hpp"
 #include "plugin/simbody/particle_simulation.hpp"
 
-namespace redmax::cli {
+namespace redmax::validation {
 
-std::string simbodyEngineUnsupportedReason(const validation::SimulationModel& m, const validation::SimulateOptions& so,
+std::string simbodyEngineUnsupportedReason(const SimulationModel& m, const SimulateOptions& so,
                                            bool quadratic_velocity) {
   if (so.integrator != "rk45" && so.integrator != "cvode")
     return "--engine simbody takes --integrator rk45 (Simbody's RungeKuttaMersonIntegrator) or cvode (Simbody's "
@@ -26,33 +25,13 @@ std::string simbodyEngineUnsupportedReason(const validation::SimulationModel& m,
   return "";
 }
 
-std::vector<std::string> simbodyEngineFlagNames() { return {"simbody-method", "simbody-norm"}; }
-
-SimbodyEngineFlags parseSimbodyEngineFlags(const Args& a, const std::string& engine) {
-  SimbodyEngineFlags f;
-  for (const std::string& n : simbodyEngineFlagNames())
-    if (a.has(n) && engine != "simbody") throw UsageError{"--" + n + " needs --engine simbody"};
-  f.method = a.get("simbody-method", "");
-  if (a.has("simbody-method") && f.method != "merson" && f.method != "feldberg" && f.method != "rk3" &&
-      f.method != "verlet" && f.method != "cpodes")
-    throw UsageError{"--simbody-method must be merson, feldberg, rk3, verlet or cpodes, got '" + f.method + "'"};
-  const std::string norm = a.get("simbody-norm", "rms");
-  if (norm != "rms" && norm != "inf") throw UsageError{"--simbody-norm must be rms or inf, got '" + norm + "'"};
-  f.infinity_norm = norm == "inf";
-  return f;
+const std::vector<std::string>& simbodyMethodNames() {
+  static const std::vector<std::string> names = {"merson", "feldberg", "rk3", "verlet", "cpodes"};
+  return names;
 }
 
-const char* simbodyEngineFlagsUsage() {
-  return "  --simbody-method M   with --engine simbody: merson (RungeKuttaMerson), feldberg\n"
-         "                       (RungeKuttaFeldberg), rk3, verlet or cpodes instead of --integrator's\n"
-         "  --simbody-norm rms|inf  Simbody's step error norm: rms over all q and over all u, the\n"
-         "                       particles' included (default), or the largest component; the finger\n"
-         "                       agrees with the core to 1e-6 rad over 1 s with --simbody-method\n"
-         "                       feldberg --simbody-norm inf --rtol 3e-12 --atol 3e-13\n";
-}
-
-validation::SimulationResult simulateSimbody(const validation::SimulationModel& m, const State& initial,
-                                             const validation::SimulateOptions& so, const SimbodyEngineFlags& flags) {
+SimulationResult simulateSimbody(const SimulationModel& m, const State& initial,
+                                             const SimulateOptions& so, const SimbodyEngineOptions& engine) {
   if (!(so.duration > 0.0) || !std::isfinite(so.duration))
     throw std::invalid_argument("the duration must be a positive number of seconds");
   if (!(so.output_dt >= 0.0) || !std::isfinite(so.output_dt))
@@ -63,8 +42,8 @@ validation::SimulationResult simulateSimbody(const validation::SimulationModel& 
   po.accuracy = so.integrator_options.rtol;
   po.constraint_tolerance = so.integrator_options.atol;
   po.max_step = so.integrator_options.max_step;
-  if (!flags.method.empty()) po.integrator = flags.method;
-  po.infinity_norm = flags.infinity_norm;
+  if (!engine.method.empty()) po.integrator = engine.method;
+  po.infinity_norm = engine.infinity_norm;
 
   // the core driver's output times (adaptive methods): t0 + k h_out, the last one t0 + duration
   const double h_out = so.output_dt > 0.0 ? so.output_dt : 0.01;
@@ -72,7 +51,7 @@ validation::SimulationResult simulateSimbody(const validation::SimulationModel& 
   const long n_rows = std::max(1L, static_cast<long>(std::ceil(so.duration / h_out - 1e-9)));
   if (n_rows > 50'000'000) throw std::invalid_argument("more than 5e7 output rows: raise the output interval");
 
-  validation::SimulationResult res;
+  SimulationResult res;
   res.states.name = "redmax simulate states";
   res.states.version = 1;
   res.states.in_degrees = false;
@@ -81,8 +60,8 @@ validation::SimulationResult simulateSimbody(const validation::SimulationModel& 
   for (const char* e : {"kinetic_energy", "potential_energy", "total_energy"}) res.states.labels.push_back(e);
 
   const auto start = std::chrono::steady_clock::now();
-  simbody::ParticleSimulation sim(model, m.build.model.muscles(), initial, po);
-  validation::StateRecorder recorder(res);
+  simbody::ParticleSimulation sim(model, m.muscles, initial, po);
+  StateRecorder recorder(res);
   auto record = [&](const State& s) -> bool {
     return recorder.add(s.t, s.q, s.qdot, sim.kineticEnergy(), sim.potentialEnergy(), " (Simbody)");
   };
@@ -97,7 +76,7 @@ validation::SimulationResult simulateSimbody(const validation::SimulationModel& 
       res.failure = e.what();
       // the usual cause with via points: a particle cannot jump in velocity [particle_muscles.hpp]
       bool via = false;
-      for (const Muscle& mu : m.build.model.muscles()) via = via || (mu.mass_points.size() > 0 && mu.path.points.size() > 2);
+      for (const Muscle& mu : m.muscles) via = via || (mu.mass_points.size() > 0 && mu.path.points.size() > 2);
       if (via)
         res.failure += "\n(a mass point sliding past a via point needs a velocity jump that a Simbody particle "
                        "cannot follow: fewer --mass-points, --mass-region fibre, or --engine core)";
@@ -116,4 +95,4 @@ validation::SimulationResult simulateSimbody(const validation::SimulationModel& 
   return res;
 }
 
-}  // namespace redmax::cli
+}  // namespace redmax::validation
