@@ -200,8 +200,9 @@ CommandRegistration reg(
      "                       |tau| and its change), mass_sweep_fit.csv (R^2 of tau(s) - tau(0)\n"
      "                       against s), plots mass_sweep_torques (--sweep-columns, default ankle,\n"
      "                       knee and hip of the transfer side) and mass_sweep_peak_change, and\n"
-     "                       summary.mass_sweep. Only its zero check (the value 0 reproduces the\n"
-     "                       zero-mass result to 1e-12 of each column's peak) can fail the run.\n"
+     "                       summary.mass_sweep. Fails the run: the zero check (the value 0\n"
+     "                       reproduces the zero-mass result to 1e-12 of each column's peak) and\n"
+     "                       core vs Simbody with muscle inertia at every value (mass_sweep_simbody.csv).\n"
      "Prints one line per engine and per comparison (worst column, PASS/FAIL).\n"
      "Exit codes: 0 every comparison passed, 1 a comparison failed (or a frame could not be solved,\n"
      "or the report could not be written), 2 bad input or usage.\n") + muscleMassFooter());

@@ -75,7 +75,7 @@ PathLengthResult calcPathLengths(const osim::ModelDescription& d, const osim::Bu
   const bool model_lengths = o.wrap == LengthWrap::Smooth || o.wrap == LengthWrap::Neural;
   // which built paths are reported: muscles (every path force with all_paths)
   std::vector<int> report;
-  for (size_t k = 0; k < build.muscles.size(); ++k)
+  for (size_t k = 0; k < build.model.muscles().size(); ++k)
     if (o.all_paths || d.muscles[build.muscle_source[k]].is_muscle) report.push_back(static_cast<int>(k));
   if (report.empty()) throw osim::ConvertError(model_file, 0, "no muscle with a path to report");
 
@@ -101,7 +101,7 @@ PathLengthResult calcPathLengths(const osim::ModelDescription& d, const osim::Bu
   // the paths without their wraps when asked (None: straight segments only)
   std::vector<MusclePath> paths;
   for (int k : report) {
-    MusclePath p = build.muscles[k].path;
+    MusclePath p = build.model.muscles()[k].path;
     if (o.wrap == LengthWrap::None) p.wraps.clear();
     res.wrapping += p.wraps.empty() ? 0 : 1;
     paths.push_back(std::move(p));
@@ -113,7 +113,7 @@ PathLengthResult calcPathLengths(const osim::ModelDescription& d, const osim::Bu
     for (size_t m = 0; m < paths.size(); ++m) {
       if (paths[m].wraps.empty()) continue;  // no wrap object: the polyline either way
       Muscle& mu = model_muscle[m];
-      mu.name = build.muscles[report[m]].name;
+      mu.name = build.model.muscles()[report[m]].name;
       mu.path = paths[m];
       mu.wrap = o.wrap_model;
       const std::string why = wrapMassPointsUnsupportedReason(mu);
@@ -128,7 +128,7 @@ PathLengthResult calcPathLengths(const osim::ModelDescription& d, const osim::Bu
   osim::Storage& out = res.lengths;
   out.name = "MuscleTendonLengths";
   out.in_degrees = false;
-  for (int k : report) out.labels.push_back(build.muscles[k].name);
+  for (int k : report) out.labels.push_back(build.model.muscles()[k].name);
   out.time = coords.time;
   out.data.resize(coords.numRows(), static_cast<int>(report.size()));
   // optional: the surface length l of every wrap object of every reported path (0 when unused)

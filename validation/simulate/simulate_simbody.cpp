@@ -60,7 +60,7 @@ SimulationResult simulateSimbody(const SimulationModel& m, const State& initial,
   for (const char* e : {"kinetic_energy", "potential_energy", "total_energy"}) res.states.labels.push_back(e);
 
   const auto start = std::chrono::steady_clock::now();
-  simbody::ParticleSimulation sim(model, m.muscles, initial, po);
+  simbody::ParticleSimulation sim(model, m.build.model.muscles(), initial, po);
   StateRecorder recorder(res);
   auto record = [&](const State& s) -> bool {
     return recorder.add(s.t, s.q, s.qdot, sim.kineticEnergy(), sim.potentialEnergy(), " (Simbody)");
@@ -76,7 +76,7 @@ SimulationResult simulateSimbody(const SimulationModel& m, const State& initial,
       res.failure = e.what();
       // the usual cause with via points: a particle cannot jump in velocity [particle_muscles.hpp]
       bool via = false;
-      for (const Muscle& mu : m.muscles) via = via || (mu.mass_points.size() > 0 && mu.path.points.size() > 2);
+      for (const Muscle& mu : m.build.model.muscles()) via = via || (mu.mass_points.size() > 0 && mu.path.points.size() > 2);
       if (via)
         res.failure += "\n(a mass point sliding past a via point needs a velocity jump that a Simbody particle "
                        "cannot follow: fewer --mass-points, --mass-region fibre, or --engine core)";
