@@ -12,39 +12,19 @@
 #include <random>
 
 #include "core/dynamics/system.hpp"
+#include "tests/core/dynamics/random_muscle.hpp"
 #include "tests/core/muscles/muscle_test_util.hpp"
 #include "validation/scenes/scenes.hpp"
 
 namespace redmax {
 namespace {
 
-// random Type II muscle: origin anywhere, 2 via points (one moving), insertion on a body
-Muscle randomMuscle(const Model& m, std::mt19937& rng, double mass, const std::string& name) {
-  auto body = [&](bool world) {
-    const int lo = world ? -1 : 0;
-    return lo + static_cast<int>(rng() % static_cast<unsigned>(m.nb() - lo));
-  };
-  Muscle mu;
-  mu.name = name;
-  auto cubic = std::make_shared<PolynomialFunction>(std::vector<double>{0.05, -0.1, 0.2, 0.1});
-  mu.path.points = {makeFixedPoint(body(true), test::randomVec(rng, 0.3)),
-                    makeFixedPoint(body(false), test::randomVec(rng, 0.3)),
-                    makeMovingPoint(body(false), static_cast<int>(rng() % m.nr()), {cubic, nullptr, cubic},
-                                    Vec3(0, 0.1, 0)),
-                    makeFixedPoint(body(false), test::randomVec(rng, 0.3))};
-  mu.optimal_fiber_length = 0.3;
-  mu.tendon_slack_length = 0.2;
-  MassPointOptions opt;
-  opt.count = 8;
-  mu.mass_points = makeMassPoints(mass, 0.3, 0.2, opt);
-  return mu;
-}
 
 TEST(MuscleTerm, ZeroMassIsIdenticalToTheSkeleton) {
   const Model m = scenes::randomTree(8, 31, scenes::TreeJoints::SimbodyComparable);
   std::mt19937 rng(5);
   std::vector<Muscle> muscles;
-  for (int k = 0; k < 4; ++k) muscles.push_back(randomMuscle(m, rng, 0.0, "zero" + std::to_string(k)));
+  for (int k = 0; k < 4; ++k) muscles.push_back(test::randomViaMuscle(m, rng, 0.0, "zero" + std::to_string(k)));
   System bare(m), with(m);
   with.addTerm(std::make_shared<MuscleTerm>(m, muscles));
   DynamicsWorkspace wa(m), wb(m);
@@ -176,7 +156,7 @@ TEST_P(MuscleTermSeeds, ForceIsLagrangianAndMassIsKineticEnergyHessian) {
   const Model m = scenes::randomTree(6, 200 + GetParam(), scenes::TreeJoints::SimbodyComparable);
   std::mt19937 rng(GetParam());
   std::vector<Muscle> muscles;
-  for (int k = 0; k < 3; ++k) muscles.push_back(randomMuscle(m, rng, 0.5 + k, "m" + std::to_string(k)));
+  for (int k = 0; k < 3; ++k) muscles.push_back(test::randomViaMuscle(m, rng, 0.5 + k, "m" + std::to_string(k)));
   const auto term = std::make_shared<MuscleTerm>(m, muscles);
   const State s = test::randomState(m.nr(), rng);
   SkeletonWorkspace sk(m);
@@ -227,7 +207,7 @@ INSTANTIATE_TEST_SUITE_P(Seeds, MuscleTermSeeds, ::testing::Range(0, 4),
 TEST(MuscleTerm, DroppingTheQuadraticVelocityVector) {
   const Model m = scenes::randomTree(5, 9, scenes::TreeJoints::SimbodyComparable);
   std::mt19937 rng(2);
-  std::vector<Muscle> muscles = {randomMuscle(m, rng, 1.0, "a"), randomMuscle(m, rng, 0.5, "b")};
+  std::vector<Muscle> muscles = {test::randomViaMuscle(m, rng, 1.0, "a"), test::randomViaMuscle(m, rng, 0.5, "b")};
   MuscleTermOptions no_qvv;
   no_qvv.quadratic_velocity = false;
   const MuscleTerm full(m, muscles), dropped(m, muscles, no_qvv);

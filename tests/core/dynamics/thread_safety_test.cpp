@@ -14,33 +14,13 @@
 
 #include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/system.hpp"
+#include "tests/core/dynamics/random_muscle.hpp"
 #include "tests/core/muscles/muscle_test_util.hpp"
 #include "validation/scenes/scenes.hpp"
 
 namespace redmax {
 namespace {
 
-// Type II muscle: origin anywhere, a fixed and a moving via point, insertion on a body
-Muscle viaMuscle(const Model& m, std::mt19937& rng, double mass, const std::string& name) {
-  auto body = [&](bool world) {
-    const int lo = world ? -1 : 0;
-    return lo + static_cast<int>(rng() % static_cast<unsigned>(m.nb() - lo));
-  };
-  Muscle mu;
-  mu.name = name;
-  auto cubic = std::make_shared<PolynomialFunction>(std::vector<double>{0.05, -0.1, 0.2, 0.1});
-  mu.path.points = {makeFixedPoint(body(true), test::randomVec(rng, 0.3)),
-                    makeFixedPoint(body(false), test::randomVec(rng, 0.3)),
-                    makeMovingPoint(body(false), static_cast<int>(rng() % m.nr()), {cubic, nullptr, cubic},
-                                    Vec3(0, 0.1, 0)),
-                    makeFixedPoint(body(false), test::randomVec(rng, 0.3))};
-  mu.optimal_fiber_length = 0.3;
-  mu.tendon_slack_length = 0.2;
-  MassPointOptions opt;
-  opt.count = 8;
-  mu.mass_points = makeMassPoints(mass, 0.3, 0.2, opt);
-  return mu;
-}
 
 struct Sample {
   State s;
@@ -67,8 +47,8 @@ TEST(ThreadSafety, FourThreadsOnOneSystemEqualTheSerialRunBitForBit) {
   const Model m = scenes::randomTree(8, 31, scenes::TreeJoints::SimbodyComparable);
   std::mt19937 rng(11);
   std::vector<Muscle> muscles;
-  for (int k = 0; k < 4; ++k) muscles.push_back(viaMuscle(m, rng, 0.2 + 0.1 * k, "m" + std::to_string(k)));
-  muscles.push_back(viaMuscle(m, rng, 0.0, "massless"));
+  for (int k = 0; k < 4; ++k) muscles.push_back(test::randomViaMuscle(m, rng, 0.2 + 0.1 * k, "m" + std::to_string(k)));
+  muscles.push_back(test::randomViaMuscle(m, rng, 0.0, "massless"));
   System sys(m);
   sys.addTerm(std::make_shared<MuscleTerm>(m, muscles));
   std::vector<Sample> samples(48);
@@ -110,7 +90,7 @@ TEST(ThreadSafety, TermScratchHoldsOneEvaluationOfItsSystem) {
   const Model m = scenes::randomTree(5, 7, scenes::TreeJoints::SimbodyComparable);
   std::mt19937 rng(3);
   System sys(m);
-  sys.addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{viaMuscle(m, rng, 0.5, "a")}));
+  sys.addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{test::randomViaMuscle(m, rng, 0.5, "a")}));
   DynamicsWorkspace ws(m);
   EXPECT_EQ(ws.system_id, 0u);
   const State s = test::randomState(m.nr(), rng);
@@ -133,7 +113,7 @@ TEST(ThreadSafety, TermScratchHoldsOneEvaluationOfItsSystem) {
   const std::uint64_t before = sys.id();
   System changed = sys;
   const std::uint64_t copied = changed.id();
-  changed.addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{viaMuscle(m, rng, 0.1, "b")}));
+  changed.addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{test::randomViaMuscle(m, rng, 0.1, "b")}));
   EXPECT_NE(changed.id(), copied);
   EXPECT_EQ(sys.id(), before);
   changed.calcMassAndForce(s, ws);
