@@ -353,6 +353,17 @@ std::pair<double, double> calcEnergies(const SimulationModel& m, const State& s)
   return {m.system->kineticEnergy(s, ws), m.system->potentialEnergy(s, ws)};
 }
 
+SimulationResult makeStatesResult(const SimulationModel& m) {
+  SimulationResult res;
+  res.states.name = "redmax simulate states";
+  res.states.version = 1;
+  res.states.in_degrees = false;
+  res.states.labels = m.q_labels;
+  res.states.labels.insert(res.states.labels.end(), m.u_labels.begin(), m.u_labels.end());
+  for (const char* e : {"kinetic_energy", "potential_energy", "total_energy"}) res.states.labels.push_back(e);
+  return res;
+}
+
 SimulationResult simulate(const SimulationModel& m, const State& initial, const SimulateOptions& options) {
   const System& sys = *m.system;
   if (!(options.duration > 0.0) || !std::isfinite(options.duration))
@@ -389,13 +400,7 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
   }
   std::sort(targets.begin(), targets.end(), [](const Target& a, const Target& b) { return a.t < b.t; });
 
-  SimulationResult res;
-  res.states.name = "redmax simulate states";
-  res.states.version = 1;
-  res.states.in_degrees = false;
-  res.states.labels = m.q_labels;
-  res.states.labels.insert(res.states.labels.end(), m.u_labels.begin(), m.u_labels.end());
-  for (const char* e : {"kinetic_energy", "potential_energy", "total_energy"}) res.states.labels.push_back(e);
+  SimulationResult res = makeStatesResult(m);
   DynamicsWorkspace ws(sys.model());
   StateRecorder recorder(res);
 

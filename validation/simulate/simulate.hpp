@@ -145,6 +145,9 @@ struct SimulationResult {
   double failure_time = 0.0, failure_step = 0.0;
 };
 
+/// An empty states table of m's runs (core or Simbody): q, qdot, then the three energy columns.
+SimulationResult makeStatesResult(const SimulationModel& m);
+
 /// The rows of a run's STATES table (time; q, qdot, kinetic, potential and total energy) and its
 /// energy bookkeeping, shared by the core and the Simbody drivers so that both report drift alike.
 class StateRecorder {

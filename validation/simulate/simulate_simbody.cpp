@@ -51,13 +51,7 @@ SimulationResult simulateSimbody(const SimulationModel& m, const State& initial,
   const long n_rows = std::max(1L, static_cast<long>(std::ceil(so.duration / h_out - 1e-9)));
   if (n_rows > 50'000'000) throw std::invalid_argument("more than 5e7 output rows: raise the output interval");
 
-  SimulationResult res;
-  res.states.name = "redmax simulate states";
-  res.states.version = 1;
-  res.states.in_degrees = false;
-  res.states.labels = m.q_labels;
-  res.states.labels.insert(res.states.labels.end(), m.u_labels.begin(), m.u_labels.end());
-  for (const char* e : {"kinetic_energy", "potential_energy", "total_energy"}) res.states.labels.push_back(e);
+  SimulationResult res = makeStatesResult(m);
 
   const auto start = std::chrono::steady_clock::now();
   simbody::ParticleSimulation sim(model, m.build.model.muscles(), initial, po);
