@@ -170,14 +170,16 @@ TEST_F(WrapFlagsCli, PhysiologicalWrapMassConservesEnergy) {
                                       " --wrap smooth --out " + path("p.sto"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("wrap_muscle: 0.02 kg, 20 points"), std::string::npos) << r.err;  // 50 * 480 / 0.6e6 * 0.5
-  EXPECT_LE(energyDrift(readStorage(path("p.sto"))), 1e-8);
+  const double drift = energyDrift(readStorage(path("p.sto")));
+  EXPECT_LE(drift, 1e-9);  // measured 7.0e-11
+  std::printf("[ measured ] wrapping pendulum, physiological wrap mass, 1 s rk45 1e-11: energy drift %.3e\n", drift);
 }
 
 // The running leg's gastrocnemii (origin on the femur, condyle cylinder, insertion on the calcaneus)
 // take their physiological mass through Type III. Falling freely with the hip, knee and ankle
 // swinging (3, -4, 2 rad/s) the knee flexes from 0 past the wrap/no-wrap event (about 18 deg) to
 // about 70 deg; tight rk45 for 1 s as the work-precision running-leg scene. With the gastrocnemii
-// carrying mass (--muscles), the smooth model keeps the drift at integrator error (bound 1e-9;
+// carrying mass (--muscles), the smooth model keeps the drift at integrator error (bound 1e-10;
 // the exact model's jump at the event is orders larger). With every muscle the tibialis anterior's
 // via point adds its own sliding-point drift (Type II, docs/notes.md), printed only.
 TEST_F(WrapFlagsCli, RunningLegGastrocnemiiCarryMassAndConserveEnergy) {
@@ -198,7 +200,7 @@ TEST_F(WrapFlagsCli, RunningLegGastrocnemiiCarryMassAndConserveEnergy) {
   EXPECT_LT(s.data.col(knee).minCoeff(), -0.5);
   const double drift = energyDrift(s);
   EXPECT_GE(drift, 0.0);
-  EXPECT_LE(drift, 1e-9);
+  EXPECT_LE(drift, 1e-10);  // measured 9.3e-12
   const CmdResult re = run(base + gas + " --wrap exact --quiet --out " + path("leg_exact.sto"));
   ASSERT_EQ(re.code, 0) << re.err;
   const double drift_exact = energyDrift(readStorage(path("leg_exact.sto")));
@@ -232,8 +234,8 @@ TEST_F(WrapFlagsCli, IdEnginesTakeWrapMassAlike) {
   ASSERT_EQ(c.data.rows(), b.data.rows());
   ASSERT_EQ(l.data.rows(), bl.data.rows());
   const double peak = c.data.cwiseAbs().maxCoeff();
-  EXPECT_LE((c.data - b.data).cwiseAbs().maxCoeff(), 1e-9 * peak);
-  EXPECT_LE((l.data - bl.data).cwiseAbs().maxCoeff(), 1e-9 * peak);
+  EXPECT_LE((c.data - b.data).cwiseAbs().maxCoeff(), 2e-13 * peak);  // measured 1.1e-14
+  EXPECT_LE((l.data - bl.data).cwiseAbs().maxCoeff(), 2e-13 * peak);
   EXPECT_GT((c.data - l.data).cwiseAbs().maxCoeff(), 1e-4 * peak);
   std::printf("[ measured ] running leg swing, physiological: core vs Simbody with wrap mass %.2g of the peak; "
               "gastrocnemii's mass changes the torques by up to %.3g of the peak\n",

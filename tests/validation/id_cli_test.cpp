@@ -50,7 +50,7 @@ TEST_F(IdCli, WritesOpenSimStyleResultsMatchingTheClosedForm) {
     worst = std::max(worst, (s.data.row(k).transpose() - ref).cwiseAbs().maxCoeff());
     peak = std::max(peak, ref.cwiseAbs().maxCoeff());
   }
-  EXPECT_LT(worst, 1e-7 * peak);
+  EXPECT_LT(worst, 1e-9 * peak);  // measured 5.7e-11 (quintic interpolation of the sampled motion)
   std::printf("[ measured ] redmax id on the double pendulum: worst error / peak = %.3g\n", worst / peak);
 
   // the Simbody engine on the same inputs
