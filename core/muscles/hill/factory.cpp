@@ -9,6 +9,16 @@ const std::vector<std::string>& muscleModelClasses() {
   return names;
 }
 
+bool isOpenSimMuscleClass(const std::string& cls) {
+  static const std::vector<std::string> all = {
+      "Thelen2003Muscle",         "Thelen2003Muscle_Deprecated",   "Millard2012EquilibriumMuscle",
+      "Millard2012AccelerationMuscle", "DeGrooteFregly2016Muscle", "RigidTendonMuscle",
+      "Schutte1993Muscle_Deprecated",  "Delp1990Muscle_Deprecated"};
+  for (const auto& c : all)
+    if (c == cls) return true;
+  return false;
+}
+
 std::shared_ptr<const MuscleModel> makeMuscleModel(const std::string& cls, const MuscleParameters& p) {
   if (cls == "Thelen2003Muscle") return std::make_shared<Thelen2003Muscle>(p);
   if (cls == "Thelen2003Muscle_Deprecated") return std::make_shared<Thelen2003MuscleDeprecated>(p);

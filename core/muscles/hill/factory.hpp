@@ -12,6 +12,10 @@ namespace redmax::hill {
 /// The muscle classes makeMuscleModel builds (OpenSim 4 names).
 const std::vector<std::string>& muscleModelClasses();
 
+/// Whether `opensim_class` is one of OpenSim's Muscle classes (modelled or not: Delp1990Muscle,
+/// Millard2012AccelerationMuscle, ... are muscles redmax reads but does not model).
+bool isOpenSimMuscleClass(const std::string& opensim_class);
+
 /// The model of OpenSim class `opensim_class` from `parameters` (OpenSim's defaults for absent
 /// properties). Throws MuscleParameterError for a value the class refuses and MuscleModelError
 /// naming the supported classes for an unknown class.
