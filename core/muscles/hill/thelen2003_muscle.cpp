@@ -52,7 +52,9 @@ double FirstOrderActivation::derivative(double a, double u) const {
 
 Thelen2003Muscle::Thelen2003Muscle(const MuscleParameters& p) : name_(p.name) {
   act_.minimum_activation = p.get("minimum_activation", 0.01);
-  m_ = readMuscleProperties(p, act_.minimum_activation);
+  // min_control's default is the default minimum activation (set at construction, before the
+  // XML is read), 0.01, whatever minimum_activation the file gives
+  m_ = readMuscleProperties(p, 0.01);
   noIgnoreFlags(p, m_, "Thelen2003Muscle");
   c_.FmaxTendonStrain = p.get("FmaxTendonStrain", 0.04);
   c_.FmaxMuscleStrain = p.get("FmaxMuscleStrain", 0.6);
