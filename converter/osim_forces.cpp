@@ -49,7 +49,7 @@ const std::set<std::string>& muscleNumberProperties() {
       "damping", "Af", "Flen", "fv_linear_extrap_threshold",
       // DeGrooteFregly2016Muscle
       "active_force_width_scale", "passive_fiber_strain_at_one_norm_force",
-      "tendon_strain_at_one_norm_force", "default_normalized_tendon_force",
+      "tendon_strain_at_one_norm_force", "default_normalized_tendon_force", "activation_dynamics_smoothing",
       // Schutte1993Muscle_Deprecated
       "time_scale", "activation1", "activation2"};
   return s;
@@ -303,6 +303,13 @@ void OsimReader::readMuscleParameters(const XMLElement* e, PathForceDesc& m) {
       put(tag, c, false);
     } else if (muscleFlagProperties().count(tag)) {
       put(tag, c, true);
+    } else if (tag == "tendon_compliance_dynamics_mode" && !textOf(c).empty()) {
+      // DeGrooteFregly2016Muscle: a string property, 0 explicit, 1 implicit
+      const std::string mode = textOf(c);
+      if (mode != "explicit" && mode != "implicit")
+        fail(c, "tendon_compliance_dynamics_mode '" + mode + "' is not explicit or implicit");
+      p.set(tag, mode == "explicit" ? 0.0 : 1.0);
+      m.parameter_lines[tag] = lineOf(c);
     } else if (auto it = muscleCurveProperties().find(tag); it != muscleCurveProperties().end()) {
       for (const XMLElement* cc : childElements(c))
         if (it->second.count(cc->Name())) put(tag + "/" + cc->Name(), cc, false);

@@ -9,7 +9,10 @@
 #include "converter/json_writer.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/muscles/hill/factory.hpp"
+#include "core/muscles/hill/millard2012_equilibrium_muscle.hpp"
 #include "core/muscles/hill/thelen2003_muscle.hpp"
+#include "core/muscles/path_kinematics.hpp"
+#include "core/skeleton/kinematics.hpp"
 #include "tests/converter/converter_test_util.hpp"
 
 namespace redmax::osim {
@@ -74,6 +77,57 @@ TEST(MuscleModels, Arm26ReadAsEachModelledClass) {
   EXPECT_EQ(edit.finalize().muscleModels()[0]->className(), "Thelen2003Muscle");
 }
 
+// OpenSim's testAnalyzeTool check on Tug_of_War_Millard_Iso: along the block's motion
+// (Tug_of_War_ConstantVelocity.sto: block_tz from -0.05 to 0.05 m), equilibrium leaves the tendon
+// force equal to the active + passive fibre force along the tendon within F_max SqrtEps, the
+// fibre at or above its minimum length, and the force continuous (steps below F_max / 10)
+TEST(MuscleModels, TugOfWarMillardIsoEquilibrium) {
+  REDMAX_REQUIRE_SHARED();
+  const ModelDescription d =
+      readOsimModel(test::sharedOpenSim("opensim-core/Applications/Analyze/tests/resources/Tug_of_War_Millard_Iso.osim"));
+  const BuildResult b = buildCoreModel(d);
+  const MusculoskeletalModel& m = b.model;
+  ASSERT_EQ(m.nr(), 1);
+  const int k = m.findMuscle("LeftMuscle");
+  ASSERT_GE(k, 0);
+  const auto* mus = dynamic_cast<const hill::Millard2012EquilibriumMuscle*>(m.muscleModels()[k].get());
+  ASSERT_NE(mus, nullptr);
+  // the file's curves: minimum_value 0, transition 0.6259, fibre strain 0.6; empty optional
+  // properties take OpenSim's values; no fiber_damping: the damped model
+  EXPECT_EQ(mus->curveParameters().transition_norm_fiber_length, 0.6259);
+  EXPECT_NEAR(mus->curveParameters().fpe_stiffness_at_one_norm_force, 2.0 / 0.6, 1e-15);
+  EXPECT_NEAR(mus->curveParameters().tendon_stiffness_at_one_norm_force, 1.375 / 0.049, 1e-12);
+  EXPECT_TRUE(mus->damped());
+  EXPECT_EQ(mus->properties().default_activation, 1.0);
+  const double F_max = mus->properties().max_isometric_force, tol = F_max * 1.4901161193847656e-8;
+  std::vector<Mat4> E;
+  int checked = 0;
+  for (double a : {1.0, 0.5, 0.01}) {
+    double prev = -1, worst = 0;
+    for (int i = 0; i <= 100; ++i) {
+      VecX q = m.skeleton().defaultQ();
+      q[0] = -0.05 + 0.001 * i;
+      calcBodyPoses(m, q, E);
+      const double L = calcPathLength(m, m.muscles()[k].path, q, E);
+      double z[2];
+      mus->defaultState(z);
+      z[0] = a;
+      mus->equilibrate({L, 0.0, a}, z);
+      EXPECT_GE(z[1], mus->minFiberLength());
+      hill::MuscleOutput out;
+      double zdot[2];
+      mus->calc(z, {L, 0.0, a}, out, zdot);
+      const double along = (out.active_fiber_force + out.passive_fiber_force) * std::cos(out.pennation_angle);
+      worst = std::max(worst, std::abs(out.tendon_force - along));
+      if (prev >= 0) EXPECT_LT(std::abs(out.tendon_force - prev), F_max / 10) << "step " << i;
+      prev = out.tendon_force;
+      ++checked;
+    }
+    EXPECT_LE(worst, tol) << "activation " << a;
+  }
+  EXPECT_EQ(checked, 303);
+}
+
 std::string muscleXml(const std::string& cls, const std::string& props) {
   return "<ForceSet><objects>\n<" + cls + " name=\"m\">\n<GeometryPath name=\"path\">\n"
          "<PathPointSet><objects>\n"
@@ -119,6 +173,18 @@ TEST(MuscleModels, BadValuesAreErrorsAtTheirLine) {
               "<ignore_tendon_compliance>", "not implemented");
   expectError(osimWithMuscle("Thelen2003Muscle", "<pennation_angle_at_optimal>2</pennation_angle_at_optimal>\n"),
               "<pennation_angle_at_optimal>", "pennation_angle_at_optimal");
+  // a curve parameter: at its own line
+  expectError(osimWithMuscle("Millard2012EquilibriumMuscle",
+                             "<TendonForceLengthCurve>\n<strain_at_one_norm_force>-0.049</strain_at_one_norm_force>\n"
+                             "</TendonForceLengthCurve>\n"),
+              "<strain_at_one_norm_force>", "strain_at_one_norm_force");
+  expectError(osimWithMuscle("Millard2012EquilibriumMuscle",
+                             "<ForceVelocityCurve>\n<isometric_slope>0.5</isometric_slope>\n</ForceVelocityCurve>\n"),
+              "<isometric_slope>", "isometric_slope");
+  // a mix of given and absent optional curve properties: at the curve
+  expectError(osimWithMuscle("Millard2012EquilibriumMuscle",
+                             "<FiberForceLengthCurve>\n<curviness>0.5</curviness>\n</FiberForceLengthCurve>\n"),
+              "<FiberForceLengthCurve>", "must all be given");
 }
 
 TEST(MuscleModels, ConvertReportsClassAndParameters) {
