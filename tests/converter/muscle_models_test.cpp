@@ -233,19 +233,8 @@ std::string osimWithMuscle(const std::string& cls, const std::string& props) {
                     muscleXml(cls, props));
 }
 
-// read text; expect a ConvertError "FILE:LINE: ..." at the line of `at` mentioning `what`
 void expectError(const std::string& text, const std::string& at, const std::string& what) {
-  test::TempDir dir;
-  const std::string path = dir.write("bad.osim", text);
-  const int line = lineContaining(text, at);
-  ASSERT_GT(line, 0) << "test bug: '" << at << "' not in the text";
-  try {
-    readOsimModel(path);
-    ADD_FAILURE() << "no error for: " << what;
-  } catch (const ConvertError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind(path + ":" + std::to_string(line) + ": ", 0), 0u) << e.what();
-    EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
-  }
+  test::expectReadError(text, at, what);
 }
 
 TEST(MuscleModels, BadValuesAreErrorsAtTheirLine) {

@@ -76,7 +76,8 @@ double DeGrooteFregly2016Curves::forceVelocityInverse(double fv) {
   return (std::sinh(1.0 / d1 * (fv - d4)) - d3) / d2;
 }
 
-DeGrooteFregly2016Muscle::DeGrooteFregly2016Muscle(const MuscleParameters& p) : name_(p.name) {
+DeGrooteFregly2016Muscle::DeGrooteFregly2016Muscle(const MuscleParameters& p) {
+  name_ = p.name;
   m_ = readMuscleProperties(p, 0.0);
   tau_act_ = p.get("activation_time_constant", 0.015);
   tau_deact_ = p.get("deactivation_time_constant", 0.060);

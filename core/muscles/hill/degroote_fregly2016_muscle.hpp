@@ -33,7 +33,7 @@ struct DeGrooteFregly2016Curves {
   static double forceVelocityInverse(double fv);
 };
 
-class DeGrooteFregly2016Muscle final : public MuscleModel {
+class DeGrooteFregly2016Muscle final : public MuscleWithProperties {
  public:
   /// OpenSim 4's properties and checks; tendon_compliance_dynamics_mode is 0 (explicit) or 1
   /// (implicit, whose tendon-force derivative is a control: not modelled, refused)
@@ -47,12 +47,9 @@ class DeGrooteFregly2016Muscle final : public MuscleModel {
   /// [0, 5] to 1e-10 with the tendon at rest (the path's speed goes to the fibre); throws when the
   /// equilibrium residual has the same sign at both ends
   void equilibrate(const MusculotendonInput& in, double* z) const override;
-  double minControl() const override { return m_.min_control; }
-  double maxControl() const override { return m_.max_control; }
   std::vector<std::pair<std::string, double>> parameterList() const override;
 
   const DeGrooteFregly2016Curves& curves() const { return c_; }
-  const MuscleProperties& properties() const { return m_; }
   /// the equilibrium residual fT - F_M cos(phi) / F_max at tendon force fT, tendon at rest
   double equilibriumResidual(const MusculotendonInput& in, double activation, double fT) const;
 
@@ -64,8 +61,6 @@ class DeGrooteFregly2016Muscle final : public MuscleModel {
   };
   void evaluate(double a, double fT, const MusculotendonInput& in, bool explicit_tendon, Eval& e) const;
 
-  std::string name_;
-  MuscleProperties m_;
   DeGrooteFregly2016Curves c_;
   double tau_act_ = 0.015, tau_deact_ = 0.060, default_tendon_force_ = 0.5, beta_ = 0.0, smoothing_ = 0.1;
   std::vector<std::string> state_names_;

@@ -41,7 +41,8 @@ bool optionalGroup(const MuscleParameters& p, const std::string& curve_name,
 
 }  // namespace
 
-Millard2012EquilibriumMuscle::Millard2012EquilibriumMuscle(const MuscleParameters& p) : name_(p.name) {
+Millard2012EquilibriumMuscle::Millard2012EquilibriumMuscle(const MuscleParameters& p) {
+  name_ = p.name;
   // min_control's default is the default minimum activation, 0.01 (set at construction)
   m_ = readMuscleProperties(p, 0.01);
   m_.default_activation = p.get("default_activation", 0.05);
@@ -333,38 +334,27 @@ void Millard2012EquilibriumMuscle::equilibrate(const MusculotendonInput& in, dou
     dFt_d_lce = dFt_d_tl * (lce * sinphi * dphi - cosphi);
   };
 
-  int iter = 0;
   position();
   multipliers();
   Fm = fiso * (ma * fal * fv) + (fiso * fpe + fiso * beta_ * dlceN);
   partials();
   error();
   partials();
-  double ferr_prev = ferr, lce_prev = lce;
-  while (std::abs(ferr) > tol && iter < max_iter) {
-    const double dferr_d_lce = dFmAT_dlce - dFt_d_lce;
-    double h = 1.0;
-    // halve the Newton step until the error falls
-    while (std::abs(ferr) >= std::abs(ferr_prev)) {
-      const double delta = -h * ferr_prev / dferr_d_lce;
-      if (std::abs(delta) > kSignificantReal) {
-        lce = lce_prev + delta;
-      } else {
-        lce = lce_prev - (delta > 0 ? 1.0 : delta < 0 ? -1.0 : 0.0) * kSqrtEps;
-        h = 0;
-      }
-      if (lce < l_min_) lce = l_min_;
-      position();
-      multipliers();
-      error();
-      if (h <= kSqrtEps) break;
-      h = 0.5 * h;
-    }
-    ferr_prev = ferr;
-    lce_prev = lce;
-    partials();
-    ++iter;
-  }
+  const FiberLengthSolve r = solveFiberLength(
+      lce, ferr, dFmAT_dlce - dFt_d_lce, l_min_, tol, max_iter,
+      [&](double l) {
+        lce = l;
+        position();
+        multipliers();
+        error();
+        return ferr;
+      },
+      [&] {
+        partials();
+        return dFmAT_dlce - dFt_d_lce;
+      });
+  lce = r.lce;
+  const int iter = r.iterations;
   if (std::abs(ferr) < tol) {
     z[i_len_] = std::max(lce, l_min_);
     return;

@@ -31,7 +31,7 @@ struct Millard2012CurveParameters {
   double tendon_norm_force_at_toe_end = 2.0 / 3.0, tendon_curviness = 0.5;
 };
 
-class Millard2012EquilibriumMuscle final : public MuscleModel {
+class Millard2012EquilibriumMuscle final : public MuscleWithProperties {
  public:
   /// reads OpenSim 4's properties with its defaults, applies the adjustments of
   /// extendFinalizeFromProperties (classic model: minimum_value >= 0.1 and slopes at v_max >=
@@ -47,11 +47,8 @@ class Millard2012EquilibriumMuscle final : public MuscleModel {
   /// steps to max(1e-8 F_max, 10 SignificantReal), 200 iterations; the fibre stops at its
   /// minimum length. Nothing to do for a rigid tendon.
   void equilibrate(const MusculotendonInput& in, double* z) const override;
-  double minControl() const override { return m_.min_control; }
-  double maxControl() const override { return m_.max_control; }
   std::vector<std::pair<std::string, double>> parameterList() const override;
 
-  const MuscleProperties& properties() const { return m_; }
   const Millard2012CurveParameters& curveParameters() const { return cp_; }
   const SmoothSegmentedFunction& activeForceLengthCurve() const { return fal_; }
   const SmoothSegmentedFunction& forceVelocityCurve() const { return fv_; }
@@ -67,8 +64,6 @@ class Millard2012EquilibriumMuscle final : public MuscleModel {
  private:
   double activationOf(const double* z, double excitation) const;
 
-  std::string name_;
-  MuscleProperties m_;
   Millard2012CurveParameters cp_;
   double beta_ = 0.1, maximum_pennation_angle_ = 0.0, l_min_ = 0.0;
   bool damped_ = true;

@@ -93,4 +93,34 @@ double FixedWidthPennation::dPennationAngleDFiberLength(double l_f) const {
   return (-r / l_f) / std::sqrt(1.0 - r * r);
 }
 
+FiberLengthSolve solveFiberLength(double lce, double ferr, double slope, double l_min, double tol, int max_iter,
+                                  const std::function<double(double)>& error_at,
+                                  const std::function<double()>& accept) {
+  const double sqrt_eps = std::sqrt(kEps);
+  double ferr_prev = ferr, lce_prev = lce;
+  int iter = 0;
+  while (std::abs(ferr) > tol && iter < max_iter) {
+    double h = 1.0;
+    // halve the Newton step until the error falls (the first trial always runs)
+    while (std::abs(ferr) >= std::abs(ferr_prev)) {
+      const double delta = -h * ferr_prev / slope;
+      if (std::abs(delta) > kSignificantReal) {
+        lce = lce_prev + delta;
+      } else {
+        lce = lce_prev - (delta > 0 ? 1.0 : delta < 0 ? -1.0 : 0.0) * sqrt_eps;
+        h = 0;
+      }
+      if (lce < l_min) lce = l_min;
+      ferr = error_at(lce);
+      if (h <= sqrt_eps) break;
+      h = 0.5 * h;
+    }
+    ferr_prev = ferr;
+    lce_prev = lce;
+    slope = accept();
+    ++iter;
+  }
+  return {lce, ferr, iter};
+}
+
 }  // namespace redmax::hill

@@ -4,8 +4,10 @@
 // (MuscleFixedWidthPennationModel): the fibre keeps its height h = l_opt sin(phi_opt) above the
 // tendon, so sin(phi) = h / l_f, capped at the maximum pennation angle, which sets the minimum
 // fibre length l_min = h / sin(phi_max) (l_opt / 100 when phi_max = 0) [Millard 2013, Sec. 2.3].
+#include <functional>
 #include <string>
 
+#include "core/muscles/hill/muscle_model.hpp"
 #include "core/muscles/hill/parameters.hpp"
 
 namespace redmax::hill {
@@ -56,6 +58,32 @@ class FixedWidthPennation {
  private:
   double phi_opt_ = 0.0, phi_max_ = 0.0;
   double h_ = 0.0, sin_phi_max_ = 0.0, l_min_ = 0.0, l_min_at_ = 0.0;
+};
+
+/// OpenSim's fibre-equilibrium iteration (Thelen2003Muscle::initMuscleState,
+/// Millard2012EquilibriumMuscle::estimateMuscleFiberState): Newton on the fibre length, each step
+/// halved until the error |F_M cos(phi) - F_T| falls (down to SqrtEps of a step), the fibre held
+/// at l_min. Starts from (lce, its error ferr, the error's slope); `error_at(lce)` evaluates the
+/// error at a trial length, `accept()` is called at each accepted length and returns the slope
+/// there. Stops when |ferr| <= tol or after max_iter steps.
+struct FiberLengthSolve {
+  double lce, ferr;
+  int iterations;
+};
+FiberLengthSolve solveFiberLength(double lce, double ferr, double slope, double l_min, double tol, int max_iter,
+                                  const std::function<double(double)>& error_at,
+                                  const std::function<double()>& accept);
+
+/// the properties every muscle class has, and its control bounds (a base for the models)
+class MuscleWithProperties : public MuscleModel {
+ public:
+  double minControl() const override { return m_.min_control; }
+  double maxControl() const override { return m_.max_control; }
+  const MuscleProperties& properties() const { return m_; }
+
+ protected:
+  std::string name_;
+  MuscleProperties m_;
 };
 
 }  // namespace redmax::hill

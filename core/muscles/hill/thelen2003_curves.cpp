@@ -4,10 +4,44 @@
 #include <limits>
 
 #include "core/muscles/hill/muscle_model.hpp"
+#include "core/muscles/hill/parameters.hpp"
 
 namespace redmax::hill {
 namespace {
 const double kSignificantReal = std::pow(std::numeric_limits<double>::epsilon(), 0.875);
+}
+
+// ---------------------------------------------------------------------------------------------
+// shape parameters
+
+void ThelenShapeParameters::read(const MuscleParameters& p) {
+  FmaxTendonStrain = p.get("FmaxTendonStrain", FmaxTendonStrain);
+  FmaxMuscleStrain = p.get("FmaxMuscleStrain", FmaxMuscleStrain);
+  KshapeActive = p.get("KshapeActive", KshapeActive);
+  KshapePassive = p.get("KshapePassive", KshapePassive);
+  Af = p.get("Af", Af);
+  Flen = p.get("Flen", Flen);
+}
+
+void ThelenShapeParameters::check(const std::string& muscle) const {
+  const std::pair<const char*, double> positive[] = {{"FmaxTendonStrain", FmaxTendonStrain},
+                                                     {"FmaxMuscleStrain", FmaxMuscleStrain},
+                                                     {"KshapeActive", KshapeActive},
+                                                     {"KshapePassive", KshapePassive},
+                                                     {"Af", Af}};
+  for (const auto& [key, v] : positive)
+    if (!(v > 0) || !std::isfinite(v))
+      throw MuscleParameterError(key, "muscle '" + muscle + "': " + key + " must be finite and > 0");
+  if (!(Flen > 1.0)) throw MuscleParameterError("Flen", "muscle '" + muscle + "': Flen must be greater than 1");
+}
+
+void ThelenShapeParameters::append(ParameterList& out) const {
+  out.emplace_back("FmaxTendonStrain", FmaxTendonStrain);
+  out.emplace_back("FmaxMuscleStrain", FmaxMuscleStrain);
+  out.emplace_back("KshapeActive", KshapeActive);
+  out.emplace_back("KshapePassive", KshapePassive);
+  out.emplace_back("Af", Af);
+  out.emplace_back("Flen", Flen);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -2,16 +2,31 @@
 // Thelen 2003's musculotendon curves [Thelen 2003, Eqs. 1-5], as OpenSim computes them in
 // Thelen2003Muscle (4.x) and Thelen2003Muscle_Deprecated (the 2.x pipeline's muscle_deriv_func9).
 // Lengths are normalized: lceN = l_f / l_opt, tlN = l_T / l_s; velocities by v_max l_opt.
+#include <string>
+
+#include "core/muscles/hill/parameters.hpp"
+
 namespace redmax::hill {
 
+/// The shape parameters both Thelen classes read (their defaults differ).
+struct ThelenShapeParameters {
+  double FmaxTendonStrain;  ///< e0 of the tendon: strain at F_max
+  double FmaxMuscleStrain;  ///< e0^M: passive strain at F_max
+  double KshapeActive;      ///< gamma: width of the Gaussian active force-length curve
+  double KshapePassive;     ///< k^PE
+  double Af;                ///< force-velocity shape factor
+  double Flen;              ///< maximum normalized lengthening force
+
+  /// each from `p` under its OpenSim name, the current value where absent
+  void read(const MuscleParameters& p);
+  /// > 0 each (Flen > 1), as Thelen2003Muscle checks; throws MuscleParameterError
+  void check(const std::string& muscle) const;
+  void append(ParameterList& out) const;
+};
+
 /// Thelen2003Muscle's curves and its force-velocity inverse with linear extrapolation.
-struct Thelen2003Curves {
-  double FmaxTendonStrain = 0.04;  ///< e0 of the tendon: strain at F_max
-  double FmaxMuscleStrain = 0.6;   ///< e0^M: passive strain at F_max
-  double KshapeActive = 0.45;      ///< gamma: width of the Gaussian active force-length curve
-  double KshapePassive = 5.0;      ///< k^PE
-  double Af = 0.25;                ///< force-velocity shape factor
-  double Flen = 1.4;               ///< maximum normalized lengthening force
+struct Thelen2003Curves : ThelenShapeParameters {
+  Thelen2003Curves() : ThelenShapeParameters{0.04, 0.6, 0.45, 5.0, 0.25, 1.4} {}
   double fv_linear_extrap_threshold = 0.95;
 
   /// active force-length exp(-(lceN-1)^2 / gamma) [Thelen 2003, Eq. 3] and d/dlceN
@@ -38,9 +53,9 @@ struct Thelen2003Curves {
 };
 
 /// Thelen2003Muscle_Deprecated's curves (the same paper, as OpenSim 1.x-3.x coded it).
-struct Thelen2003DeprecatedCurves {
-  double FmaxTendonStrain = 0.033, FmaxMuscleStrain = 0.6, KshapeActive = 0.5, KshapePassive = 4.0;
-  double damping = 0.05, Af = 0.3, Flen = 1.8;
+struct Thelen2003DeprecatedCurves : ThelenShapeParameters {
+  Thelen2003DeprecatedCurves() : ThelenShapeParameters{0.033, 0.6, 0.5, 4.0, 0.3, 1.8} {}
+  double damping = 0.05;
 
   /// exp(-(lceN-1)^2 / gamma)
   double active(double lceN) const;

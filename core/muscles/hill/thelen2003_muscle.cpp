@@ -9,7 +9,6 @@ namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 const double kSignificantReal = std::pow(kEps, 0.875);  // SimTK::SignificantReal
-const double kSqrtEps = std::sqrt(kEps);                // SimTK::SqrtEps
 constexpr double kRoundoff = 2e-13;                     // SimmMacros.h ROUNDOFF_ERROR
 
 [[noreturn]] void bad(const std::string& muscle, const std::string& key, const std::string& what) {
@@ -50,30 +49,21 @@ double FirstOrderActivation::derivative(double a, double u) const {
 // ---------------------------------------------------------------------------------------------
 // Thelen2003Muscle
 
-Thelen2003Muscle::Thelen2003Muscle(const MuscleParameters& p) : name_(p.name) {
+Thelen2003Muscle::Thelen2003Muscle(const MuscleParameters& p) {
+  name_ = p.name;
   act_.minimum_activation = p.get("minimum_activation", 0.01);
   // min_control's default is the default minimum activation (set at construction, before the
   // XML is read), 0.01, whatever minimum_activation the file gives
   m_ = readMuscleProperties(p, 0.01);
   noIgnoreFlags(p, m_, "Thelen2003Muscle");
-  c_.FmaxTendonStrain = p.get("FmaxTendonStrain", 0.04);
-  c_.FmaxMuscleStrain = p.get("FmaxMuscleStrain", 0.6);
-  c_.KshapeActive = p.get("KshapeActive", 0.45);
-  c_.KshapePassive = p.get("KshapePassive", 5.0);
-  c_.Af = p.get("Af", 0.25);
-  c_.Flen = p.get("Flen", 1.4);
+  c_.read(p);
   c_.fv_linear_extrap_threshold = p.get("fv_linear_extrap_threshold", 0.95);
   maximum_pennation_angle_ = p.get("maximum_pennation_angle", std::acos(0.1));
   act_.activation_time_constant = p.get("activation_time_constant", 0.015);
   act_.deactivation_time_constant = p.get("deactivation_time_constant", 0.050);
 
   // Thelen2003Muscle::extendFinalizeFromProperties
-  positive(p, "FmaxTendonStrain", c_.FmaxTendonStrain);
-  positive(p, "FmaxMuscleStrain", c_.FmaxMuscleStrain);
-  positive(p, "KshapeActive", c_.KshapeActive);
-  positive(p, "KshapePassive", c_.KshapePassive);
-  positive(p, "Af", c_.Af);
-  if (!(c_.Flen > 1.0)) bad(p.name, "Flen", "must be greater than 1");
+  c_.check(p.name);
   if (!(c_.fv_linear_extrap_threshold > 1.0 / c_.Flen))
     bad(p.name, "fv_linear_extrap_threshold", "must be greater than 1/Flen");
   if (!(act_.minimum_activation >= 0.01)) bad(p.name, "minimum_activation", "cannot be less than 0.01");
@@ -203,7 +193,6 @@ void Thelen2003Muscle::equilibrate(const MusculotendonInput& in, double* z) cons
     fv = c_.fvInverse(ma, fal, dlceN, tol, 100);
   };
 
-  int iter = 0;
   position();
   multipliers();
   fv = 1.0;
@@ -211,32 +200,22 @@ void Thelen2003Muscle::equilibrate(const MusculotendonInput& in, double* z) cons
   velocity();
   error();
   partials();
-  double ferr_prev = ferr, lce_prev = lce, h = 1.0;
-  while (std::abs(ferr) > tol && iter < max_iter) {
-    const double dferr_d_lce = dFmAT_dlce - dFt_d_lce;
-    h = 1.0;
-    // halve the Newton step until the error falls
-    while (std::abs(ferr) >= std::abs(ferr_prev)) {
-      const double delta = -h * ferr_prev / dferr_d_lce;
-      if (std::abs(delta) > kSignificantReal) {
-        lce = lce_prev + delta;
-      } else {
-        lce = lce_prev - (delta > 0 ? 1.0 : delta < 0 ? -1.0 : 0.0) * kSqrtEps;
-        h = 0;
-      }
-      if (lce < l_min) lce = l_min;
-      position();
-      multipliers();
-      error();
-      if (h <= kSqrtEps) break;
-      h = 0.5 * h;
-    }
-    ferr_prev = ferr;
-    lce_prev = lce;
-    partials();
-    velocity();
-    ++iter;
-  }
+  const FiberLengthSolve r = solveFiberLength(
+      lce, ferr, dFmAT_dlce - dFt_d_lce, l_min, tol, max_iter,
+      [&](double l) {
+        lce = l;
+        position();
+        multipliers();
+        error();
+        return ferr;
+      },
+      [&] {
+        partials();
+        velocity();
+        return dFmAT_dlce - dFt_d_lce;
+      });
+  lce = r.lce;
+  const int iter = r.iterations;
   if (std::abs(ferr) < tol) {
     z[1] = lce;
     return;
@@ -255,12 +234,7 @@ std::vector<std::pair<std::string, double>> Thelen2003Muscle::parameterList() co
   appendMuscleProperties(m_, out);
   out.emplace_back("default_activation", m_.default_activation);
   out.emplace_back("default_fiber_length", m_.default_fiber_length);
-  out.emplace_back("FmaxTendonStrain", c_.FmaxTendonStrain);
-  out.emplace_back("FmaxMuscleStrain", c_.FmaxMuscleStrain);
-  out.emplace_back("KshapeActive", c_.KshapeActive);
-  out.emplace_back("KshapePassive", c_.KshapePassive);
-  out.emplace_back("Af", c_.Af);
-  out.emplace_back("Flen", c_.Flen);
+  c_.append(out);
   out.emplace_back("fv_linear_extrap_threshold", c_.fv_linear_extrap_threshold);
   out.emplace_back("maximum_pennation_angle", maximum_pennation_angle_);
   out.emplace_back("activation_time_constant", act_.activation_time_constant);
@@ -273,28 +247,20 @@ std::vector<std::pair<std::string, double>> Thelen2003Muscle::parameterList() co
 // ---------------------------------------------------------------------------------------------
 // Thelen2003Muscle_Deprecated
 
-Thelen2003MuscleDeprecated::Thelen2003MuscleDeprecated(const MuscleParameters& p) : name_(p.name) {
+Thelen2003MuscleDeprecated::Thelen2003MuscleDeprecated(const MuscleParameters& p) {
+  name_ = p.name;
   m_ = readMuscleProperties(p, 0.0);
   noIgnoreFlags(p, m_, "Thelen2003Muscle_Deprecated");
   tau_act_ = p.get("activation_time_constant", 0.01);
   tau_deact_ = p.get("deactivation_time_constant", 0.04);
   Vmax_ = p.get("Vmax", 10.0);
   Vmax0_ = p.get("Vmax0", 5.0);
-  c_.FmaxTendonStrain = p.get("FmaxTendonStrain", 0.033);
-  c_.FmaxMuscleStrain = p.get("FmaxMuscleStrain", 0.6);
-  c_.KshapeActive = p.get("KshapeActive", 0.5);
-  c_.KshapePassive = p.get("KshapePassive", 4.0);
+  c_.read(p);
   c_.damping = p.get("damping", 0.05);
-  c_.Af = p.get("Af", 0.3);
-  c_.Flen = p.get("Flen", 1.8);
   // OpenSim checks none of these; these are the values whose equations divide by zero
   positive(p, "activation_time_constant", tau_act_);
   positive(p, "deactivation_time_constant", tau_deact_);
-  positive(p, "FmaxTendonStrain", c_.FmaxTendonStrain);
-  positive(p, "FmaxMuscleStrain", c_.FmaxMuscleStrain);
-  positive(p, "KshapeActive", c_.KshapeActive);
-  positive(p, "Af", c_.Af);
-  if (!(c_.Flen > 1.0)) bad(p.name, "Flen", "must be greater than 1");
+  c_.check(p.name);
   if (!(c_.damping >= 0)) bad(p.name, "damping", "must be >= 0");
   if (!std::isfinite(Vmax_) || !std::isfinite(Vmax0_)) bad(p.name, "Vmax", "must be finite");
 }
@@ -394,16 +360,20 @@ void Thelen2003MuscleDeprecated::equilibrate(const MusculotendonInput& in, doubl
     z[1] = width;
     return;
   }
+  // the tendon and pennation at fiber_length; a tendon shorter than its slack length is slack,
+  // the fibre takes the rest (OpenSim floors it at the width only before the iteration)
+  const auto place = [&](bool floor_at_width) {
+    cos_factor = std::cos(pennation(fiber_length, l_opt));
+    tendon_length = length - fiber_length * cos_factor;
+    if (tendon_length < l_s) {
+      tendon_length = l_s;
+      cos_factor = std::cos(std::atan(width / (length - tendon_length)));
+      fiber_length = (length - tendon_length) / cos_factor;
+      if (floor_at_width && fiber_length < width) fiber_length = width;
+    }
+  };
   fiber_length = l_opt;
-  cos_factor = std::cos(pennation(fiber_length, l_opt));
-  tendon_length = length - fiber_length * cos_factor;
-  // a tendon shorter than its slack length: slack tendon, the fibre takes the rest
-  if (tendon_length < l_s) {
-    tendon_length = l_s;
-    cos_factor = std::cos(std::atan(width / (length - tendon_length)));
-    fiber_length = (length - tendon_length) / cos_factor;
-    if (fiber_length < width) fiber_length = width;
-  }
+  place(true);
 
   double old_fiber_length = 0.0, error_force = 0.0;
   for (int i = 0; i < 100; ++i) {
@@ -436,13 +406,7 @@ void Thelen2003MuscleDeprecated::equilibrate(const MusculotendonInput& in, doubl
       old_fiber_length = fiber_length;
       fiber_length += error_force > 0.0 ? change : -change;
     }
-    cos_factor = std::cos(pennation(fiber_length, l_opt));
-    tendon_length = length - fiber_length * cos_factor;
-    if (tendon_length < l_s) {
-      tendon_length = l_s;
-      cos_factor = std::cos(std::atan(width / (length - tendon_length)));
-      fiber_length = (length - tendon_length) / cos_factor;
-    }
+    place(false);
   }
   z[1] = fiber_length;
 }
@@ -454,13 +418,8 @@ std::vector<std::pair<std::string, double>> Thelen2003MuscleDeprecated::paramete
   out.emplace_back("deactivation_time_constant", tau_deact_);
   out.emplace_back("Vmax", Vmax_);
   out.emplace_back("Vmax0", Vmax0_);
-  out.emplace_back("FmaxTendonStrain", c_.FmaxTendonStrain);
-  out.emplace_back("FmaxMuscleStrain", c_.FmaxMuscleStrain);
-  out.emplace_back("KshapeActive", c_.KshapeActive);
-  out.emplace_back("KshapePassive", c_.KshapePassive);
+  c_.append(out);
   out.emplace_back("damping", c_.damping);
-  out.emplace_back("Af", c_.Af);
-  out.emplace_back("Flen", c_.Flen);
   return out;
 }
 

@@ -20,7 +20,7 @@ struct FirstOrderActivation {
   double derivative(double a, double u) const;
 };
 
-class Thelen2003Muscle final : public MuscleModel {
+class Thelen2003Muscle final : public MuscleWithProperties {
  public:
   /// reads OpenSim 4's properties with its defaults; throws MuscleParameterError as
   /// Thelen2003Muscle::extendFinalizeFromProperties does
@@ -34,25 +34,20 @@ class Thelen2003Muscle final : public MuscleModel {
   /// 10 SignificantReal), 20 iterations, velocity split by the stiffnesses; the fibre stops at
   /// its minimum length
   void equilibrate(const MusculotendonInput& in, double* z) const override;
-  double minControl() const override { return m_.min_control; }
-  double maxControl() const override { return m_.max_control; }
   std::vector<std::pair<std::string, double>> parameterList() const override;
 
-  const MuscleProperties& properties() const { return m_; }
   const Thelen2003Curves& curves() const { return c_; }
   const FixedWidthPennation& pennation() const { return pen_; }
   const FirstOrderActivation& activationModel() const { return act_; }
 
  private:
-  std::string name_;
-  MuscleProperties m_;
   Thelen2003Curves c_;
   double maximum_pennation_angle_;
   FixedWidthPennation pen_;
   FirstOrderActivation act_;
 };
 
-class Thelen2003MuscleDeprecated final : public MuscleModel {
+class Thelen2003MuscleDeprecated final : public MuscleWithProperties {
  public:
   explicit Thelen2003MuscleDeprecated(const MuscleParameters& p);
 
@@ -65,19 +60,14 @@ class Thelen2003MuscleDeprecated final : public MuscleModel {
   /// OpenSim's computeIsometricForce: secant/stiffness iteration to |F_T - F_M cos phi| <= 0.01 N,
   /// 100 iterations; it never reports failure (neither does OpenSim)
   void equilibrate(const MusculotendonInput& in, double* z) const override;
-  double minControl() const override { return m_.min_control; }
-  double maxControl() const override { return m_.max_control; }
   std::vector<std::pair<std::string, double>> parameterList() const override;
 
   const Thelen2003DeprecatedCurves& curves() const { return c_; }
-  const MuscleProperties& properties() const { return m_; }
 
  private:
   /// the 2.x pennation: asin(l_opt sin(phi_opt) / l_f), 0 and pi/2 at its ends
   double pennation(double l_f, double l_opt) const;
 
-  std::string name_;
-  MuscleProperties m_;
   Thelen2003DeprecatedCurves c_;
   double tau_act_ = 0.01, tau_deact_ = 0.04, Vmax_ = 10.0, Vmax0_ = 5.0;
 };
