@@ -211,3 +211,41 @@ TEST(MuscleFactory, BuildsByClassAndRefusesBadValues) {
 
 }  // namespace
 }  // namespace redmax::hill
+
+namespace redmax::hill {
+namespace {
+
+// hard cases of the 2.x code: pennation at 90 degrees (a fibre no longer than its width) takes
+// OpenSim's stiff-tendon branch; activation below 1e-6 is raised to 1e-6 in the velocity only
+TEST(Thelen2003MuscleDeprecated, NinetyDegreePennationAndNearZeroActivation) {
+  const Thelen2003MuscleDeprecated m(triLong());
+  const double l_opt = 0.134, width = l_opt * std::sin(0.20943951);
+  const double z[2] = {0.3, 0.9 * width};  // sin(phi) >= 1: phi = pi/2
+  MuscleOutput out;
+  double zdot[2];
+  m.calc(z, {0.30, 0.2, 0.3}, out, zdot);
+  EXPECT_EQ(out.pennation_angle, M_PI / 2);
+  // OpenSim: h = l_MT / l_opt - l_s (a normalized length minus metres), w = l_opt sin(phi_opt)
+  const double h = 0.30 / l_opt - 0.143;
+  const double new_nfl = std::sqrt(h * h + width * width) / l_opt;
+  const double new_ca = std::cos(std::asin(std::min(1.0, std::sin(0.20943951) / new_nfl)));
+  const double vmax = (5 + 0.3 * 5) * l_opt;
+  EXPECT_NEAR(zdot[1], 0.2 / (vmax * new_ca) * vmax, 1e-12);
+  EXPECT_TRUE(std::isfinite(out.tendon_force));
+  // (the 2.x tendon never carries zero force, 0.001 (1 + strain) even when slack, so OpenSim's
+  // "tendon force zero: fibre at rest" branch at 90 degrees is taken only at strain -1)
+
+  // activation 0: the velocity uses 1e-6, the activation rate the state itself
+  const double z0[2] = {0.0, 0.12};
+  m.calc(z0, {0.28, 0.0, 0.0}, out, zdot);
+  EXPECT_EQ(zdot[0], 0.0);
+  EXPECT_TRUE(std::isfinite(zdot[1]));
+  const double z1[2] = {1e-6, 0.12};
+  double zdot1[2];
+  m.calc(z1, {0.28, 0.0, 0.0}, out, zdot1);
+  // (Vmax differs with a; the normalized velocity does not)
+  EXPECT_NEAR(zdot[1] / (5.0 * l_opt), zdot1[1] / ((5 + 1e-6 * 5) * l_opt), 1e-12);
+}
+
+}  // namespace
+}  // namespace redmax::hill
