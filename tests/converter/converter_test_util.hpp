@@ -11,6 +11,9 @@
 
 #include <unistd.h>
 
+#include "converter/error.hpp"
+#include "converter/osim_reader.hpp"
+
 namespace redmax::osim::test {
 
 inline std::string sharedOpenSim(const std::string& rel) {
@@ -107,6 +110,26 @@ inline std::string weldXml(const std::string& name, const std::string& parent,
   return "<WeldJoint name=\"" + name + "\">\n<socket_parent_frame>" + parent +
          "</socket_parent_frame>\n<socket_child_frame>" + child +
          "</socket_child_frame>\n</WeldJoint>\n";
+}
+
+/// read `text` as a .osim file in a temporary folder; expect a ConvertError whose message starts
+/// "FILE:LINE: " at the first line containing `at` ("" for any line) and contains `what`
+inline void expectReadError(const std::string& text, const std::string& at, const std::string& what) {
+  TempDir dir;
+  const std::string path = dir.write("bad.osim", text);
+  const int line = at.empty() ? 0 : lineContaining(text, at);
+  ASSERT_TRUE(at.empty() || line > 0) << "test bug: '" << at << "' not in the text";
+  try {
+    readOsimModel(path);
+    ADD_FAILURE() << "no error for: " << what;
+  } catch (const ConvertError& e) {
+    EXPECT_EQ(e.file(), path);
+    if (line > 0) {
+      EXPECT_EQ(e.line(), line) << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind(path + ":" + std::to_string(line) + ": ", 0), 0u) << e.what();
+    }
+    EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace redmax::osim::test

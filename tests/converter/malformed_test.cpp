@@ -20,22 +20,7 @@ using test::pinXml;
 
 // read text; expect a ConvertError at the line of `at` whose message contains `what`
 void expectError(const std::string& text, const std::string& at, const std::string& what) {
-  test::TempDir dir;
-  const std::string path = dir.write("bad.osim", text);
-  const int line = at.empty() ? 0 : lineContaining(text, at);
-  ASSERT_TRUE(at.empty() || line > 0) << "test bug: '" << at << "' not in the text";
-  try {
-    readOsimModel(path);
-    ADD_FAILURE() << "no error for: " << what;
-  } catch (const ConvertError& e) {
-    EXPECT_EQ(e.file(), path);
-    if (line > 0) {
-      EXPECT_EQ(e.line(), line) << e.what();
-      EXPECT_EQ(std::string(e.what()).rfind(path + ":" + std::to_string(line) + ": ", 0), 0u)
-          << e.what();
-    }
-    EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
-  }
+  test::expectReadError(text, at, what);
 }
 
 const std::string kTwoBodies = bodyXml("a") + bodyXml("b");
