@@ -106,6 +106,9 @@ int runId(const IdFlags& f, const CLI::App& app) {
   osim::Storage result;
   try {
     result = tool->run(*engine, progress);
+    // --wrap neural: the core's fallbacks, counted in its workspace; the monitor warns once per muscle
+    if (auto* core = dynamic_cast<osim::CoreIdEngine*>(engine.get()))
+      if (const auto monitor = makeWrapFallbackMonitor(f.in.muscle_mass.wrap)) core->takeWrapFallbackCounts(*monitor);
   } catch (const osim::IdEngineError& e) {
     std::cerr << "error: " << tool->config().coordinates_file << ": " << e.what() << "\n";
     return 1;

@@ -74,6 +74,11 @@ class CoreIdEngine final : public IdEngine {
   /// workspace (equal to (v, vdot) without marked joints)
   const State& lastState() const { return ws_.state; }
   const VecX& lastQddot() const { return ws_.qddot; }
+  /// the network wrap-model counts of the frames solved with the engine's own workspace, added to
+  /// `monitor` and zeroed (a caller's own CoreIdWorkspace: takeWrapFallbackCounts(system(), ws.dyn, ...))
+  void takeWrapFallbackCounts(WrapFallbackMonitor& monitor) {
+    redmax::takeWrapFallbackCounts(system_, ws_.dyn, monitor);
+  }
 
  private:
   System system_;
