@@ -50,13 +50,14 @@ int runId(const IdFlags& f, const CLI::App& app) {
     if (with_mass && !quiet) std::cerr << osim::describeMuscleMass(tool->muscleMassPlan());
     if (engine_name == "core") {
       if (f.inertia_fallback) {
-        // the model --engine simbody solves where Debian's Simbody rejects an inertia
-        Model model = tool->model();
+        // the model --engine simbody solves where Debian's Simbody rejects an inertia (an edit
+        // through the model's builder)
+        MusculoskeletalModel model = tool->musculoskeletalModel();
         for (const auto& b : osim::applyOpenSimInertiaFallback(model))
           std::cerr << "warning: body '" << b << "': inertia replaced by OpenSim's isotropic fallback (--inertia-fallback)\n";
-        engine = std::make_unique<osim::CoreIdEngine>(model, tool->muscles(), tool->engineOptions());
+        engine = std::make_unique<osim::CoreIdEngine>(model, tool->engineOptions());
       } else {
-        engine = std::make_unique<osim::CoreIdEngine>(tool->model(), tool->muscles(), tool->engineOptions());
+        engine = std::make_unique<osim::CoreIdEngine>(tool->musculoskeletalModel(), tool->engineOptions());
       }
     } else {
       try {
@@ -64,7 +65,7 @@ int runId(const IdFlags& f, const CLI::App& app) {
         // inertia Debian's Simbody (a checking build) rejects gets OpenSim's isotropic fallback, as
         // OpenSim does when its Simbody checks
         validation::SimbodyCrossCheckEngine built =
-            validation::makeSimbodyCrossCheckEngine(tool->model(), tool->muscles(), tool->engineOptions());
+            validation::makeSimbodyCrossCheckEngine(tool->musculoskeletalModel(), tool->engineOptions());
         if (built.usedFallback())
           std::cerr << "warning: Simbody rejects the inertia of " << built.replacedBodies() << " (" << built.rejection
                     << "): --engine simbody uses OpenSim's isotropic fallback for them (--engine core "
@@ -105,6 +106,9 @@ int runId(const IdFlags& f, const CLI::App& app) {
   osim::Storage result;
   try {
     result = tool->run(*engine, progress);
+    // --wrap neural: the core's fallbacks, counted in its workspace; the monitor warns once per muscle
+    if (auto* core = dynamic_cast<osim::CoreIdEngine*>(engine.get()))
+      if (const auto monitor = makeWrapFallbackMonitor(f.in.muscle_mass.wrap)) core->takeWrapFallbackCounts(*monitor);
   } catch (const osim::IdEngineError& e) {
     std::cerr << "error: " << tool->config().coordinates_file << ": " << e.what() << "\n";
     return 1;

@@ -39,7 +39,8 @@ int runLengths(const LengthsFlags& f, const CLI::App& app) {
   }
   const bool model_lengths = wrap == "smooth" || wrap == "neural";
   const bool quiet = f.quiet;
-  if (quiet && wrap_flags.wrap.monitor) wrap_flags.wrap.monitor->setSink({});
+  const std::shared_ptr<WrapFallbackMonitor> monitor = wrap == "none" ? nullptr : makeWrapFallbackMonitor(f.wrap);
+  if (quiet && monitor) monitor->setSink({});
 
   osim::ModelDescription d;
   osim::BuildResult build;
@@ -67,6 +68,7 @@ int runLengths(const LengthsFlags& f, const CLI::App& app) {
             : wrap == "neural" ? validation::LengthWrap::Neural
                                : validation::LengthWrap::Exact;
   po.wrap_model = wrap_flags.wrap;
+  po.monitor = monitor.get();
   po.all_paths = f.all_paths;
   po.wrap_lengths = given(app, "--wrap-lengths");
   using Clock = std::chrono::steady_clock;
@@ -110,12 +112,12 @@ int runLengths(const LengthsFlags& f, const CLI::App& app) {
       detail = ", " + std::to_string(res.exact_fallbacks) + " on the exact length";
     std::printf("lengths: %d frames, %d muscles (%d wrapping, wrap %s%s), %.4f s wall -> %s\n", coords.numRows(),
                 res.lengths.numColumns(), res.wrapping, wrap.c_str(), detail.c_str(), wall, out_path.c_str());
-    if (wrap_flags.wrap.monitor) {
+    if (monitor) {
       long evaluations = 0;
-      for (const auto& [name, c] : wrap_flags.wrap.monitor->counts()) evaluations += c.evaluations;
+      for (const auto& [name, c] : monitor->counts()) evaluations += c.evaluations;
       std::printf("network: %ld of %ld wrapped-segment evaluations fell back to the smooth model\n",
-                  wrap_flags.wrap.monitor->totalFallbacks(), evaluations);
-      std::printf("%s", wrap_flags.wrap.monitor->summary().c_str());
+                  monitor->totalFallbacks(), evaluations);
+      std::printf("%s", monitor->summary().c_str());
     }
   }
   return 0;

@@ -96,6 +96,9 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   if (given(app, "--impulse"))
     for (const std::string& item : splitList(f.impulse, ";")) mo.impulses.push_back(validation::parseImpulse(item));
   const bool quiet = f.quiet;
+  // --wrap neural: the run's workspaces count the fallbacks, summed into this (muscle_mass_flags.hpp)
+  const std::shared_ptr<WrapFallbackMonitor> monitor = makeWrapFallbackMonitor(f.mm.wrap);
+  so.wrap_fallbacks = monitor.get();
 
   // model and initial state: every problem here is the user's input (exit 2)
   validation::SimulationModel model;
@@ -205,7 +208,7 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
                 out_path.c_str());
   }
   // --wrap neural: how often the smooth model stood in for the network (muscle_mass_flags.hpp)
-  if (const auto& monitor = mo.muscle_mass.wrap.monitor; monitor && !quiet) {
+  if (monitor && !quiet) {
     const std::string counts = monitor->summary();
     if (!counts.empty()) std::fprintf(stderr, "wrap network fallbacks:\n%s", counts.c_str());
   }

@@ -111,9 +111,6 @@ void parseWrapFlags(const WrapFlags& f, osim::MuscleMassOptions& o) {
     } catch (const std::exception& e) {
       throw UsageError{std::string("--wrap-network: ") + e.what()};
     }
-    // outside the training box the smooth model takes over: warn once per muscle, count them all
-    o.wrap.monitor = std::make_shared<WrapFallbackMonitor>(
-        [](const std::string& message) { std::cerr << "warning: " << message << "\n"; });
   } else if (model != "lumped") {
     throw UsageError{"--wrap must be smooth, exact, neural or lumped, got '" + model + "'"};
   }
@@ -124,6 +121,13 @@ void parseWrapFlags(const WrapFlags& f, osim::MuscleMassOptions& o) {
     o.wrap.width = f.width;
   }
   if (f.hasNetwork() && model != "neural") throw UsageError{"--wrap-network needs --wrap neural"};
+}
+
+std::shared_ptr<WrapFallbackMonitor> makeWrapFallbackMonitor(const WrapFlags& f) {
+  if (f.model != "neural") return nullptr;
+  // outside the training box the smooth model takes over: warn once per muscle, count them all
+  return std::make_shared<WrapFallbackMonitor>(
+      [](const std::string& message) { std::cerr << "warning: " << message << "\n"; });
 }
 
 osim::MuscleMassOptions parseMuscleMassFlags(const MuscleMassFlags& f, bool fraction_from_sweep) {

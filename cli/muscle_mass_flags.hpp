@@ -11,10 +11,12 @@
 //     their mass over the smooth model (C2 across contact changes, so energy-consistent); exact and
 //     neural are the dissertation's routes; lumped keeps them massless.
 // Meanings and defaults: converter/build/muscle_mass.hpp.
+#include <memory>
 #include <string>
 
 #include "cli/flags.hpp"
 #include "converter/build/muscle_mass.hpp"
+#include "core/muscles/wrap/network_model.hpp"
 
 namespace redmax::cli {
 
@@ -74,9 +76,12 @@ osim::MuscleMassOptions parseMuscleMassFlags(const MuscleMassFlags& f, bool frac
 /// --muscle-mass-kg`). Not given: wrap_mass on, smooth model, default width. lumped: wrap_mass off.
 /// Throws UsageError for an unknown model, a width given without smooth/neural, --wrap-network
 /// without neural, neural without --wrap-network or with a file loadWrapNetwork refuses. neural
-/// sets o.wrap.network and a WrapFallbackMonitor (o.wrap.monitor) that warns on stderr once per
-/// muscle; commands print its summary().
+/// sets o.wrap.network.
 void parseWrapFlags(const WrapFlags& f, osim::MuscleMassOptions& o);
+
+/// --wrap neural: a WrapFallbackMonitor that warns on stderr once per muscle (the command sums the
+/// counts of its workspaces into it and prints its summary()); null for the other models.
+std::shared_ptr<WrapFallbackMonitor> makeWrapFallbackMonitor(const WrapFlags& f);
 
 /// What the run prints about muscle mass, for the footer of a command's --help.
 const char* muscleMassFooter();

@@ -77,10 +77,10 @@ IdSpeedResult timeIdEngines(const IdSpeedOptions& options) {
   std::unique_ptr<osim::IdEngine> simbody;
   if (options.simbody) {
     try {
-      SimbodyCrossCheckEngine built = makeSimbodyCrossCheckEngine(model, {}, tool.engineOptions());
+      SimbodyCrossCheckEngine built = makeSimbodyCrossCheckEngine(makeMusculoskeletalModel(model), tool.engineOptions());
       simbody = std::move(built.engine);
       if (built.usedFallback()) {
-        model = *built.fallback_model;
+        model = built.fallback_model->skeleton();
         r.simbody_note = "both engines timed with OpenSim's isotropic fallback inertia on " + built.replacedBodies();
       }
     } catch (const std::exception& e) {

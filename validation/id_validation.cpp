@@ -251,7 +251,7 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
       sw.restart();
       // Debian's Simbody checks inertias that OpenSim's release build keeps (gait2392's toes):
       // then both engines are cross-checked on OpenSim's isotropic fallback for those bodies
-      SimbodyCrossCheckEngine built = makeSimbodyCrossCheckEngine(tool.model(), {}, tool.engineOptions());
+      SimbodyCrossCheckEngine built = makeSimbodyCrossCheckEngine(makeMusculoskeletalModel(tool.model()), tool.engineOptions());
       sb_run.build_seconds = sw.seconds();
       sb = std::move(built.engine);
       if (built.usedFallback()) {
@@ -362,13 +362,13 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
       sbm.name = "simbody_mass";
       try {
         SimbodyCrossCheckEngine sb =
-            makeSimbodyCrossCheckEngine(*mass_engine.model, mass_engine.muscles, tool.engineOptions());
+            makeSimbodyCrossCheckEngine(*mass_engine.model, tool.engineOptions());
         osim::Storage sbm_result = runEngine(tool, *sb.engine, sbm, opt.progress);
         ie.simbody_ran = true;
         // with the fallback inertia, the core solves that same model and mass points again
         osim::Storage core_mass_same = mass_result;
         if (sb.usedFallback()) {
-          osim::CoreIdEngine core_fallback(*sb.fallback_model, mass_engine.muscles, tool.engineOptions());
+          osim::CoreIdEngine core_fallback(*sb.fallback_model, tool.engineOptions());
           core_mass_same = tool.run(core_fallback);
           ie.simbody_note = describeInertiaFallback(sb);
           r.warnings.push_back("simbody with muscle inertia: " + ie.simbody_note);

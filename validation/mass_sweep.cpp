@@ -110,10 +110,9 @@ MassSweepEngineFactory makeCoreMassEngineFactory(const osim::InverseDynamicsTool
     if (mm.build.model.nr() != t->model().nr())
       throw osim::ConvertError(t->config().model_file, 0, "the model with muscle mass has other coordinates");
     e.muscle_mass = mm.plan.total_muscle_mass;
-    e.model = std::make_shared<const Model>(mm.build.model);
-    e.muscles = mm.build.model.muscles();
+    e.model = std::make_shared<const MusculoskeletalModel>(mm.build.model);
     // the core with the muscles' mass points as a MuscleTerm (core_id_engine.hpp)
-    e.engine = std::make_unique<osim::CoreIdEngine>(mm.build.model, mm.build.model.muscles(), t->engineOptions());
+    e.engine = std::make_unique<osim::CoreIdEngine>(*e.model, t->engineOptions());
     return e;
   };
 }
@@ -286,7 +285,7 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
       } else {
         SimbodyCrossCheckEngine sb;
         try {
-          sb = makeSimbodyCrossCheckEngine(*e.model, e.muscles, tool.engineOptions());
+          sb = makeSimbodyCrossCheckEngine(*e.model, tool.engineOptions());
         } catch (const std::exception& ex) {
           c.skipped = std::string("the Simbody engine cannot build this model: ") + ex.what();
         }
@@ -297,7 +296,7 @@ MassSweepResult runMassSweep(const osim::InverseDynamicsTool& tool, const osim::
             c.ran = true;
             if (sb.usedFallback()) {
               // the same model for both: the core again, with the fallback inertia
-              osim::CoreIdEngine core_fallback(*sb.fallback_model, e.muscles, tool.engineOptions());
+              osim::CoreIdEngine core_fallback(*sb.fallback_model, tool.engineOptions());
               c.core_result = tool.run(core_fallback);
               c.core_result.name = osim::kIdStorageName;
               c.note = describeInertiaFallback(sb);

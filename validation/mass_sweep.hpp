@@ -109,9 +109,8 @@ struct MassSweepEngine {
   std::string description;       ///< osim::describeMuscleMass of the plan
   osim::WrapMassCount wrap;      ///< wrapping (Type III) muscles: how many carry mass, why the others do not
   /// the model with the mass taken from the bodies and its muscles with their mass points (for a
-  /// second engine, e.g. Simbody with muscle inertia); empty when the factory does not give them
-  std::shared_ptr<const Model> model;
-  std::vector<Muscle> muscles;
+  /// second engine, e.g. Simbody with muscle inertia); null when the factory does not give it
+  std::shared_ptr<const MusculoskeletalModel> model;
 };
 
 /// Makes the engine of one value's options for the tool's model (same coordinates, same velocity

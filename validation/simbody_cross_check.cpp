@@ -11,21 +11,22 @@ std::string SimbodyCrossCheckEngine::replacedBodies() const {
   return s;
 }
 
-SimbodyCrossCheckEngine makeSimbodyCrossCheckEngine(const Model& model, const std::vector<Muscle>& muscles,
+SimbodyCrossCheckEngine makeSimbodyCrossCheckEngine(const MusculoskeletalModel& model,
                                                     const osim::IdEngineOptions& options) {
   SimbodyCrossCheckEngine r;
   try {
-    r.engine = std::make_unique<simbody::SimbodyIdEngine>(model, muscles, options);
+    r.engine = std::make_unique<simbody::SimbodyIdEngine>(model, options);
     return r;
   } catch (const simbody::SimbodyBuildError& e) {
-    auto fallback = std::make_shared<Model>(model);
+    // an edit of the model through its builder (applyOpenSimInertiaFallback's aggregate overload)
+    auto fallback = std::make_shared<MusculoskeletalModel>(model);
     r.replaced = osim::applyOpenSimInertiaFallback(*fallback);
     if (r.replaced.empty()) throw;  // not an inertia Simbody checks: nothing to fall back on
     r.rejection = e.what();
     r.fallback_model = fallback;
   }
   // a second rejection is a real build error: it propagates
-  r.engine = std::make_unique<simbody::SimbodyIdEngine>(*r.fallback_model, muscles, options);
+  r.engine = std::make_unique<simbody::SimbodyIdEngine>(*r.fallback_model, options);
   return r;
 }
 

@@ -10,8 +10,7 @@
 #include <vector>
 
 #include "converter/id/id_engine.hpp"
-#include "core/muscles/mass_points.hpp"
-#include "core/skeleton/model.hpp"
+#include "core/model/musculoskeletal_model.hpp"
 #include "plugin/simbody/id_engine.hpp"
 
 namespace redmax::validation {
@@ -23,7 +22,7 @@ struct SimbodyCrossCheckEngine {
   std::vector<std::string> replaced;
   /// the model with the fallback inertias (only when `replaced` is not empty; the core must solve
   /// this one for the comparison)
-  std::shared_ptr<const Model> fallback_model;
+  std::shared_ptr<const MusculoskeletalModel> fallback_model;
   /// Simbody's complaint about the model as given (when `replaced` is not empty)
   std::string rejection;
 
@@ -32,11 +31,11 @@ struct SimbodyCrossCheckEngine {
   std::string replacedBodies() const;
 };
 
-/// Builds SimbodyIdEngine(model, muscles, options); when Simbody rejects the model
-/// (SimbodyBuildError) and OpenSim's fallback changes some body inertia, builds it on a copy with
-/// the fallback. Rethrows the build error when the fallback changes nothing (a different
-/// problem), and ModelError for muscles that do not fit.
-SimbodyCrossCheckEngine makeSimbodyCrossCheckEngine(const Model& model, const std::vector<Muscle>& muscles,
+/// Builds SimbodyIdEngine(model, options); when Simbody rejects the model (SimbodyBuildError) and
+/// OpenSim's fallback changes some body inertia, builds it on an edit of the model with the
+/// fallback. Rethrows the build error when the fallback changes nothing (a different problem), and
+/// ModelError for muscles that do not fit.
+SimbodyCrossCheckEngine makeSimbodyCrossCheckEngine(const MusculoskeletalModel& model,
                                                     const osim::IdEngineOptions& options);
 
 /// The warning that says so: "Simbody rejects the inertia of toes_r (...); core vs simbody is

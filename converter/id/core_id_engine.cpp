@@ -27,12 +27,13 @@ CoreIdEngine::CoreIdEngine(Model model, IdEngineOptions options)
   }
 }
 
-CoreIdEngine::CoreIdEngine(Model model, std::vector<Muscle> muscles, IdEngineOptions options)
-    : CoreIdEngine(std::move(model), std::move(options)) {
+CoreIdEngine::CoreIdEngine(const MusculoskeletalModel& model, IdEngineOptions options)
+    : CoreIdEngine(model.skeleton(), std::move(options)) {
+  const std::vector<Muscle>& muscles = model.muscles();
   const bool any_mass = std::any_of(muscles.begin(), muscles.end(),
                                     [](const Muscle& m) { return m.mass_points.size() > 0; });
   if (!any_mass) return;
-  auto term = std::make_shared<MuscleTerm>(system_.model(), std::move(muscles));
+  auto term = std::make_shared<MuscleTerm>(system_.model(), muscles, model.settings().muscle_term);
   muscle_mass_ = term->totalMass();
   system_.addTerm(std::move(term));
   system_.bind(ws_.dyn);  // slots for the new term

@@ -19,10 +19,11 @@
 #include <vector>
 
 #include "converter/id/id_engine.hpp"
+#include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/speed_map.hpp"
 #include "core/dynamics/system.hpp"
-#include "core/muscles/mass_points.hpp"
 #include "core/joints/joint.hpp"
+#include "core/model/musculoskeletal_model.hpp"
 
 namespace redmax::osim {
 
@@ -48,13 +49,14 @@ class CoreIdEngine final : public IdEngine {
  public:
   /// Throws IdEngineError if a marked joint has no OpenSim speed map, or the options do not
   /// match the model's joints.
+  /// The skeleton alone (no muscle inertia).
   explicit CoreIdEngine(Model model, IdEngineOptions options = {});
-  /// With inertial musculotendons: a MuscleTerm over `muscles` (core/dynamics/muscle_term.hpp)
-  /// joins the System when any of them carries mass points, so tau gains the muscles' inertia,
-  /// quadratic velocity and gravity terms [D Eq. 5.7]. The term works in the core's qdot = dq/dt
-  /// convention like the rest of the system, so the rates_as_u change of variables applies
-  /// unchanged. Also throws ModelError for a muscle that does not fit the model.
-  CoreIdEngine(Model model, std::vector<Muscle> muscles, IdEngineOptions options = {});
+  /// The model's skeleton; when any muscle carries mass points, a MuscleTerm over the model's
+  /// muscles (settings().muscle_term, core/dynamics/muscle_term.hpp) joins the System, so tau
+  /// gains the muscles' inertia, quadratic velocity and gravity terms [D Eq. 5.7]. The term works
+  /// in the core's qdot = dq/dt convention like the rest of the system, so the rates_as_u change
+  /// of variables applies unchanged. Constraints and force elements are not solved (OpenSim's ID).
+  explicit CoreIdEngine(const MusculoskeletalModel& model, IdEngineOptions options = {});
   std::string name() const override { return "core"; }
   /// one frame with the engine's own workspace (lastState(), lastQddot())
   void calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,
@@ -72,6 +74,11 @@ class CoreIdEngine final : public IdEngine {
   /// workspace (equal to (v, vdot) without marked joints)
   const State& lastState() const { return ws_.state; }
   const VecX& lastQddot() const { return ws_.qddot; }
+  /// the network wrap-model counts of the frames solved with the engine's own workspace, added to
+  /// `monitor` and zeroed (a caller's own CoreIdWorkspace: takeWrapFallbackCounts(system(), ws.dyn, ...))
+  void takeWrapFallbackCounts(WrapFallbackMonitor& monitor) {
+    redmax::takeWrapFallbackCounts(system_, ws_.dyn, monitor);
+  }
 
  private:
   System system_;

@@ -112,8 +112,6 @@ class InverseDynamicsTool {
   /// the whole model: skeleton and, with muscle mass, every built muscle (those with mass carry
   /// their points); without muscle mass no muscles (the model as OpenSim's ID sees it)
   const MusculoskeletalModel& musculoskeletalModel() const { return build_->model; }
-  /// the muscles for a CoreIdEngine (musculoskeletalModel().muscles())
-  const std::vector<Muscle>& muscles() const { return build_->model.muscles(); }
   /// what the muscle-mass options did (source None: every muscle lumped, no bodies changed)
   const MuscleMassPlan& muscleMassPlan() const { return muscle_mass_plan_; }
   /// the description the model was built from (bodies with their mass reduced); the file's own

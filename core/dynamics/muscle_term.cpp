@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/dynamics/system.hpp"
+
 namespace redmax {
 
 MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options)
@@ -119,6 +121,23 @@ double MuscleTerm::potentialEnergy(const Model& model, const State& s, const Ter
   for (size_t m = 0; m < massive_.size(); ++m)
     V += musclePotentialEnergy(massive_[m].mass_points, sc.ws.muscles[m], model.gravity());
   return V;
+}
+
+void MuscleTerm::takeWrapFallbackCounts(TermScratch* scratch, WrapFallbackMonitor& monitor) const {
+  auto* sc = dynamic_cast<MuscleTermScratch*>(scratch);
+  if (!sc) return;
+  for (size_t k = 0; k < sc->ws.muscles.size() && k < massive_.size(); ++k) {
+    WrapFallbackCounts& c = sc->ws.muscles[k].wrap_counts;
+    monitor.add(massive_[k], c);
+    c = {};
+  }
+}
+
+void takeWrapFallbackCounts(const System& sys, DynamicsWorkspace& ws, WrapFallbackMonitor& monitor) {
+  if (ws.system_id != sys.id()) return;  // slots of another system (or none yet)
+  for (size_t i = 0; i < sys.terms().size() && i < ws.term_scratch.size(); ++i)
+    if (const auto* term = dynamic_cast<const MuscleTerm*>(sys.terms()[i].get()))
+      term->takeWrapFallbackCounts(ws.term_scratch[i].get(), monitor);
 }
 
 }  // namespace redmax

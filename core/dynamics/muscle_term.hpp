@@ -15,7 +15,8 @@
 // workspace (TermContext::evaluation), so that addMass, addForce, Mdot qdot and the energies of
 // one state share one muscle evaluation; threads with their own workspaces share one term without
 // waiting on each other. Only the muscles with mass points are evaluated (no Jdot of massless
-// muscles), at the velocity stage.
+// muscles), at the velocity stage. Run-time counts (the network wrap model's fallbacks) live in
+// the scratch too; callers sum them (takeWrapFallbackCounts).
 #include <vector>
 
 #include "core/dynamics/force_term.hpp"
@@ -60,6 +61,9 @@ class MuscleTerm final : public ForceTerm {
 
   const std::vector<Muscle>& muscles() const { return muscles_; }
   const MuscleTermOptions& options() const { return options_; }
+  /// add the network wrap-model counts gathered in `scratch` (this term's slot of a workspace) to
+  /// `monitor` and zero them there; no-op for a null slot
+  void takeWrapFallbackCounts(TermScratch* scratch, WrapFallbackMonitor& monitor) const;
   /// sum of all mass-point masses (kg)
   double totalMass() const;
 
@@ -74,5 +78,14 @@ class MuscleTerm final : public ForceTerm {
   MuscleTermOptions options_;
   int nr_ = 0;
 };
+
+class System;
+struct DynamicsWorkspace;
+
+/// takeWrapFallbackCounts of every MuscleTerm of `sys` over its slots in `ws`: what a caller that
+/// reports fallbacks calls for each workspace it evaluated in, after a run or after each span (the
+/// counts are zeroed, so nothing is added twice). Evaluations without a slot (a term called
+/// directly, with a bare SkeletonWorkspace) are not counted.
+void takeWrapFallbackCounts(const System& sys, DynamicsWorkspace& ws, WrapFallbackMonitor& monitor);
 
 }  // namespace redmax

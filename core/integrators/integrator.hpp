@@ -67,6 +67,10 @@ class Integrator {
   /// finite step reached (fixed-step methods) or is left as it was passed (adaptive methods).
   virtual void advance(const System& sys, State& state, double t_out) = 0;
   const IntegratorStats& stats() const { return stats_; }
+  /// the workspace advance() last evaluated the system in (null before the first call), kept
+  /// across calls for the same system: callers that report run-time counts take them from its
+  /// term slots (takeWrapFallbackCounts, core/dynamics/muscle_term.hpp)
+  virtual DynamicsWorkspace* lastWorkspace() { return nullptr; }
 
  protected:
   IntegratorStats stats_;
@@ -101,6 +105,7 @@ class FixedStepIntegrator : public Integrator {
   const IntegratorOptions& options() const { return opt_; }
   /// the workspace advance() uses for sys (a new one when sys is not the system of the last)
   DynamicsWorkspace& workspace(const System& sys);
+  DynamicsWorkspace* lastWorkspace() override { return ws_.get(); }
 
  protected:
   IntegratorOptions opt_;

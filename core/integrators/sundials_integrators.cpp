@@ -338,7 +338,8 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
   if (t_out == s.t) return;
   SundialsSolver& S = *solver_;
   const int n = sys.ndof();
-  DynamicsWorkspace ws(sys.model());
+  if (!ws_ || ws_->system_id != sys.id()) ws_ = std::make_unique<DynamicsWorkspace>(sys);
+  DynamicsWorkspace& ws = *ws_;
   Binding bind(S, sys, ws);
   try {
     // resume from the internal solution only if the caller did not touch the returned state

@@ -30,10 +30,14 @@ class SundialsIntegrator : public Integrator {
   SundialsIntegrator(const SundialsIntegrator&) = delete;
   SundialsIntegrator& operator=(const SundialsIntegrator&) = delete;
   void advance(const System& sys, State& state, double t_out) override;
+  DynamicsWorkspace* lastWorkspace() override { return ws_.get(); }
 
  protected:
   IntegratorOptions opt_;
   std::unique_ptr<detail::SundialsSolver> solver_;
+
+ private:
+  std::unique_ptr<DynamicsWorkspace> ws_;  // kept across advance() calls for one system
 };
 
 /// Dormand-Prince 5(4) with local error control (ARKODE ERKStep, ARKODE_DORMAND_PRINCE_7_4_5),

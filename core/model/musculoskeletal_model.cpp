@@ -120,4 +120,10 @@ MusculoskeletalModel MusculoskeletalModelBuilder::finalize() const {
   return m;
 }
 
+MusculoskeletalModel makeMusculoskeletalModel(const Model& skeleton, std::vector<Muscle> muscles) {
+  MusculoskeletalModelBuilder b(skeleton);
+  for (Muscle& mu : muscles) b.addMuscle(std::move(mu));
+  return b.finalize();
+}
+
 }  // namespace redmax

@@ -141,4 +141,8 @@ class MusculoskeletalModelBuilder {
   ModelSettings settings_;
 };
 
+/// The model of `skeleton` and `muscles` only (a builder that adds each muscle, then finalize()):
+/// for scenes and tests that make their muscles in code. Throws ModelError as finalize() does.
+MusculoskeletalModel makeMusculoskeletalModel(const Model& skeleton, std::vector<Muscle> muscles = {});
+
 }  // namespace redmax

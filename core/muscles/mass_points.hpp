@@ -25,8 +25,7 @@
 
 namespace redmax {
 
-class Mlp;                  // core/muscles/wrap/network.hpp
-class WrapFallbackMonitor;  // core/muscles/wrap/network_model.hpp
+class Mlp;  // core/muscles/wrap/network.hpp
 
 /// Where the points of a muscle sit along the path.
 struct MassPointOptions {
@@ -70,9 +69,7 @@ struct WrapMassOptions {
   std::shared_ptr<const Mlp> network;
   bool network_fd_jdot = false;   ///< Neural: Jdot by the forward difference [D Eq. 5.58], not exactly
   double network_fd_eps = 0.0;    ///< Neural: its time step (s); <= 0: 1e-6
-  /// Neural: counts evaluations and fallbacks per muscle and passes the first fallback of each to
-  /// its sink (the core does not print); null: fallbacks are silent
-  std::shared_ptr<WrapFallbackMonitor> monitor;
+  // fallbacks are counted in the workspace (MuscleKinematics::wrap_counts), not here
 };
 
 /// A musculotendon: its path and, when it carries inertia, its mass points. A muscle with no mass

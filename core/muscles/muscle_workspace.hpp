@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/muscles/mass_points.hpp"
+#include "core/muscles/wrap/network_model.hpp"
 
 namespace redmax {
 
@@ -61,6 +62,11 @@ struct MuscleKinematics {
   MatX Jdot_ar;                     // Jdot_am J_mr + J_am Jdot_mr [D Eq. 5.5]              (3N x k)
 
   bool velocity = false;            // true when the velocity-stage fields are valid
+
+  // wrap-model scratch (Type III, Neural): network buffers, and outcomes counted since this
+  // workspace was made (callers sum them: WrapFallbackMonitor::add)
+  NetworkWrapWorkspace network;
+  WrapFallbackCounts wrap_counts;
 };
 
 /// Columns of a path on `model` (cols, col_of) and buffers sized for all its points; the

@@ -80,9 +80,11 @@ void calcWrapPathMap(const WrapSurface& surface, const WrapMassOptions& wrap, co
   }
 
   // the core's wrap model in s (its one dispatch point: smooth, exact or neural) [D Eq. 5.38, 5.44]
+  // (Neural: not counted here; this map serves the Simbody plugins, which do not report fallbacks)
   WrapModelPoints wp;
+  NetworkWrapWorkspace network;
   try {
-    calcWrapModelPoints(wrap, surface, p1, p2, p1dot, p2dot, mp.alpha, {}, false, vel, wp);
+    calcWrapModelPoints(wrap, surface, p1, p2, p1dot, p2dot, mp.alpha, {}, false, vel, wp, network);
   } catch (const std::invalid_argument& e) {
     throw MuscleError("muscle '" + muscle_name + "', wrap surface: " + e.what());
   }

@@ -281,9 +281,10 @@ void calcExactWrapPointsFd(const WrapSurface& surface, const Vec3& p1, const Vec
   }
 }
 
-void calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
-                         const Vec3& p1dot, const Vec3& p2dot, const std::vector<double>& alphas,
-                         const std::vector<double>& alphadots, bool with_alpha, bool velocity, WrapModelPoints& out) {
+NetworkWrapEval calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
+                                    const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
+                                    const std::vector<double>& alphas, const std::vector<double>& alphadots,
+                                    bool with_alpha, bool velocity, WrapModelPoints& out, NetworkWrapWorkspace& network) {
   const int n = static_cast<int>(alphas.size());
   const Vec3 v1 = velocity ? p1dot : Vec3::Zero(), v2 = velocity ? p2dot : Vec3::Zero();
   auto alphadot = [&](int a) { return velocity && !alphadots.empty() ? alphadots[a] : 0.0; };
@@ -317,17 +318,16 @@ void calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surf
           out.Jdot[a] = sp.Jdot;
         }
       }
-      return;
+      return {};
     }
     case WrapModel::Neural:  // the network, or the smooth model outside its training box (wrap/network_model.hpp)
-      calcNeuralWrapModelPoints(options, surface, p1, p2, v1, v2, alphas, alphadots, velocity, out,
-                                with_alpha ? &out.x_alpha : nullptr, with_alpha ? &out.x_alphadot : nullptr);
-      return;
+      return calcNeuralWrapModelPoints(options, surface, p1, p2, v1, v2, alphas, alphadots, velocity, out, network,
+                                       with_alpha ? &out.x_alpha : nullptr, with_alpha ? &out.x_alphadot : nullptr);
     case WrapModel::Exact:
       if (with_alpha || moving_alpha)
         throw std::logic_error("calcWrapModelPoints: the exact model has no derivative along the fraction");
       calcExactWrapPointsFd(surface, p1, p2, v1, v2, alphas, out, options.fd_step, velocity);
-      return;
+      return {};
   }
   throw std::logic_error("calcWrapModelPoints: unknown wrap model");
 }
@@ -584,8 +584,9 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
     const WrapSurfaceMotion& m = surfaces[w];
     const SegmentEnds& e = ends[i];
     try {
-      calcWrapModelPoints(muscle.wrap, pw.surface, e.p1, e.p2, e.p1dot, e.p2dot, betas, betadots, moving_beta, vel, wp);
-      recordNeuralWrapEval(muscle, pw);  // Neural: count fallbacks, warn once (wrap/network_model.hpp)
+      const NetworkWrapEval ev = calcWrapModelPoints(muscle.wrap, pw.surface, e.p1, e.p2, e.p1dot, e.p2dot, betas,
+                                                     betadots, moving_beta, vel, wp, mk.network);
+      if (muscle.wrap.model == WrapModel::Neural) mk.wrap_counts.record(ev, w);  // summed by callers
     } catch (const std::invalid_argument& ex) {
       throw MuscleError(who + ", wrap object '" + pw.name + "': " + ex.what());
     }

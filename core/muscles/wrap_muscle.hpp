@@ -59,7 +59,7 @@
 //                     smooth model takes, scaled by the surface size: exact J and Jdot of the
 //                     network; the smooth model wherever the network cannot answer (outside its
 //                     training box, another surface type, a quadrant wrap, beyond the cylinder's
-//                     length), counted and warned about once per muscle (recordNeuralWrapEval).
+//                     length), counted in the muscle's workspace (MuscleKinematics::wrap_counts).
 // Dispatch: calcWrapModelPoints() is the one place where a surface-frame wrap model is chosen
 // (p1, p2, fractions -> w, Jw, Jwdot) among the three.
 // Columns: a wrap surface on a body that moves no path point adds its body's coordinates to the
@@ -107,11 +107,13 @@ struct WrapModelPoints : WrapMassPoints {
 /// THE wrap-model dispatch point: mass points at fractions `alphas` of the wrapped segment p1 -> p2
 /// (frame s) by options.model, moving with (p1dot, p2dot) and fraction rates `alphadots` (empty:
 /// all zero). `with_alpha` also fills x_alpha and x_alphadot (the exact model cannot: it has no
-/// alpha derivative; std::logic_error). Without `velocity` Jdot is zero. Throws
+/// alpha derivative; std::logic_error). Without `velocity` Jdot is zero. `network` holds the Neural
+/// model's buffers; returns its outcome (None for the other models). Throws
 /// std::invalid_argument for an end point inside the surface or an unsupported surface.
-void calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
-                         const Vec3& p1dot, const Vec3& p2dot, const std::vector<double>& alphas,
-                         const std::vector<double>& alphadots, bool with_alpha, bool velocity, WrapModelPoints& out);
+NetworkWrapEval calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
+                                    const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
+                                    const std::vector<double>& alphas, const std::vector<double>& alphadots,
+                                    bool with_alpha, bool velocity, WrapModelPoints& out, NetworkWrapWorkspace& network);
 
 /// The wrap model's length of the wrapped segment p1 -> p2 (frame s) with dL/d(p1, p2) and its time
 /// derivative (the smooth model's; every model that distributes points over several segments uses

@@ -63,12 +63,11 @@ SimbodyIdEngine::SimbodyIdEngine(const Model& model, const IdEngineOptions& opti
   m.E_wi.resize(model.nb());
 }
 
-SimbodyIdEngine::SimbodyIdEngine(const Model& model, std::vector<Muscle> muscles,
-                                 const IdEngineOptions& options)
-    : SimbodyIdEngine(model, options) {
+SimbodyIdEngine::SimbodyIdEngine(const MusculoskeletalModel& model, const IdEngineOptions& options)
+    : SimbodyIdEngine(model.skeleton(), options) {
   bool any = false;
-  for (const Muscle& mu : muscles) any = any || mu.mass_points.size() > 0;
-  if (any) impl_->muscles = std::make_unique<MuscleInertia>(*impl_->sm, impl_->model, std::move(muscles));
+  for (const Muscle& mu : model.muscles()) any = any || mu.mass_points.size() > 0;
+  if (any) impl_->muscles = std::make_unique<MuscleInertia>(*impl_->sm, model);
 }
 
 SimbodyIdEngine::~SimbodyIdEngine() = default;

@@ -7,7 +7,7 @@
 // Joints marked IdEngineOptions::rates_as_u become Ball/Free mobilizers whose u and udot are the
 // given rates as they are (what OpenSim does); for the others u = T qdot, udot = T qddot + Tdot
 // qdot and tau = T^T tau_u (model_to_simbody.hpp's velocity map), so both engines answer in the
-// same convention. With muscles that carry mass points (second constructor), their generalized
+// same convention. With muscles that carry mass points (the MusculoskeletalModel constructor), their generalized
 // forces from plugin/simbody/muscle_inertia.hpp (Simbody station kinematics + the core's path
 // maps) are added to Simbody's residual in u space before the map back. The header is Simbody-free (pimpl) so that the command line compiles quickly.
 #include <memory>
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/dynamics/id_engine.hpp"
-#include "core/muscles/mass_points.hpp"
+#include "core/model/musculoskeletal_model.hpp"
 #include "core/skeleton/model.hpp"
 
 namespace redmax::simbody {
@@ -26,11 +26,11 @@ class SimbodyIdEngine final : public IdEngine {
   /// Gimbal otherwise). Throws SimbodyBuildError (simbody_options.hpp) when the model has a joint
   /// without a Simbody counterpart, or a marked joint whose mobilizer has u = qdot (not Ball/Free).
   explicit SimbodyIdEngine(const Model& model, const IdEngineOptions& options = {});
-  /// The same, plus the inertia and weight of the mass points of `muscles` (muscles without mass
-  /// points add nothing). Throws ModelError for a muscle that does not fit the model (validateMuscle);
-  /// calcGeneralizedForces throws IdEngineError naming the muscle when its path degenerates at a frame
-  /// (e.g. coincident consecutive path points).
-  SimbodyIdEngine(const Model& model, std::vector<Muscle> muscles, const IdEngineOptions& options = {});
+  /// The model's skeleton, plus the inertia and weight of its muscles' mass points (muscles
+  /// without mass points add nothing). Throws ModelError for a muscle that does not fit the model
+  /// (validateMuscle); calcGeneralizedForces throws IdEngineError naming the muscle when its path
+  /// degenerates at a frame (e.g. coincident consecutive path points).
+  explicit SimbodyIdEngine(const MusculoskeletalModel& model, const IdEngineOptions& options = {});
   ~SimbodyIdEngine() override;
   SimbodyIdEngine(const SimbodyIdEngine&) = delete;
   SimbodyIdEngine& operator=(const SimbodyIdEngine&) = delete;

@@ -12,12 +12,9 @@ MatterMap makeMatterMap(const SimbodyModel& sm, const Model& model) {
   return map;
 }
 
-MuscleInertia::MuscleInertia(const SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles)
-    : MuscleInertia(sm, model, std::move(muscles), model.gravity()) {}
-
-MuscleInertia::MuscleInertia(const SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles,
-                             const Vec3& gravity)
-    : impl_(sm.matter, makeMatterMap(sm, model), model, std::move(muscles), gravity) {}
+MuscleInertia::MuscleInertia(const SimbodyModel& sm, const MusculoskeletalModel& model)
+    : impl_(sm.matter, makeMatterMap(sm, model.skeleton()), model.skeleton(), model.muscles(),
+            model.skeleton().gravity()) {}
 
 VecX MuscleInertia::calcGeneralizedForces(const SimTK::State& state, const VecX& udot) {
   SimTK::Vector f_u;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/model/musculoskeletal_model.hpp"
 #include "plugin/simbody/matter_muscle_inertia.hpp"
 #include "plugin/simbody/model_to_simbody.hpp"
 
@@ -18,14 +19,14 @@ namespace redmax::simbody {
 /// The MatterMap of a SimbodyModel built from `model`: its own mobilized bodies and q slots.
 MatterMap makeMatterMap(const SimbodyModel& sm, const Model& model);
 
-/// Muscle mass points of a Simbody system. Keeps references to `sm` (it must outlive this object);
-/// copies the model's muscles. Muscles without mass points are skipped.
+/// Muscle mass points of a Simbody system built from `model`'s skeleton. Keeps references to `sm`
+/// (it must outlive this object); copies the model's muscles. Muscles without mass points are
+/// skipped.
 class MuscleInertia {
  public:
-  /// Validates the muscles against `model` (validateMuscle: throws ModelError); `gravity` (world,
-  /// m/s^2) acts on the mass points, by default the model's.
-  MuscleInertia(const SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles);
-  MuscleInertia(const SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles, const Vec3& gravity);
+  /// Validates the muscles against the skeleton (validateMuscle: throws ModelError); the
+  /// skeleton's gravity acts on the mass points.
+  MuscleInertia(const SimbodyModel& sm, const MusculoskeletalModel& model);
 
   /// f_u (nu, Simbody u order) of the mass points at `state` (realized to Stage::Velocity at
   /// least) for generalized accelerations udot (nu). Throws MuscleError for a degenerate path.

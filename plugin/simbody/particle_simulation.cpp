@@ -17,9 +17,10 @@ struct ParticleSimulation::Impl {
   State state;
 };
 
-ParticleSimulation::ParticleSimulation(const Model& model, std::vector<Muscle> muscles, const State& initial,
+ParticleSimulation::ParticleSimulation(const MusculoskeletalModel& mm, const State& initial,
                                        const ParticleSimulationOptions& options)
     : impl_(std::make_unique<Impl>()) {
+  const Model& model = mm.skeleton();
   Impl& m = *impl_;
   if (!(options.accuracy > 0.0) || !(options.constraint_tolerance > 0.0))
     throw std::invalid_argument("particle simulation: accuracy and constraint tolerance must be positive");
@@ -30,7 +31,7 @@ ParticleSimulation::ParticleSimulation(const Model& model, std::vector<Muscle> m
   if (!(options.max_step >= 0.0)) throw std::invalid_argument("particle simulation: negative maximum step");
   m.model = model;
   m.sm = makeSimbodyModel(model);
-  m.particles = std::make_unique<ParticleMuscles>(*m.sm, model, std::move(muscles));
+  m.particles = std::make_unique<ParticleMuscles>(*m.sm, model, mm.muscles());
   SimTK::State st = m.sm->default_state;
   setSimbodyState(*m.sm, model, initial, st);
   m.particles->placeParticles(st);

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/muscles/mass_points.hpp"
+#include "core/model/musculoskeletal_model.hpp"
 #include "core/skeleton/model.hpp"
 #include "core/skeleton/state.hpp"
 
@@ -44,7 +44,7 @@ class ParticleSimulation {
   /// Throws SimbodyBuildError (simbody_options.hpp) for a joint or a muscle Simbody cannot take
   /// (see particle_muscles.hpp), ModelError for an invalid muscle, std::invalid_argument for an
   /// unknown integrator name or non-positive tolerances.
-  ParticleSimulation(const Model& model, std::vector<Muscle> muscles, const State& initial,
+  ParticleSimulation(const MusculoskeletalModel& model, const State& initial,
                      const ParticleSimulationOptions& options = {});
   ~ParticleSimulation();
   ParticleSimulation(const ParticleSimulation&) = delete;

@@ -130,7 +130,7 @@ osim::Storage runRedmaxId(const std::string& setup, const osim::MuscleMassOption
   st.setup_file = setup;
   st.muscle_mass = mm;
   osim::InverseDynamicsTool tool(osim::resolveIdSettings(st));
-  osim::CoreIdEngine engine(tool.model(), tool.muscles(), tool.engineOptions());
+  osim::CoreIdEngine engine(tool.musculoskeletalModel(), tool.engineOptions());
   return tool.run(engine);
 }
 

@@ -135,7 +135,7 @@ Muscle randomWrapMuscle(const Model& m, int variant, std::mt19937& rng, const St
 // both Simbody-side components at one state; returns the number of compared states (0 or 1)
 int compareAt(const simbody::SimbodyModel& sm, const Model& m, const std::vector<Muscle>& muscles,
               const State& s, const VecX& qddot, bool with_core, double& worst_same, double& worst_core) {
-  simbody::MuscleInertia reference(sm, m, muscles);
+  simbody::MuscleInertia reference(sm, makeMusculoskeletalModel(m, muscles));
   // the map a foreign system would give: the SimbodyModel's own mobilized bodies and q slots
   opensim::MatterMuscleInertia ours(sm.matter, simbody::makeMatterMap(sm, m), m, muscles, m.gravity());
   SimTK::State sb = sm.default_state;

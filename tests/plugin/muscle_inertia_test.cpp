@@ -175,7 +175,7 @@ int compareOnRandomTrees(bool with_pendulum, std::uint32_t seed, int variants, i
         std::vector<Muscle> muscles = make(m, variant, trial, s, rng);
         for (Muscle& mu : muscles) validateMuscle(m, mu);
         const MuscleTerm term(m, muscles);
-        simbody::MuscleInertia mi(*sm, m, muscles);
+        simbody::MuscleInertia mi(*sm, makeMusculoskeletalModel(m, muscles));
         const VecX qddot = VecX::NullaryExpr(m.nr(), [&] { return randomVec(rng, 3.0)[0]; });
         VecX core;
         try {
@@ -287,13 +287,13 @@ TEST(SimbodyMuscleInertia, MasslessMusclesAddNothingAndBadMusclesThrow) {
   Muscle mu;
   mu.name = "lumped";
   mu.path.points = {makeFixedPoint(-1, Vec3(0.1, 0, 0)), makeFixedPoint(1, Vec3(0, -0.5, 0))};
-  simbody::MuscleInertia mi(*sm, m, {mu});
+  simbody::MuscleInertia mi(*sm, makeMusculoskeletalModel(m, {mu}));
   SimTK::State sb = sm->default_state;
   sm->system.realize(sb, SimTK::Stage::Velocity);
   EXPECT_EQ(mi.calcGeneralizedForces(sb, VecX::Ones(2)).norm(), 0.0);
   // a point on a body the model does not have
   mu.path.points.back().body = 5;
-  EXPECT_THROW(simbody::MuscleInertia(*sm, m, {mu}), ModelError);
+  EXPECT_THROW(simbody::MuscleInertia(*sm, makeMusculoskeletalModel(m, {mu})), ModelError);
 }
 
 // OpenSim's Euler-rate speeds (IdEngineOptions::rates_as_u) with muscles: for marked Ball/Free joints
@@ -313,7 +313,7 @@ TEST(SimbodyIdEngineMuscles, RatesAsUMatchesCoreOnRandomTrees) {
     const State s_any = randomState(m.nr(), rng);
     std::vector<Muscle> muscles{randomMuscle(m, 2, rng, s_any), randomMuscle(m, 6, rng, s_any)};
     for (Muscle& mu : muscles) validateMuscle(m, mu);
-    simbody::SimbodyIdEngine sb_engine(m, muscles, opt);
+    simbody::SimbodyIdEngine sb_engine(makeMusculoskeletalModel(m, muscles), opt);
     osim::CoreIdEngine core_engine(m, opt);
     const MuscleTerm term(m, muscles);
     for (int k = 0; k < 3; ++k) {
@@ -358,7 +358,7 @@ TEST(SimbodyIdEngineMuscles, DegeneratePathIsAnEngineError) {
   mu.name = "collapsed";
   mu.path.points = {makeFixedPoint(0, Vec3(0, -1, 0)), makeFixedPoint(1, Vec3::Zero())};
   mu.mass_points = makeMassPoints({0.5}, {0.1});
-  simbody::SimbodyIdEngine engine(m, {mu});
+  simbody::SimbodyIdEngine engine(makeMusculoskeletalModel(m, {mu}));
   VecX tau;
   try {
     engine.calcGeneralizedForces(0.25, Vec2(0.1, 0.2), Vec2::Zero(), Vec2::Zero(), {}, tau);
@@ -377,7 +377,7 @@ std::string scenePath(const std::string& file) { return std::string(REDMAX_SOURC
 // coordinates' ranges; returns how many states were compared
 int compareEngines(const osim::ModelDescription& d, const Model& model, const std::vector<Muscle>& muscles,
                    int states, std::uint32_t seed, const std::function<void(const State&)>& on_state = {}) {
-  simbody::SimbodyIdEngine with(model, muscles), without(model);
+  simbody::SimbodyIdEngine with(makeMusculoskeletalModel(model, muscles)), without(model);
   System sys(model);
   sys.addTerm(std::make_shared<MuscleTerm>(model, muscles));
   DynamicsWorkspace ws(sys.model());
@@ -574,7 +574,7 @@ TEST(SimbodyMuscleInertia, TwoWrapsMatchCoreMuscleTermOnRandomTrees) {
 // CPU time per inverse-dynamics call (printed, not asserted): Simbody with and without the muscles,
 // and the core with them
 void printIdCost(const Model& model, const std::vector<Muscle>& muscles) {
-  simbody::SimbodyIdEngine with(model, muscles), without(model);
+  simbody::SimbodyIdEngine with(makeMusculoskeletalModel(model, muscles)), without(model);
   System sys(model);
   sys.addTerm(std::make_shared<MuscleTerm>(model, muscles));
   DynamicsWorkspace ws(sys.model());

@@ -136,7 +136,7 @@ TEST(SimbodyParticleFinger, MatchesCoreOverOneSecond) {
   opt.accuracy = 3e-12;
   opt.constraint_tolerance = 3e-13;
   const std::clock_t c0 = std::clock();
-  simbody::ParticleSimulation sim(m, f.muscles, f.s0, opt);
+  simbody::ParticleSimulation sim(makeMusculoskeletalModel(m, f.muscles), f.s0, opt);
   double worst_q = 0.0, worst_u = 0.0;
   for (size_t k = 0; k < times.size(); ++k) {
     sim.advance(times[k]);
@@ -161,14 +161,14 @@ TEST(SimbodyParticleFinger, IntegratorNamesAndOptions) {
     simbody::ParticleSimulationOptions opt;
     opt.integrator = name;
     opt.infinity_norm = true;
-    EXPECT_NO_THROW(simbody::ParticleSimulation(f.model, f.muscles, f.s0, opt)) << name;
+    EXPECT_NO_THROW(simbody::ParticleSimulation(makeMusculoskeletalModel(f.model, f.muscles), f.s0, opt)) << name;
   }
   simbody::ParticleSimulationOptions bad;
   bad.integrator = "rk4";
-  EXPECT_THROW(simbody::ParticleSimulation(f.model, f.muscles, f.s0, bad), std::invalid_argument);
+  EXPECT_THROW(simbody::ParticleSimulation(makeMusculoskeletalModel(f.model, f.muscles), f.s0, bad), std::invalid_argument);
   bad.integrator = "feldberg";
   bad.accuracy = 0.0;
-  EXPECT_THROW(simbody::ParticleSimulation(f.model, f.muscles, f.s0, bad), std::invalid_argument);
+  EXPECT_THROW(simbody::ParticleSimulation(makeMusculoskeletalModel(f.model, f.muscles), f.s0, bad), std::invalid_argument);
 }
 
 }  // namespace

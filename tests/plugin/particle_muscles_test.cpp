@@ -238,7 +238,7 @@ TEST(SimbodyParticleSimulation, EnergyMatchesCoreAndIsConserved) {
   simbody::ParticleSimulationOptions opt;
   opt.accuracy = 1e-10;
   opt.constraint_tolerance = 1e-11;
-  simbody::ParticleSimulation sim(m, muscles, s0, opt);
+  simbody::ParticleSimulation sim(makeMusculoskeletalModel(m, muscles), s0, opt);
   EXPECT_NEAR(sim.kineticEnergy(), T_core, 1e-12 * (1.0 + std::abs(T_core)));
   EXPECT_NEAR(sim.potentialEnergy(), V_core, 1e-12 * (1.0 + std::abs(V_core)));
   const double E0 = sim.kineticEnergy() + sim.potentialEnergy();
@@ -253,7 +253,7 @@ TEST(SimbodyParticleSimulation, EnergyMatchesCoreAndIsConserved) {
   EXPECT_LT((sim.state().q - q_core.back()).cwiseAbs().maxCoeff(), 1e-6);
   EXPECT_GT(sim.steps(), 0);
   EXPECT_THROW(sim.advance(0.5), std::invalid_argument);
-  EXPECT_THROW(simbody::ParticleSimulation(m, muscles, s0, {"euler", 1e-8, 1e-10}), std::invalid_argument);
+  EXPECT_THROW(simbody::ParticleSimulation(makeMusculoskeletalModel(m, muscles), s0, {"euler", 1e-8, 1e-10}), std::invalid_argument);
   std::printf("  particle simulation: energy drift %.3e J of %.3f J over 1 s, %ld steps\n", drift, E0, sim.steps());
 }
 

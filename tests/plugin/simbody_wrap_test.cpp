@@ -235,7 +235,7 @@ void compareParticlesWithCore(const Model& m, const std::vector<Muscle>& muscles
   po.accuracy = 1e-10;
   po.constraint_tolerance = 1e-11;
   const std::clock_t t0 = std::clock();
-  simbody::ParticleSimulation sim(m, muscles, s0, po);
+  simbody::ParticleSimulation sim(makeMusculoskeletalModel(m, muscles), s0, po);
   double worst = 0.0;
   for (size_t k = 0; k < times.size(); ++k) {
     const State& s = sim.advance(times[k]);
@@ -326,14 +326,14 @@ TEST(SimbodyParticleMuscles, ExactModelOnViaPathsAndConditionalParticlesAreRefus
   validateMuscle(m, mu);
   auto sm = simbody::makeSimbodyModel(m);
   EXPECT_EQ(simbody::simbodyWrapShapeUnsupportedReason(mu), "");
-  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, m, {mu}));
+  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, makeMusculoskeletalModel(m, {mu})));
   mu.wrap.model = WrapModel::Exact;
   validateMuscle(m, mu);  // the core takes it
   const std::string why = simbody::simbodyWrapShapeUnsupportedReason(mu);
   EXPECT_NE(why.find("exact wrap model"), std::string::npos) << why;
   EXPECT_NE(why.find(mu.name), std::string::npos) << why;
   try {
-    simbody::MuscleInertia mi(*sm, m, {mu});
+    simbody::MuscleInertia mi(*sm, makeMusculoskeletalModel(m, {mu}));
     ADD_FAILURE() << "MuscleInertia took the exact model on a via path";
   } catch (const ModelError& e) {
     EXPECT_NE(std::string(e.what()).find(mu.name), std::string::npos) << e.what();
@@ -347,7 +347,7 @@ TEST(SimbodyParticleMuscles, ExactModelOnViaPathsAndConditionalParticlesAreRefus
   Muscle cond = w.muscles[0];
   cond.path.points.insert(cond.path.points.begin() + 1, makeConditionalPoint(0, Vec3(-0.12, -0.8, 0.0), 1, -1.0, 1.0, "cvia"));
   validateMuscle(m, cond);
-  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, m, {cond}));
+  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, makeMusculoskeletalModel(m, {cond})));
   auto sm2 = simbody::makeSimbodyModel(m);
   EXPECT_THROW(simbody::ParticleMuscles(*sm2, m, {cond}), simbody::SimbodyBuildError);
 }

@@ -52,7 +52,7 @@ IdRun runId(const std::string& model, const std::string& motion, const MuscleMas
   s.muscle_mass = mm;
   const IdToolConfig config = resolveIdSettings(s);
   InverseDynamicsTool tool(config);
-  CoreIdEngine engine(tool.model(), tool.muscles(), tool.engineOptions());
+  CoreIdEngine engine(tool.musculoskeletalModel(), tool.engineOptions());
   IdRun r;
   r.out = tool.run(engine);
   r.muscle_mass = engine.muscleMass();
@@ -266,13 +266,13 @@ TEST_F(IdMuscleMass, OpenSimSpeedMapAppliesWithMuscleMass) {
   st.muscle_mass = mm;
   const InverseDynamicsTool tool(resolveIdSettings(st));
   ASSERT_TRUE(tool.engineOptions().marked(0)) << "the ball joint takes OpenSim's u";
-  CoreIdEngine engine(tool.model(), tool.muscles(), tool.engineOptions());
+  CoreIdEngine engine(tool.musculoskeletalModel(), tool.engineOptions());
   EXPECT_GT(engine.muscleMass(), 0.05);
   const Storage out = tool.run(engine);
 
   // by hand: qdot = T^-1 u, qddot = T^-1 (udot - Tdot qdot), tau_u = T^-T tau_qdot on the ball block
   System sys(tool.model());
-  sys.addTerm(std::make_shared<MuscleTerm>(tool.model(), tool.muscles()));
+  sys.addTerm(std::make_shared<MuscleTerm>(tool.model(), tool.musculoskeletalModel().muscles()));
   DynamicsWorkspace ws(sys.model());
   const Joint& ball = tool.model().joints()[0].joint;
   double worst = 0, peak = 0, muscle_effect = 0;
@@ -307,7 +307,7 @@ TEST_F(IdMuscleMass, OpenSimSpeedMapAppliesWithMuscleMass) {
   // --exact reads the same columns as qdot: a different answer, so the map above was in play
   st.opensim_compat = false;
   const InverseDynamicsTool exact_tool(resolveIdSettings(st));
-  CoreIdEngine exact(exact_tool.model(), exact_tool.muscles(), exact_tool.engineOptions());
+  CoreIdEngine exact(exact_tool.musculoskeletalModel(), exact_tool.engineOptions());
   const Storage ex = exact_tool.run(exact);
   EXPECT_GT((ex.data - out.data).cwiseAbs().maxCoeff(), 1e-3 * peak);
 }

@@ -662,7 +662,7 @@ TEST_F(MassSweep, SetFMuscleShareSatisfiesLagrangeByDifferences) {
   ASSERT_TRUE(e.model);
   const redmax::Model& m = *e.model;
   redmax::osim::CoreIdEngine skeleton(m, tool.engineOptions());
-  const redmax::MuscleTerm term(m, e.muscles);
+  const redmax::MuscleTerm term(m, e.model->muscles());
   redmax::SkeletonWorkspace sk(m);
   auto energy = [&](const redmax::VecX& q, const redmax::VecX& qdot, bool kinetic) {
     redmax::State s;

@@ -51,7 +51,7 @@ void checkThreads(const Trial& tr) {
   s.model_file = tr.model;
   s.muscle_mass.source = MuscleMassOptions::Source::Physiological;
   const InverseDynamicsTool tool(resolveIdSettings(s));
-  CoreIdEngine engine(tool.model(), tool.muscles(), tool.engineOptions());
+  CoreIdEngine engine(tool.musculoskeletalModel(), tool.engineOptions());
   ASSERT_GT(engine.muscleMass(), 0.0) << "set " << tr.name << ": no muscle mass, nothing to share";
 
   std::vector<Frame> frames(static_cast<size_t>(tool.numFrames()));

@@ -20,7 +20,8 @@ constexpr int kNetworkLengthSegments = 200;
 }  // namespace
 
 double calcModelPathLength(const Model& model, const Muscle& muscle, const VecX& q, const std::vector<Mat4>& E_wi,
-                           NetworkWrapWorkspace& ws, std::vector<int>& active, std::vector<Vec3>& x_w) {
+                           NetworkWrapWorkspace& ws, std::vector<int>& active, std::vector<Vec3>& x_w,
+                           WrapFallbackMonitor* monitor) {
   const MusclePath& path = muscle.path;
   active.clear();
   x_w.clear();
@@ -53,7 +54,7 @@ double calcModelPathLength(const Model& model, const Muscle& muscle, const VecX&
         NetworkWrapEval ev;
         const double l =
             calcNetworkWrapPathLength(o.network.get(), w.surface, p1, p2, kNetworkLengthSegments, ws, &ev, no);
-        if (o.monitor) o.monitor->record(muscle.name, w.name, ev, o.network.get());
+        if (monitor) monitor->record(muscle.name, w.name, ev, o.network.get());
         // the fallback is the smooth model: its own length, not a polyline through its points
         length += ev.usedNetwork()
                       ? l
@@ -165,7 +166,7 @@ PathLengthResult calcPathLengths(const osim::ModelDescription& d, const osim::Bu
       }
     }
     for (size_t m = 0; m < paths.size(); ++m) {
-      const double l = use_model[m] ? calcModelPathLength(model, model_muscle[m], q, E_wi, nws, active, x_w)
+      const double l = use_model[m] ? calcModelPathLength(model, model_muscle[m], q, E_wi, nws, active, x_w, o.monitor)
                                     : calcPathLength(model, paths[m], q, E_wi);
       if (!std::isfinite(l)) {
         std::ostringstream os;

@@ -27,14 +27,17 @@ namespace redmax::validation {
 /// end lies inside its surface (origin -> surface -> insertion only; calcSegmentWraps skips such
 /// segments elsewhere) is straight, as OpenSim's InsideRadius leaves it. `E_wi` are the body poses
 /// at q; ws, active and x_w are scratch.
+/// `monitor` (Neural; may be null) counts every wrapped-segment evaluation.
 double calcModelPathLength(const Model& model, const Muscle& muscle, const VecX& q, const std::vector<Mat4>& E_wi,
-                           NetworkWrapWorkspace& ws, std::vector<int>& active, std::vector<Vec3>& x_w);
+                           NetworkWrapWorkspace& ws, std::vector<int>& active, std::vector<Vec3>& x_w,
+                           WrapFallbackMonitor* monitor = nullptr);
 
 enum class LengthWrap { Exact, None, Smooth, Neural };
 
 struct PathLengthOptions {
   LengthWrap wrap = LengthWrap::Exact;  ///< None: straight segments, no wraps
-  WrapMassOptions wrap_model;           ///< Smooth, Neural: the model's settings (width, network, monitor)
+  WrapMassOptions wrap_model;           ///< Smooth, Neural: the model's settings (width, network)
+  WrapFallbackMonitor* monitor = nullptr;  ///< Neural: receives the fallback counts (may be null)
   bool all_paths = false;               ///< every force with a path, not only muscles
   bool wrap_lengths = false;            ///< also the surface length of every wrap object
 };

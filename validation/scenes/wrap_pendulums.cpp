@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
@@ -66,11 +67,9 @@ double wrapPenetration(const Model& model, const Muscle& muscle, const State& s)
 
 WrapPendulumRun runWrapPendulum(const WrapPendulumSpec& spec, WrapMassOptions wrap, double duration, double tol) {
   const auto t0 = std::chrono::steady_clock::now();
-  std::shared_ptr<WrapFallbackMonitor> monitor;
-  if (wrap.model == WrapModel::Neural) {
-    monitor = std::make_shared<WrapFallbackMonitor>();
-    wrap.monitor = monitor;
-  }
+  // Neural: the run's counts, summed from the integrator's and the energies' workspaces
+  std::optional<WrapFallbackMonitor> monitor;
+  if (wrap.model == WrapModel::Neural) monitor.emplace();
   const Model m = doublePendulum();
   const Muscle mu = makeWrapPendulumMuscle(spec, wrap);
   System sys(m);
@@ -92,6 +91,10 @@ WrapPendulumRun runWrapPendulum(const WrapPendulumSpec& spec, WrapMassOptions wr
   for (int k = 1; k <= n; ++k) {
     integ->advance(sys, s, 0.01 * k);
     const double E = energy(s), d = wrapPenetration(m, mu, s);
+    if (monitor) {
+      takeWrapFallbackCounts(sys, *integ->lastWorkspace(), *monitor);
+      takeWrapFallbackCounts(sys, ws, *monitor);
+    }
     r.max_drift = std::max(r.max_drift, std::abs(E - r.E0));
     r.max_step_change = std::max(r.max_step_change, std::abs(E - E_prev));
     r.contact_changes += (d > 0) != (d_prev > 0);

@@ -50,8 +50,7 @@ struct WrapPendulumRun {
 };
 
 /// Simulate a spec for `duration` s with rk45 (rtol = atol = tol) under wrap model `wrap`; for
-/// Neural a monitor is attached (its counts land in the result; a monitor already in `wrap` is
-/// replaced for the run).
+/// Neural the run's fallback counts (summed from its workspaces) land in the result.
 WrapPendulumRun runWrapPendulum(const WrapPendulumSpec& spec, WrapMassOptions wrap, double duration, double tol = 1e-12);
 
 /// The group's table, one line per pendulum (spec, drift, steps, fallbacks).

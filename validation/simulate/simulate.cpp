@@ -428,6 +428,13 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
     res.stats.failed_steps += st.failed_steps;
   };
 
+  // the network wrap model's counts live in the workspaces: the integrator's and the energies'
+  auto take_counts = [&] {
+    if (!options.wrap_fallbacks) return;
+    if (DynamicsWorkspace* iw = integ->lastWorkspace()) takeWrapFallbackCounts(sys, *iw, *options.wrap_fallbacks);
+    takeWrapFallbackCounts(sys, ws, *options.wrap_fallbacks);
+  };
+
   const auto start = std::chrono::steady_clock::now();
   State s = initial;
   checkAdvanceArguments(sys, s, t1, "simulate");
@@ -450,10 +457,12 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
       break;
     }
     restart = adaptive && targets[k].brk;
+    take_counts();  // before a restart drops the integrator's workspace
     if (!targets[k].row) continue;
     ok = record(s);
     if (options.on_row) options.on_row(s.t);
   }
+  take_counts();
   add_stats(integ->stats());
   if (res.failed && res.failure_step == 0.0) res.failure_step = adaptive ? 0.0 : dt;
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

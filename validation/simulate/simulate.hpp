@@ -130,6 +130,9 @@ struct SimulateOptions {
   /// called after every output row; a non-empty return stops the run as a failure with that message
   /// (studies use it to call a run unstable, e.g. when its energy grows)
   std::function<std::string(const State& s, double kinetic, double potential)> check;
+  /// network wrap model: receives the fallback counts of the run's workspaces after every span
+  /// (so its sink warns early); null: not counted. Only simulate() (the core engine) fills it.
+  WrapFallbackMonitor* wrap_fallbacks = nullptr;
 };
 
 struct SimulationResult {

@@ -36,7 +36,6 @@ SimulationResult simulateSimbody(const SimulationModel& m, const State& initial,
     throw std::invalid_argument("the duration must be a positive number of seconds");
   if (!(so.output_dt >= 0.0) || !std::isfinite(so.output_dt))
     throw std::invalid_argument("the output interval must be a positive number of seconds");
-  const Model& model = m.system->model();
   simbody::ParticleSimulationOptions po;
   po.integrator = so.integrator == "cvode" ? "cpodes" : "merson";
   po.accuracy = so.integrator_options.rtol;
@@ -54,7 +53,7 @@ SimulationResult simulateSimbody(const SimulationModel& m, const State& initial,
   SimulationResult res = makeStatesResult(m);
 
   const auto start = std::chrono::steady_clock::now();
-  simbody::ParticleSimulation sim(model, m.build.model.muscles(), initial, po);
+  simbody::ParticleSimulation sim(m.build.model, initial, po);
   StateRecorder recorder(res);
   auto record = [&](const State& s) -> bool {
     return recorder.add(s.t, s.q, s.qdot, sim.kineticEnergy(), sim.potentialEnergy(), " (Simbody)");

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <regex>
 #include <sstream>
@@ -447,8 +448,10 @@ std::string wrapModelName(WrapModel model) {
 }
 
 // rk45 rtol = atol = 1e-12 from s0, total energy and the penetration every 10 ms; the jumps at
-// the penetration's sign changes
-void measureWrapJumps(const System& sys, const State& s0, const Muscle& mu, double duration, WrapJumpCase& c) {
+// the penetration's sign changes; `monitor` (may be null) gets the integrator's wrap-model counts
+// (the energy samples' own evaluations are not counted)
+void measureWrapJumps(const System& sys, const State& s0, const Muscle& mu, double duration, WrapJumpCase& c,
+                      WrapFallbackMonitor* monitor = nullptr) {
   const Model& m = sys.model();
   IntegratorOptions io;
   io.rtol = 1e-12;
@@ -462,6 +465,7 @@ void measureWrapJumps(const System& sys, const State& s0, const Muscle& mu, doub
   const double c0 = cpuSeconds();
   for (int k = 1; k <= n; ++k) {
     integ->advance(sys, s, s0.t + 0.01 * k);
+    if (monitor) takeWrapFallbackCounts(sys, *integ->lastWorkspace(), *monitor);
     E[k] = energy(sys, s);
     d[k] = wrapPenetration(m, mu, s);
     c.drift = std::max(c.drift, std::abs(E[k] - c.energy0));
@@ -508,8 +512,8 @@ WrapJumpCase runWrapJumpCase(const std::string& models_dir, WrapModel model, dou
 
 WrapJumpCase runWrapJumpCaseInBox(WrapMassOptions wrap, double duration) {
   const scenes::WrapPendulumSpec spec;
-  std::shared_ptr<WrapFallbackMonitor> monitor;
-  if (wrap.model == WrapModel::Neural) wrap.monitor = monitor = std::make_shared<WrapFallbackMonitor>();
+  std::optional<WrapFallbackMonitor> monitor;
+  if (wrap.model == WrapModel::Neural) monitor.emplace();
   const Muscle mu = scenes::makeWrapPendulumMuscle(spec, wrap);
   const Model m = scenes::doublePendulum();
   System sys(m);
@@ -520,7 +524,7 @@ WrapJumpCase runWrapJumpCaseInBox(WrapMassOptions wrap, double duration) {
   WrapJumpCase c;
   c.model = wrapModelName(wrap.model);
   c.scene = "in_box";
-  measureWrapJumps(sys, s0, mu, duration, c);
+  measureWrapJumps(sys, s0, mu, duration, c, monitor ? &*monitor : nullptr);
   if (monitor) {
     c.evaluations = monitor->evaluations(mu.name);
     c.fallbacks = monitor->fallbacks(mu.name);

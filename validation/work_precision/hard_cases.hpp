@@ -154,7 +154,7 @@ WrapJumpCase runWrapJumpCase(const std::string& models_dir, WrapModel model, dou
 /// The same measurement on the code-built pendulum scenes::WrapPendulumSpec{}
 /// (validation/scenes/wrap_pendulums.hpp: end points 2.8 radii from the axis, inside the committed
 /// networks' training box, where WrapModel::Neural runs without falling back) with wrap options
-/// `wrap` (for Neural: its network; a fallback monitor is attached here).
+/// `wrap` (for Neural: its network; the integrator's fallback counts land in the result).
 WrapJumpCase runWrapJumpCaseInBox(WrapMassOptions wrap, double duration);
 
 struct HardCasesResult {

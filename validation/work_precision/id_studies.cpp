@@ -70,7 +70,8 @@ IdStudyRow solveRow(const MassSweepEngineFactory& factory, const osim::MuscleMas
   MassSweepEngine e = factory(o);
   r.muscle_mass = e.muscle_mass;
   r.muscles_with_mass = e.muscles_with_mass;
-  for (const auto& m : e.muscles) r.points_total += m.mass_points.size();
+  if (e.model)
+    for (const auto& m : e.model->muscles()) r.points_total += m.mass_points.size();
   r.cpu_per_frame_s = solveFrames(*e.engine, frames, ncol, min_timing_s, r.tau);
   return r;
 }

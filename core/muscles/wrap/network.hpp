@@ -67,7 +67,7 @@ class Mlp {
   /// "6x256" style description of the hidden layers
   std::string architecture() const;
 
-  /// Weights of layer l (n_{l+1} x n_l) and biases (n_{l+1}); mutable for training.
+  /// Weights of layer l (n_{l+1} x n_l) and biases (n_{l+1}); writable for training.
   MatX& weights(int l) { return W_[l]; }
   VecX& biases(int l) { return b_[l]; }
   const MatX& weights(int l) const { return W_[l]; }

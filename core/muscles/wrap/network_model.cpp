@@ -13,8 +13,6 @@ namespace redmax {
 
 namespace {
 
-thread_local NetworkWrapEval last_eval;  // lastNetworkWrapEval()
-
 std::string num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", v);
@@ -111,7 +109,6 @@ NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface,
                                      bool with_jdot, WrapMassPoints& out, NetworkWrapWorkspace& ws,
                                      const NetworkWrapOptions& options, const std::vector<double>& alphadots,
                                      std::vector<Vec3>* x_alpha, std::vector<Vec3>* x_alphadot) {
-  last_eval = NetworkWrapEval{};
   const std::string why = smoothWrapUnsupportedReason(surface);
   if (!why.empty()) throw std::invalid_argument("network wrap: " + why);
   if (net) {
@@ -156,7 +153,6 @@ NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface,
         }
       }
   }
-  last_eval = ev;
 
   if (ev.usedNetwork()) {
     const double R = surface.radius, c = 1.0 / R;
@@ -208,63 +204,72 @@ NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface,
   return ev;
 }
 
-const NetworkWrapEval& lastNetworkWrapEval() { return last_eval; }
-
 // ---------------------------------------------------------------------------------------------
+
+void WrapFallbackCounts::record(const NetworkWrapEval& e, int wrap) {
+  ++evaluations;
+  if (e.usedNetwork()) return;
+  ++by_reason[static_cast<int>(e.fallback)];
+  if (fallbacks++ > 0) return;
+  first = e;
+  first_wrap = wrap;
+}
 
 WrapFallbackMonitor::WrapFallbackMonitor(Sink sink) : sink_(std::move(sink)) {}
 
+void WrapFallbackMonitor::warnFirst(const std::string& muscle, const std::string& wrap, long before, const Counts& c) {
+  if (before > 0 || c.fallbacks == 0 || !sink_) return;
+  sink_("muscle '" + muscle + "', wrap object '" + wrap + "': the network wrap model fell back to the smooth model (" +
+        c.first + "); further fallbacks of this muscle are counted in the run summary");
+}
+
 void WrapFallbackMonitor::record(const std::string& muscle, const std::string& wrap, const NetworkWrapEval& e,
                                  const Mlp* net) {
-  std::string message;
-  Sink sink;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    Counts& c = counts_[muscle];
-    ++c.evaluations;
-    if (e.usedNetwork()) return;
-    ++c.by_reason[e.fallback];
-    if (++c.fallbacks > 1) return;
-    c.first = e.describe(net);
-    message = "muscle '" + muscle + "', wrap object '" + wrap +
-              "': the network wrap model fell back to the smooth model (" + c.first +
-              "); further fallbacks of this muscle are counted in the run summary";
-    sink = sink_;
-  }
-  if (sink) sink(message);  // outside the lock: the sink may take its time
+  Counts& c = counts_[muscle];
+  ++c.evaluations;
+  if (e.usedNetwork()) return;
+  ++c.by_reason[e.fallback];
+  const long before = c.fallbacks++;
+  if (before == 0) c.first = e.describe(net);
+  warnFirst(muscle, wrap, before, c);
 }
 
-void WrapFallbackMonitor::setSink(Sink sink) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  sink_ = std::move(sink);
+void WrapFallbackMonitor::add(const Muscle& muscle, const WrapFallbackCounts& w) {
+  if (w.evaluations == 0) return;
+  Counts& c = counts_[muscle.name];
+  const long before = c.fallbacks;
+  c.evaluations += w.evaluations;
+  c.fallbacks += w.fallbacks;
+  for (int i = 1; i < WrapFallbackCounts::kReasons; ++i)
+    if (w.by_reason[i] > 0) c.by_reason[static_cast<NetworkWrapFallback>(i)] += w.by_reason[i];
+  if (before > 0 || w.fallbacks == 0) return;
+  c.first = w.first.describe(muscle.wrap.network.get());
+  const auto& wraps = muscle.path.wraps;
+  const bool named = w.first_wrap >= 0 && w.first_wrap < static_cast<int>(wraps.size());
+  warnFirst(muscle.name, named ? wraps[w.first_wrap].name : std::string("?"), before, c);
 }
 
-std::map<std::string, WrapFallbackMonitor::Counts> WrapFallbackMonitor::counts() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return counts_;
-}
+void WrapFallbackMonitor::setSink(Sink sink) { sink_ = std::move(sink); }
+
+std::map<std::string, WrapFallbackMonitor::Counts> WrapFallbackMonitor::counts() const { return counts_; }
 
 long WrapFallbackMonitor::fallbacks(const std::string& muscle) const {
-  std::lock_guard<std::mutex> lock(mutex_);
   const auto it = counts_.find(muscle);
   return it == counts_.end() ? 0 : it->second.fallbacks;
 }
 
 long WrapFallbackMonitor::evaluations(const std::string& muscle) const {
-  std::lock_guard<std::mutex> lock(mutex_);
   const auto it = counts_.find(muscle);
   return it == counts_.end() ? 0 : it->second.evaluations;
 }
 
 long WrapFallbackMonitor::totalFallbacks() const {
-  std::lock_guard<std::mutex> lock(mutex_);
   long t = 0;
   for (const auto& [name, c] : counts_) t += c.fallbacks;
   return t;
 }
 
 std::string WrapFallbackMonitor::summary() const {
-  std::lock_guard<std::mutex> lock(mutex_);
   std::ostringstream os;
   for (const auto& [name, c] : counts_) {
     os << "  " << name << ": " << c.fallbacks << " of " << c.evaluations
@@ -279,30 +284,21 @@ std::string WrapFallbackMonitor::summary() const {
   return os.str();
 }
 
-void WrapFallbackMonitor::reset() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  counts_.clear();
-}
+void WrapFallbackMonitor::reset() { counts_.clear(); }
 
 // ---------------------------------------------------------------------------------------------
 
 NetworkWrapEval calcNeuralWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
                                           const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
                                           const std::vector<double>& alphas, const std::vector<double>& alphadots,
-                                          bool velocity, WrapMassPoints& out, std::vector<Vec3>* x_alpha,
-                                          std::vector<Vec3>* x_alphadot) {
-  thread_local NetworkWrapWorkspace ws;
+                                          bool velocity, WrapMassPoints& out, NetworkWrapWorkspace& ws,
+                                          std::vector<Vec3>* x_alpha, std::vector<Vec3>* x_alphadot) {
   NetworkWrapOptions o;
   o.fd_jdot = options.network_fd_jdot;
   o.fd_eps = options.network_fd_eps > 0.0 ? options.network_fd_eps : 1e-6;
   o.fallback.width = options.width;
   return calcNetworkWrapModel(options.network.get(), surface, p1, p2, p1dot, p2dot, alphas, velocity, out, ws, o,
                               alphadots, x_alpha, x_alphadot);
-}
-
-void recordNeuralWrapEval(const Muscle& muscle, const PathWrap& w) {
-  if (muscle.wrap.model != WrapModel::Neural || !muscle.wrap.monitor) return;
-  muscle.wrap.monitor->record(muscle.name, w.name, lastNetworkWrapEval(), muscle.wrap.network.get());
 }
 
 std::shared_ptr<const Mlp> loadWrapNetwork(const std::string& path) {

@@ -29,10 +29,15 @@
 // The fallback model is C2 but not equal to the network, so a switch between them moves the
 // points: a run that falls back mid-way is not energy-consistent at the switch (callers count and
 // warn; WrapFallbackMonitor).
+//
+// Counting. An evaluation's outcome is its return value; a muscle's outcomes are counted in its
+// workspace (MuscleKinematics::wrap_counts, WrapFallbackCounts), never in model data, so threads
+// with their own workspaces count without sharing anything. Callers that report fallbacks sum
+// the counts of the workspaces they evaluated in into one WrapFallbackMonitor.
+#include <array>
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
@@ -94,8 +99,8 @@ std::string neuralWrapUnsupportedReason(const Mlp* net, const WrapSurface& surfa
 /// The network's mass points at fractions alphas over `surface` (frame s), see the header; the
 /// fractions move at `alphadots` (empty: all fixed), which enter Jdot (alpha is a network input).
 /// With with_jdot false, Jdot is zero and no velocity pass is made. When x_alpha / x_alphadot are
-/// given they receive dw/dalpha (m) and its time derivative along (p1dot, p2dot, alphadot). Every
-/// call records its outcome for lastNetworkWrapEval(). std::invalid_argument for an unusable
+/// given they receive dw/dalpha (m) and its time derivative along (p1dot, p2dot, alphadot). Returns
+/// the outcome. std::invalid_argument for an unusable
 /// network or surface (neuralWrapUnsupportedReason), an end point inside the surface or coincident
 /// end points (as the smooth model).
 NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
@@ -105,14 +110,25 @@ NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface,
                                      const std::vector<double>& alphadots = {}, std::vector<Vec3>* x_alpha = nullptr,
                                      std::vector<Vec3>* x_alphadot = nullptr);
 
-/// The outcome of this thread's last calcNetworkWrapModel call (for callers that see only the
-/// points, e.g. the muscle-level monitor after the wrap-model dispatch).
-const NetworkWrapEval& lastNetworkWrapEval();
+/// One muscle's network wrap-model outcomes in one workspace (MuscleKinematics::wrap_counts): the
+/// wrap-model dispatch adds to them, callers sum them (WrapFallbackMonitor::add).
+struct WrapFallbackCounts {
+  static constexpr int kReasons = static_cast<int>(NetworkWrapFallback::OutsideBox) + 1;
+  long evaluations = 0;                  ///< calls of the wrap model
+  long fallbacks = 0;                    ///< of which the smooth model gave the points
+  std::array<long, kReasons> by_reason{};  ///< per NetworkWrapFallback (index None unused)
+  NetworkWrapEval first;                 ///< the first fallback (fallback None: none yet)
+  int first_wrap = -1;                   ///< its wrap object, index into path.wraps
+
+  void record(const NetworkWrapEval& e, int wrap);
+};
 
 /// Per-muscle run summary of the network wrap model: evaluations, fallbacks and the first reason.
 /// The core never prints: the first fallback of each muscle is passed to the sink (the CLI prints
-/// it as a warning); later ones are only counted. Thread-safe; share one monitor between muscles
-/// (they are told apart by name).
+/// it as a warning); later ones are only counted. Not thread-safe: it is the caller's, filled
+/// from one thread with the counts of the workspaces it evaluated in (add(), or
+/// takeWrapFallbackCounts in core/dynamics/muscle_term.hpp); share one between muscles (they are
+/// told apart by name).
 class WrapFallbackMonitor {
  public:
   using Sink = std::function<void(const std::string& message)>;
@@ -127,6 +143,9 @@ class WrapFallbackMonitor {
   /// count one evaluation of muscle `muscle` (wrap object `wrap`); on its first fallback, tell the
   /// sink "muscle 'M', wrap object 'W': the network wrap model fell back to the smooth model (...)"
   void record(const std::string& muscle, const std::string& wrap, const NetworkWrapEval& e, const Mlp* net);
+  /// add a workspace's counts of `muscle` (its name, wrap names and network); the sink hears of the
+  /// muscle's first fallback as record() would tell it
+  void add(const Muscle& muscle, const WrapFallbackCounts& c);
   void setSink(Sink sink);
 
   std::map<std::string, Counts> counts() const;
@@ -140,24 +159,21 @@ class WrapFallbackMonitor {
   void reset();
 
  private:
-  mutable std::mutex mutex_;
+  /// after c's fallbacks grew from `before`: tell the sink of the muscle's first one
+  void warnFirst(const std::string& muscle, const std::string& wrap, long before, const Counts& c);
   Sink sink_;
   std::map<std::string, Counts> counts_;
 };
 
 /// The Neural case of the wrap-model dispatch (core/muscles/wrap_muscle.cpp calcWrapModelPoints):
 /// calcNetworkWrapModel with the network and options of `options` (network_fd_jdot,
-/// network_fd_eps, width of the fallback) and a thread-local workspace.
+/// network_fd_eps, width of the fallback) in the caller's workspace `ws`.
 NetworkWrapEval calcNeuralWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
                                           const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
                                           const std::vector<double>& alphas, const std::vector<double>& alphadots,
-                                          bool velocity, WrapMassPoints& out, std::vector<Vec3>* x_alpha = nullptr,
+                                          bool velocity, WrapMassPoints& out, NetworkWrapWorkspace& ws,
+                                          std::vector<Vec3>* x_alpha = nullptr,
                                           std::vector<Vec3>* x_alphadot = nullptr);
-
-/// After a muscle's wrap-model evaluation over wrap object w: when muscle.wrap.model is Neural and
-/// muscle.wrap.monitor is set, record lastNetworkWrapEval() for the muscle (count; first fallback
-/// to the sink). No-op otherwise.
-void recordNeuralWrapEval(const Muscle& muscle, const PathWrap& w);
 
 /// Input layout of the network of a surface type: origin (3), insertion (3), alpha, then the
 /// size parameters: radius (cylinder, sphere), semi-axes a b c (ellipsoid), inner and outer

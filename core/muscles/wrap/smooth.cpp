@@ -238,11 +238,8 @@ bool closestOnEllipsoid(const Vec3& a, const V3<T>& q, const std::array<int, 3>&
   return true;
 }
 
-// the fan's parameters on values, per thread for the last chord: the derivative passes of a
-// point share them
+// the fan's closest-point parameters on values
 struct FanParameters {
-  bool used = false;
-  Vec3 a = Vec3::Zero(), r1c = Vec3::Zero(), r1r2 = Vec3::Zero();
   std::array<double, kFanSamples> t{};
   std::array<char, kFanSamples> ok{};
 };
@@ -305,42 +302,6 @@ struct EllipsoidArc {
   }
 };
 
-// bitwise equality of scalars with all their dual parts (cache keys)
-inline bool sameScalar(double x, double y) { return x == y || (x != x && y != y); }
-template <class T> bool sameScalar(const Dual<T>& x, const Dual<T>& y) { return sameScalar(x.a, y.a) && sameScalar(x.b, y.b); }
-template <class T> bool sameVec(const V3<T>& u, const V3<T>& v) {
-  return sameScalar(u[0], v[0]) && sameScalar(u[1], v[1]) && sameScalar(u[2], v[2]);
-}
-
-// the last few alpha-independent constructions per thread, keyed by the surface's size and the
-// end points with all their dual parts: a muscle's mass points (same end points, several alphas)
-// and the derivative passes of one point share them. Correctness does not depend on a hit.
-template <class S, class T>
-struct SetupCache {
-  struct Entry {
-    bool used = false;
-    Vec3 size = Vec3::Zero();
-    V3<T> p1{}, p2{};
-    bool ok = false;
-    S setup{};
-  };
-  std::array<Entry, 8> entries;
-  int next = 0;
-  template <class F>
-  const Entry& get(const Vec3& size, const V3<T>& p1, const V3<T>& p2, const F& make) {
-    for (const Entry& e : entries)
-      if (e.used && e.size == size && sameVec(e.p1, p1) && sameVec(e.p2, p2)) return e;
-    Entry& e = entries[next];
-    next = (next + 1) % static_cast<int>(entries.size());
-    e.used = true;
-    e.size = size;
-    e.p1 = p1;
-    e.p2 = p2;
-    e.ok = make(e.setup);
-    return e;
-  }
-};
-
 // everything of the ellipsoid path that does not depend on alpha, in the library's scaled
 // coordinates
 template <class T>
@@ -393,16 +354,10 @@ bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, E
   }
   if (value(mub) < kMuBlendMax) {
     const std::array<int, 3> all{0, 1, 2};
-    static thread_local FanParameters fan;
-    const Vec3 r1cv = values(r1c), r1r2v = values(r1r2);
-    if (!fan.used || fan.a != a || fan.r1c != r1cv || fan.r1r2 != r1r2v) {
-      fan.used = true;
-      fan.a = a;
-      fan.r1c = r1cv;
-      fan.r1r2 = r1r2v;
-      for (int i = 1; i < kFanSamples - 1; ++i)
-        fan.ok[i] = closestParameterPolished(a, values(r1c + (static_cast<double>(i) / kFanSamples) * r1r2), all, 3, fan.t[i]);
-    }
+    // solved on values once per setup (no memo across calls: core/ keeps no per-thread state)
+    FanParameters fan;
+    for (int i = 1; i < kFanSamples - 1; ++i)
+      fan.ok[i] = closestParameterPolished(a, values(r1c + (static_cast<double>(i) / kFanSamples) * r1r2), all, 3, fan.t[i]);
     V3<T> v_sum{T(0.0), T(0.0), T(0.0)}, cp = c1;
     for (int i = 1; i < kFanSamples - 1; ++i) {
       const V3<T> svi = r1c + (static_cast<double>(i) / kFanSamples) * r1r2;
@@ -455,10 +410,8 @@ bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, E
 template <class T>
 bool ellipsoidPoint(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, const Alpha<T>& alpha, V3<T>& x,
                     T* total_out = nullptr) {
-  static thread_local SetupCache<EllipsoidWrap<T>, T> cache;
-  const auto& entry = cache.get(surf.dimensions, P1, P2, [&](EllipsoidWrap<T>& ew) { return ellipsoidSetup(surf, P1, P2, ew); });
-  if (!entry.ok) return false;
-  const EllipsoidWrap<T>& ew = entry.setup;
+  EllipsoidWrap<T> ew;
+  if (!ellipsoidSetup(surf, P1, P2, ew)) return false;
   const EllipsoidArc<T>& arc = ew.arc;
   // the point at fraction alpha of p1 -> r1 -> arc -> r2 -> p2 (scaled back)
   if (total_out) *total_out = ew.total / ew.factor;
@@ -563,12 +516,8 @@ V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, con
     // the smooth quadrant cylinder in the anchor's frame (lengths and blends are frame-free);
     // where the library does not wrap at all (no anchor, an end inside the local cylinder) the
     // straight path
-    // the anchor and frame do not depend on alpha: shared by a muscle's mass points (per thread)
-    static thread_local SetupCache<TorusFrame<T>, T> cache;
-    const Vec3 key(surf.outer_radius, surf.quadrant_axis, surf.quadrant_sign);
-    const auto& entry = cache.get(key, p1, p2, [&](TorusFrame<T>& fr) { return torusFrame(surf, p1, p2, fr); });
-    const TorusFrame<T>& f = entry.setup;
-    const bool ok = entry.ok;
+    TorusFrame<T> f;
+    const bool ok = torusFrame(surf, p1, p2, f);
     const WrapSurface cyl = torusCylinder(surf);
     const double ri = cyl.radius;
     const Vec3 q1 = values(f.q1), q2 = values(f.q2);

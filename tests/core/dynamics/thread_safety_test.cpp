@@ -4,7 +4,8 @@
 // serial run; states are dealt round-robin and solved backwards. The term's scratch holds one
 // evaluation: after calcMassAndForce it is tagged with the workspace's evaluation counter, a new
 // state moves the counter on, and a workspace bound to another system gets new slots.
-// (The real-model version, sets E and F, is tests/validation/thread_safety_test.cpp.)
+// The network wrap model's fallback counts, summed over the threads' workspaces, equal the serial
+// run's. (The real-model version, sets E and F, is tests/validation/thread_safety_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <random>
@@ -16,7 +17,9 @@
 #include "core/dynamics/system.hpp"
 #include "tests/core/dynamics/random_muscle.hpp"
 #include "tests/core/muscles/muscle_test_util.hpp"
+#include "core/muscles/wrap/network_model.hpp"
 #include "validation/scenes/scenes.hpp"
+#include "validation/scenes/wrap_pendulums.hpp"
 
 namespace redmax {
 namespace {
@@ -84,6 +87,72 @@ TEST(ThreadSafety, FourThreadsOnOneSystemEqualTheSerialRunBitForBit) {
   // the loads are an input: they change tau (the check above compares something)
   DynamicsWorkspace bare(sys);
   EXPECT_FALSE(sys.inverseDynamics(samples[0].s, samples[0].qddot, bare) == serial[0].tau);
+}
+
+// The network wrap model counts its fallbacks in each workspace (no shared counter): two wrapping
+// muscles, one inside the committed network's training box (the network) and one outside it (the
+// smooth fallback), evaluated by 4 threads give the serial run's results and, summed over the
+// threads' workspaces, its counts.
+TEST(ThreadSafety, NetworkWrapFallbackCountsSummedOverThreadsEqualTheSerialRun) {
+  const Model m = scenes::doublePendulum();
+  WrapMassOptions neural;
+  neural.model = WrapModel::Neural;
+  neural.network = loadWrapNetwork(std::string(REDMAX_SOURCE_DIR) + "/osim_models/networks/cylinder_3x64.txt");
+  Muscle in_box = scenes::makeWrapPendulumMuscle(scenes::WrapPendulumSpec{}, neural);
+  in_box.name = "in_box";
+  scenes::WrapPendulumSpec far;  // osim_models/double_pendulum_wrap.osim's end points, 5 radii out
+  far.origin = Vec3(-0.1, -0.6, 0);
+  far.insertion = Vec3(-0.1, -0.4, 0);
+  Muscle outside = scenes::makeWrapPendulumMuscle(far, neural);
+  outside.name = "outside";
+  System sys(m);
+  sys.addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{in_box, outside}));
+  std::mt19937 rng(5);
+  std::vector<Sample> samples(24);
+  for (Sample& x : samples) {
+    x.s = test::randomState(m.nr(), rng, 0.3);
+    x.qddot = test::randomState(m.nr(), rng).qdot;
+  }
+
+  std::vector<Result> serial;
+  DynamicsWorkspace ws(sys);
+  for (const Sample& x : samples) serial.push_back(evaluate(sys, x, ws));
+  WrapFallbackMonitor serial_counts;
+  takeWrapFallbackCounts(sys, ws, serial_counts);
+
+  constexpr int kThreads = 4;
+  std::vector<Result> parallel(samples.size());
+  std::vector<DynamicsWorkspace> own;
+  for (int j = 0; j < kThreads; ++j) own.emplace_back(sys);
+  std::vector<std::thread> pool;
+  for (int j = 0; j < kThreads; ++j)
+    pool.emplace_back([&, j] {
+      for (size_t k = 0; k < samples.size(); ++k)
+        if (static_cast<int>(k % kThreads) == j) parallel[k] = evaluate(sys, samples[k], own[j]);
+    });
+  for (auto& th : pool) th.join();
+  WrapFallbackMonitor summed;
+  for (DynamicsWorkspace& w : own) takeWrapFallbackCounts(sys, w, summed);
+
+  for (size_t k = 0; k < samples.size(); ++k) {
+    EXPECT_TRUE(parallel[k].tau == serial[k].tau) << "sample " << k;
+    EXPECT_TRUE(parallel[k].qddot == serial[k].qddot) << "sample " << k;
+  }
+  const auto a = serial_counts.counts(), b = summed.counts();
+  ASSERT_EQ(a.size(), 2u);
+  for (const auto& [name, c] : a) {
+    ASSERT_EQ(b.count(name), 1u) << name;
+    EXPECT_EQ(b.at(name).evaluations, c.evaluations) << name;
+    EXPECT_EQ(b.at(name).fallbacks, c.fallbacks) << name;
+    EXPECT_EQ(b.at(name).by_reason, c.by_reason) << name;
+  }
+  // both paths ran
+  EXPECT_GE(a.at("in_box").evaluations, static_cast<long>(samples.size()));
+  EXPECT_LT(a.at("in_box").fallbacks, a.at("in_box").evaluations);
+  EXPECT_EQ(a.at("outside").fallbacks, a.at("outside").evaluations);
+  // taking zeroes the workspace's counts: nothing is added twice
+  takeWrapFallbackCounts(sys, ws, serial_counts);
+  EXPECT_EQ(serial_counts.evaluations("in_box"), a.at("in_box").evaluations);
 }
 
 TEST(ThreadSafety, TermScratchHoldsOneEvaluationOfItsSystem) {
