@@ -1,0 +1,135 @@
+// The ForwardTool library (validation/forward/forward_tool.hpp):
+//   - CoordinateActuators driven by a ControlSet add optimal_force * u to f (the double pendulum);
+//   - OpenSim 3 state names in a states file, closest earlier row;
+//   - OpenSim's own ForwardTool standard for arm26 (Applications/Forward/tests: Thelen2003Muscle_
+//     Deprecated via --muscle-class, SO controls, initial states, std_arm26_states.sto): every state
+//     at the first and last rows within OpenSim's 5e-3 (testForward.cpp), and the RMS of every
+//     state over the run within a bound near the measured one (docs/forward.md).
+#include "validation/forward/forward_tool.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+namespace redmax::validation {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string shared(const std::string& rel) { return std::string(REDMAX_SHARED_DIR) + "/opensim/" + rel; }
+
+struct TempDir {
+  TempDir() : path(fs::temp_directory_path() / ("redmax_forward_tool_" + std::to_string(::getpid()))) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path / name) << text;
+    return (path / name).string();
+  }
+  fs::path path;
+};
+
+TEST(ForwardTool, CoordinateActuatorsAddOptimalForceTimesControl) {
+  const std::string model = shared("opensim-models/Models/DoublePendulum/double_pendulum.osim");
+  if (!fs::exists(model)) GTEST_SKIP() << "shared OpenSim data not found: " << model;
+  TempDir dir;
+  dir.write("c.xml", "<ControlSet><objects><ControlLinear name=\"Torq2.excitation\"><x_nodes>"
+                     "<ControlLinearNode><t>0</t><value>3</value></ControlLinearNode>"
+                     "</x_nodes></ControlLinear></objects></ControlSet>");
+  dir.write("states.sto", "s\nversion=1\nnRows=2\nnColumns=3\ninDegrees=no\nendheader\n"
+                          "time\tq1\tq2_u\n0\t0.1\t0.5\n0.5\t0.2\t-0.5\n");
+  ForwardToolSettings s;
+  s.setup_file = dir.write("setup.xml", "<ForwardTool name=\"p\"><model_file>" + model +
+                                            "</model_file><initial_time>0.4</initial_time>"
+                                            "<final_time>0.5</final_time><controls_file>c.xml</controls_file>"
+                                            "<states_file>states.sto</states_file></ForwardTool>");
+  const ForwardTool tool(s);
+  const System& sys = tool.system();
+  ASSERT_EQ(sys.controlNames(), (std::vector<std::string>{"Torq1", "Torq2"}));
+  // the closest earlier row (t = 0), OpenSim 3 names
+  const State& s0 = tool.initialState();
+  EXPECT_DOUBLE_EQ(s0.t, 0.4);
+  EXPECT_DOUBLE_EQ(s0.q[0], 0.1);
+  EXPECT_DOUBLE_EQ(s0.qdot[1], 0.5);
+  // f with the controls minus f without: optimal_force (1) * 3 on q2
+  DynamicsWorkspace ws(sys);
+  sys.calcMassAndForce(s0, ws);
+  const VecX f = ws.f;
+  ASSERT_EQ(ws.controls.size(), 2);
+  EXPECT_DOUBLE_EQ(ws.controls[1], 3.0);
+  System bare(sys.model());
+  DynamicsWorkspace wb(bare);
+  bare.calcMassAndForce(s0, wb);
+  EXPECT_NEAR(f[1] - wb.f[1], 3.0, 1e-12);
+  EXPECT_NEAR(f[0] - wb.f[0], 0.0, 1e-12);
+  const ForwardResult r = tool.run();
+  ASSERT_FALSE(r.failed) << r.failure;
+  EXPECT_EQ(r.states.numRows(), 11);
+}
+
+// OpenSim 3 label of std_arm26_states.sto -> our column
+int ourColumn(const osim::Storage& ours, const std::string& label) {
+  std::string key;
+  if (label.find('.') != std::string::npos) {
+    key = "/forceset/" + label.substr(0, label.find('.')) + "/" + label.substr(label.find('.') + 1);
+    return ours.findColumn(key);
+  }
+  const bool speed = label.size() > 2 && label.compare(label.size() - 2, 2, "_u") == 0;
+  const std::string coord = speed ? label.substr(0, label.size() - 2) : label;
+  const std::string tail = "/" + coord + (speed ? "/speed" : "/value");
+  for (int j = 0; j < ours.numColumns(); ++j) {
+    const std::string& l = ours.labels[j];
+    if (l.size() >= tail.size() && l.compare(l.size() - tail.size(), tail.size(), tail) == 0) return j;
+  }
+  return -1;
+}
+
+TEST(ForwardTool, Arm26MatchesOpenSimsForwardStandard) {
+  const std::string dir = shared("opensim-core/Applications/Forward/tests/resources");
+  if (!fs::exists(dir + "/arm26_Setup_Forward.xml")) GTEST_SKIP() << "shared OpenSim data not found: " << dir;
+  const osim::Storage std_states = osim::readStorage(dir + "/std_arm26_states.sto");
+  ForwardToolSettings s;
+  s.setup_file = dir + "/arm26_Setup_Forward.xml";
+  s.muscle_class = "Thelen2003Muscle_Deprecated";
+  s.output_times = std_states.time;
+  std::unique_ptr<ForwardTool> tool;
+  try {
+    tool = std::make_unique<ForwardTool>(s);
+  } catch (const std::exception& e) {
+    FAIL() << e.what();
+  }
+  if (tool->system().numStates() == 0)
+    GTEST_SKIP() << "no Hill muscle model for Thelen2003Muscle_Deprecated in this build: the arm26 standard needs one";
+  const ForwardResult r = tool->run();
+  ASSERT_FALSE(r.failed) << r.failure;
+  ASSERT_EQ(r.states.numRows(), std_states.numRows());
+  double worst_end = 0.0;
+  for (int j = 0; j < std_states.numColumns(); ++j) {
+    const std::string& label = std_states.labels[j];
+    const int c = ourColumn(r.states, label);
+    ASSERT_GE(c, 0) << label;
+    const int last = std_states.numRows() - 1;
+    const double d0 = std::abs(r.states.data(0, c) - std_states.data(0, j));
+    const double d1 = std::abs(r.states.data(last, c) - std_states.data(last, j));
+    // testForward.cpp: every state at the first and last rows within 5e-3
+    EXPECT_LE(d0, 5e-3) << label;
+    EXPECT_LE(d1, 5e-3) << label;
+    worst_end = std::max(worst_end, d1);
+    double ss = 0.0;
+    for (int k = 0; k <= last; ++k) ss += std::pow(r.states.data(k, c) - std_states.data(k, j), 2);
+    const double rms = std::sqrt(ss / (last + 1));
+    std::printf("[ measured ] arm26 forward %-22s end %.3e  rms %.3e\n", label.c_str(), d1, rms);
+    EXPECT_LE(rms, 5e-4) << label;
+  }
+  std::printf("[ measured ] arm26 forward: worst end-row difference %.3e, %ld steps, %.3f s wall\n", worst_end,
+              r.stats.steps, r.wall_s);
+}
+
+}  // namespace
+}  // namespace redmax::validation
