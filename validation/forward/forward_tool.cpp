@@ -29,8 +29,9 @@ bool listsAll(const std::vector<std::string>& list) {
 
 // the muscle model of every muscle of the model (null: none)
 std::vector<std::shared_ptr<const hill::MuscleModel>> muscleModelsOf(const MusculoskeletalModel& model) {
-  // TODO(forward): MusculoskeletalModel::muscleModels() once the Hill models are on main
-  return std::vector<std::shared_ptr<const hill::MuscleModel>>(model.muscles().size());
+  std::vector<std::shared_ptr<const hill::MuscleModel>> models = model.muscleModels();
+  models.resize(model.muscles().size());
+  return models;
 }
 
 }  // namespace
