@@ -91,11 +91,14 @@ CommandRegistration reg(
                       "Thelen2003Muscle_Deprecated")
            ->type_name("CLASS");
        app.add_option("--integrator", f->integrator, "rk45 (default), cvode, or a fixed-step method")
+           ->type_name("euler|symplectic|bdf1|sdirk2|rk45|cvode")
            ->check(oneOf({"euler", "symplectic", "bdf1", "sdirk2", "rk45", "cvode"}));
        app.add_option("--report-interval", f->report_interval, "s between output rows (default 0.01)")
+           ->type_name("S")
            ->check(positive());
        app.add_option("--tolerance", f->tolerance,
                       "rtol = atol of the adaptive integrator (default: integrator_error_tolerance)")
+           ->type_name("T")
            ->check(positive());
        app.add_flag("--quiet", f->quiet, "no summary and no warnings");
        addMuscleMassFlags(app, f->mm);
