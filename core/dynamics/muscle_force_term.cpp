@@ -72,12 +72,51 @@ void MuscleForceTerm::evalPath(const Model& model, const State& s, const Skeleto
     e.speed = mk.lengthening_speed;
     return;
   }
-  // wrapped path (OpenSim's definition of the length): central differences over the path's columns
+  // wrapped path: OpenSim's length; the generalized force and the lengthening speed as OpenSim
+  // applies them, the tension along the final straight segments with every point held in its
+  // body (tangent points in their surface's body): d/dq of the polyline through the points frozen
+  // there, by central differences over the path's columns. A segment whose ends share a body
+  // keeps its length, so the arc over a surface adds nothing (docs/forward.md §3).
   if (mk.col_of.size() != static_cast<size_t>(model.nr())) initMuscleKinematics(model, path, mk);
-  e.length = calcWrappedPath(model, path, s.q.head(model.nr()), sk.E_wi).length;
+  const VecX q = s.q.head(model.nr());
+  const WrappedPath wp = calcWrappedPath(model, path, q, sk.E_wi);
+  e.length = wp.length;
+  struct Frozen {
+    int body;
+    Vec3 x_b;
+    int point;  // path point index (moving points are re-evaluated), -1 for a tangent point
+  };
+  std::vector<Frozen> pts;
+  pts.reserve(wp.points.size());
+  for (const WrappedPathPoint& p : wp.points) {
+    Frozen f{-1, p.x_w, p.point};
+    f.body = p.point >= 0 ? path.points[p.point].body : path.wraps[p.wrap].body;
+    if (f.body >= 0) {
+      const Mat4& E = sk.E_wi[f.body];
+      f.x_b = E.topLeftCorner<3, 3>().transpose() * (p.x_w - E.topRightCorner<3, 1>());
+    }
+    pts.push_back(f);
+  }
+  auto polyline = [&](const VecX& qq, const std::vector<Mat4>& E_wi) {
+    double L = 0.0;
+    Vec3 prev = Vec3::Zero();
+    for (size_t i = 0; i < pts.size(); ++i) {
+      Vec3 x_b = pts[i].x_b;
+      if (pts[i].point >= 0 && path.points[pts[i].point].kind == PathPointKind::Moving) {
+        Vec3 d1, d2;
+        calcPointLocation(path.points[pts[i].point], qq, x_b, d1, d2);
+      }
+      const Vec3 x = pts[i].body >= 0 ? Vec3(E_wi[pts[i].body].topLeftCorner<3, 3>() * x_b +
+                                             E_wi[pts[i].body].topRightCorner<3, 1>())
+                                      : x_b;
+      if (i > 0) L += (x - prev).norm();
+      prev = x;
+    }
+    return L;
+  };
   const int kc = static_cast<int>(mk.cols.size());
   e.dl_dq.setZero(kc);
-  sc.q = s.q.head(model.nr());
+  sc.q = q;
   if (sc.E_wi.size() != static_cast<size_t>(model.nb())) sc.E_wi.resize(model.nb());
   constexpr double h = 1e-7;
   for (int j = 0; j < kc; ++j) {
@@ -85,10 +124,10 @@ void MuscleForceTerm::evalPath(const Model& model, const State& s, const Skeleto
     const double q0 = sc.q[c];
     sc.q[c] = q0 + h;
     calcBodyPoses(model, sc.q, sc.E_wi);
-    const double lp = calcWrappedPath(model, path, sc.q, sc.E_wi).length;
+    const double lp = polyline(sc.q, sc.E_wi);
     sc.q[c] = q0 - h;
     calcBodyPoses(model, sc.q, sc.E_wi);
-    const double lm = calcWrappedPath(model, path, sc.q, sc.E_wi).length;
+    const double lm = polyline(sc.q, sc.E_wi);
     sc.q[c] = q0;
     e.dl_dq[j] = (lp - lm) / (2.0 * h);
   }

@@ -15,6 +15,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/dynamics/muscle_force_term.hpp"
+#include "core/muscles/path_kinematics.hpp"
+#include "core/skeleton/kinematics.hpp"
+
 namespace redmax::validation {
 namespace {
 
@@ -71,6 +75,45 @@ TEST(ForwardTool, CoordinateActuatorsAddOptimalForceTimesControl) {
   const ForwardResult r = tool.run();
   ASSERT_FALSE(r.failed) << r.failure;
   EXPECT_EQ(r.states.numRows(), 11);
+}
+
+// a wrapped (Type III) path: the generalized force direction is the polyline through the points
+// held in their bodies (OpenSim's); over a cylinder (a geodesic wrap) it equals d(length)/dq
+TEST(ForwardTool, WrappedPathForceDirectionIsTheLengthGradientOverACylinder) {
+  const std::string scene = std::string(REDMAX_SOURCE_DIR) + "/osim_models/double_pendulum_wrap.osim";
+  SimulationModel m = loadSimulationModel(scene, SimulationModelOptions{});
+  const MusculoskeletalModel& mm = m.build.model;
+  ASSERT_EQ(mm.numMuscles(), 1);
+  ASSERT_TRUE(mm.muscleModels()[0]) << "no force model for " << mm.muscleClasses()[0];
+  const Model& sk = mm.skeleton();
+  const MuscleForceTerm term(sk, mm.muscles(), mm.muscleModels());
+  int checked = 0;
+  for (double a : {0.3, 0.9, 1.6, 2.2}) {
+    State s;
+    s.q = VecX::Constant(sk.nr(), a);
+    s.q[0] = -0.4 * a;
+    s.qdot = VecX::LinSpaced(sk.nr(), 0.5, -1.0);
+    SkeletonWorkspace ws(sk);
+    calcKinematics(sk, s, ws);
+    double len, speed;
+    VecX dl;
+    term.calcPath(sk, s, ws, 0, len, speed, dl);
+    VecX fd(sk.nr());
+    std::vector<Mat4> E;
+    for (int j = 0; j < sk.nr(); ++j) {
+      VecX qp = s.q, qm = s.q;
+      qp[j] += 1e-6;
+      qm[j] -= 1e-6;
+      calcBodyPoses(sk, qp, E);
+      const double lp = calcPathLength(sk, mm.muscles()[0].path, qp, E);
+      calcBodyPoses(sk, qm, E);
+      fd[j] = (lp - calcPathLength(sk, mm.muscles()[0].path, qm, E)) / 2e-6;
+    }
+    EXPECT_LE((dl - fd).norm(), 1e-6 * (1 + fd.norm())) << "q = " << s.q.transpose();
+    EXPECT_NEAR(speed, fd.dot(s.qdot), 1e-6 * (1 + std::abs(speed)));
+    ++checked;
+  }
+  EXPECT_EQ(checked, 4);
 }
 
 // OpenSim 3 label of std_arm26_states.sto -> our column
