@@ -17,6 +17,7 @@
 
 #include "cli/muscle_mass_flags.hpp"
 #include "core/muscles/wrap/network_model.hpp"
+#include "validation/forward/forward_tool.hpp"
 #include "validation/report/progress.hpp"
 #include "validation/simulate/simulate.hpp"
 #include "validation/simulate/simulate_simbody.hpp"
@@ -51,7 +52,7 @@ std::vector<std::pair<std::string, double>> parseMassList(const std::string& tex
 const std::vector<std::string> kIntegrators = {"euler", "symplectic", "bdf1", "sdirk2", "rk45", "cvode"};
 
 struct SimulateFlags {
-  std::string model, out, initial, muscle_mass_kg, impulse, engine = "core";
+  std::string model, out, initial, muscle_mass_kg, impulse, engine = "core", controls;
   validation::SimulateOptions so;
   double initial_time = 0.0;
   bool no_qvv = false, progress = false, quiet = false, full_precision = false;
@@ -66,6 +67,7 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   const std::string &model_path = f.model, &out_path = f.out, &engine = f.engine;
   for (const char* n : {"--simbody-method", "--simbody-norm"})
     if (given(app, n) && engine != "simbody") throw UsageError{std::string(n) + " needs --engine simbody"};
+  if (given(app, "--controls") && engine != "core") throw UsageError{"--controls needs --engine core"};
   validation::SimbodyEngineOptions simbody_flags;
   simbody_flags.method = f.simbody_method;
   simbody_flags.infinity_norm = f.simbody_norm == "inf";
@@ -103,16 +105,29 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   // model and initial state: every problem here is the user's input (exit 2)
   validation::SimulationModel model;
   State initial;
+  std::vector<std::string> control_warnings;
   try {
     model = validation::loadSimulationModel(model_path, mo);
+    if (given(app, "--controls")) {
+      // the muscles and actuators as forces, driven by the file (validation/forward/forward_tool.hpp)
+      validation::addActuatorTerms(model, control_warnings);
+      validation::addControlsFile(*model.system, f.controls, control_warnings);
+    }
     if (given(app, "--initial")) {
       const osim::Storage table = osim::readStorage(f.initial);
       initial = validation::initialStateFromStorage(
           model, table, f.initial,
           given(app, "--initial-time") ? f.initial_time : std::numeric_limits<double>::quiet_NaN());
+      if (model.system->numStates() > 0) {
+        int row = 0;
+        for (int r = 0; r < table.numRows(); ++r)
+          if (std::abs(table.time[r] - initial.t) <= 1e-9) row = r;
+        validation::readAuxiliaryStates(*model.system, table, row, f.initial, initial);
+      }
     } else {
       if (given(app, "--initial-time")) throw UsageError{"--initial-time needs --initial STATE.sto"};
       initial = validation::defaultInitialState(model);
+      initial.z = model.system->defaultState().z;
     }
   } catch (const osim::ConvertError& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -122,6 +137,8 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
     return 2;
   }
   for (const auto& w : model.build.warnings) std::cerr << "warning: " << w << "\n";
+  if (!quiet)
+    for (const auto& w : control_warnings) std::cerr << "warning: " << w << "\n";
   if (!quiet) {
     const Model& core = model.system->model();
     std::printf("simulate: %s, %d coordinates, %d constraint rows, %zu muscles (%.4g kg in mass points)\n",
@@ -261,6 +278,13 @@ CommandRegistration reg(
        app.add_option("--initial-time", f->initial_time, "with --initial: the row to start from")
            ->type_name("T")
            ->check(number());
+       app.add_option("--controls", f->controls,
+                      "excite the muscles and CoordinateActuators from an OpenSim ControlSet (.xml)\n"
+                      "or controls table (.sto), as `redmax forward` does (docs/forward.md): muscles\n"
+                      "with a force model then pull and their activation and fibre-length states\n"
+                      "are integrated and written after the energies")
+           ->type_name("FILE")
+           ->check(existingFile());
        app.add_option("--muscle-mass-kg", f->muscle_mass_kg,
                       "give these muscles KG each in mass points, ADDED to the model (no body\n"
                       "gives mass; e.g. the finger's 0.2 kg flexors of [D 6.2.5]); --mass-points,\n"
@@ -301,7 +325,7 @@ CommandRegistration reg(
            "usage: redmax simulate --model M.osim --duration S --out STATES.sto\n"
            "                       [--integrator euler|symplectic|bdf1|sdirk2|rk45|cvode] [--dt S]\n"
            "                       [--rtol R] [--atol A] [--max-step S] [--output-dt S]\n"
-           "                       [--initial STATE.sto [--initial-time T]]\n"
+           "                       [--initial STATE.sto [--initial-time T]] [--controls FILE]\n"
            "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
            "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
            "                       [--engine core|simbody [--simbody-method M] [--simbody-norm rms|inf]]\n"

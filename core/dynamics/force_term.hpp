@@ -10,9 +10,17 @@
 // scratch and the evaluation counter through TermContext; the counter tells it whether the scratch
 // already holds this state's results, so that addMass, addForce and the energies of one state
 // share one evaluation without comparing states.
+//
+// Auxiliary states and controls (docs/forward.md): a term may own first-order states (a muscle's
+// activation and fibre length) and read controls (its actuators' excitations). The System gives
+// each term an offset into State::z and into the workspace's controls (TermContext::z_offset,
+// u_offset) in the order the terms were added; a term reads its states as
+// s.z.segment(ctx.z_offset, numStates()) and its controls from ctx.controls. Terms without
+// states or controls see nothing of either.
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/skeleton/kinematics.hpp"
 #include "core/skeleton/state.hpp"
@@ -39,8 +47,24 @@ struct TermContext {
   const SkeletonWorkspace& sk;
   TermScratch* scratch = nullptr;
   std::uint64_t evaluation = 0;
-  /// the same kinematics without the scratch (e.g. for evaluations at other states)
-  TermContext withoutScratch() const { return TermContext(sk); }
+  /// where this term's states start in State::z, and its controls in *controls
+  int z_offset = 0;
+  int u_offset = 0;
+  /// the controls of this evaluation (System::numControls(); null: none, every control is 0)
+  const VecX* controls = nullptr;
+  /// control k of this term (0 without controls)
+  double control(int k) const {
+    return controls && u_offset + k < controls->size() ? (*controls)[u_offset + k] : 0.0;
+  }
+  /// the same kinematics without the scratch (e.g. for evaluations at other states); offsets and
+  /// controls are kept
+  TermContext withoutScratch() const {
+    TermContext c(sk);
+    c.z_offset = z_offset;
+    c.u_offset = u_offset;
+    c.controls = controls;
+    return c;
+  }
 };
 
 class ForceTerm {
@@ -83,6 +107,23 @@ class ForceTerm {
     Mdot_v.noalias() += ((Mp - Mm) * s.qdot) / (2.0 * e);
   }
   virtual double kineticEnergy(const Model&, const State&, const TermContext&) const { return 0.0; }
+
+  // auxiliary first-order states (State::z) and controls; defaults: none
+  /// number of states this term owns in State::z
+  virtual int numStates() const { return 0; }
+  /// their full names (numStates), OpenSim 4 style, e.g. "/forceset/BIClong/activation"
+  virtual std::vector<std::string> stateNames() const { return {}; }
+  /// their default values (numStates)
+  virtual void defaultStates(const Model&, Eigen::Ref<VecX> z) const {}
+  /// their time derivatives at s (numStates); needs Stage::Velocity and ctx.controls of s
+  virtual void calcStateDerivatives(const Model&, const State&, const TermContext&, Eigen::Ref<VecX> zdot) const {}
+  /// OpenSim's equilibrium of the auxiliary states at s (e.g. fibre lengths balancing the tendon):
+  /// writes into z (numStates, initially s's); needs Stage::Velocity. Default: leaves z.
+  virtual void equilibrateStates(const Model&, const State&, const TermContext&, Eigen::Ref<VecX> z) const {}
+  /// number of controls (excitations) this term reads through TermContext::control
+  virtual int numControls() const { return 0; }
+  /// their names (numControls): the actuator names, as OpenSim's controls files name them
+  virtual std::vector<std::string> controlNames() const { return {}; }
   virtual double potentialEnergy(const Model&, const State&, const TermContext&) const { return 0.0; }
 };
 

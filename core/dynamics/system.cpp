@@ -42,6 +42,88 @@ void System::bind(DynamicsWorkspace& ws) const {
   ws.system_id = id_.value;
 }
 
+void System::addTerm(std::shared_ptr<const ForceTerm> term) {
+  if (!term) throw ModelError("System::addTerm: null term");
+  z_offset_.push_back(nz_);
+  u_offset_.push_back(nu_);
+  nz_ += term->numStates();
+  nu_ += term->numControls();
+  terms_.push_back(std::move(term));
+  id_.renew();
+}
+
+std::vector<std::string> System::stateNames() const {
+  std::vector<std::string> names;
+  for (const auto& t : terms_)
+    for (std::string& n : t->stateNames()) names.push_back(std::move(n));
+  return names;
+}
+
+std::vector<std::string> System::controlNames() const {
+  std::vector<std::string> names;
+  for (const auto& t : terms_)
+    for (std::string& n : t->controlNames()) names.push_back(std::move(n));
+  return names;
+}
+
+void System::addController(std::shared_ptr<const Controller> c) {
+  if (!c) throw ModelError("System::addController: null controller");
+  controllers_.push_back(std::move(c));
+  id_.renew();
+}
+
+void System::calcControls(const State& s_sk, DynamicsWorkspace& ws) const {
+  if (nu_ == 0) return;
+  if (controllers_.empty()) {
+    if (ws.controls.size() != nu_) ws.controls.setZero(nu_);
+    return;
+  }
+  ws.controls.setZero(nu_);
+  for (const auto& c : controllers_) c->addControls(model_, s_sk, ws.sk, ws.controls);
+}
+
+void System::calcStateDerivativesHere(const State& s_sk, DynamicsWorkspace& ws) const {
+  ws.zdot.setZero(nz_);
+  for (size_t i = 0; i < terms_.size(); ++i) {
+    const int m = terms_[i]->numStates();
+    if (m > 0) terms_[i]->calcStateDerivatives(model_, s_sk, context(ws, i), ws.zdot.segment(z_offset_[i], m));
+  }
+}
+
+void System::calcStateDerivatives(const State& s, DynamicsWorkspace& ws) const {
+  if (nz_ == 0) {
+    ws.zdot.resize(0);
+    return;
+  }
+  if (s.z.size() != nz_)
+    throw ModelError("System::calcStateDerivatives: state has " + std::to_string(s.z.size()) +
+                     " auxiliary states, the system has " + std::to_string(nz_));
+  const State* s_sk = &s;
+  if (map_) {
+    expandInto(s, ws);
+    s_sk = &ws.s_r;
+  }
+  calcSkeletonKinematics(*s_sk, ws);
+  calcControls(*s_sk, ws);
+  calcStateDerivativesHere(*s_sk, ws);
+}
+
+void System::equilibrateStates(State& s, DynamicsWorkspace& ws) const {
+  if (nz_ == 0) return;
+  if (s.z.size() != nz_) s.z = defaultState().z;
+  for (size_t i = 0; i < terms_.size(); ++i) {
+    const int m = terms_[i]->numStates();
+    if (m == 0) continue;
+    // each term at the states the terms before it left: kinematics and controls at s (and its
+    // rates, unused here), a new evaluation
+    calcStateDerivatives(s, ws);
+    const State& s_sk = map_ ? ws.s_r : s;
+    VecX zi = s.z.segment(z_offset_[i], m);
+    terms_[i]->equilibrateStates(model_, s_sk, context(ws, i), zi);
+    s.z.segment(z_offset_[i], m) = zi;
+  }
+}
+
 void System::calcSkeletonKinematics(const State& s, DynamicsWorkspace& ws) const {
   bind(ws);
   calcKinematics(model_, s, ws.sk);
@@ -81,11 +163,19 @@ State System::defaultState() const {
   s.q = map_ ? map_->reduce(model_.defaultQ()) : model_.defaultQ();
   s.q.conservativeResizeLike(VecX::Zero(ndof()));  // extra coordinates start at zero
   s.qdot = VecX::Zero(ndof());
+  if (nz_ > 0) {
+    s.z = VecX::Zero(nz_);
+    for (size_t i = 0; i < terms_.size(); ++i) {
+      const int m = terms_[i]->numStates();
+      if (m > 0) terms_[i]->defaultStates(model_, s.z.segment(z_offset_[i], m));
+    }
+  }
   return s;
 }
 
 void System::expandInto(const State& s, DynamicsWorkspace& ws) const {
   ws.s_r.t = s.t;
+  if (nz_ > 0) ws.s_r.z = s.z;
   map_->calc(s.q, s.qdot, ws.s_r.q, ws.s_r.qdot, ws.J_rR, ws.Jdot_rR);
 }
 
@@ -93,6 +183,7 @@ State System::expandState(const State& s) const {
   if (!map_) return s;
   State r;
   r.t = s.t;
+  r.z = s.z;
   MatX J, Jdot;
   map_->calc(s.q, s.qdot, r.q, r.qdot, J, Jdot);
   return r;
@@ -102,6 +193,7 @@ State System::reduceState(const State& s_r) const {
   if (!map_) return s_r;
   State s;
   s.t = s_r.t;
+  s.z = s_r.z;
   s.q = map_->reduce(s_r.q);
   s.qdot = map_->reduce(s_r.qdot);
   return s;
@@ -139,8 +231,12 @@ int System::reparameterize(State& s) const {
 }
 
 void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
+  if (nz_ > 0 && s.z.size() != nz_)
+    throw ModelError("System::calcMassAndForce: state has " + std::to_string(s.z.size()) +
+                     " auxiliary states, the system has " + std::to_string(nz_));
   if (!map_) {
     calcSkeletonKinematics(s, ws);
+    calcControls(s, ws);
     if (n_extra_ == 0) {
       calcSkeletonMass(model_, ws.sk, ws.M);
       calcSkeletonForce(model_, s, ws.sk, ws.f);
@@ -166,6 +262,7 @@ void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
   // skeleton and terms in q_r at the expanded state, then chained through J_rR [D Eq. 4.86]
   expandInto(s, ws);
   calcSkeletonKinematics(ws.s_r, ws);
+  calcControls(ws.s_r, ws);
   calcSkeletonMass(model_, ws.sk, ws.M_r);
   calcSkeletonForce(model_, ws.s_r, ws.sk, ws.f_r);
   if (!ws.loads.empty()) addExternalLoads(model_, ws.sk, ws.loads, ws.f_r);
@@ -308,6 +405,8 @@ VecX System::solveKKT(const MatX& M, const MatX& G, const VecX& a, const VecX& b
 
 VecX System::forwardDynamics(const State& s, DynamicsWorkspace& ws) const {
   calcMassAndForce(s, ws);
+  // the auxiliary states' rates share this evaluation (the terms' scratch holds it)
+  if (nz_ > 0) calcStateDerivativesHere(map_ ? ws.s_r : s, ws);
   if (nc_ == 0) {
     ws.lambda.resize(0);
     return ws.M.ldlt().solve(ws.f);
@@ -362,6 +461,7 @@ double System::kineticEnergy(const State& s, DynamicsWorkspace& ws) const {
     sk_state = &ws.s_r;
   }
   calcSkeletonKinematics(*sk_state, ws);
+  calcControls(*sk_state, ws);
   double T = skeletonKineticEnergy(model_, ws.sk);
   for (size_t i = 0; i < terms_.size(); ++i) T += terms_[i]->kineticEnergy(model_, *sk_state, context(ws, i));
   return T;
@@ -374,6 +474,7 @@ double System::potentialEnergy(const State& s, DynamicsWorkspace& ws) const {
     sk_state = &ws.s_r;
   }
   calcSkeletonKinematics(*sk_state, ws);
+  calcControls(*sk_state, ws);
   double V = skeletonPotentialEnergy(model_, *sk_state, ws.sk);
   if (!ws.loads.empty()) V += externalLoadsPotential(ws.sk, ws.loads);
   for (size_t i = 0; i < terms_.size(); ++i) V += terms_[i]->potentialEnergy(model_, *sk_state, context(ws, i));

@@ -15,12 +15,19 @@
 //   M = J_rR^T M_r J_rR,  f = J_rR^T (f_r - M_r Jdot_rR qdot_R),  G = G_r J_rR,
 //   rhs = rhs_r - G_r Jdot_rR qdot_R                                 [D Eq. 4.84-4.86, 4.105]
 // Without a map (the default) nothing changes: q = q_r and ndof = nr.
+//
+// Auxiliary first-order states and controls (docs/forward.md): the terms' states (ForceTerm::
+// numStates) are stacked in State::z in term order (nz = numStates(), each term at its offset),
+// their derivatives zdot go to ws.zdot (forwardDynamics, calcStateDerivatives); the controllers
+// (core/dynamics/controller.hpp) write the terms' controls into ws.controls at every evaluation,
+// before the terms. With nz = 0 and no controls every path is the one without them.
 #include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "core/dynamics/body_loads.hpp"
 #include "core/dynamics/constraint.hpp"
+#include "core/dynamics/controller.hpp"
 #include "core/dynamics/coordinate_map.hpp"
 #include "core/dynamics/force_term.hpp"
 #include "core/skeleton/kinematics.hpp"
@@ -47,6 +54,9 @@ struct DynamicsWorkspace {
 
   // inputs of the next evaluation (set by the caller with the State; never written by the System)
   ExternalLoads loads;       // external point forces and torques (measured GRF)  (any count)
+  VecX controls;             // actuator controls (excitations): written by the System's
+                             // controllers at every evaluation; without controllers the caller's
+                             // (zero when not of size System::numControls())     (nu)
 
   // position and velocity stage
   SkeletonWorkspace sk;
@@ -60,6 +70,7 @@ struct DynamicsWorkspace {
   VecX rhs;        // acceleration-level rhs           (nc)
   VecX lambda;     // constraint multipliers           (nc)
   VecX pos_err, vel_err;                            // (nc)
+  VecX zdot;       // auxiliary state derivatives (forwardDynamics, calcStateDerivatives) (nz)
 
   // hyper-reduced coordinates only (System with a CoordinateMap); skeleton-side quantities,
   // sized on first use
@@ -108,15 +119,35 @@ class System {
   int numExtraCoordinates() const { return n_extra_; }
   int numConstraintRows() const { return nc_; }
 
-  void addTerm(std::shared_ptr<const ForceTerm> term) {
-    terms_.push_back(std::move(term));
-    id_.renew();
-  }
+  /// add a term; its states and controls (if any) follow those of the terms before it
+  void addTerm(std::shared_ptr<const ForceTerm> term);
   void addConstraint(std::shared_ptr<const Constraint> c);
   const std::vector<std::shared_ptr<const ForceTerm>>& terms() const { return terms_; }
   const std::vector<std::shared_ptr<const Constraint>>& constraints() const { return constraints_; }
   StabilizationOptions stabilization;
 
+  // auxiliary states and controls
+  /// nz: the terms' states, stacked in State::z
+  int numStates() const { return nz_; }
+  /// every state's name (nz), in State::z order
+  std::vector<std::string> stateNames() const;
+  /// offset of term i's states in State::z, and of its controls in ws.controls
+  int stateOffset(size_t i) const { return z_offset_[i]; }
+  int controlOffset(size_t i) const { return u_offset_[i]; }
+  /// nu: the terms' controls
+  int numControls() const { return nu_; }
+  /// every control's name (nu): the actuators' names
+  std::vector<std::string> controlNames() const;
+  /// add a controller (they add up, OpenSim's ControllerSet)
+  void addController(std::shared_ptr<const Controller> c);
+  const std::vector<std::shared_ptr<const Controller>>& controllers() const { return controllers_; }
+  /// kinematics, controls and zdot (ws.zdot) at s; no M, f
+  void calcStateDerivatives(const State& s, DynamicsWorkspace& ws) const;
+  /// the terms' equilibrium of the auxiliary states at s (ForceTerm::equilibrateStates), in term
+  /// order, into s.z
+  void equilibrateStates(State& s, DynamicsWorkspace& ws) const;
+
+  /// default q, qdot = 0 and the terms' default states z
   State defaultState() const;
 
   /// Use hyper-reduced coordinates q_r = g(q_R) [D Sec. 4.6.2]; nullptr goes back to q_r.
@@ -194,13 +225,24 @@ class System {
   void calcSkeletonKinematics(const State& s, DynamicsWorkspace& ws) const;
   // what term i sees of the current evaluation of ws
   TermContext context(const DynamicsWorkspace& ws, size_t i) const {
-    return TermContext(ws.sk, ws.term_scratch[i].get(), ws.evaluation);
+    TermContext c(ws.sk, ws.term_scratch[i].get(), ws.evaluation);
+    c.z_offset = z_offset_[i];
+    c.u_offset = u_offset_[i];
+    if (nu_ > 0) c.controls = &ws.controls;
+    return c;
   }
+  // ws.controls at skeleton state s_sk (after its kinematics): the controllers', or the caller's
+  void calcControls(const State& s_sk, DynamicsWorkspace& ws) const;
+  // ws.zdot at skeleton state s_sk of the current evaluation
+  void calcStateDerivativesHere(const State& s_sk, DynamicsWorkspace& ws) const;
 
   Id id_;
   Model model_;
   std::vector<std::shared_ptr<const ForceTerm>> terms_;
   std::vector<std::shared_ptr<const Constraint>> constraints_;
+  std::vector<std::shared_ptr<const Controller>> controllers_;
+  std::vector<int> z_offset_, u_offset_;  // per term                          (number of terms)
+  int nz_ = 0, nu_ = 0;
   int nc_ = 0;
   std::shared_ptr<const CoordinateMap> map_;
   int ndof_ = 0;

@@ -44,7 +44,7 @@ std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const Integr
   return integ;
 }
 
-void checkFinite(const State& s, double h, const char* where) {
+void checkFinite(const State& s, double h, const char* where, const std::vector<std::string>* z_names) {
   for (int k = 0; k < s.q.size(); ++k) {
     const bool q_ok = std::isfinite(s.q[k]) && std::abs(s.q[k]) <= kDivergenceLimit;
     const bool qd_ok = std::isfinite(s.qdot[k]) && std::abs(s.qdot[k]) <= kDivergenceLimit;
@@ -58,6 +58,18 @@ void checkFinite(const State& s, double h, const char* where) {
     os << " at t = " << s.t << " with step h = " << h;
     throw SimulationError(os.str(), s.t, h);
   }
+  for (int k = 0; k < s.z.size(); ++k) {
+    const double v = s.z[k];
+    if (std::isfinite(v) && std::abs(v) <= kDivergenceLimit) continue;
+    std::ostringstream os;
+    os << where << ": " << (std::isfinite(v) ? "diverged: " : "non-finite ") << "state ";
+    if (z_names && k < static_cast<int>(z_names->size())) os << (*z_names)[k];
+    else os << "z[" << k << "]";
+    os << " = " << v;
+    if (std::isfinite(v)) os << " (beyond " << kDivergenceLimit << " in magnitude)";
+    os << " at t = " << s.t << " with step h = " << h;
+    throw SimulationError(os.str(), s.t, h);
+  }
 }
 
 void checkAdvanceArguments(const System& sys, const State& s, double t_out, const char* where) {
@@ -66,6 +78,11 @@ void checkAdvanceArguments(const System& sys, const State& s, double t_out, cons
     std::ostringstream os;
     os << where << ": state has " << s.q.size() << " coordinates and " << s.qdot.size()
        << " speeds, the system has " << n;
+    throw std::invalid_argument(os.str());
+  }
+  if (s.z.size() != sys.numStates()) {
+    std::ostringstream os;
+    os << where << ": state has " << s.z.size() << " auxiliary states, the system has " << sys.numStates();
     throw std::invalid_argument(os.str());
   }
   if (!std::isfinite(t_out) || !std::isfinite(s.t)) {
@@ -100,15 +117,24 @@ void FixedStepIntegrator::advance(const System& sys, State& s, double t_out) {
   }
   const double h = span / static_cast<double>(n);
   const double t0 = s.t;
-  checkFinite(s, h, who.c_str());
+  const int nz = sys.numStates();
+  const std::vector<std::string> z_names = nz > 0 ? sys.stateNames() : std::vector<std::string>{};
+  checkFinite(s, h, who.c_str(), &z_names);
   DynamicsWorkspace& ws = workspace(sys);
   State last_good = s;
+  VecX zdot;
   for (long k = 0; k < n; ++k) {
     try {
+      // auxiliary states: explicit Euler with the rate at the step's start (see the header)
+      if (nz > 0) {
+        sys.calcStateDerivatives(s, ws);
+        zdot = ws.zdot;
+      }
       step(sys, s, h, ws);
+      if (nz > 0) s.z.noalias() += h * zdot;
       // time from the step count, so round-off does not accumulate over long runs
       s.t = (k + 1 == n) ? t_out : t0 + static_cast<double>(k + 1) * h;
-      checkFinite(s, h, who.c_str());
+      checkFinite(s, h, who.c_str(), &z_names);
     } catch (...) {
       // hand back the last finite state, never NaN
       s = last_good;
@@ -119,6 +145,7 @@ void FixedStepIntegrator::advance(const System& sys, State& s, double t_out) {
     last_good.t = s.t;
     last_good.q = s.q;
     last_good.qdot = s.qdot;
+    if (nz > 0) last_good.z = s.z;
   }
   s.t = t_out;
 }

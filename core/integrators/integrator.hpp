@@ -16,9 +16,16 @@
 // Every method treats q and qdot as independent coordinates with dq/dt = qdot (true for every
 // joint type, see core/joints/joint.hpp). After each internal step the joints get a chance to
 // switch chart (System::reparameterize, exponential coordinates [D Sec. 4.5.8]).
+//
+// Auxiliary states z (State::z, System::numStates(): muscle activations, fibre lengths,
+// docs/forward.md): rk45 and cvode integrate y = [q, qdot, z] as one system (the same rtol, atol);
+// the fixed-step methods advance z by explicit Euler with zdot at the start of each step
+// (z+ = z + h zdot(t, q, qdot, z)), holding z at its start value inside the step's own (implicit)
+// solve of q and qdot: first order in z, whatever their order in q. With nz = 0 nothing changes.
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/dynamics/system.hpp"
 
@@ -28,7 +35,7 @@ struct IntegratorOptions {
   double dt = 1e-3;        // fixed step (euler, bdf1, sdirk2); the last step of a span is not shortened:
                            // a span is cut into ceil(span / dt) equal steps
   double rtol = 1e-6;      // adaptive methods (rk45, cvode)
-  double atol = 1e-8;      // absolute tolerance on every q and qdot entry (rk45, cvode)
+  double atol = 1e-8;      // absolute tolerance on every q, qdot and z entry (rk45, cvode)
   double max_step = 0.0;   // adaptive methods: largest internal step; 0 = unlimited
   double initial_step = 0.0;    // adaptive methods: first step; 0 = estimated by SUNDIALS
   long max_steps = 10'000'000;  // per advance() call
@@ -81,14 +88,16 @@ class Integrator {
 /// on invalid options (non-positive dt or tolerances).
 std::unique_ptr<Integrator> makeIntegrator(const std::string& name, const IntegratorOptions& opt);
 
-/// Throws SimulationError naming the first non-finite entry of q or qdot, or the first entry whose
-/// magnitude exceeds kDivergenceLimit (a diverging simulation, reported before it overflows).
-void checkFinite(const State& s, double h, const char* where);
+/// Throws SimulationError naming the first non-finite entry of q, qdot or z, or the first entry
+/// whose magnitude exceeds kDivergenceLimit (a diverging simulation, reported before it overflows).
+/// z entries are named by z_names (System::stateNames()) when given, else as z[k].
+void checkFinite(const State& s, double h, const char* where,
+                 const std::vector<std::string>* z_names = nullptr);
 
 /// |q| or |qdot| beyond this is reported as divergence by checkFinite.
 inline constexpr double kDivergenceLimit = 1e100;
 
-/// Throws std::invalid_argument if the state does not fit the system or t_out < state.t.
+/// Throws std::invalid_argument if the state (q, qdot, z) does not fit the system or t_out < state.t.
 void checkAdvanceArguments(const System& sys, const State& s, double t_out, const char* where);
 
 /// Shared driver of the fixed-step methods: cuts [state.t, t_out] into ceil(span / dt) equal

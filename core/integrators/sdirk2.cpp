@@ -21,6 +21,7 @@ void Sdirk2::solveStage(const System& sys, double t, const VecX& zq, const VecX&
   static const MatX no_rows;
   State st;
   st.t = t;
+  st.z = z_;  // auxiliary states held over the step (integrator.hpp)
   // residual R(V) = V - zv - hg qddot(zq + hg V, V); fills ws (M, f, G) at the iterate
   auto residual = [&](const VecX& Vk) -> VecX {
     st.q = zq + hg * Vk;
@@ -105,6 +106,7 @@ void Sdirk2::step(const System& sys, State& s, double h, DynamicsWorkspace& ws) 
   const double g = gamma();
   const double hg = h * g;
   const VecX q0 = s.q, v0 = s.qdot;
+  z_ = s.z;
 
   // stage 1 at t + gamma h: Y1 = y0 + h gamma F(Y1); predictor from the previous step's end
   // acceleration when this step continues it, else the start velocity

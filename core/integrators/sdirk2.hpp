@@ -42,6 +42,7 @@ class Sdirk2 final : public FixedStepIntegrator {
   // accurate, so it is qddot(y+)), predicts the next stage 1 if the next step starts there
   VecX a_end_;
   State end_;
+  VecX z_;  // the auxiliary states of the step being taken
 };
 
 }  // namespace redmax

@@ -35,7 +35,7 @@ struct SundialsSolver {
 
   // SUNDIALS objects, created once per system size
   SUNContext ctx = nullptr;
-  N_Vector y = nullptr;     // internal state (2 ndof) at t_cur
+  N_Vector y = nullptr;     // internal state y = [q, qdot, z] (2 ndof + nz) at t_cur
   N_Vector yout = nullptr;  // interpolated output
   void* mem = nullptr;
   SUNMatrix A = nullptr;
@@ -46,6 +46,7 @@ struct SundialsSolver {
   const System* sys = nullptr;
   DynamicsWorkspace* ws = nullptr;
   State scratch;
+  std::vector<std::string> z_names;  // System::stateNames() of the bound system
   std::exception_ptr rhs_exception;  // thrown inside the RHS (never propagated through C frames)
   std::string rhs_error;             // why the RHS refused (non-finite input or output)
   double rhs_error_t = 0.0;          // at which time
@@ -122,8 +123,9 @@ struct SundialsSolver {
     auto* self = static_cast<SundialsSolver*>(user);
     try {
       const int n = self->sys->ndof();
-      const Eigen::Map<const VecX> Y(N_VGetArrayPointer(yv), 2 * n);
-      Eigen::Map<VecX> Yd(N_VGetArrayPointer(ydot), 2 * n);
+      const int nz = self->sys->numStates();
+      const Eigen::Map<const VecX> Y(N_VGetArrayPointer(yv), 2 * n + nz);
+      Eigen::Map<VecX> Yd(N_VGetArrayPointer(ydot), 2 * n + nz);
       if (!Y.allFinite()) {
         std::ostringstream os;
         os << "non-finite state passed to the dynamics at t = " << t;
@@ -134,7 +136,8 @@ struct SundialsSolver {
       State& s = self->scratch;
       s.t = t;
       s.q = Y.head(n);
-      s.qdot = Y.tail(n);
+      s.qdot = Y.segment(n, n);
+      if (nz > 0) s.z = Y.tail(nz);
       const VecX qddot = self->sys->forwardDynamics(s, *self->ws);
       for (int k = 0; k < n; ++k) {
         if (!std::isfinite(qddot[k])) {
@@ -145,8 +148,20 @@ struct SundialsSolver {
           return -1;  // unrecoverable: no smaller step fixes a singular mass matrix
         }
       }
+      for (int k = 0; k < nz; ++k) {
+        if (!std::isfinite(self->ws->zdot[k])) {
+          std::ostringstream os;
+          os << "non-finite rate of state "
+             << (k < static_cast<int>(self->z_names.size()) ? self->z_names[k] : "z[" + std::to_string(k) + "]")
+             << " = " << self->ws->zdot[k] << " at t = " << t;
+          self->rhs_error = os.str();
+          self->rhs_error_t = t;
+          return -1;
+        }
+      }
       Yd.head(n) = s.qdot;
-      Yd.tail(n) = qddot;
+      Yd.segment(n, n) = qddot;
+      if (nz > 0) Yd.tail(nz) = self->ws->zdot;
       return 0;
     } catch (...) {
       self->rhs_exception = std::current_exception();
@@ -161,7 +176,7 @@ struct SundialsSolver {
                         (msg ? msg : "");
   }
 
-  /// make sure the vectors fit 2 ndof; a new size frees and recreates everything
+  /// make sure the vectors fit 2 ndof + nz; a new size frees and recreates everything
   void ensureSize(int n2) {
     if (ctx && N == n2) return;
     release();
@@ -292,18 +307,23 @@ struct SundialsSolver {
 namespace {
 using detail::SundialsSolver;
 
-void toState(N_Vector v, int n, double t, State& s) {
-  const Eigen::Map<const VecX> Y(N_VGetArrayPointer(v), 2 * n);
+// y = [q, qdot, z]
+void toState(N_Vector v, int n, int nz, double t, State& s) {
+  const Eigen::Map<const VecX> Y(N_VGetArrayPointer(v), 2 * n + nz);
   s.t = t;
   s.q = Y.head(n);
-  s.qdot = Y.tail(n);
+  s.qdot = Y.segment(n, n);
+  if (nz > 0) s.z = Y.tail(nz);
+  else s.z.resize(0);
 }
 
 void fromState(const State& s, N_Vector v) {
   const int n = static_cast<int>(s.q.size());
-  Eigen::Map<VecX> Y(N_VGetArrayPointer(v), 2 * n);
+  const int nz = static_cast<int>(s.z.size());
+  Eigen::Map<VecX> Y(N_VGetArrayPointer(v), 2 * n + nz);
   Y.head(n) = s.q;
-  Y.tail(n) = s.qdot;
+  Y.segment(n, n) = s.qdot;
+  if (nz > 0) Y.tail(nz) = s.z;
 }
 
 /// binds the System and workspace to the solver for one advance() call
@@ -338,17 +358,20 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
   if (t_out == s.t) return;
   SundialsSolver& S = *solver_;
   const int n = sys.ndof();
+  const int nz = sys.numStates();
   if (!ws_ || ws_->system_id != sys.id()) ws_ = std::make_unique<DynamicsWorkspace>(sys);
   DynamicsWorkspace& ws = *ws_;
   Binding bind(S, sys, ws);
+  S.z_names = nz > 0 ? sys.stateNames() : std::vector<std::string>{};
+  const std::vector<std::string>* z_names = &S.z_names;
   try {
     // resume from the internal solution only if the caller did not touch the returned state
-    const bool resume = S.valid && S.last_sys == sys.id() && S.N == 2 * n && s.t == S.last_out.t &&
-                        s.q == S.last_out.q && s.qdot == S.last_out.qdot;
+    const bool resume = S.valid && S.last_sys == sys.id() && S.N == 2 * n + nz && s.t == S.last_out.t &&
+                        s.q == S.last_out.q && s.qdot == S.last_out.qdot && s.z == S.last_out.z;
     if (!resume) {
-      checkFinite(s, 0.0, who.c_str());
+      checkFinite(s, 0.0, who.c_str(), z_names);
       S.valid = false;
-      S.ensureSize(2 * n);
+      S.ensureSize(2 * n + nz);
       fromState(s, S.y);
       S.init(s.t);
       S.valid = true;
@@ -361,7 +384,7 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
       // needed for output (a restart discards it)
       if (S.pending_chart_check) {
         S.pending_chart_check = false;
-        toState(S.y, n, S.t_cur, internal);
+        toState(S.y, n, nz, S.t_cur, internal);
         const int switched = sys.reparameterize(internal);
         if (switched > 0) {
           stats_.reparameterizations += switched;
@@ -379,19 +402,20 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
       }
       const double t = S.step(t_out);
       S.syncStats(stats_);
-      toState(S.y, n, t, internal);
-      checkFinite(internal, S.lastStep(), who.c_str());
+      toState(S.y, n, nz, t, internal);
+      checkFinite(internal, S.lastStep(), who.c_str(), z_names);
       S.pending_chart_check = true;
     }
     // dense output at t_out; the returned state may switch chart on its own copy
     S.interpolate(t_out, S.yout);
     State out;
-    toState(S.yout, n, t_out, out);
-    checkFinite(out, S.lastStep(), who.c_str());
+    toState(S.yout, n, nz, t_out, out);
+    checkFinite(out, S.lastStep(), who.c_str(), z_names);
     sys.reparameterize(out);
     s.t = out.t;
     s.q = out.q;
     s.qdot = out.qdot;
+    s.z = out.z;
     S.last_out = out;
     S.last_sys = sys.id();
   } catch (...) {

@@ -116,6 +116,7 @@ void VariationalEuler::stepMomentum(const System& sys, State& s, VecX& p, double
   const VecX v_k = s.qdot;
   State sv;
   sv.t = s.t;
+  sv.z = s.z;  // auxiliary states held over the step (integrator.hpp)
   sv.q = q_k;
   sv.qdot = v_k;
 

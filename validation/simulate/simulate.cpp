@@ -271,6 +271,8 @@ State finishInitialState(const SimulationModel& m, State s_r) {
   const System& sys = *m.system;
   State s = sys.reduceState(s_r);
   s.t = s_r.t;
+  // the force terms' own states (muscles: docs/forward.md) at their defaults
+  if (s.z.size() != sys.numStates()) s.z = sys.defaultState().z;
   if (sys.numConstraintRows() > 0) {
     DynamicsWorkspace ws(sys.model());
     sys.projectPositions(s, ws);
@@ -361,6 +363,8 @@ SimulationResult makeStatesResult(const SimulationModel& m) {
   res.states.labels = m.q_labels;
   res.states.labels.insert(res.states.labels.end(), m.u_labels.begin(), m.u_labels.end());
   for (const char* e : {"kinetic_energy", "potential_energy", "total_energy"}) res.states.labels.push_back(e);
+  if (m.system)
+    for (const std::string& n : m.system->stateNames()) res.states.labels.push_back(n);
   return res;
 }
 
@@ -407,7 +411,7 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
   auto record = [&](const State& s) -> bool {
     const double K = sys.kineticEnergy(s, ws), V = sys.potentialEnergy(s, ws);
     const State s_r = sys.expandState(s);
-    if (!recorder.add(s.t, s_r.q, s_r.qdot, K, V)) return false;
+    if (!recorder.add(s.t, s_r.q, s_r.qdot, K, V, "", s.z)) return false;
     if (options.check) {
       const std::string why = options.check(s, K, V);
       if (!why.empty()) {
@@ -471,9 +475,11 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
   return res;
 }
 
-bool StateRecorder::add(double t, const VecX& q, const VecX& qdot, double K, double V, const std::string& where) {
-  VecX row(q.size() + qdot.size() + 3);
-  row << q, qdot, K, V, K + V;
+bool StateRecorder::add(double t, const VecX& q, const VecX& qdot, double K, double V, const std::string& where,
+                        const VecX& z) {
+  VecX row(q.size() + qdot.size() + 3 + z.size());
+  row.head(q.size() + qdot.size() + 3) << q, qdot, K, V, K + V;
+  if (z.size() > 0) row.tail(z.size()) = z;
   if (!row.allFinite()) {
     std::ostringstream os;
     os << "non-finite state or energy at t = " << t << " s" << where;

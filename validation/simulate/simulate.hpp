@@ -148,7 +148,8 @@ struct SimulationResult {
   double failure_time = 0.0, failure_step = 0.0;
 };
 
-/// An empty states table of m's runs (core or Simbody): q, qdot, then the three energy columns.
+/// An empty states table of m's runs (core or Simbody): q, qdot, then the three energy columns,
+/// then the system's auxiliary states (System::stateNames(), docs/forward.md) when it has any.
 SimulationResult makeStatesResult(const SimulationModel& m);
 
 /// The rows of a run's STATES table (time; q, qdot, kinetic, potential and total energy) and its
@@ -158,7 +159,9 @@ class StateRecorder {
   explicit StateRecorder(SimulationResult& res) : res_(res) {}
   /// Append a row and update res's energies. False when a value is not finite: res.failed is set
   /// and res.failure says so at time t, followed by `where` (e.g. " (Simbody)").
-  bool add(double t, const VecX& q, const VecX& qdot, double K, double V, const std::string& where = "");
+  /// z: the auxiliary states (empty without), after the energies.
+  bool add(double t, const VecX& q, const VecX& qdot, double K, double V, const std::string& where = "",
+           const VecX& z = VecX());
   /// Copy the rows into res.states.data (one column per label of res.states) and set
   /// res.energy_drift_rel.
   void finish();

@@ -1,0 +1,323 @@
+#include "validation/forward/forward_tool.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "converter/build/functions_to_core.hpp"
+#include "core/dynamics/controller.hpp"
+#include "core/dynamics/coordinate_actuator_term.hpp"
+#include "core/dynamics/muscle_force_term.hpp"
+#include "core/muscles/hill/muscle_model.hpp"
+
+namespace redmax::validation {
+
+namespace {
+namespace fs = std::filesystem;
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool listsAll(const std::vector<std::string>& list) {
+  return list.empty() || (list.size() == 1 && lower(list[0]) == "all");
+}
+
+// the muscle model of every muscle of the model (null: none)
+std::vector<std::shared_ptr<const hill::MuscleModel>> muscleModelsOf(const MusculoskeletalModel& model) {
+  std::vector<std::shared_ptr<const hill::MuscleModel>> models = model.muscleModels();
+  models.resize(model.muscles().size());
+  return models;
+}
+
+}  // namespace
+
+void addControlsFile(System& sys, const std::string& file, std::vector<std::string>& warnings,
+                     const std::vector<std::string>& actuator_list) {
+  const osim::ControlSetDesc cs = osim::readControlSet(file);
+  const std::vector<std::string> names = sys.controlNames();
+  std::set<std::string> allowed;
+  if (!listsAll(actuator_list)) allowed.insert(actuator_list.begin(), actuator_list.end());
+  std::vector<PrescribedControls::Entry> entries;
+  std::set<std::string> used;
+  for (int k = 0; k < static_cast<int>(names.size()); ++k) {
+    if (!allowed.empty() && !allowed.count(names[k])) continue;
+    const osim::ControlLinearDesc* c = cs.findForActuator(names[k]);
+    if (!c) {
+      warnings.push_back(file + ": no control for actuator '" + names[k] + "' (its control stays 0)");
+      continue;
+    }
+    used.insert(c->name);
+    entries.push_back({k, osim::makeControlFunction(*c)});
+  }
+  for (const osim::ControlLinearDesc& c : cs.controls)
+    if (!used.count(c.name) && c.is_model_control)
+      warnings.push_back(file + ": control '" + c.name + "' names no actuator of the model; ignored");
+  if (!entries.empty()) sys.addController(std::make_shared<PrescribedControls>("ControlSetController " + file, entries));
+}
+
+void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vector<std::string>& warnings) {
+  const std::vector<std::string> names = sys.controlNames();
+  for (const osim::ControllerSetupDesc& c : setup.controllers) {
+    if (c.disabled) continue;
+    if (c.type == "ControlSetController") {
+      if (c.controls_file.empty())
+        throw osim::ConvertError(setup.source_file, c.line, "ControlSetController '" + c.name + "' has no controls_file");
+      addControlsFile(sys, c.controls_file, warnings, c.actuator_list);
+      continue;
+    }
+    // PrescribedController: a function named after an actuator drives it; otherwise the k-th
+    // function drives the k-th actuator of actuator_list (OpenSim's order)
+    std::vector<PrescribedControls::Entry> entries;
+    for (size_t k = 0; k < c.functions.size(); ++k) {
+      const auto& [fname, fdesc] = c.functions[k];
+      std::string actuator;
+      if (std::find(names.begin(), names.end(), fname) != names.end()) actuator = fname;
+      else if (k < c.actuator_list.size() && !listsAll(c.actuator_list)) actuator = c.actuator_list[k];
+      else
+        throw osim::ConvertError(setup.source_file, fdesc.line ? fdesc.line : c.line,
+                                 "PrescribedController '" + c.name + "': function " + std::to_string(k + 1) +
+                                     " names no actuator (name it after one, or list the actuators in actuator_list)");
+      const auto it = std::find(names.begin(), names.end(), actuator);
+      if (it == names.end()) {
+        warnings.push_back(setup.source_file + ": PrescribedController '" + c.name + "': actuator '" + actuator +
+                           "' is not an actuator the model simulates; ignored");
+        continue;
+      }
+      entries.push_back({static_cast<int>(it - names.begin()),
+                         osim::makeCoreFunction(fdesc, 1, setup.source_file, "PrescribedController '" + c.name + "'")});
+    }
+    if (!entries.empty()) sys.addController(std::make_shared<PrescribedControls>("PrescribedController " + c.name, entries));
+    if (!c.controls_file.empty()) addControlsFile(sys, c.controls_file, warnings, c.actuator_list);
+  }
+}
+
+void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings) {
+  auto sys = std::make_shared<System>(*m.system);
+  const MusculoskeletalModel& model = m.build.model;
+  const auto models = muscleModelsOf(model);
+  bool any = false;
+  for (size_t k = 0; k < models.size(); ++k) {
+    if (models[k]) {
+      any = true;
+      continue;
+    }
+    const std::string cls = k < model.muscleClasses().size() ? model.muscleClasses()[k] : "";
+    warnings.push_back("muscle '" + model.muscles()[k].name + "' (" + (cls.empty() ? "unknown class" : cls) +
+                       "): no force model, it exerts no force");
+  }
+  if (any) sys->addTerm(std::make_shared<MuscleForceTerm>(model.skeleton(), model.muscles(), models));
+  // CoordinateActuators; the other actuator classes are listed as not modelled
+  std::vector<CoordinateActuatorTerm::Actuator> acts;
+  for (const osim::ForceDesc& f : m.description.forces) {
+    if (!f.applies_force) continue;
+    if (f.class_name == "CoordinateActuator") {
+      int index = -1;
+      for (size_t k = 0; k < m.description.coordinates.size(); ++k)
+        if (m.description.coordinates[k].name == f.coordinate && k < m.build.coordinate_index.size())
+          index = m.build.coordinate_index[k];
+      if (index < 0) {
+        warnings.push_back("CoordinateActuator '" + f.name + "': coordinate '" + f.coordinate +
+                           "' is not in the built model; ignored");
+        continue;
+      }
+      acts.push_back({f.name, index, f.optimal_force});
+    } else if (f.class_name.find("Actuator") != std::string::npos) {
+      warnings.push_back(f.class_name + " '" + f.name + "' is not modelled in forward simulation; ignored");
+    }
+  }
+  if (!acts.empty()) sys->addTerm(std::make_shared<CoordinateActuatorTerm>(model.skeleton(), std::move(acts)));
+  m.system = sys;
+}
+
+State forwardInitialState(const SimulationModel& m, const osim::Storage& table, const std::string& file, double time) {
+  if (table.numRows() == 0) throw osim::ConvertError(file, 0, "the states table has no rows");
+  // the closest earlier row (OpenSim's ForwardTool: no interpolation)
+  int row = 0;
+  for (int r = 0; r < table.numRows(); ++r)
+    if (table.time[r] <= time + 1e-12) row = r;
+  osim::Storage one = table;
+  one.time = {table.time[row]};
+  one.data = table.data.row(row);
+  State s = initialStateFromStorage(m, one, file);
+  readAuxiliaryStates(*m.system, table, row, file, s);
+  s.t = time;
+  return s;
+}
+
+void readAuxiliaryStates(const System& sys, const osim::Storage& table, int row, const std::string& file, State& s) {
+  if (s.z.size() != sys.numStates()) s.z = sys.defaultState().z;
+  if (row < 0 || row >= table.numRows()) return;
+  const std::vector<std::string> names = sys.stateNames();
+  for (size_t k = 0; k < names.size(); ++k) {
+    // /forceset/M/S, or OpenSim 3's M.S
+    int col = table.findColumn(names[k]);
+    if (col < 0 && names[k].rfind("/forceset/", 0) == 0) {
+      const std::string rest = names[k].substr(10);
+      const auto slash = rest.find('/');
+      if (slash != std::string::npos) col = table.findColumn(rest.substr(0, slash) + "." + rest.substr(slash + 1));
+    }
+    if (col < 0) continue;
+    const double v = table.data(row, col);
+    if (!std::isfinite(v)) throw osim::ConvertError(file, 0, "state '" + names[k] + "' is not finite");
+    s.z[static_cast<int>(k)] = v;
+  }
+}
+
+ForwardResult runForward(const SimulationModel& m, const State& initial, const std::vector<double>& times,
+                         const std::string& integrator, const IntegratorOptions& options, long max_total_steps) {
+  const System& sys = *m.system;
+  ForwardResult res;
+  const std::vector<std::string> z_names = sys.stateNames();
+  res.states.name = "states";
+  res.states.labels = m.q_labels;
+  res.states.labels.insert(res.states.labels.end(), m.u_labels.begin(), m.u_labels.end());
+  res.states.labels.insert(res.states.labels.end(), z_names.begin(), z_names.end());
+  res.controls.name = "controls";
+  res.controls.labels = sys.controlNames();
+  std::vector<VecX> rows, crow;
+  std::vector<double> t_rows;
+  DynamicsWorkspace ws(sys);
+  auto record = [&](const State& s) {
+    const State e = sys.expandState(s);
+    VecX r(e.q.size() + e.qdot.size() + s.z.size());
+    r.head(e.q.size()) = e.q;
+    r.segment(e.q.size(), e.qdot.size()) = e.qdot;
+    if (s.z.size() > 0) r.tail(s.z.size()) = s.z;
+    rows.push_back(r);
+    t_rows.push_back(s.t);
+    if (sys.numControls() > 0) {
+      sys.calcMassAndForce(s, ws);
+      crow.push_back(ws.controls);
+    } else {
+      crow.push_back(VecX());
+    }
+  };
+  IntegratorOptions opt = options;
+  auto integ = makeIntegrator(integrator, opt);
+  State s = initial;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    for (double t : times) {
+      if (t < s.t) continue;
+      if (t > s.t) integ->advance(sys, s, t);
+      record(s);
+      if (max_total_steps > 0 && integ->stats().steps > max_total_steps) {
+        std::ostringstream os;
+        os << integrator << ": more than maximum_number_of_integrator_steps = " << max_total_steps
+           << " steps by t = " << s.t;
+        throw SimulationError(os.str(), s.t, 0.0);
+      }
+    }
+  } catch (const SimulationError& e) {
+    res.failed = true;
+    res.failure = e.what();
+  }
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.stats = integ->stats();
+  const int nrow = static_cast<int>(rows.size());
+  res.states.time = t_rows;
+  res.states.data.resize(nrow, static_cast<int>(res.states.labels.size()));
+  res.controls.time = t_rows;
+  res.controls.data.resize(nrow, static_cast<int>(res.controls.labels.size()));
+  for (int r = 0; r < nrow; ++r) {
+    res.states.data.row(r) = rows[r].transpose();
+    if (crow[r].size() == res.controls.data.cols()) res.controls.data.row(r) = crow[r].transpose();
+  }
+  return res;
+}
+
+ForwardTool::ForwardTool(ForwardToolSettings settings) : settings_(std::move(settings)) {
+  setup_ = osim::readForwardSetup(settings_.setup_file);
+  warnings_ = setup_.warnings;
+  const std::string& sf = setup_.source_file;
+  if (setup_.model_file.empty()) throw osim::ConvertError(sf, 0, "the setup names no model_file");
+  if (!setup_.force_set_files.empty())
+    throw osim::ConvertError(sf, 0, "force_set_files are not supported yet (docs/forward.md)");
+  if (!setup_.external_loads_file.empty())
+    throw osim::ConvertError(sf, 0, "external_loads_file is not supported yet in forward simulation (docs/forward.md)");
+  if (!(settings_.report_interval > 0.0) || !std::isfinite(settings_.report_interval))
+    throw std::invalid_argument("the report interval must be positive");
+  SimulationModelOptions mo;
+  mo.muscle_mass = settings_.muscle_mass;
+  model_ = loadSimulationModel(setup_.model_file, mo);
+  for (const std::string& w : model_.build.warnings) warnings_.push_back(w);
+  if (!settings_.muscle_class.empty()) {
+    // OpenSim's Object::renameType on every muscle: the models follow the class
+    MusculoskeletalModelBuilder b(model_.build.model);
+    b.overrideMuscleClass(settings_.muscle_class);
+    model_.build.model = b.finalize();
+  }
+  // replace_force_set without force_set_files leaves the model without forces (OpenSim)
+  if (!setup_.replace_force_set) addActuatorTerms(model_, warnings_);
+  System& sys = *model_.system;
+  addSetupControllers(sys, setup_, warnings_);
+  if (!setup_.controls_file.empty()) addControlsFile(sys, setup_.controls_file, warnings_);
+  // initial state
+  initial_ = defaultInitialState(model_);
+  initial_.z = sys.defaultState().z;
+  initial_.t = setup_.initial_time;
+  if (!setup_.states_file.empty()) {
+    const osim::Storage table = osim::readStorage(setup_.states_file);
+    initial_ = forwardInitialState(model_, table, setup_.states_file, setup_.initial_time);
+  }
+  if (setup_.solve_for_equilibrium) {
+    DynamicsWorkspace ws(sys);
+    sys.equilibrateStates(initial_, ws);
+  }
+  for (const double t : settings_.output_times)
+    if (!std::isfinite(t)) throw std::invalid_argument("non-finite output time");
+}
+
+std::string ForwardTool::resultsDirectory() const {
+  return settings_.out_dir ? *settings_.out_dir : setup_.results_directory;
+}
+std::string ForwardTool::statesPath() const {
+  return (fs::path(resultsDirectory()) / (setup_.name + "_states.sto")).string();
+}
+std::string ForwardTool::controlsPath() const {
+  return (fs::path(resultsDirectory()) / (setup_.name + "_controls.sto")).string();
+}
+
+ForwardResult ForwardTool::run() const {
+  const double t0 = setup_.initial_time, t1 = setup_.final_time;
+  std::vector<double> times;
+  if (!settings_.output_times.empty()) {
+    for (double t : settings_.output_times)
+      if (t >= t0 - 1e-12 && t <= t1 + 1e-12) times.push_back(std::clamp(t, t0, t1));
+    std::sort(times.begin(), times.end());
+  } else {
+    const long n = std::max(1L, std::lround(std::ceil((t1 - t0) / settings_.report_interval - 1e-9)));
+    for (long k = 0; k <= n; ++k) times.push_back(k == n ? t1 : t0 + k * settings_.report_interval);
+  }
+  IntegratorOptions opt;
+  const double tol = settings_.tolerance ? *settings_.tolerance : setup_.integrator_error_tolerance;
+  opt.rtol = tol;
+  opt.atol = tol;
+  opt.max_step = setup_.maximum_integrator_step_size;
+  opt.dt = std::min(1e-3, setup_.maximum_integrator_step_size);
+  ForwardResult r = runForward(model_, initial_, times, settings_.integrator, opt, setup_.maximum_number_of_integrator_steps);
+  r.states.name = setup_.name + "_states";
+  r.controls.name = setup_.name + "_controls";
+  return r;
+}
+
+void ForwardTool::write(const ForwardResult& r) const {
+  const std::string dir = resultsDirectory();
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw osim::ConvertError(dir, 0, "cannot create the results directory: " + ec.message());
+  osim::StorageWriteOptions o;
+  o.decimals = std::max(8, setup_.output_precision);
+  o.scientific = true;
+  o.description = "redmax forward: states of " + setup_.source_file;
+  osim::writeStorage(statesPath(), r.states, o);
+  o.description = "redmax forward: controls of " + setup_.source_file;
+  osim::writeStorage(controlsPath(), r.controls, o);
+}
+
+}  // namespace redmax::validation

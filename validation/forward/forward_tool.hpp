@@ -1,0 +1,109 @@
+#pragma once
+// OpenSim's ForwardTool in the REDMAX core: the library behind `redmax forward` and
+// `redmax simulate --controls` (docs/forward.md).
+//
+//   setup (converter/forward_setup.hpp) -> model_file read and built as for `simulate`
+//     (loadSimulationModel: constraints, muscle mass) -> --muscle-class override -> System:
+//     the skeleton (+ MuscleTerm with mass) + MuscleForceTerm (muscles with a model) +
+//     CoordinateActuatorTerm; controllers from the ControllerSet (ControlSetController,
+//     PrescribedController) and the tool's own controls_file, as PrescribedControls
+//   -> initial state: defaults, then states_file's closest earlier row to initial_time (no
+//     interpolation; OpenSim 3 names r_elbow_flex, r_elbow_flex_u, BIClong.activation accepted
+//     beside OpenSim 4's), then the muscles' equilibrium if the setup asks
+//   -> rk45 (or another integrator) from initial_time to final_time with rtol = atol =
+//     integrator_error_tolerance, maximum_integrator_step_size, maximum_number_of_integrator_steps
+//   -> DIR/<name>_states.sto (time, /jointset/J/C/value, .../speed, every auxiliary state under
+//     its OpenSim 4 name) and DIR/<name>_controls.sto (one column per actuator), written atomically.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "converter/build/muscle_mass.hpp"
+#include "converter/controls.hpp"
+#include "converter/forward_setup.hpp"
+#include "converter/storage.hpp"
+#include "core/integrators/integrator.hpp"
+#include "validation/simulate/simulate.hpp"
+
+namespace redmax::validation {
+
+/// Controls from a file (ControlSet .xml or controls .sto) for every control of sys it names
+/// (bare actuator name or <actuator>.excitation), as one PrescribedControls; names of the file
+/// that match no actuator go to warnings. Throws osim::ConvertError for unreadable files.
+void addControlsFile(System& sys, const std::string& file, std::vector<std::string>& warnings,
+                     const std::vector<std::string>& actuator_list = {});
+
+/// The setup's controllers (disabled ones skipped) added to sys. Throws osim::ConvertError naming
+/// the setup file and the controller's line for a controller that cannot be built (no controls
+/// file, a function that cannot be evaluated, more functions than actuators).
+void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vector<std::string>& warnings);
+
+/// The muscles' force terms and actuators of a loaded model, added to its system: MuscleForceTerm
+/// over the muscles that have a muscle model, CoordinateActuatorTerm over the model's
+/// CoordinateActuators. Unsupported actuators go to warnings.
+void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings);
+
+/// A state of m's system from a states table: the closest row at or before `time` (the first row
+/// when none is), every coordinate, speed and auxiliary state the table names (OpenSim 4 paths or
+/// OpenSim 3 names); state.t = time. Throws osim::ConvertError naming `file`.
+State forwardInitialState(const SimulationModel& m, const osim::Storage& table, const std::string& file, double time);
+
+/// The auxiliary states of m's system that the table names at `row` (/forceset/M/S or OpenSim 3's
+/// M.S) into s.z (sized and defaulted first when it does not fit). Throws osim::ConvertError
+/// naming `file` for a non-finite value.
+void readAuxiliaryStates(const System& sys, const osim::Storage& table, int row, const std::string& file, State& s);
+
+struct ForwardToolSettings {
+  std::string setup_file;
+  std::optional<std::string> out_dir;  ///< replaces the setup's results_directory
+  std::string muscle_class;            ///< "" keeps each muscle's class (OpenSim's renameType)
+  osim::MuscleMassOptions muscle_mass;
+  std::string integrator = "rk45";
+  /// s between output rows (the last row is final_time); ignored when output_times is given
+  double report_interval = 0.01;
+  std::vector<double> output_times;    ///< exact output times in [initial, final] (e.g. a standard's)
+  std::optional<double> tolerance;     ///< replaces integrator_error_tolerance (rtol = atol)
+};
+
+struct ForwardResult {
+  osim::Storage states, controls;
+  IntegratorStats stats;
+  double wall_s = 0.0;
+  bool failed = false;
+  std::string failure;  ///< what diverged, with the time
+};
+
+class ForwardTool {
+ public:
+  /// Read everything and build the system and initial state. Throws osim::ConvertError
+  /// ("FILE:LINE: what"), ModelError or std::invalid_argument (bad settings) on bad input.
+  explicit ForwardTool(ForwardToolSettings settings);
+  const osim::ForwardSetup& setup() const { return setup_; }
+  const SimulationModel& model() const { return model_; }
+  const System& system() const { return *model_.system; }
+  const State& initialState() const { return initial_; }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  /// the results folder and the two output files
+  std::string resultsDirectory() const;
+  std::string statesPath() const;
+  std::string controlsPath() const;
+
+  ForwardResult run() const;
+  /// the states and controls tables, atomically (the folder is created)
+  void write(const ForwardResult& r) const;
+
+ private:
+  ForwardToolSettings settings_;
+  osim::ForwardSetup setup_;
+  SimulationModel model_;
+  State initial_;
+  std::vector<std::string> warnings_;
+};
+
+/// Integrate sys from `initial` to t1, recording states (q, qdot expanded to the skeleton, z) and
+/// controls at `times` (ascending, within [initial.t, t1]); shared by the ForwardTool and
+/// `simulate --controls`.
+ForwardResult runForward(const SimulationModel& m, const State& initial, const std::vector<double>& times,
+                         const std::string& integrator, const IntegratorOptions& options, long max_total_steps);
+
+}  // namespace redmax::validation
