@@ -1,5 +1,9 @@
 #include "converter/json_writer.hpp"
 
+#include <algorithm>
+
+#include "core/muscles/hill/factory.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -344,6 +348,29 @@ std::string describeAsJson(const ModelDescription& d) {
       w.key("optimal_fiber_length").value(m.optimal_fiber_length);
       w.key("tendon_slack_length").value(m.tendon_slack_length);
       w.key("pennation_angle_at_optimal").value(m.pennation_angle_at_optimal);
+      // the force model: its class and every parameter it computes with (OpenSim's defaults for
+      // the absent ones); a class redmax does not model lists the properties as read
+      const auto& known = hill::muscleModelClasses();
+      const bool modelled = std::find(known.begin(), known.end(), m.class_name) != known.end();
+      hill::ParameterList params;
+      std::vector<std::string> states;
+      if (modelled) {
+        const auto model = hill::makeMuscleModel(m.class_name, m.parameters);  // validated on reading
+        params = model->parameterList();
+        states = model->stateNames();
+      } else {
+        params.assign(m.parameters.values.begin(), m.parameters.values.end());
+      }
+      if (modelled)
+        w.key("force_model").value(m.class_name);
+      else
+        w.key("force_model").null();
+      w.key("states").beginArray();
+      for (const auto& sn : states) w.value("/forceset/" + m.name + "/" + sn);
+      w.endArray();
+      w.key("parameters").beginObject();
+      for (const auto& [k, v] : params) w.key(k).value(v);
+      w.endObject();
     }
     w.key("points").beginArray();
     for (const auto& p : m.points) {
@@ -444,11 +471,13 @@ std::string formatSummary(const ModelDescription& d) {
   std::snprintf(buf, sizeof buf, "  tree         %zu mobilizers, %d reversed, %zu slave bodies\n",
                 d.tree.mobilizers.size(), reversed, d.tree.slaves.size());
   o += buf;
-  int types[3] = {0, 0, 0}, muscles = 0, cond = 0, moving = 0, wraps = 0;
+  int types[3] = {0, 0, 0}, muscles = 0, cond = 0, moving = 0, wraps = 0, with_model = 0;
   std::map<std::string, int> by_class;
   for (const auto& m : d.muscles) {
     types[static_cast<int>(m.path_type)]++;
     muscles += m.is_muscle;
+    const auto& known = hill::muscleModelClasses();
+    with_model += m.is_muscle && std::find(known.begin(), known.end(), m.class_name) != known.end();
     by_class[m.class_name]++;
     wraps += static_cast<int>(m.wraps.size());
     for (const auto& p : m.points) {
@@ -465,6 +494,9 @@ std::string formatSummary(const ModelDescription& d) {
     sep = "";
     for (const auto& [k, n] : by_class) o += sep + std::to_string(n) + " " + k, sep = ", ";
     o += "\n";
+    std::snprintf(buf, sizeof buf, "               force models for %d of %d muscles (core/muscles/hill)\n",
+                  with_model, muscles);
+    o += buf;
   }
   std::snprintf(buf, sizeof buf,
                 "  paths        %d conditional points, %d moving points, %d wraps on %zu wrap "

@@ -8,10 +8,12 @@
 // X_GB = X_GP * X_PF * X_FM(q) * inverse(X_BM)   [semantics §2].
 // Units are SI, angles radians. Body names refer to BodyDesc::name or to the ground's name.
 #include <array>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/muscles/hill/parameters.hpp"
 #include "core/spatial/types.hpp"
 
 namespace redmax::osim {
@@ -231,6 +233,10 @@ struct PathForceDesc {
   double pennation_angle_at_optimal = 0.0, max_contraction_velocity = 10.0;
   double optimal_force = 1.0;                                      ///< PathActuator
   double resting_length = 0.0, stiffness = 0.0, dissipation = 0.0;  ///< PathSpring
+  /// muscles: every numeric and boolean property the Hill models read (OpenSim 4 names; curve
+  /// sub-objects as "ActiveForceLengthCurve/min_norm_active_fiber_length"), as written
+  hill::MuscleParameters parameters;
+  std::map<std::string, int> parameter_lines;  ///< property -> line it was read from
   std::vector<PathPointDesc> points;
   std::vector<PathWrapDesc> wraps;
   PathType path_type = PathType::I;

@@ -6,6 +6,7 @@
 
 #include "converter/detail/osim_functions.hpp"
 #include "converter/detail/osim_reader_impl.hpp"
+#include "core/muscles/hill/factory.hpp"
 
 namespace redmax::osim::detail {
 namespace {
@@ -33,6 +34,46 @@ const std::set<std::string>& actuatorClasses() {
                                           "BodyActuator",       "PointToPointActuator",
                                           "GeneralizedForce",   "Force",
                                           "Torque"};
+  return s;
+}
+
+// the muscle properties the Hill models read (core/muscles/hill): numbers, and booleans (flags)
+const std::set<std::string>& muscleNumberProperties() {
+  static const std::set<std::string> s = {
+      "max_isometric_force", "optimal_fiber_length", "tendon_slack_length",
+      "pennation_angle_at_optimal", "max_contraction_velocity", "min_control", "max_control",
+      "default_activation", "default_fiber_length", "activation_time_constant",
+      "deactivation_time_constant", "minimum_activation", "maximum_pennation_angle", "fiber_damping",
+      // Thelen2003Muscle(_Deprecated)
+      "Vmax", "Vmax0", "FmaxTendonStrain", "FmaxMuscleStrain", "KshapeActive", "KshapePassive",
+      "damping", "Af", "Flen", "fv_linear_extrap_threshold",
+      // DeGrooteFregly2016Muscle
+      "active_force_width_scale", "passive_fiber_strain_at_one_norm_force",
+      "tendon_strain_at_one_norm_force", "default_normalized_tendon_force", "activation_dynamics_smoothing",
+      // Schutte1993Muscle_Deprecated
+      "time_scale", "activation1", "activation2"};
+  return s;
+}
+const std::set<std::string>& muscleFlagProperties() {
+  static const std::set<std::string> s = {"ignore_tendon_compliance", "ignore_activation_dynamics",
+                                          "ignore_passive_fiber_force"};
+  return s;
+}
+// Millard2012EquilibriumMuscle's curve sub-objects and their properties
+const std::map<std::string, std::set<std::string>>& muscleCurveProperties() {
+  static const std::map<std::string, std::set<std::string>> s = {
+      {"ActiveForceLengthCurve",
+       {"min_norm_active_fiber_length", "transition_norm_fiber_length", "max_norm_active_fiber_length",
+        "shallow_ascending_slope", "minimum_value"}},
+      {"ForceVelocityCurve",
+       {"concentric_slope_at_vmax", "concentric_slope_near_vmax", "isometric_slope",
+        "eccentric_slope_at_vmax", "eccentric_slope_near_vmax", "max_eccentric_velocity_force_multiplier",
+        "concentric_curviness", "eccentric_curviness"}},
+      {"FiberForceLengthCurve",
+       {"strain_at_zero_force", "strain_at_one_norm_force", "stiffness_at_low_force",
+        "stiffness_at_one_norm_force", "curviness"}},
+      {"TendonForceLengthCurve",
+       {"strain_at_one_norm_force", "stiffness_at_one_norm_force", "norm_force_at_toe_end", "curviness"}}};
   return s;
 }
 
@@ -181,6 +222,7 @@ void OsimReader::readPathForce(const XMLElement* e, const std::string& name,
   m.resting_length = childDouble(doc(), e, "resting_length", 0.0);
   m.stiffness = childDouble(doc(), e, "stiffness", 0.0);
   m.dissipation = childDouble(doc(), e, "dissipation", 0.0);
+  if (is_muscle) readMuscleParameters(e, m);
 
   // the path: a GeometryPath (any name), or a pre-2.0.3 MusclePointSet directly in the muscle
   const XMLElement* path = firstChild(e, "GeometryPath");
@@ -243,6 +285,65 @@ void OsimReader::readPathForce(const XMLElement* e, const std::string& name,
   for (const auto& p : m.points) extra = extra || p.kind != PathPointKind::Fixed;
   m.path_type = !m.wraps.empty() ? PathType::III : extra ? PathType::II : PathType::I;
   d_.muscles.push_back(std::move(m));
+}
+
+// every property a Hill model reads, as written (absent ones keep the model's OpenSim default),
+// then the model is made once so that a value its class refuses is an error at its line
+void OsimReader::readMuscleParameters(const XMLElement* e, PathForceDesc& m) {
+  hill::MuscleParameters& p = m.parameters;
+  p.name = m.name;
+  const auto put = [&](const std::string& key, const XMLElement* c, bool flag) {
+    if (textOf(c).empty()) return;  // an empty property keeps its default, as childDouble does
+    p.set(key, flag ? (parseBool(doc(), c) ? 1.0 : 0.0) : parseNumber(doc(), c, textOf(c)));
+    m.parameter_lines[key] = lineOf(c);
+  };
+  for (const XMLElement* c : childElements(e)) {
+    const std::string tag = c->Name();
+    if (muscleNumberProperties().count(tag)) {
+      put(tag, c, false);
+    } else if (muscleFlagProperties().count(tag)) {
+      put(tag, c, true);
+    } else if (tag == "tendon_compliance_dynamics_mode" && !textOf(c).empty()) {
+      // DeGrooteFregly2016Muscle: a string property, 0 explicit, 1 implicit
+      const std::string mode = textOf(c);
+      if (mode != "explicit" && mode != "implicit")
+        fail(c, "tendon_compliance_dynamics_mode '" + mode + "' is not explicit or implicit");
+      p.set(tag, mode == "explicit" ? 0.0 : 1.0);
+      m.parameter_lines[tag] = lineOf(c);
+    } else if (auto it = muscleCurveProperties().find(tag); it != muscleCurveProperties().end()) {
+      for (const XMLElement* cc : childElements(c))
+        if (it->second.count(cc->Name())) put(tag + "/" + cc->Name(), cc, false);
+      m.parameter_lines[tag] = lineOf(c);
+    }
+  }
+  // pennation_angle: the <= 20301 spelling (Muscle::updateFromXMLNode)
+  if (!p.has("pennation_angle_at_optimal"))
+    if (const XMLElement* c = firstChild(e, "pennation_angle"); c && !textOf(c).empty()) {
+      p.set("pennation_angle_at_optimal", parseNumber(doc(), c, textOf(c)));
+      m.parameter_lines["pennation_angle_at_optimal"] = lineOf(c);
+    }
+  // before 30513 a min_control of 0 or a max_control of 1 was written by mistake and is dropped,
+  // so that the class's default applies (Muscle::updateFromXMLNode)
+  if (version_ < 30513) {
+    if (p.has("min_control") && p.values.at("min_control") == 0.0) p.values.erase("min_control");
+    if (p.has("max_control") && p.values.at("max_control") == 1.0) p.values.erase("max_control");
+  }
+  // check the values now, at the line that holds them
+  if (std::find(hill::muscleModelClasses().begin(), hill::muscleModelClasses().end(), m.class_name) ==
+      hill::muscleModelClasses().end())
+    return;
+  try {
+    hill::makeMuscleModel(m.class_name, p);
+  } catch (const hill::MuscleParameterError& err) {
+    auto it = m.parameter_lines.find(err.property());
+    if (it == m.parameter_lines.end()) {
+      // a curve parameter: the line of its curve, else the muscle's
+      const auto slash = err.property().find('/');
+      if (slash != std::string::npos) it = m.parameter_lines.find(err.property().substr(0, slash));
+    }
+    const int line = it != m.parameter_lines.end() ? it->second : m.line;
+    throw ConvertError(doc().path(), line, m.class_name + " " + err.what());
+  }
 }
 
 PathPointDesc OsimReader::readPathPoint(const XMLElement* e, const std::string& owner,

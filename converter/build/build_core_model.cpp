@@ -483,7 +483,16 @@ class Builder {
         r_.unsupported.push_back({pf.line, what + " is left out: " + e.what()});
         continue;
       }
-      model_->addMuscle(std::move(m), pf.class_name);
+      // muscles carry their XML properties and, where redmax models the class, a force model
+      if (pf.is_muscle) {
+        try {
+          model_->addMuscle(std::move(m), pf.class_name, pf.parameters);
+        } catch (const hill::MuscleModelError& e) {
+          throw ConvertError(d_.source_file, pf.line, what + ": " + e.what());
+        }
+      } else {
+        model_->addMuscle(std::move(m), pf.class_name);
+      }
       r_.muscle_source.push_back(static_cast<int>(mi));
     }
   }

@@ -100,6 +100,7 @@ class OsimReader {
   void readForces();
   void readPathForce(const XMLElement* e, const std::string& name, const std::string& cls,
                      bool is_muscle, bool applies);
+  void readMuscleParameters(const XMLElement* e, PathForceDesc& m);
   PathPointDesc readPathPoint(const XMLElement* e, const std::string& owner,
                               std::set<std::string>& names);
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "core/muscles/hill/factory.hpp"
+
 namespace redmax {
 
 int MusculoskeletalModel::findMuscle(const std::string& name) const {
@@ -34,6 +36,8 @@ MusculoskeletalModelBuilder::MusculoskeletalModelBuilder(const MusculoskeletalMo
     : skeleton_(model.skeleton_),
       muscles_(model.muscles_),
       muscle_classes_(model.muscle_classes_),
+      muscle_models_(model.muscle_models_),
+      muscle_parameters_(model.muscle_parameters_),
       constraints_(model.constraints_),
       coordinate_map_(model.coordinate_map_),
       force_elements_(model.force_elements_),
@@ -42,7 +46,26 @@ MusculoskeletalModelBuilder::MusculoskeletalModelBuilder(const MusculoskeletalMo
 int MusculoskeletalModelBuilder::addMuscle(Muscle muscle, std::string opensim_class) {
   muscles_.push_back(std::move(muscle));
   muscle_classes_.push_back(std::move(opensim_class));
+  muscle_models_.push_back(nullptr);
+  muscle_parameters_.push_back(nullptr);
   return numMuscles() - 1;
+}
+
+namespace {
+bool modelled(const std::string& cls) {
+  const auto& known = hill::muscleModelClasses();
+  return std::find(known.begin(), known.end(), cls) != known.end();
+}
+}  // namespace
+
+int MusculoskeletalModelBuilder::addMuscle(Muscle muscle, std::string opensim_class,
+                                           hill::MuscleParameters parameters) {
+  if (parameters.name.empty()) parameters.name = muscle.name;
+  auto model = modelled(opensim_class) ? hill::makeMuscleModel(opensim_class, parameters) : nullptr;
+  const int k = addMuscle(std::move(muscle), std::move(opensim_class));
+  muscle_models_[k] = std::move(model);
+  muscle_parameters_[k] = std::make_shared<const hill::MuscleParameters>(std::move(parameters));
+  return k;
 }
 
 Muscle& MusculoskeletalModelBuilder::muscle(int k) {
@@ -55,7 +78,14 @@ void MusculoskeletalModelBuilder::setMuscleMassPoints(int k, MassPoints points) 
 }
 
 void MusculoskeletalModelBuilder::overrideMuscleClass(const std::string& opensim_class) {
-  for (auto& c : muscle_classes_) c = opensim_class;
+  // every model first, so that a refused property leaves the builder as it was
+  std::vector<std::shared_ptr<const hill::MuscleModel>> models(muscle_models_.size());
+  for (size_t k = 0; k < muscle_parameters_.size(); ++k)
+    if (muscle_parameters_[k]) models[k] = hill::makeMuscleModel(opensim_class, *muscle_parameters_[k]);
+  muscle_models_ = std::move(models);
+  // muscles only: a PathSpring or PathActuator keeps its class
+  for (size_t k = 0; k < muscle_classes_.size(); ++k)
+    if (muscle_parameters_[k] || hill::isOpenSimMuscleClass(muscle_classes_[k])) muscle_classes_[k] = opensim_class;
 }
 
 void MusculoskeletalModelBuilder::addConstraint(std::shared_ptr<const Constraint> c) {
@@ -81,6 +111,8 @@ MusculoskeletalModel MusculoskeletalModelBuilder::finalize() const {
                      " coordinates on a skeleton with " + std::to_string(m.skeleton_.nr()));
   m.muscles_ = muscles_;
   m.muscle_classes_ = muscle_classes_;
+  m.muscle_models_ = muscle_models_;
+  m.muscle_parameters_ = muscle_parameters_;
   m.constraints_ = constraints_;
   m.coordinate_map_ = coordinate_map_;
   m.force_elements_ = force_elements_;

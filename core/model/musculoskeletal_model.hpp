@@ -18,6 +18,8 @@
 #include "core/dynamics/force_term.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/system.hpp"
+#include "core/muscles/hill/muscle_model.hpp"
+#include "core/muscles/hill/parameters.hpp"
 #include "core/muscles/mass_points.hpp"
 #include "core/skeleton/model.hpp"
 
@@ -45,6 +47,13 @@ class MusculoskeletalModel {
   const std::vector<Muscle>& muscles() const { return muscles_; }
   /// the OpenSim class each muscle is read as ("" when unknown)                        (nmus)
   const std::vector<std::string>& muscleClasses() const { return muscle_classes_; }
+  /// each muscle's force model (core/muscles/hill), null for a path force without one (a
+  /// PathSpring, a muscle class redmax does not model, a muscle added without parameters)  (nmus)
+  const std::vector<std::shared_ptr<const hill::MuscleModel>>& muscleModels() const { return muscle_models_; }
+  /// each muscle's XML properties as read (null when it has none)                       (nmus)
+  const std::vector<std::shared_ptr<const hill::MuscleParameters>>& muscleParameters() const {
+    return muscle_parameters_;
+  }
   /// constraints to add to a System
   const std::vector<std::shared_ptr<const Constraint>>& constraints() const { return constraints_; }
   /// hyper-reduced coordinates (null: the system's coordinates are q_r)
@@ -72,6 +81,8 @@ class MusculoskeletalModel {
   Model skeleton_;
   std::vector<Muscle> muscles_;
   std::vector<std::string> muscle_classes_;
+  std::vector<std::shared_ptr<const hill::MuscleModel>> muscle_models_;
+  std::vector<std::shared_ptr<const hill::MuscleParameters>> muscle_parameters_;
   std::vector<std::shared_ptr<const Constraint>> constraints_;
   std::shared_ptr<const CoordinateMap> coordinate_map_;
   std::vector<std::shared_ptr<const ForceTerm>> force_elements_;
@@ -93,15 +104,20 @@ class MusculoskeletalModelBuilder {
 
   /// append a muscle; `opensim_class` is the class it is read as. Returns its index.
   int addMuscle(Muscle muscle, std::string opensim_class = "");
+  /// append a muscle with its XML properties: its force model is hill::makeMuscleModel(class,
+  /// parameters) when redmax models the class (null otherwise). Throws hill::MuscleParameterError
+  /// for a value the class refuses.
+  int addMuscle(Muscle muscle, std::string opensim_class, hill::MuscleParameters parameters);
   int numMuscles() const { return static_cast<int>(muscles_.size()); }
   /// muscle k for editing (mass points, wrap model); finalize() validates it
   Muscle& muscle(int k);
   void setMuscleMassPoints(int k, MassPoints points);
 
   /// Read every muscle as OpenSim class `opensim_class` (OpenSim's Object::renameType, the
-  /// CLI's --muscle-class). The edit point for a muscle-class override: today it only renames
-  /// muscleClasses(), since the core models no muscle force; a force model keyed on the class
-  /// reads it from there.
+  /// CLI's --muscle-class): the same XML properties, read as that class, make each muscle's new
+  /// force model (muscles without parameters are only renamed). Throws hill::MuscleModelError for
+  /// a class redmax does not model and hill::MuscleParameterError for a property the new class
+  /// refuses; the builder is unchanged then.
   void overrideMuscleClass(const std::string& opensim_class);
 
   void addConstraint(std::shared_ptr<const Constraint> c);
@@ -117,6 +133,8 @@ class MusculoskeletalModelBuilder {
   ModelBuilder skeleton_;
   std::vector<Muscle> muscles_;
   std::vector<std::string> muscle_classes_;
+  std::vector<std::shared_ptr<const hill::MuscleModel>> muscle_models_;
+  std::vector<std::shared_ptr<const hill::MuscleParameters>> muscle_parameters_;
   std::vector<std::shared_ptr<const Constraint>> constraints_;
   std::shared_ptr<const CoordinateMap> coordinate_map_;
   std::vector<std::shared_ptr<const ForceTerm>> force_elements_;

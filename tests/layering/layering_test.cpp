@@ -1,6 +1,7 @@
 // Dependencies point down only (docs/design.md §3): this test fails on any upward or forbidden #include.
 //   core/spatial <- core/joints <- core/skeleton <- core/muscles <- core/dynamics <- core/integrators
 //   core/spatial <- core/geometry <- core/muscles   (surface geometry: wrap surfaces, dual numbers)
+//   core/muscles/hill (Hill-type muscle models: the standard library only) <- core/muscles
 //   core/dynamics <- core/model (the musculoskeletal aggregate, beside core/integrators)
 //   converter/, plugin/ -> core/ (plugin may also read the converter's description)
 //   tools/ -> core/ (offline work the engine never runs: wrap-network training, wrap benchmarks)
@@ -51,7 +52,8 @@ std::vector<Include> scan(const fs::path& root, const std::string& dir) {
 // the project folder an include names ("core/joints/joint.hpp" -> "core/joints"), or "" if external
 std::string layerOf(const std::string& inc) {
   static const std::vector<std::string> layers = {
-      "core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles", "core/dynamics",
+      "core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles",
+      "core/dynamics",
       "core/integrators", "core/model", "converter", "plugin", "tools", "validation", "cli"};
   for (const auto& l : layers)
     if (inc.rfind(l + "/", 0) == 0) return l;
@@ -71,17 +73,18 @@ bool isSundials(const std::string& inc) {
 std::map<std::string, std::set<std::string>> layerRules() {
   std::map<std::string, std::set<std::string>> rules = {
       {"core/spatial", {"core/spatial"}},
+      {"core/muscles/hill", {"core/muscles/hill"}},
       {"core/geometry", {"core/spatial", "core/geometry"}},
       {"core/joints", {"core/spatial", "core/joints"}},
       {"core/skeleton", {"core/spatial", "core/joints", "core/skeleton"}},
-      {"core/muscles", {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles"}},
+      {"core/muscles", {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles"}},
       {"core/dynamics",
-       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles", "core/dynamics"}},
+       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles", "core/dynamics"}},
       {"core/integrators",
-       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles", "core/dynamics",
+       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles", "core/dynamics",
         "core/integrators"}},
       {"core/model",
-       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles", "core/dynamics",
+       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles", "core/dynamics",
         "core/model"}},
   };
   std::set<std::string> core_all = rules.at("core/integrators");
@@ -113,6 +116,7 @@ TEST(Layering, IncludesPointDownOnly) {
   for (const auto& rule : rules) {
     const std::string& dir = rule.first;
     for (const auto& inc : scan(root, dir)) {
+      if (layerOf(inc.file) != dir) continue;  // a sub-layer's file (core/muscles/hill) has its own rule
       ++checked;
       const std::string where = inc.file + ":" + std::to_string(inc.line) + " includes " + inc.target;
       EXPECT_TRUE(mayInclude(dir, inc.target)) << where << " (upward or sideways dependency)";
@@ -155,6 +159,12 @@ TEST(Layering, DetectsAViolation) {
   EXPECT_FALSE(mayInclude("tools", "validation/report/csv.hpp"));
   EXPECT_TRUE(mayInclude("tools", "core/muscles/wrap/network.hpp"));
   EXPECT_TRUE(mayInclude("core/spatial", "Eigen/Core"));
+  // the Hill models sit below everything: not even spatial algebra
+  EXPECT_EQ(layerOf("core/muscles/hill/muscle_model.hpp"), "core/muscles/hill");
+  EXPECT_FALSE(mayInclude("core/muscles/hill", "core/muscles/path.hpp"));
+  EXPECT_FALSE(mayInclude("core/muscles/hill", "core/spatial/types.hpp"));
+  EXPECT_TRUE(mayInclude("core/muscles", "core/muscles/hill/muscle_model.hpp"));
+  EXPECT_TRUE(mayInclude("converter", "core/muscles/hill/factory.hpp"));
   EXPECT_TRUE(isSimbody("Simbody.h"));
   EXPECT_TRUE(isSundials("arkode/arkode_erkstep.h"));
 }

@@ -8,8 +8,10 @@
 // The states of one muscle are named as OpenSim 4 names them under the muscle
 // (/forceset/<muscle>/<stateName>), in the order stateNames() gives; a System stores them in
 // State::z (docs/muscle_dynamics.md).
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace redmax::hill {
@@ -25,7 +27,8 @@ class MuscleModelError : public std::runtime_error {
 struct MusculotendonInput {
   double length = 0.0;      ///< musculotendon (path) length l_MT, m
   double speed = 0.0;       ///< lengthening speed dl_MT/dt, m/s
-  double excitation = 0.0;  ///< control u (clamped by the model to [min_control, max_control])
+  double excitation = 0.0;  ///< control u, as OpenSim passes it (OpenSim's muscles do not clamp
+                            ///< it to [min_control, max_control]: controllers do)
 };
 
 /// OpenSim's Muscle outputs at one state; forces in N, lengths in m, velocities in m/s.
@@ -59,6 +62,13 @@ class MuscleModel {
   /// so that fibre and tendon forces balance at `in`, keeping the other entries of z. Throws
   /// MuscleModelError when no fibre length does.
   virtual void equilibrate(const MusculotendonInput& in, double* z) const = 0;
+
+  /// the muscle's control bounds (OpenSim's min_control, max_control, after the class defaults)
+  virtual double minControl() const { return 0.0; }
+  virtual double maxControl() const { return 1.0; }
+  /// the parameters the model computes with (after OpenSim's defaults), in a fixed order, for
+  /// reports (`redmax convert`)
+  virtual std::vector<std::pair<std::string, double>> parameterList() const { return {}; }
 };
 
 }  // namespace redmax::hill

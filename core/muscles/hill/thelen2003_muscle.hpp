@@ -1,0 +1,85 @@
+#pragma once
+// OpenSim's Thelen2003Muscle (4.x: Millard's re-implementation with the fixed-width pennation
+// model, clamped first-order activation and an extrapolated force-velocity inverse) and
+// Thelen2003Muscle_Deprecated (the 1.x-3.x code the arm26 ForwardTool standard was made with).
+// States (activation, fiber_length) in that order; docs/muscle_dynamics.md gives the equations.
+#include "core/muscles/hill/muscle_model.hpp"
+#include "core/muscles/hill/muscle_properties.hpp"
+#include "core/muscles/hill/parameters.hpp"
+#include "core/muscles/hill/thelen2003_curves.hpp"
+
+namespace redmax::hill {
+
+/// OpenSim's MuscleFirstOrderActivationDynamicModel: a in [a_min, 1],
+/// da/dt = (u - a) / tau with tau = tau_a (0.5 + 1.5 a) when u > a, tau_d / (0.5 + 1.5 a) else
+/// [Thelen 2003, Eq. 6, 7].
+struct FirstOrderActivation {
+  double activation_time_constant = 0.015, deactivation_time_constant = 0.050;
+  double minimum_activation = 0.01;
+  double clamp(double a) const;
+  double derivative(double a, double u) const;
+};
+
+class Thelen2003Muscle final : public MuscleModel {
+ public:
+  /// reads OpenSim 4's properties with its defaults; throws MuscleParameterError as
+  /// Thelen2003Muscle::extendFinalizeFromProperties does
+  explicit Thelen2003Muscle(const MuscleParameters& p);
+
+  std::string className() const override { return "Thelen2003Muscle"; }
+  const std::vector<std::string>& stateNames() const override;
+  void defaultState(double* z) const override;
+  void calc(const double* z, const MusculotendonInput& in, MuscleOutput& out, double* zdot) const override;
+  /// OpenSim's initMuscleState: Newton on l_f with halving steps, tolerance max(1e-8 F_max,
+  /// 10 SignificantReal), 20 iterations, velocity split by the stiffnesses; the fibre stops at
+  /// its minimum length
+  void equilibrate(const MusculotendonInput& in, double* z) const override;
+  double minControl() const override { return m_.min_control; }
+  double maxControl() const override { return m_.max_control; }
+  std::vector<std::pair<std::string, double>> parameterList() const override;
+
+  const MuscleProperties& properties() const { return m_; }
+  const Thelen2003Curves& curves() const { return c_; }
+  const FixedWidthPennation& pennation() const { return pen_; }
+  const FirstOrderActivation& activationModel() const { return act_; }
+
+ private:
+  std::string name_;
+  MuscleProperties m_;
+  Thelen2003Curves c_;
+  double maximum_pennation_angle_;
+  FixedWidthPennation pen_;
+  FirstOrderActivation act_;
+};
+
+class Thelen2003MuscleDeprecated final : public MuscleModel {
+ public:
+  explicit Thelen2003MuscleDeprecated(const MuscleParameters& p);
+
+  std::string className() const override { return "Thelen2003Muscle_Deprecated"; }
+  const std::vector<std::string>& stateNames() const override;
+  /// OpenSim's ActivationFiberLengthMuscle_Deprecated has no default_activation or
+  /// default_fiber_length property: both default to 0
+  void defaultState(double* z) const override;
+  void calc(const double* z, const MusculotendonInput& in, MuscleOutput& out, double* zdot) const override;
+  /// OpenSim's computeIsometricForce: secant/stiffness iteration to |F_T - F_M cos phi| <= 0.01 N,
+  /// 100 iterations; it never reports failure (neither does OpenSim)
+  void equilibrate(const MusculotendonInput& in, double* z) const override;
+  double minControl() const override { return m_.min_control; }
+  double maxControl() const override { return m_.max_control; }
+  std::vector<std::pair<std::string, double>> parameterList() const override;
+
+  const Thelen2003DeprecatedCurves& curves() const { return c_; }
+  const MuscleProperties& properties() const { return m_; }
+
+ private:
+  /// the 2.x pennation: asin(l_opt sin(phi_opt) / l_f), 0 and pi/2 at its ends
+  double pennation(double l_f, double l_opt) const;
+
+  std::string name_;
+  MuscleProperties m_;
+  Thelen2003DeprecatedCurves c_;
+  double tau_act_ = 0.01, tau_deact_ = 0.04, Vmax_ = 10.0, Vmax0_ = 5.0;
+};
+
+}  // namespace redmax::hill
