@@ -50,6 +50,9 @@ class DeGrooteFregly2016Muscle final : public MuscleModel {
   double minControl() const override { return m_.min_control; }
   double maxControl() const override { return m_.max_control; }
   std::vector<std::pair<std::string, double>> parameterList() const override;
+  /// rigid tendon at its slack length: F_max a fal fv along the fibre (OpenSim returns
+  /// MuscleDynamicsInfo::activeFiberForce, not its projection on the tendon), v_f = speed cos(phi)
+  double inextensibleTendonActiveFiberForce(const MusculotendonInput& in, double activation) const override;
 
   const DeGrooteFregly2016Curves& curves() const { return c_; }
   const MuscleProperties& properties() const { return m_; }
