@@ -8,21 +8,12 @@
 #include "core/muscles/hill/degroote_fregly2016_muscle.hpp"
 #include "core/muscles/hill/millard2012_equilibrium_muscle.hpp"
 #include "core/muscles/hill/thelen2003_muscle.hpp"
+#include "tests/core/muscles/hill/hill_test_util.hpp"
 
 namespace redmax::hill {
 namespace {
 
-// arm26's TRIlong geometry (pennated, so the pennation terms count)
-MuscleParameters triLong() {
-  MuscleParameters p;
-  p.name = "TRIlong";
-  p.set("max_isometric_force", 798.52);
-  p.set("optimal_fiber_length", 0.134);
-  p.set("tendon_slack_length", 0.143);
-  p.set("pennation_angle_at_optimal", 0.20943951);
-  p.set("max_contraction_velocity", 10);
-  return p;
-}
+using test::triLong;  // arm26's TRIlong (pennated, so the pennation terms count)
 constexpr double kFmax = 798.52, kLopt = 0.134, kLs = 0.143, kPhiOpt = 0.20943951;
 const double kH = kLopt * std::sin(kPhiOpt);
 
@@ -37,7 +28,7 @@ TEST(InextensibleTendonActiveFiberForce, Thelen2003MuscleClosedForms) {
   for (double L : {0.25, 0.277, 0.30}) {
     double lf, c;
     rigidFibre(L, lf, c);
-    const double fal = std::exp(-(lf / kLopt - 1) * (lf / kLopt - 1) / 0.45);
+    const double fal = std::exp(-(lf / kLopt - 1) * (lf / kLopt - 1) / 0.5);  // KshapeActive 0.5
     EXPECT_NEAR(m.inextensibleTendonActiveFiberForce({L, 0.0, 0.0}, 1.0), kFmax * fal * c, 1e-10 * kFmax);
     EXPECT_NEAR(m.inextensibleTendonActiveFiberForce({L, 0.0, 0.0}, 0.5), 0.5 * kFmax * fal * c, 1e-10 * kFmax);
     // activation is clamped to [minimum_activation, 1]
