@@ -11,26 +11,6 @@ namespace redmax::osim {
 namespace fs = std::filesystem;
 using namespace detail;
 
-namespace {
-
-// the tool/loads object: <OpenSimDocument><Tag> or a bare <Tag> root
-const XMLElement* toolElement(const XmlDocument& doc, const char* tag) {
-  const XMLElement* root = doc.root();
-  if (std::string(root->Name()) == tag) return root;
-  if (std::string(root->Name()) == "OpenSimDocument") {
-    if (const XMLElement* e = firstChild(root, tag)) return e;
-    doc.fail(root, std::string("no <") + tag + "> element in <OpenSimDocument>");
-  }
-  doc.fail(root, "root element is <" + std::string(root->Name()) + ">, expected <" + tag +
-                     "> or <OpenSimDocument>");
-}
-
-std::string folderOf(const std::string& file) {
-  const fs::path p = fs::path(file).parent_path();
-  return p.empty() ? std::string(".") : p.string();
-}
-
-}  // namespace
 
 std::string resolveRelativeTo(const std::string& dir, const std::string& path) {
   if (path.empty()) return {};
@@ -41,7 +21,7 @@ std::string resolveRelativeTo(const std::string& dir, const std::string& path) {
 
 ExternalLoads readExternalLoads(const std::string& xml_path, const std::string& working_dir) {
   XmlDocument doc(xml_path);
-  const XMLElement* el = toolElement(doc, "ExternalLoads");
+  const XMLElement* el = toolRoot(doc, "ExternalLoads");
   ExternalLoads loads;
   loads.source_file = xml_path;
   loads.name = attribute(el, "name");
@@ -143,7 +123,7 @@ void checkExternalLoads(ExternalLoads& loads, const ModelDescription& model) {
 
 InverseDynamicsSetup readInverseDynamicsSetup(const std::string& path) {
   XmlDocument doc(path);
-  const XMLElement* el = toolElement(doc, "InverseDynamicsTool");
+  const XMLElement* el = toolRoot(doc, "InverseDynamicsTool");
   InverseDynamicsSetup s;
   s.source_file = path;
   s.name = attribute(el, "name");

@@ -8,6 +8,7 @@
 // X_GB = X_GP * X_PF * X_FM(q) * inverse(X_BM)   [semantics §2].
 // Units are SI, angles radians. Body names refer to BodyDesc::name or to the ground's name.
 #include <array>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -251,6 +252,9 @@ struct ForceDesc {
   bool modelled = false;   ///< false: its force is not computed by redmax (see unsupported)
   std::string coordinate;  ///< CoordinateActuator
   double optimal_force = 1.0;
+  /// Actuator min_control / max_control (OpenSim's defaults: -inf, +inf)
+  double min_control = -std::numeric_limits<double>::infinity();
+  double max_control = std::numeric_limits<double>::infinity();
   int line = 0;
 };
 

@@ -187,6 +187,8 @@ void OsimReader::readForces() {
     if (actuatorClasses().count(cls)) {
       f.coordinate = childText(e, "coordinate");
       f.optimal_force = childDouble(doc(), e, "optimal_force", 1.0);
+      f.min_control = childDouble(doc(), e, "min_control", f.min_control);
+      f.max_control = childDouble(doc(), e, "max_control", f.max_control);
     } else if (applies) {
       addUnsupported(e, "force '" + name + "' (" + cls + ") is listed but its force is not modelled");
     }
@@ -205,7 +207,7 @@ void OsimReader::readPathForce(const XMLElement* e, const std::string& name,
                                const std::string& cls, bool is_muscle, bool applies) {
   PathForceDesc m;
   m.name = name;
-  m.class_name = cls;
+  m.class_name = is_muscle && !muscle_class_.empty() ? muscle_class_ : cls;
   m.is_muscle = is_muscle;
   m.applies_force = applies;
   m.line = lineOf(e);

@@ -12,8 +12,11 @@
 
 namespace redmax::osim {
 
-ModelDescription readOsimModel(const std::string& path) {
+ModelDescription readOsimModel(const std::string& path) { return readOsimModel(path, ""); }
+
+ModelDescription readOsimModel(const std::string& path, const std::string& muscle_class) {
   detail::OsimReader reader(path);
+  reader.setMuscleClass(muscle_class);
   return reader.read();
 }
 

@@ -13,6 +13,10 @@ namespace redmax::osim {
 /// modelled are listed in ModelDescription::unsupported. Throws ConvertError ("FILE:LINE: what")
 /// on unreadable, malformed or inconsistent input; never leaves a partial result.
 ModelDescription readOsimModel(const std::string& path);
+/// The same with every muscle read as OpenSim class `muscle_class` ("": as written), as
+/// OpenSim's Object::renameType does: the XML properties are read, checked and defaulted as that
+/// class's, so a check of the written class does not apply (`--muscle-class`).
+ModelDescription readOsimModel(const std::string& path, const std::string& muscle_class);
 
 /// Build the multibody tree as Simbody's MultibodyGraphMaker does for OpenSim (§3.1): fills
 /// d.tree, appends FreeJoints for unconnected bodies and loop-closure constraints, and reorders

@@ -41,6 +41,8 @@ class OsimReader {
  public:
   explicit OsimReader(const std::string& path);
   ModelDescription read();
+  /// read every muscle as this class (renameType); "" = as written
+  void setMuscleClass(std::string cls) { muscle_class_ = std::move(cls); }
 
   // ---- shared helpers ----
   const XmlDocument& doc() const { return doc_; }
@@ -107,6 +109,7 @@ class OsimReader {
   XmlDocument doc_;
   ModelDescription d_;
   int version_ = 0;
+  std::string muscle_class_;
   const XMLElement* model_ = nullptr;
   const XMLElement* engine_ = nullptr;  ///< 1.x <DynamicsEngine><SimbodyEngine>, if any
   std::set<std::string> unsupported_frames_;  ///< paths of frames we cannot place

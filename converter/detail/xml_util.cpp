@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 
@@ -189,6 +190,29 @@ double roundLikeOstream(double x) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%g", x);
   return std::strtod(buf, nullptr);
+}
+
+const XMLElement* toolRoot(const XmlDocument& doc, const char* tag) {
+  const XMLElement* root = doc.root();
+  if (std::string(root->Name()) == tag) return root;
+  if (std::string(root->Name()) == "OpenSimDocument") {
+    if (const XMLElement* e = firstChild(root, tag)) return e;
+    doc.fail(root, std::string("no <") + tag + "> element in <OpenSimDocument>");
+  }
+  doc.fail(root, "root element is <" + std::string(root->Name()) + ">, expected <" + tag +
+                     "> or <OpenSimDocument>");
+}
+
+std::string folderOf(const std::string& file) {
+  const std::filesystem::path p = std::filesystem::path(file).parent_path();
+  return p.empty() ? std::string(".") : p.string();
+}
+
+std::string joinNames(const std::vector<std::string>& names, size_t max_names) {
+  std::string out;
+  for (size_t k = 0; k < names.size() && k < max_names; ++k) out += (k ? ", " : "") + names[k];
+  if (names.size() > max_names) out += ", ... (" + std::to_string(names.size()) + " in all)";
+  return out;
 }
 
 }  // namespace detail

@@ -46,6 +46,13 @@ std::string textOf(const XMLElement* e);
 std::vector<std::string> splitWords(const std::string& text);
 std::string trim(const std::string& s);
 std::string toLower(std::string s);
+/// the tool element of a setup file: <OpenSimDocument><tag> or a bare <tag> root (doc.fail
+/// otherwise)
+const XMLElement* toolRoot(const XmlDocument& doc, const char* tag);
+/// the folder of a file path ("." for a bare name)
+std::string folderOf(const std::string& file);
+/// "a, b, c", at most max_names of them, then ", ... (N in all)"
+std::string joinNames(const std::vector<std::string>& names, size_t max_names = 12);
 
 /// parse one number as OpenSim does (also inf, infinity, nan); fails with the element's line
 double parseNumber(const XmlDocument& doc, const XMLElement* e, const std::string& word);

@@ -1,5 +1,7 @@
 #include "converter/id/inverse_dynamics_tool.hpp"
 
+#include "converter/detail/xml_util.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -20,12 +22,7 @@ std::string lower(std::string s) {
   return s;
 }
 
-std::string joinNames(const std::vector<std::string>& names, size_t max_names = 12) {
-  std::string out;
-  for (size_t k = 0; k < names.size() && k < max_names; ++k) out += (k ? ", " : "") + names[k];
-  if (names.size() > max_names) out += ", ... (" + std::to_string(names.size()) + " in all)";
-  return out;
-}
+using detail::joinNames;
 
 std::vector<double> columnOf(const MatX& data, int c) {
   std::vector<double> v(static_cast<size_t>(data.rows()));
@@ -95,7 +92,7 @@ IdToolConfig resolveIdSettings(const IdToolSettings& s) {
 // ---------------------------------------------------------------------------------------------
 InverseDynamicsTool::InverseDynamicsTool(IdToolConfig config) : config_(std::move(config)) {
   warnings_ = config_.warnings;
-  description_ = readOsimModel(config_.model_file);
+  description_ = readOsimModel(config_.model_file, config_.muscle_class);
 
   // the model as OpenSim's ID sees it: no constraints (calcResidualForceIgnoringConstraints), no
   // muscles (redmax models no muscle forces; see checkForces) unless they take mass: then the

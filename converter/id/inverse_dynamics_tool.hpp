@@ -72,6 +72,8 @@ struct IdToolConfig {
   /// so that --muscles top:K ranks over the trial's output frames; the engines then get the model
   /// with the bodies' mass reduced (model()) and the muscles with mass points (muscles())
   MuscleMassOptions muscle_mass;
+  /// every muscle read as this OpenSim class (readOsimModel's renameType); "" = as written
+  std::string muscle_class;
   std::vector<std::string> warnings;  ///< from the setup file (settings 4.x ignores)
 };
 

@@ -158,6 +158,17 @@ void DeGrooteFregly2016Muscle::evaluate(double a, double fT, const Musculotendon
   e.tendon_force = rigid ? e.fiber_along : F_max * fT;
 }
 
+double DeGrooteFregly2016Muscle::inextensibleTendonActiveFiberForce(const MusculotendonInput& in,
+                                                                    double activation) const {
+  const double l_opt = m_.optimal_fiber_length;
+  const double w = l_opt * std::sin(m_.pennation_angle_at_optimal);
+  const double l_at = in.length - m_.tendon_slack_length;  // rigid: the tendon at its slack length
+  const double lf = std::sqrt(l_at * l_at + w * w);
+  const double cos_phi = l_at / lf;
+  const double vN = in.speed * cos_phi / (m_.max_contraction_velocity * l_opt);
+  return m_.max_isometric_force * (activation * c_.activeForceLength(lf / l_opt) * c_.forceVelocity(vN));
+}
+
 void DeGrooteFregly2016Muscle::calc(const double* z, const MusculotendonInput& in, MuscleOutput& out,
                                     double* zdot) const {
   const double a = i_act_ >= 0 ? z[i_act_] : in.excitation;

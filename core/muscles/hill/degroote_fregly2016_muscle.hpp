@@ -48,6 +48,9 @@ class DeGrooteFregly2016Muscle final : public MuscleWithProperties {
   /// equilibrium residual has the same sign at both ends
   void equilibrate(const MusculotendonInput& in, double* z) const override;
   std::vector<std::pair<std::string, double>> parameterList() const override;
+  /// rigid tendon at its slack length: F_max a fal fv along the fibre (OpenSim returns
+  /// MuscleDynamicsInfo::activeFiberForce, not its projection on the tendon), v_f = speed cos(phi)
+  double inextensibleTendonActiveFiberForce(const MusculotendonInput& in, double activation) const override;
 
   const DeGrooteFregly2016Curves& curves() const { return c_; }
   /// the equilibrium residual fT - F_M cos(phi) / F_max at tendon force fT, tendon at rest

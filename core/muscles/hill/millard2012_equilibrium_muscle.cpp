@@ -181,6 +181,24 @@ void Millard2012EquilibriumMuscle::defaultState(double* z) const {
   if (i_len_ >= 0) z[i_len_] = std::max(m_.default_fiber_length, l_min_);
 }
 
+double Millard2012EquilibriumMuscle::inextensibleTendonActiveFiberForce(const MusculotendonInput& in,
+                                                                       double activation) const {
+  const double l_opt = m_.optimal_fiber_length;
+  const double lce = pen_.fiberLength(in.length, m_.tendon_slack_length);
+  const double phi = pen_.pennationAngle(lce);
+  const double dlce = in.speed * std::cos(phi);  // rigid tendon
+  if (std::isnan(dlce)) return 0.0;
+  // calcActiveFiberForceAlongTendon
+  if (lce <= l_min_) return 0.0;
+  const double a = act_.clamp(activation);
+  const double lceN = lce / l_opt;
+  const double dlceN = dlce / (l_opt * m_.max_contraction_velocity);
+  const double fal = fal_.value(lceN), fv = fv_.value(dlceN);
+  // OpenSim passes the normalized fibre length to the pennation model here
+  const double phi_n = pen_.pennationAngle(lceN);
+  return m_.max_isometric_force * (a * fal * fv) * std::cos(phi_n);
+}
+
 double Millard2012EquilibriumMuscle::activationOf(const double* z, double u) const {
   return act_.clamp(i_act_ >= 0 ? z[i_act_] : u);
 }

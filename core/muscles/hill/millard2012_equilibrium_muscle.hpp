@@ -48,6 +48,11 @@ class Millard2012EquilibriumMuscle final : public MuscleWithProperties {
   /// minimum length. Nothing to do for a rigid tendon.
   void equilibrate(const MusculotendonInput& in, double* z) const override;
   std::vector<std::pair<std::string, double>> parameterList() const override;
+  /// rigid tendon: l_f from the pennation model, v_f = speed cos(phi); 0 at or below
+  /// minFiberLength(), else F_max a fal(lceN) fv(vN) cos(phi') with a clamped to
+  /// [minimum_activation, 1] and, as OpenSim's calcActiveFiberForceAlongTendon does, phi'
+  /// the pennation model evaluated at the normalized fibre length lceN
+  double inextensibleTendonActiveFiberForce(const MusculotendonInput& in, double activation) const override;
 
   const Millard2012CurveParameters& curveParameters() const { return cp_; }
   const SmoothSegmentedFunction& activeForceLengthCurve() const { return fal_; }

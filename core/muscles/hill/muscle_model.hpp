@@ -63,6 +63,19 @@ class MuscleModel {
   /// MuscleModelError when no fibre length does.
   virtual void equilibrate(const MusculotendonInput& in, double* z) const = 0;
 
+  /// OpenSim's calcInextensibleTendonActiveFiberForce(s, activation), which static optimization
+  /// uses with use_muscle_physiology: the active fibre force (N) at `activation` with a rigid
+  /// tendon at its slack length, the fibre length from the path length through the class's
+  /// pennation model and the fibre velocity from the path's lengthening speed; each class states
+  /// OpenSim's rules (along the tendon or the fibre, zero at the minimum fibre length). The base
+  /// throws MuscleModelError: a class without it cannot take part in static optimization with
+  /// muscle physiology.
+  virtual double inextensibleTendonActiveFiberForce(const MusculotendonInput& in, double activation) const {
+    (void)in;
+    (void)activation;
+    throw MuscleModelError(className() + ": calcInextensibleTendonActiveFiberForce is not modelled");
+  }
+
   /// the muscle's control bounds (OpenSim's min_control, max_control, after the class defaults)
   virtual double minControl() const { return 0.0; }
   virtual double maxControl() const { return 1.0; }

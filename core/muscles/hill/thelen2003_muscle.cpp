@@ -83,6 +83,21 @@ Thelen2003Muscle::Thelen2003Muscle(const MuscleParameters& p) {
   }
 }
 
+double Thelen2003Muscle::inextensibleTendonActiveFiberForce(const MusculotendonInput& in, double activation) const {
+  const double l_opt = m_.optimal_fiber_length;
+  const double lf = pen_.fiberLength(in.length, m_.tendon_slack_length);
+  if (!(lf > pen_.minFiberLength())) return 0.0;
+  const double phi = pen_.pennationAngle(lf);
+  const double vf = in.speed * std::cos(phi);  // rigid tendon: the whole speed goes to the fibre
+  // calcActiveFiberForceAlongTendon
+  const double a = act_.clamp(activation);
+  const double lceN = pen_.clampFiberLength(lf) / l_opt;
+  const double dlceN = vf / (l_opt * m_.max_contraction_velocity);
+  const double fal = c_.fal(lceN);
+  const double fv = c_.fvInverse(a, fal, dlceN, 1e-6, 100);
+  return m_.max_isometric_force * a * fal * fv * std::cos(phi);
+}
+
 const std::vector<std::string>& Thelen2003Muscle::stateNames() const { return activationFiberLengthStates(); }
 
 void Thelen2003Muscle::defaultState(double* z) const {
@@ -337,28 +352,37 @@ void Thelen2003MuscleDeprecated::calc(const double* z, const MusculotendonInput&
 }
 
 void Thelen2003MuscleDeprecated::equilibrate(const MusculotendonInput& in, double* z) const {
-  const double a = z[0];
+  isometricForce(in, z[0], &z[1]);
+}
+
+// computeIsometricForce, returning the tendon force and the fibre length it ends at
+double Thelen2003MuscleDeprecated::isometricForce(const MusculotendonInput& in, double a,
+                                                  double* fiber_length_out) const {
   const double l_opt = m_.optimal_fiber_length, l_s = m_.tendon_slack_length;
   const double F_max = m_.max_isometric_force, pen_opt = m_.pennation_angle_at_optimal;
   const auto tendonForce = [&](double tendon_length) {
     const double ntl = tendon_length / l_opt, norm_rest = l_s / l_opt;
     return c_.tendon((ntl - norm_rest) / norm_rest);
   };
+  double& z1 = *fiber_length_out;
   if (l_opt < kRoundoff) {
-    z[1] = 0.0;
-    return;
+    z1 = 0.0;
+    return 0.0;
   }
   const double length = in.length;
   const double width = l_opt * std::sin(pen_opt);
   double fiber_length, tendon_length, cos_factor;
   if (l_s < kRoundoff) {
     // no tendon: the fibre spans the path
-    z[1] = length / std::cos(std::atan(width / length));
-    return;
+    const double cos_factor0 = std::cos(std::atan(width / length));
+    z1 = length / cos_factor0;
+    const double active = std::max(0.0, c_.active(z1 / l_opt) * a);
+    const double passive = std::max(0.0, c_.passive(z1 / l_opt));
+    return (active + passive) * F_max * cos_factor0;
   }
   if (length < l_s) {
-    z[1] = width;
-    return;
+    z1 = width;
+    return 0.0;
   }
   // the tendon and pennation at fiber_length; a tendon shorter than its slack length is slack,
   // the fibre takes the rest (OpenSim floors it at the width only before the iteration)
@@ -375,14 +399,14 @@ void Thelen2003MuscleDeprecated::equilibrate(const MusculotendonInput& in, doubl
   fiber_length = l_opt;
   place(true);
 
-  double old_fiber_length = 0.0, error_force = 0.0;
+  double old_fiber_length = 0.0, error_force = 0.0, tendon_force = 0.0;
   for (int i = 0; i < 100; ++i) {
     double active = c_.active(fiber_length / l_opt) * a;
     if (active < 0.0) active = 0.0;
     double passive = c_.passive(fiber_length / l_opt);
     if (passive < 0.0) passive = 0.0;
     const double fiber_force = (active + passive) * F_max * cos_factor;
-    const double tendon_force = tendonForce(tendon_length) * F_max;
+    tendon_force = tendonForce(tendon_length) * F_max;
     double old_error_force = error_force;
     error_force = tendon_force - fiber_force;
     if (std::abs(error_force) <= 0.01) break;  // OpenSim's ERROR_LIMIT, N
@@ -408,7 +432,19 @@ void Thelen2003MuscleDeprecated::equilibrate(const MusculotendonInput& in, doubl
     }
     place(false);
   }
-  z[1] = fiber_length;
+  z1 = fiber_length;
+  return tendon_force;
+}
+
+double Thelen2003MuscleDeprecated::inextensibleTendonActiveFiberForce(const MusculotendonInput& in,
+                                                                      double activation) const {
+  double fiber_length = 0.0;
+  const double isometric = isometricForce(in, activation, &fiber_length);
+  // the base class's generic curve at unit activation and length
+  const double v = -std::cos(m_.pennation_angle_at_optimal) * in.speed /
+                   (m_.max_contraction_velocity * m_.optimal_fiber_length);
+  const double fv = 1.8 - 1.8 / (1.0 + std::exp((0.04 - v) / 0.18));
+  return isometric * fv;
 }
 
 std::vector<std::pair<std::string, double>> Thelen2003MuscleDeprecated::parameterList() const {

@@ -35,6 +35,10 @@ class Thelen2003Muscle final : public MuscleWithProperties {
   /// its minimum length
   void equilibrate(const MusculotendonInput& in, double* z) const override;
   std::vector<std::pair<std::string, double>> parameterList() const override;
+  /// rigid tendon: l_f from the fixed-width pennation, v_f = speed cos(phi), then
+  /// F_max a fal fv cos(phi) with a clamped to [minimum_activation, 1] and fv from the
+  /// force-velocity inverse (calcfvInv, 1e-6, 100 iterations); 0 at or below the minimum length
+  double inextensibleTendonActiveFiberForce(const MusculotendonInput& in, double activation) const override;
 
   const Thelen2003Curves& curves() const { return c_; }
   const FixedWidthPennation& pennation() const { return pen_; }
@@ -61,12 +65,19 @@ class Thelen2003MuscleDeprecated final : public MuscleWithProperties {
   /// 100 iterations; it never reports failure (neither does OpenSim)
   void equilibrate(const MusculotendonInput& in, double* z) const override;
   std::vector<std::pair<std::string, double>> parameterList() const override;
+  /// ActivationFiberLengthMuscle_Deprecated's: the isometric tendon force of the equilibrium
+  /// iteration (computeIsometricForce) at `activation` times the generic force-velocity factor
+  /// 1.8 - 1.8 / (1 + exp((0.04 - v) / 0.18)), v = -cos(phi_opt) speed / (v_max l_opt)
+  double inextensibleTendonActiveFiberForce(const MusculotendonInput& in, double activation) const override;
 
   const Thelen2003DeprecatedCurves& curves() const { return c_; }
 
  private:
   /// the 2.x pennation: asin(l_opt sin(phi_opt) / l_f), 0 and pi/2 at its ends
   double pennation(double l_f, double l_opt) const;
+  /// computeIsometricForce: the tendon force (N) of the iteration at activation a; the fibre
+  /// length it ends at goes to *fiber_length
+  double isometricForce(const MusculotendonInput& in, double a, double* fiber_length) const;
 
   Thelen2003DeprecatedCurves c_;
   double tau_act_ = 0.01, tau_deact_ = 0.04, Vmax_ = 10.0, Vmax0_ = 5.0;

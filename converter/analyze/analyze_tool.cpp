@@ -1,0 +1,518 @@
+// OpenSim's AnalyzeTool + StaticOptimization (docs/analyze.md): setup, force set, frames, the
+// per-frame program and OpenSim's output files.
+#include "converter/analyze/analyze_tool.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "converter/analyze/static_optimization.hpp"
+#include "converter/atomic_file.hpp"
+#include "converter/build/build_core_model.hpp"
+#include "converter/detail/xml_util.hpp"
+#include "converter/id/core_id_engine.hpp"
+#include "converter/id/inverse_dynamics_tool.hpp"
+#include "converter/id_setup.hpp"
+#include "core/muscles/hill/factory.hpp"
+#include "core/muscles/hill/muscle_model.hpp"
+#include "core/muscles/muscle_workspace.hpp"
+#include "core/muscles/path_kinematics.hpp"
+#include "core/skeleton/kinematics.hpp"
+
+namespace redmax::osim {
+namespace fs = std::filesystem;
+using namespace detail;
+
+namespace {
+
+// OpenSim's Analysis classes (osimAnalyses, osimSimulation, osimTools): known by name, so that an
+// analysis redmax does not run is listed as such and anything else is a typo
+const std::set<std::string>& openSimAnalysisClasses() {
+  static const std::set<std::string> s = {
+      "Actuation",        "BodyKinematics", "ForceReporter",    "InducedAccelerations",
+      "JointReaction",    "Kinematics",     "MuscleAnalysis",   "OutputReporter",
+      "PointKinematics",  "ProbeReporter",  "StatesReporter",   "StaticOptimization",
+      "IMUDataReporter",  "ControlReporter"};
+  return s;
+}
+
+bool isCoordinateActuator(const std::string& cls) {
+  return cls == "CoordinateActuator" || cls == "ActivationCoordinateActuator";
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// setup
+
+AnalyzeSetup readAnalyzeSetup(const std::string& path) {
+  XmlDocument doc(path);
+  const XMLElement* el = toolRoot(doc, "AnalyzeTool");
+  AnalyzeSetup s;
+  s.source_file = path;
+  s.name = attribute(el, "name");
+  s.directory = folderOf(path);
+  auto file = [&](const char* tag) { return resolveRelativeTo(s.directory, childText(el, tag)); };
+  s.model_file = file("model_file");
+  s.coordinates_file = file("coordinates_file");
+  s.states_file = file("states_file");
+  s.speeds_file = file("speeds_file");
+  s.external_loads_file = file("external_loads_file");
+  const std::string rd = childText(el, "results_directory");
+  s.results_directory = rd.empty() ? s.directory : resolveRelativeTo(s.directory, rd);
+  for (const std::string& f : splitWords(childText(el, "force_set_files")))
+    s.force_set_files.push_back(resolveRelativeTo(s.directory, f));
+  s.replace_force_set = childBool(doc, el, "replace_force_set", false);
+  s.initial_time = childDouble(doc, el, "initial_time", 0.0);
+  s.final_time = childDouble(doc, el, "final_time", 1.0);
+  if (!(s.initial_time <= s.final_time))
+    doc.fail(firstChild(el, "final_time"), "final_time is before initial_time");
+  s.lowpass_cutoff_frequency_for_coordinates =
+      childDouble(doc, el, "lowpass_cutoff_frequency_for_coordinates", -1.0);
+  s.solve_for_equilibrium_for_auxiliary_states =
+      childBool(doc, el, "solve_for_equilibrium_for_auxiliary_states", false);
+  if (const XMLElement* p = firstChild(el, "output_precision"); p && !textOf(p).empty())
+    s.output_precision = parseInt(doc, p);
+  if (s.output_precision < 1 || s.output_precision > 30)
+    doc.fail(firstChild(el, "output_precision"), "output_precision must be in [1, 30]");
+
+  const XMLElement* set = firstChild(el, "AnalysisSet");
+  for (const XMLElement* a : childElements(set ? firstChild(set, "objects") : nullptr)) {
+    AnalysisEntry e;
+    e.class_name = a->Name();
+    e.name = attribute(a, "name");
+    if (e.name.empty()) e.name = e.class_name;
+    e.line = lineOf(a);
+    e.on = childBool(doc, a, "on", true);
+    if (!openSimAnalysisClasses().count(e.class_name))
+      doc.fail(a, "unknown analysis <" + e.class_name + "> in the AnalysisSet (OpenSim has no such class)");
+    if (e.class_name == "StaticOptimization" && e.on) {
+      StaticOptimizationSettings& so = s.static_optimization;
+      if (so.present) doc.fail(a, "a second StaticOptimization that is on: redmax runs one");
+      so.present = true;
+      so.name = e.name;
+      so.line = e.line;
+      so.start_time = childDouble(doc, a, "start_time", 0.0);
+      so.end_time = childDouble(doc, a, "end_time", 0.0);
+      if (const XMLElement* c = firstChild(a, "step_interval"); c && !textOf(c).empty())
+        so.step_interval = parseInt(doc, c);
+      if (so.step_interval < 1) doc.fail(firstChild(a, "step_interval"), "step_interval must be >= 1");
+      so.activation_exponent = childDouble(doc, a, "activation_exponent", 2.0);
+      if (!(so.activation_exponent > 1.0))
+        doc.fail(firstChild(a, "activation_exponent"),
+                 "activation_exponent must be > 1 (the objective sum |x|^p is then strictly convex)");
+      so.use_muscle_physiology = childBool(doc, a, "use_muscle_physiology", true);
+      so.optimizer_convergence_criterion = childDouble(doc, a, "optimizer_convergence_criterion", 1e-4);
+      if (!(so.optimizer_convergence_criterion > 0))
+        doc.fail(firstChild(a, "optimizer_convergence_criterion"), "optimizer_convergence_criterion must be > 0");
+      if (const XMLElement* c = firstChild(a, "optimizer_max_iterations"); c && !textOf(c).empty())
+        so.optimizer_max_iterations = parseInt(doc, c);
+      if (so.optimizer_max_iterations < 1)
+        doc.fail(firstChild(a, "optimizer_max_iterations"), "optimizer_max_iterations must be >= 1");
+      so.use_model_force_set = childBool(doc, a, "use_model_force_set", true);
+    }
+    s.analyses.push_back(e);
+  }
+  if (s.analyses.empty()) doc.fail(set ? set : el, "the AnalysisSet has no analyses (OpenSim refuses to run)");
+  if (!s.speeds_file.empty())
+    s.warnings.push_back("speeds_file is not read: speeds are the derivatives of the coordinates' splines");
+  return s;
+}
+
+std::vector<ActuatorEntry> readActuatorForceSet(const std::string& path) {
+  XmlDocument doc(path);
+  const XMLElement* el = toolRoot(doc, "ForceSet");
+  std::vector<ActuatorEntry> out;
+  for (const XMLElement* e : childElements(firstChild(el, "objects"))) {
+    std::string cls = e->Name();
+    if (cls == "GeneralizedForce") cls = "CoordinateActuator";
+    if (!isCoordinateActuator(cls))
+      doc.fail(e, "<" + cls + "> '" + attribute(e, "name") +
+                      "': only CoordinateActuators of force_set_files are modelled by redmax's analyze");
+    ActuatorEntry a;
+    a.name = attribute(e, "name");
+    a.source_file = path;
+    a.line = lineOf(e);
+    a.coordinate = childText(e, "coordinate");
+    if (a.coordinate.empty()) doc.fail(e, "CoordinateActuator '" + a.name + "' names no coordinate");
+    a.optimal_force = childDouble(doc, e, "optimal_force", 1.0);
+    a.min_control = childDouble(doc, e, "min_control", a.min_control);
+    a.max_control = childDouble(doc, e, "max_control", a.max_control);
+    a.applies_force = childBool(doc, e, "appliesForce", true);
+    out.push_back(a);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// the tool
+
+namespace {
+
+struct Actuator {
+  std::string name;
+  int muscle = -1;      ///< index into the geometry model's muscles, or -1
+  int coordinate = -1;  ///< core coordinate of a CoordinateActuator
+  double optimal_force = 1.0;
+  double lower = 0.0, upper = 1.0;
+};
+
+}  // namespace
+
+struct AnalyzeTool::Impl {
+  std::unique_ptr<InverseDynamicsTool> id;
+  std::unique_ptr<CoreIdEngine> engine;
+  MusculoskeletalModel geometry;  ///< the muscles' paths and force models (massless)
+  std::vector<Actuator> actuators;
+  std::vector<int> rows;                        ///< core coordinates the program constrains
+  std::vector<signal::NaturalSpline> u_splines;  ///< per core coordinate (empty: no data)
+  std::vector<MuscleKinematics> mk;             ///< columns each muscle's path depends on
+};
+
+AnalyzeTool::~AnalyzeTool() = default;
+
+AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(settings)) {
+  setup_ = readAnalyzeSetup(settings_.setup_file);
+  warnings_ = setup_.warnings;
+  const std::string& where = settings_.setup_file;
+  out_dir_ = settings_.out_dir ? *settings_.out_dir : setup_.results_directory;
+  for (const AnalysisEntry& a : setup_.analyses)
+    if (a.on && a.class_name != "StaticOptimization")
+      unsupported_.push_back(a.name + " (" + a.class_name + ")");
+  const StaticOptimizationSettings& so = setup_.static_optimization;
+  if (!so.present)
+    throw ConvertError(where, 0,
+                       "no analysis redmax runs is on (redmax runs StaticOptimization" +
+                           (unsupported_.empty() ? std::string(")")
+                                                 : "; not supported: " + joinNames(unsupported_) + ")"));
+  if (setup_.model_file.empty()) throw ConvertError(where, 0, "the setup names no model_file");
+  if (!setup_.states_file.empty())
+    throw ConvertError(where, 0, "states_file is not supported by redmax's analyze: give a coordinates_file");
+  if (setup_.coordinates_file.empty()) throw ConvertError(where, 0, "the setup names no coordinates_file");
+
+  impl_ = std::make_unique<Impl>();
+  Impl& I = *impl_;
+  IdToolConfig cfg;
+  cfg.setup_file = where;
+  cfg.model_file = setup_.model_file;
+  cfg.coordinates_file = setup_.coordinates_file;
+  cfg.external_loads_file = setup_.external_loads_file;
+  cfg.loads_working_dir = setup_.directory;
+  cfg.lowpass_cutoff_hz = setup_.lowpass_cutoff_frequency_for_coordinates;
+  cfg.t0 = setup_.initial_time;
+  cfg.t1 = setup_.final_time;
+  // the actuators are the program's unknowns; every other force is what ID leaves to them
+  cfg.forces_to_exclude = {"Actuators"};
+  cfg.opensim_compat = true;
+  cfg.muscle_mass = settings_.muscle_mass;
+  if (settings_.muscle_class) {
+    const auto& known = hill::muscleModelClasses();
+    if (std::find(known.begin(), known.end(), *settings_.muscle_class) == known.end())
+      throw ConvertError(where, 0, "--muscle-class " + *settings_.muscle_class + ": redmax has no such muscle model");
+    cfg.muscle_class = *settings_.muscle_class;
+  }
+  I.id = std::make_unique<InverseDynamicsTool>(cfg);
+  for (const auto& w : I.id->warnings()) warnings_.push_back(w);
+  I.engine = std::make_unique<CoreIdEngine>(I.id->model(), I.id->muscles(), I.id->engineOptions());
+  if (std::find(I.id->engineOptions().rates_as_u.begin(), I.id->engineOptions().rates_as_u.end(), true) !=
+      I.id->engineOptions().rates_as_u.end())
+    warnings_.push_back("Ball/Free/Ellipsoid joints: muscle moment arms are taken per coordinate rate, "
+                        "not per Simbody speed");
+
+  // the muscles' paths and force models (read as --muscle-class when given)
+  const ModelDescription& d = I.id->description();
+  BuildOptions bo;
+  bo.simbody_compat = true;
+  bo.constraints = false;
+  bo.muscles = true;
+  BuildResult built = buildCoreModel(d, bo);
+  I.geometry = std::move(built.model);
+  const Model& skel = I.id->model();
+  auto coreCoordinate = [&](const std::string& name) {
+    const int ci = d.findCoordinate(name);
+    return ci >= 0 ? built.coordinate_index[ci] : -1;
+  };
+
+  // the force set in OpenSim's order (the model's in file order, then force_set_files), those
+  // with appliesForce false removed
+  std::vector<Actuator>& acts = I.actuators;
+  const bool physiology = so.use_muscle_physiology;
+  if (!so.use_model_force_set) {
+    // CoordinateActuator::CreateForceSetOfCoordinateActuatorsForModel(s, model, 1, false)
+    for (int k = 0; k < skel.nr(); ++k) {
+      const int ci = d.findCoordinate(skel.coordinates()[k].name);
+      if (ci >= 0 && (d.coordinates[ci].locked || d.coordinates[ci].prescribed)) continue;
+      Actuator a;
+      a.name = skel.coordinates()[k].name + "_actuator";
+      a.coordinate = k;
+      a.lower = -std::numeric_limits<double>::infinity();
+      a.upper = std::numeric_limits<double>::infinity();
+      acts.push_back(a);
+    }
+  } else {
+    std::vector<std::pair<int, Actuator>> model_acts;
+    if (!setup_.replace_force_set) {
+      for (size_t m = 0; m < built.muscle_source.size(); ++m) {
+        const PathForceDesc& pf = d.muscles[built.muscle_source[m]];
+        if (!pf.applies_force) continue;
+        if (!pf.is_muscle) {
+          if (pf.class_name.find("Actuator") != std::string::npos)
+            throw ConvertError(setup_.model_file, pf.line,
+                               pf.class_name + " '" + pf.name + "' is not modelled by redmax's static optimization");
+          continue;  // a PathSpring and the like: not an actuator (ID reports it unmodelled)
+        }
+        const auto& model = I.geometry.muscleModels()[m];
+        if (!model)
+          throw ConvertError(setup_.model_file, pf.line,
+                             "muscle '" + pf.name + "' (" + I.geometry.muscleClasses()[m] +
+                                 "): redmax has no force model for this class");
+        Actuator a;
+        a.name = pf.name;
+        a.muscle = static_cast<int>(m);
+        a.optimal_force = pf.max_isometric_force;
+        a.lower = model->minControl();
+        a.upper = model->maxControl();
+        model_acts.emplace_back(pf.line, a);
+      }
+      for (const ForceDesc& f : d.forces) {
+        if (!f.applies_force) continue;
+        if (isCoordinateActuator(f.class_name)) {
+          Actuator a;
+          a.name = f.name;
+          a.coordinate = coreCoordinate(f.coordinate);
+          if (a.coordinate < 0)
+            throw ConvertError(setup_.model_file, f.line,
+                               f.class_name + " '" + f.name + "': no coordinate '" + f.coordinate + "'");
+          a.optimal_force = f.optimal_force;
+          a.lower = f.min_control;
+          a.upper = f.max_control;
+          model_acts.emplace_back(f.line, a);
+        } else if (f.class_name.find("Actuator") != std::string::npos) {
+          throw ConvertError(setup_.model_file, f.line,
+                             f.class_name + " '" + f.name + "' is not modelled by redmax's static optimization");
+        }
+      }
+      std::stable_sort(model_acts.begin(), model_acts.end(),
+                       [](const auto& x, const auto& y) { return x.first < y.first; });
+      for (auto& [line, a] : model_acts) acts.push_back(a);
+    }
+    for (const std::string& file : setup_.force_set_files) {
+      for (const ActuatorEntry& e : readActuatorForceSet(file)) {
+        if (!e.applies_force) continue;
+        Actuator a;
+        a.name = e.name;
+        a.coordinate = coreCoordinate(e.coordinate);
+        if (a.coordinate < 0)
+          throw ConvertError(file, e.line, "CoordinateActuator '" + e.name + "': the model has no coordinate '" +
+                                               e.coordinate + "'");
+        a.optimal_force = e.optimal_force;
+        a.lower = e.min_control;
+        a.upper = e.max_control;
+        acts.push_back(a);
+      }
+    }
+  }
+  if (acts.empty()) throw ConvertError(setup_.model_file, 0, "static optimization: the force set has no actuators");
+  for (const Actuator& a : acts)
+    if (!(a.lower <= a.upper) || std::isnan(a.optimal_force))
+      throw ConvertError(setup_.model_file, 0,
+                         "actuator '" + a.name + "': min_control " + std::to_string(a.lower) +
+                             " is above max_control " + std::to_string(a.upper) + " (infeasible bounds)");
+
+  // rows: the coordinates that are not locked or prescribed (OpenSim's isConstrained)
+  const auto& sources = I.id->coordinateSources();
+  std::vector<std::string> missing;
+  for (int k = 0; k < skel.nr(); ++k) {
+    const int ci = d.findCoordinate(skel.coordinates()[k].name);
+    if (ci >= 0 && (d.coordinates[ci].locked || d.coordinates[ci].prescribed)) continue;
+    I.rows.push_back(k);
+    if (sources[k].spline < 0) missing.push_back(skel.coordinates()[k].name);
+  }
+  if (!missing.empty())
+    throw ConvertError(setup_.coordinates_file, 0,
+                       "no column for coordinate(s) " + joinNames(missing) +
+                           ", which static optimization must drive (OpenSim would use 0)");
+  if (static_cast<int>(acts.size()) < static_cast<int>(I.rows.size()))
+    throw ConvertError(setup_.model_file, 0,
+                       "StaticOptimization: over-constrained system: " + std::to_string(acts.size()) +
+                           " actuators for " + std::to_string(I.rows.size()) + " degrees of freedom");
+
+  // StaticOptimization::begin: GCVSplineSet(5, states store) over every processed row, and its
+  // first derivative: the target accelerations
+  const auto& P = I.id->processed();
+  I.u_splines.resize(static_cast<size_t>(skel.nr()));
+  std::vector<double> u(P.time.size());
+  for (int k = 0; k < skel.nr(); ++k) {
+    if (sources[k].spline < 0) continue;
+    const auto& s = P.splines[static_cast<size_t>(sources[k].spline)];
+    for (size_t r = 0; r < P.time.size(); ++r) u[r] = s.calcDerivative(1, P.time[r]);
+    I.u_splines[static_cast<size_t>(k)] = signal::NaturalSpline(5, P.time, u);
+  }
+  I.mk.resize(I.geometry.muscles().size());
+  for (size_t m = 0; m < I.mk.size(); ++m) initMuscleKinematics(skel, I.geometry.muscles()[m], I.mk[m]);
+}
+
+double AnalyzeTool::muscleMass() const { return impl_->engine->muscleMass(); }
+
+std::string AnalyzeTool::muscleMassSummary() const { return describeMuscleMass(impl_->id->muscleMassPlan()); }
+
+StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
+  const Impl& I = *impl_;
+  const StaticOptimizationSettings& so = setup_.static_optimization;
+  const Model& skel = I.id->model();
+  const int nr = skel.nr(), na = static_cast<int>(I.actuators.size());
+  const int nrow = static_cast<int>(I.rows.size());
+  StaticOptimizationRun run;
+  for (const Actuator& a : I.actuators) {
+    run.actuators.push_back(a.name);
+    run.is_muscle.push_back(a.muscle >= 0);
+  }
+  std::vector<int> row_of(static_cast<size_t>(nr), -1);
+  for (int r = 0; r < nrow; ++r) row_of[static_cast<size_t>(I.rows[r])] = r;
+
+  // which muscles' paths each coordinate moves
+  const auto& muscles = I.geometry.muscles();
+  const int nm = static_cast<int>(muscles.size());
+  std::vector<char> muscle_used(static_cast<size_t>(nm), 0);
+  for (const Actuator& a : I.actuators)
+    if (a.muscle >= 0) muscle_used[static_cast<size_t>(a.muscle)] = 1;
+
+  CoreIdWorkspace ws(I.engine->system());
+  const signal::TimeWindow& w = I.id->window();
+  const auto& P = I.id->processed();
+  VecX q, v, vdot, tau, qh;
+  std::vector<IdLoadSample> loads;
+  std::vector<Mat4> E;
+  VecX length(nm), speed(nm);
+  MatX dl(nm, nr);
+  VecX prev;
+  StaticOptimizationOptions opt;
+  opt.convergence_tolerance = std::min(so.optimizer_convergence_criterion, 1e-8);
+  opt.max_iterations = so.optimizer_max_iterations;
+  constexpr double h = 1e-6;  // central differences of the path lengths (rad or m)
+
+  for (int i = w.first_row; i <= w.last_row; ++i) {
+    if (i != w.first_row && i != w.last_row && i % so.step_interval != 0) continue;
+    StaticOptimizationFrame fr;
+    fr.time = P.time[static_cast<size_t>(i)];
+    fr.activation = VecX::Constant(na, std::numeric_limits<double>::quiet_NaN());
+    fr.force = fr.activation;
+    try {
+      I.id->calcInputs(fr.time, q, v, vdot, loads);
+      for (int k = 0; k < nr; ++k)
+        vdot[k] = I.u_splines[static_cast<size_t>(k)].size() > 0
+                      ? I.u_splines[static_cast<size_t>(k)].calcDerivative(1, fr.time)
+                      : 0.0;
+      I.engine->calcGeneralizedForces(fr.time, q, v, vdot, loads, tau, ws);
+
+      // path lengths, -moment arms dl/dq and lengthening speeds
+      calcBodyPoses(skel, q, E);
+      for (int m = 0; m < nm; ++m)
+        if (muscle_used[static_cast<size_t>(m)]) length[m] = calcPathLength(skel, muscles[m].path, q, E);
+      dl.setZero();
+      for (int k = 0; k < nr; ++k) {
+        bool any = false;
+        for (int m = 0; m < nm && !any; ++m)
+          any = muscle_used[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0;
+        if (!any) continue;
+        qh = q;
+        qh[k] = q[k] + h;
+        calcBodyPoses(skel, qh, E);
+        VecX lp(nm);
+        for (int m = 0; m < nm; ++m)
+          if (muscle_used[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0)
+            lp[m] = calcPathLength(skel, muscles[m].path, qh, E);
+        qh[k] = q[k] - h;
+        calcBodyPoses(skel, qh, E);
+        for (int m = 0; m < nm; ++m)
+          if (muscle_used[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0)
+            dl(m, k) = (lp[m] - calcPathLength(skel, muscles[m].path, qh, E)) / (2 * h);
+      }
+      speed = dl * v;
+
+      StaticOptimizationProblem pb;
+      pb.A = MatX::Zero(nrow, na);
+      pb.b.resize(nrow);
+      for (int r = 0; r < nrow; ++r) pb.b[r] = tau[I.rows[r]];
+      pb.lower.resize(na);
+      pb.upper.resize(na);
+      VecX fopt(na);
+      for (int j = 0; j < na; ++j) {
+        const Actuator& a = I.actuators[static_cast<size_t>(j)];
+        pb.lower[j] = a.lower;
+        pb.upper[j] = a.upper;
+        if (a.muscle >= 0) {
+          fopt[j] = so.use_muscle_physiology
+                        ? I.geometry.muscleModels()[a.muscle]->inextensibleTendonActiveFiberForce(
+                              {length[a.muscle], speed[a.muscle], 0.0}, 1.0)
+                        : a.optimal_force;
+          for (int r = 0; r < nrow; ++r) pb.A(r, j) = -fopt[j] * dl(a.muscle, I.rows[r]);
+        } else {
+          fopt[j] = a.optimal_force;
+          if (row_of[static_cast<size_t>(a.coordinate)] >= 0) pb.A(row_of[static_cast<size_t>(a.coordinate)], j) = fopt[j];
+        }
+      }
+      pb.exponent = so.activation_exponent;
+      // warm start from the previous frame's optimum (the first frame: zero, as OpenSim starts)
+      pb.x0 = prev.size() == na ? prev : VecX::Zero(na);
+      for (int j = 0; j < na; ++j) pb.x0[j] = std::clamp(pb.x0[j], pb.lower[j], pb.upper[j]);
+      const StaticOptimizationResult res = solveStaticOptimization(pb, opt);
+      fr.iterations = res.iterations;
+      fr.constraint_violation = res.constraint_violation;
+      fr.converged = res.converged;
+      fr.status = res.status;
+      if (res.converged) {
+        fr.activation = res.x;
+        fr.force = res.x.cwiseProduct(fopt);
+        prev = res.x;
+      }
+    } catch (const std::exception& e) {
+      fr.converged = false;
+      fr.status = e.what();
+    }
+    if (!fr.converged) ++run.failed;
+    run.frames.push_back(std::move(fr));
+  }
+  return run;
+}
+
+std::vector<std::string> AnalyzeTool::writeStaticOptimization(const StaticOptimizationRun& run) const {
+  const std::string stem = setup_.name + "_" + setup_.static_optimization.name;
+  Storage act, force;
+  act.name = force.name = "Static Optimization";
+  act.version = force.version = 1;
+  act.labels = force.labels = run.actuators;
+  const auto nf = static_cast<Eigen::Index>(run.frames.size());
+  const auto na = static_cast<Eigen::Index>(run.actuators.size());
+  act.data.resize(nf, na);
+  force.data.resize(nf, na);
+  std::string failed;
+  for (Eigen::Index r = 0; r < nf; ++r) {
+    const StaticOptimizationFrame& f = run.frames[static_cast<size_t>(r)];
+    act.time.push_back(f.time);
+    force.time.push_back(f.time);
+    act.data.row(r) = f.activation.transpose();
+    force.data.row(r) = f.force.transpose();
+    if (!f.converged) {
+      std::ostringstream os;
+      os.precision(10);
+      os << "failed frame t = " << f.time << ": " << f.status << " (its row is nan)\n";
+      failed += os.str();
+    }
+  }
+  StorageWriteOptions wo;
+  wo.decimals = setup_.output_precision;
+  wo.description = "This file contains static optimization results.\n" + failed + "\n";
+  const std::string a_text = formatStorage(act, wo), f_text = formatStorage(force, wo);
+  std::error_code ec;
+  fs::create_directories(out_dir_, ec);
+  const std::string a_path = (fs::path(out_dir_) / (stem + "_activation.sto")).string();
+  const std::string f_path = (fs::path(out_dir_) / (stem + "_force.sto")).string();
+  writeFileAtomic(a_path, a_text);
+  writeFileAtomic(f_path, f_text);
+  return {a_path, f_path};
+}
+
+}  // namespace redmax::osim
