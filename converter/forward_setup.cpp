@@ -13,11 +13,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace detail;
 
-std::string folderOf(const std::string& file) {
-  const fs::path p = fs::path(file).parent_path();
-  return p.empty() ? std::string(".") : p.string();
-}
-
 ControllerSetupDesc readController(const XmlDocument& doc, const XMLElement* e, const std::string& dir) {
   ControllerSetupDesc c;
   c.type = e->Name();

@@ -215,7 +215,7 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   }
   I.id = std::make_unique<InverseDynamicsTool>(cfg);
   for (const auto& w : I.id->warnings()) warnings_.push_back(w);
-  I.engine = std::make_unique<CoreIdEngine>(I.id->model(), I.id->muscles(), I.id->engineOptions());
+  I.engine = std::make_unique<CoreIdEngine>(I.id->musculoskeletalModel(), I.id->engineOptions());
   if (std::find(I.id->engineOptions().rates_as_u.begin(), I.id->engineOptions().rates_as_u.end(), true) !=
       I.id->engineOptions().rates_as_u.end())
     warnings_.push_back("Ball/Free/Ellipsoid joints: muscle moment arms are taken per coordinate rate, "
