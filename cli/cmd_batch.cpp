@@ -1,5 +1,5 @@
 // `redmax batch`: a study of many redmax runs on a Dask cluster. The work is Python
-// (python/redmax/batch.py, over Debian's python3-distributed); this command checks the flags and
+// (python/redmax/study.py, over Debian's python3-distributed); this command checks the flags and
 // execs it with the Python interpreter, passing this executable as $REDMAX_EXE so the tasks run the
 // same build. docs/python.md §3 has the study contract.
 #include <unistd.h>
@@ -34,11 +34,11 @@ struct BatchFlags {
   bool serial = false;
 };
 
-// batch.py beside the executable's build tree (build/python/redmax/, what CMake copies), else in
+// study.py beside the executable's build tree (build/python/redmax/, what CMake copies), else in
 // the source tree this executable was built from
 std::string findBatchScript(const fs::path& exe) {
-  const std::vector<fs::path> candidates = {exe.parent_path() / ".." / "python" / "redmax" / "batch.py",
-                                            fs::path(REDMAX_SOURCE_DIR) / "python" / "redmax" / "batch.py"};
+  const std::vector<fs::path> candidates = {exe.parent_path() / ".." / "python" / "redmax" / "study.py",
+                                            fs::path(REDMAX_SOURCE_DIR) / "python" / "redmax" / "study.py"};
   for (const auto& c : candidates) {
     std::error_code ec;
     if (fs::is_regular_file(c, ec)) return fs::weakly_canonical(c).string();
@@ -53,7 +53,7 @@ int runBatch(const BatchFlags& f, const CLI::App& app) {
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   const std::string script = findBatchScript(ec ? fs::path() : exe);
   if (script.empty()) {
-    std::cerr << "error: python/redmax/batch.py not found beside " << exe.string() << " or in " << REDMAX_SOURCE_DIR
+    std::cerr << "error: python/redmax/study.py not found beside " << exe.string() << " or in " << REDMAX_SOURCE_DIR
               << "\n";
     return 2;
   }
@@ -98,7 +98,7 @@ CommandRegistration reg(
            "(--out-dir, --out or --report) is added, pointing into DIR/<trial>/<cell>/. Each cell is a\n"
            "Dask task. DIR/results.csv: trial, cell, each grid flag, status (ok|error), error, wall_s,\n"
            "output, then the summary figures the commands print. Outputs are written atomically; a\n"
-           "rerun skips complete cells. Progress on stderr. Runs python/redmax/batch.py with\n"
+           "rerun skips complete cells. Progress on stderr. Runs python/redmax/study.py with\n"
            "$REDMAX_PYTHON (default " REDMAX_PYTHON ").\n"
            "Exit codes: 0 every cell ok, 1 some cell failed (the rest complete), 2 bad input or usage.");
        return [f, &app] { return runBatch(*f, app); };

@@ -17,7 +17,7 @@ Outputs are atomic: a task writes into ``DIR/<trial>/.<cell>.tmp-<id>/`` and ren
 cells whose folder holds ``cell.json``. A failed cell leaves no folder, so a rerun retries it.
 
 Only the standard library and Dask (Debian python3-distributed) are needed; this file runs as a
-script (what ``redmax batch`` execs) or as ``redmax.batch`` in Python.
+script (what ``redmax batch`` execs) or as ``redmax.study`` in Python (``redmax.batch`` is its ``batch``).
 """
 import argparse
 import csv
