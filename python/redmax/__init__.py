@@ -94,19 +94,28 @@ def _model_path(model):
     return model.path if isinstance(model, Model) else _os.fspath(model)
 
 
-def inverse_dynamics(model=None, coordinates=None, external_loads=None, lowpass=None, t0=None, t1=None,
-                     muscle_mass="none", muscles=None, mass_points=None, specific_tension=None,
-                     muscle_density=None, transfer_body=None, transfer_fraction=None, exact=False, setup=None):
-    """`redmax id` (engine core): OpenSim's InverseDynamicsTool on a trial; keywords as the CLI's
-    flags (--lowpass -> lowpass, --mass-points -> mass_points). Returns a Table of
-    <coord>_moment / <coord>_force columns."""
-    if setup is None and (model is None or coordinates is None):
-        raise ValueError("inverse_dynamics needs setup=, or a model and coordinates=")
-    return Table(*_need_core().inverse_dynamics(
-        "" if model is None else _model_path(model), "" if coordinates is None else _os.fspath(coordinates),
-        None if external_loads is None else _os.fspath(external_loads), lowpass, t0, t1, muscle_mass, muscles,
-        mass_points, specific_tension, muscle_density, transfer_body, transfer_fraction, exact,
-        None if setup is None else _os.fspath(setup)))
+def _flags(**kw):
+    """keywords as `redmax` flags: lowpass=6 -> --lowpass 6, exact=True -> --exact, None left out"""
+    out = []
+    for k, v in kw.items():
+        if v is None or v is False:
+            continue
+        flag = "--" + k.replace("_", "-")
+        if v is True:
+            out.append(flag)
+        else:
+            out += [flag, _os.fspath(v) if isinstance(v, _os.PathLike) else (repr(v) if isinstance(v, float) else str(v))]
+    return out
+
+
+def inverse_dynamics(model=None, coordinates=None, **flags):
+    """`redmax id` (engine core): OpenSim's InverseDynamicsTool on a trial. Keywords are the CLI's
+    flags with underscores (docs/commands.md: external_loads, lowpass, t0, t1, setup, exact,
+    forces_to_exclude, muscle_mass, muscles, mass_points, specific_tension, muscle_density,
+    transfer_body, transfer_fraction, wrap, ...), parsed by the CLI's own declarations, so defaults
+    and checks are the command line's. Returns a Table of <coord>_moment / <coord>_force columns."""
+    args = _flags(model=None if model is None else _model_path(model), coordinates=coordinates, **flags)
+    return Table(*_need_core().inverse_dynamics(args))
 
 
 def path_lengths(model, coordinates, wrap="exact"):

@@ -83,7 +83,7 @@ def test_errors_carry_file_and_line(tmp_path):
     bad.write_text("<OpenSimDocument Version=\"40000\">\n<Model name=\"x\">\n<BodySet>\n</Model>\n")
     with pytest.raises(redmax.ConvertError, match=r"bad\.osim:\d+"):
         redmax.Model(bad)
-    with pytest.raises(redmax.ConvertError, match="missing.mot"):
+    with pytest.raises(ValueError, match="missing.mot"):  # the CLI's --coordinates check
         redmax.inverse_dynamics(LEG, coordinates=str(tmp_path / "missing.mot"))
     with pytest.raises(ValueError):
         redmax.inverse_dynamics(LEG, coordinates=SWING, muscle_mass="heavy")
