@@ -100,7 +100,7 @@ py::tuple inverseDynamics(std::vector<std::string> flags) {
     // what `redmax id` (engine core) does, from the same entry points
     const osim::IdToolConfig config = osim::resolveIdSettings(s);
     osim::InverseDynamicsTool tool(config);
-    osim::CoreIdEngine engine(tool.model(), tool.muscles(), tool.engineOptions());
+    osim::CoreIdEngine engine(tool.musculoskeletalModel(), tool.engineOptions());
     result = tool.run(engine);
   }
   return toPython(result);
