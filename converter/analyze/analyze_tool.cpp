@@ -2,6 +2,8 @@
 // per-frame program and OpenSim's output files.
 #include "converter/analyze/analyze_tool.hpp"
 
+#include "core/dynamics/muscle_force_term.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -169,6 +171,7 @@ struct AnalyzeTool::Impl {
   std::vector<int> rows;                        ///< core coordinates the program constrains
   std::vector<signal::NaturalSpline> u_splines;  ///< per core coordinate (empty: no data)
   std::vector<MuscleKinematics> mk;             ///< columns each muscle's path depends on
+  std::unique_ptr<MuscleForceTerm> force_term;  ///< the muscles with a force model, as forward applies them
 };
 
 AnalyzeTool::~AnalyzeTool() = default;
@@ -352,6 +355,7 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   }
   I.mk.resize(I.geometry.muscles().size());
   for (size_t m = 0; m < I.mk.size(); ++m) initMuscleKinematics(skel, I.geometry.muscles()[m], I.mk[m]);
+  I.force_term = std::make_unique<MuscleForceTerm>(skel, I.geometry.muscles(), I.geometry.muscleModels());
 }
 
 double AnalyzeTool::muscleMass() const { return impl_->engine->muscleMass(); }
@@ -387,7 +391,8 @@ StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
   std::vector<Mat4> E;
   VecX length(nm), speed(nm);
   MatX dl(nm, nr);
-  VecX prev;
+  VecX prev, dl_row;
+  SkeletonWorkspace sk(skel);
   StaticOptimizationOptions opt;
   opt.convergence_tolerance = std::min(so.optimizer_convergence_criterion, 1e-8);
   opt.max_iterations = so.optimizer_max_iterations;
@@ -429,6 +434,25 @@ StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
         for (int m = 0; m < nm; ++m)
           if (muscle_used[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0)
             dl(m, k) = (lp[m] - calcPathLength(skel, muscles[m].path, qh, E)) / (2 * h);
+      }
+      // muscles with a force model: the generalized force per unit tension as the forward
+      // simulation applies it (MuscleForceTerm: OpenSim's straight segments with wrap tangent
+      // points held in their surface's body), so both tools use one moment arm
+      if (I.force_term) {
+        State st;
+        st.t = fr.time;
+        st.q = q;
+        st.qdot = v;
+        calcKinematics(skel, st, sk);
+        for (int m = 0, k = 0; m < nm; ++m) {
+          if (!I.geometry.muscleModels()[m]) continue;
+          if (muscle_used[static_cast<size_t>(m)]) {
+            double len = 0.0, spd = 0.0;
+            I.force_term->calcPath(skel, st, sk, k, len, spd, dl_row);
+            dl.row(m) = dl_row.transpose();
+          }
+          ++k;
+        }
       }
       speed = dl * v;
 
