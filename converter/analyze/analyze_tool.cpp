@@ -382,6 +382,10 @@ StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
   std::vector<char> muscle_used(static_cast<size_t>(nm), 0);
   for (const Actuator& a : I.actuators)
     if (a.muscle >= 0) muscle_used[static_cast<size_t>(a.muscle)] = 1;
+  // muscles whose dl/dq only the central differences below give (the rest: MuscleForceTerm)
+  std::vector<char> by_differences(muscle_used);
+  for (int m = 0; m < nm; ++m)
+    if (I.geometry.muscleModels()[static_cast<size_t>(m)]) by_differences[static_cast<size_t>(m)] = 0;
 
   CoreIdWorkspace ws(I.engine->system());
   const signal::TimeWindow& w = I.id->window();
@@ -420,19 +424,19 @@ StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
       for (int k = 0; k < nr; ++k) {
         bool any = false;
         for (int m = 0; m < nm && !any; ++m)
-          any = muscle_used[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0;
+          any = by_differences[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0;
         if (!any) continue;
         qh = q;
         qh[k] = q[k] + h;
         calcBodyPoses(skel, qh, E);
         VecX lp(nm);
         for (int m = 0; m < nm; ++m)
-          if (muscle_used[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0)
+          if (by_differences[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0)
             lp[m] = calcPathLength(skel, muscles[m].path, qh, E);
         qh[k] = q[k] - h;
         calcBodyPoses(skel, qh, E);
         for (int m = 0; m < nm; ++m)
-          if (muscle_used[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0)
+          if (by_differences[static_cast<size_t>(m)] && I.mk[static_cast<size_t>(m)].col_of[static_cast<size_t>(k)] >= 0)
             dl(m, k) = (lp[m] - calcPathLength(skel, muscles[m].path, qh, E)) / (2 * h);
       }
       // muscles with a force model: the generalized force per unit tension as the forward
@@ -529,13 +533,13 @@ std::vector<std::string> AnalyzeTool::writeStaticOptimization(const StaticOptimi
   StorageWriteOptions wo;
   wo.decimals = setup_.output_precision;
   wo.description = "This file contains static optimization results.\n" + failed + "\n";
-  const std::string a_text = formatStorage(act, wo), f_text = formatStorage(force, wo);
+  // a folder that cannot be made shows up as the write's error, with the file named
   std::error_code ec;
   fs::create_directories(out_dir_, ec);
   const std::string a_path = (fs::path(out_dir_) / (stem + "_activation.sto")).string();
   const std::string f_path = (fs::path(out_dir_) / (stem + "_force.sto")).string();
-  writeFileAtomic(a_path, a_text);
-  writeFileAtomic(f_path, f_text);
+  writeStorage(a_path, act, wo);
+  writeStorage(f_path, force, wo);
   return {a_path, f_path};
 }
 

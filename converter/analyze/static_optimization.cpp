@@ -15,6 +15,9 @@ namespace {
 using Ipopt::Index;
 using Ipopt::Number;
 
+// d/dx |x|^p
+double objectiveSlope(double v, double p) { return p * std::pow(std::abs(v), p - 1.0) * (v < 0.0 ? -1.0 : 1.0); }
+
 // The frame's program for IPOPT; rows of A without any actuator are left out by the caller.
 class FrameProgram : public Ipopt::TNLP {
  public:
@@ -53,7 +56,7 @@ class FrameProgram : public Ipopt::TNLP {
     return true;
   }
   bool eval_grad_f(Index n, const Number* xs, bool, Number* g) override {
-    for (Index i = 0; i < n; ++i) g[i] = objectiveSlope(xs[i]);
+    for (Index i = 0; i < n; ++i) g[i] = objectiveSlope(xs[i], p_.exponent);
     return true;
   }
   bool eval_g(Index n, const Number* xs, bool, Index m, Number* g) override {
@@ -91,9 +94,6 @@ class FrameProgram : public Ipopt::TNLP {
   }
 
  private:
-  double objectiveSlope(double v) const {
-    return p_.exponent * std::pow(std::abs(v), p_.exponent - 1.0) * (v < 0.0 ? -1.0 : 1.0);
-  }
   const StaticOptimizationProblem& p_;
   std::vector<int> rows_;
   VecX x0_;
@@ -182,8 +182,7 @@ OptimalityReport checkOptimality(const StaticOptimizationProblem& p, const VecX&
   const int n = static_cast<int>(p.A.cols());
   OptimalityReport rep;
   VecX grad(n);
-  for (int i = 0; i < n; ++i)
-    grad[i] = p.exponent * std::pow(std::abs(x[i]), p.exponent - 1.0) * (x[i] < 0.0 ? -1.0 : 1.0);
+  for (int i = 0; i < n; ++i) grad[i] = objectiveSlope(x[i], p.exponent);
   std::vector<int> inner, low, up;
   for (int i = 0; i < n; ++i) {
     const double w = std::max(1.0, std::abs(p.upper[i] - p.lower[i]));

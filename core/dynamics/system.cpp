@@ -114,12 +114,17 @@ void System::equilibrateStates(State& s, DynamicsWorkspace& ws) const {
   for (size_t i = 0; i < terms_.size(); ++i) {
     const int m = terms_[i]->numStates();
     if (m == 0) continue;
-    // each term at the states the terms before it left: kinematics and controls at s (and its
-    // rates, unused here), a new evaluation
-    calcStateDerivatives(s, ws);
-    const State& s_sk = map_ ? ws.s_r : s;
+    // each term at the states the terms before it left: kinematics and controls at s, a new
+    // evaluation (no rates: equilibrium needs none)
+    const State* s_sk = &s;
+    if (map_) {
+      expandInto(s, ws);
+      s_sk = &ws.s_r;
+    }
+    calcSkeletonKinematics(*s_sk, ws);
+    calcControls(*s_sk, ws);
     VecX zi = s.z.segment(z_offset_[i], m);
-    terms_[i]->equilibrateStates(model_, s_sk, context(ws, i), zi);
+    terms_[i]->equilibrateStates(model_, *s_sk, context(ws, i), zi);
     s.z.segment(z_offset_[i], m) = zi;
   }
 }
