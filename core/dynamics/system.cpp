@@ -98,6 +98,10 @@ void System::calcStateDerivatives(const State& s, DynamicsWorkspace& ws) const {
   if (s.z.size() != nz_)
     throw ModelError("System::calcStateDerivatives: state has " + std::to_string(s.z.size()) +
                      " auxiliary states, the system has " + std::to_string(nz_));
+  calcStateDerivativesHere(kinematicsAndControls(s, ws), ws);
+}
+
+const State& System::kinematicsAndControls(const State& s, DynamicsWorkspace& ws) const {
   const State* s_sk = &s;
   if (map_) {
     expandInto(s, ws);
@@ -105,7 +109,7 @@ void System::calcStateDerivatives(const State& s, DynamicsWorkspace& ws) const {
   }
   calcSkeletonKinematics(*s_sk, ws);
   calcControls(*s_sk, ws);
-  calcStateDerivativesHere(*s_sk, ws);
+  return *s_sk;
 }
 
 void System::equilibrateStates(State& s, DynamicsWorkspace& ws) const {
@@ -116,15 +120,9 @@ void System::equilibrateStates(State& s, DynamicsWorkspace& ws) const {
     if (m == 0) continue;
     // each term at the states the terms before it left: kinematics and controls at s, a new
     // evaluation (no rates: equilibrium needs none)
-    const State* s_sk = &s;
-    if (map_) {
-      expandInto(s, ws);
-      s_sk = &ws.s_r;
-    }
-    calcSkeletonKinematics(*s_sk, ws);
-    calcControls(*s_sk, ws);
+    const State& s_sk = kinematicsAndControls(s, ws);
     VecX zi = s.z.segment(z_offset_[i], m);
-    terms_[i]->equilibrateStates(model_, *s_sk, context(ws, i), zi);
+    terms_[i]->equilibrateStates(model_, s_sk, context(ws, i), zi);
     s.z.segment(z_offset_[i], m) = zi;
   }
 }

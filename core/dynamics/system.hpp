@@ -235,6 +235,9 @@ class System {
   void calcControls(const State& s_sk, DynamicsWorkspace& ws) const;
   // ws.zdot at skeleton state s_sk of the current evaluation
   void calcStateDerivativesHere(const State& s_sk, DynamicsWorkspace& ws) const;
+  // kinematics and controls of s as a new evaluation (expanded first with a coordinate map);
+  // returns the skeleton state they are at (s, or ws.s_r)
+  const State& kinematicsAndControls(const State& s, DynamicsWorkspace& ws) const;
 
   Id id_;
   Model model_;
