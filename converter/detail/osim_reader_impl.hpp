@@ -41,6 +41,8 @@ class OsimReader {
  public:
   explicit OsimReader(const std::string& path);
   ModelDescription read();
+  /// append the ForceSet of this reader's file (a force_set_files file) to `model`'s forces
+  void appendForceSetTo(ModelDescription& model);
   /// read every muscle as this class (renameType); "" = as written
   void setMuscleClass(std::string cls) { muscle_class_ = std::move(cls); }
 
@@ -104,8 +106,6 @@ class OsimReader {
   void readForceSet(const XMLElement* set, const std::string& source);
   void readModelledForce(const XMLElement* e, ForceDesc& f);
   const FrameNode& forceFrame(const XMLElement* e, const std::string& value, const std::string& what);
-  /// append the ForceSet of this reader's file (a force_set_files file) to `model`'s forces
-  void appendForceSetTo(ModelDescription& model);
   void readPathForce(const XMLElement* e, const std::string& name, const std::string& cls,
                      bool is_muscle, bool applies);
   void readMuscleParameters(const XMLElement* e, PathForceDesc& m);

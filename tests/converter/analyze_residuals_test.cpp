@@ -119,7 +119,9 @@ TEST(AnalyzeResiduals, PointAndTorqueResidualsCarryThePelvisAtTheClosedForm) {
       EXPECT_LT(kkt.equality, 1e-8 * pb.b.norm()) << f.time;
     }
     // the limit bears 20 N m of the tilt moment: the residuals' share changes by it
-    if (with_limit) EXPECT_GT(std::abs(limit), 19.0);
+    if (with_limit) {
+      EXPECT_GT(std::abs(limit), 19.0);
+    }
   }
 }
 
