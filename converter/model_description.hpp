@@ -274,6 +274,10 @@ struct ForceDesc {
   /// SpringGeneralizedForce (stiffness, rest_length, viscosity) and PointToPointSpring
   /// (stiffness, rest_length), SI
   double stiffness = 0.0, rest_length = 0.0, viscosity = 0.0;
+  /// BushingForce: rotational then translational stiffness and damping (N m/rad, N/m, ...), and
+  /// frame1, frame2 as poses in body1, body2
+  Vec6 bushing_stiffness = Vec6::Zero(), bushing_damping = Vec6::Zero();
+  Mat4 X_body1 = Mat4::Identity(), X_body2 = Mat4::Identity();
   /// the force_set_files file it came from; "" for the model's own ForceSet
   std::string source_file;
   int line = 0;

@@ -101,7 +101,8 @@ int quadrantAxis(const std::string& q, int& sign) {
 // the forces whose properties readModelledForce reads and whose force redmax computes
 const std::set<std::string>& modelledForceClasses() {
   static const std::set<std::string> s = {"CoordinateActuator",   "PointActuator",          "TorqueActuator",
-                                          "CoordinateLimitForce", "SpringGeneralizedForce", "PointToPointSpring"};
+                                          "CoordinateLimitForce", "SpringGeneralizedForce", "PointToPointSpring",
+                                          "BushingForce"};
   return s;
 }
 
@@ -306,6 +307,8 @@ void OsimReader::readModelledForce(const XMLElement* e, ForceDesc& f) {
     f.point2 = childVec3(doc(), e, "point2", Vec3::Zero());
     f.stiffness = nonNegative("stiffness", 1.0);
     f.rest_length = nonNegative("rest_length", 0.0);
+  } else if (cls == "BushingForce") {
+    readBushing(e, f);
   }
   f.modelled = true;
 }
@@ -453,6 +456,61 @@ void OsimReader::readMuscleParameters(const XMLElement* e, PathForceDesc& m) {
     const int line = it != m.parameter_lines.end() ? it->second : m.line;
     throw ConvertError(doc().path(), line, m.class_name + " " + err.what());
   }
+}
+
+// BushingForce (a TwoFrameLinker): frame1, frame2 are sockets, usually to offset frames the force
+// owns in its <frames>; before 30500 body_1/body_2 with location_ and orientation_body_1/2
+void OsimReader::readBushing(const XMLElement* e, ForceDesc& f) {
+  const std::string what = "BushingForce '" + f.name + "'";
+  auto vec = [&](const char* tag) {
+    const Vec3 v = childVec3(doc(), e, tag, Vec3::Zero());
+    for (int i = 0; i < 3; ++i)
+      if (!(v[i] >= 0.0) || !std::isfinite(v[i]))
+        fail(firstChild(e, tag) ? firstChild(e, tag) : e, what + ": " + tag + " must be finite and >= 0");
+    return v;
+  };
+  f.bushing_stiffness << vec("rotational_stiffness"), vec("translational_stiffness");
+  f.bushing_damping << vec("rotational_damping"), vec("translational_damping");
+  const std::string self = "/forceset/" + f.name;
+  // the force's own offset frames
+  for (const XMLElement* fr : childElements(firstChild(e, "frames"))) {
+    if (std::string(fr->Name()) != "PhysicalOffsetFrame") fail(fr, what + ": <" + fr->Name() + "> is not a PhysicalOffsetFrame");
+    std::set<std::string> none;
+    const std::string name = componentName(fr, none);
+    const XMLElement* w = nullptr;
+    const std::string parent = socketValue(fr, "parent", &w);
+    const FrameNode& p = frameForSocket(self + "/" + name, parent, w ? w : fr, what + " frame '" + name + "'");
+    FrameNode n;
+    n.kind = FrameNode::Kind::Offset;
+    n.name = name;
+    n.path = self + "/" + name;
+    n.base_body = p.base_body;
+    n.X_base = p.X_base * makePose(childVec3(doc(), fr, "translation", Vec3::Zero()),
+                                   childVec3(doc(), fr, "orientation", Vec3::Zero()));
+    n.state = 2;
+    n.elem = fr;
+    frames_[n.path] = n;
+  }
+  for (int k = 0; k < 2; ++k) {
+    const std::string socket = k == 0 ? "frame1" : "frame2";
+    const std::string legacy = k == 0 ? "body_1" : "body_2";
+    std::string& body = k == 0 ? f.body1 : f.body2;
+    Mat4& X = k == 0 ? f.X_body1 : f.X_body2;
+    if (const XMLElement* l = firstChild(e, legacy.c_str()); l && socketValue(e, socket, nullptr).empty()) {
+      const FrameNode& b = frameForSocket(self, legacyBodyPath(textOf(l)), l, what + " " + legacy);
+      body = b.base_body;
+      const std::string n = k == 0 ? "1" : "2";
+      X = b.X_base * makePose(childVec3(doc(), e, ("location_body_" + n).c_str(), Vec3::Zero()),
+                              childVec3(doc(), e, ("orientation_body_" + n).c_str(), Vec3::Zero()));
+      continue;
+    }
+    const XMLElement* w = nullptr;
+    const std::string v = socketValue(e, socket, &w);
+    const FrameNode& fr = frameForSocket(self, v, w ? w : e, what + " " + socket);
+    body = fr.base_body;
+    X = fr.X_base;
+  }
+  if (f.body1 == f.body2) fail(e, what + ": frame1 and frame2 are fixed to the same body '" + f.body1 + "'");
 }
 
 // a force_set_files file: its ForceSet read against `model`'s frames and coordinates, as

@@ -198,14 +198,6 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   cfg.lowpass_cutoff_hz = setup_.lowpass_cutoff_frequency_for_coordinates;
   cfg.t0 = setup_.initial_time;
   cfg.t1 = setup_.final_time;
-  // the actuators are the program's unknowns; every other force is what ID leaves to them. The
-  // passive forces redmax models (converter/build/force_terms.hpp) are applied below, so ID
-  // leaves them out instead of naming them as unmodelled.
-  cfg.forces_to_exclude = {"Actuators"};
-  ModelDescription with_files = readOsimModel(setup_.model_file);
-  for (const std::string& file : setup_.force_set_files) appendForceSetFile(with_files, file);
-  for (const ForceDesc& f : with_files.forces)
-    if (f.modelled && f.class_name.find("Actuator") == std::string::npos) cfg.forces_to_exclude.push_back(f.name);
   cfg.opensim_compat = true;
   cfg.muscle_mass = settings_.muscle_mass;
   if (settings_.muscle_class) {
@@ -214,6 +206,14 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
       throw ConvertError(where, 0, "--muscle-class " + *settings_.muscle_class + ": redmax has no such muscle model");
     cfg.muscle_class = *settings_.muscle_class;
   }
+  // the actuators are the program's unknowns; every other force is what ID leaves to them. The
+  // passive forces redmax models (converter/build/force_terms.hpp) are applied below, so ID
+  // leaves them out instead of naming them as unmodelled.
+  cfg.forces_to_exclude = {"Actuators"};
+  ModelDescription with_files = readOsimModel(setup_.model_file, cfg.muscle_class);
+  for (const std::string& file : setup_.force_set_files) appendForceSetFile(with_files, file);
+  for (const ForceDesc& f : with_files.forces)
+    if (f.modelled && f.class_name.find("Actuator") == std::string::npos) cfg.forces_to_exclude.push_back(f.name);
   I.id = std::make_unique<InverseDynamicsTool>(cfg);
   for (const auto& w : I.id->warnings()) warnings_.push_back(w);
   I.engine = std::make_unique<CoreIdEngine>(I.id->musculoskeletalModel(), I.id->engineOptions());

@@ -17,6 +17,7 @@ std::vector<std::shared_ptr<const ForceTerm>> ForceTermSet::passiveTerms() const
   if (limit_forces) out.push_back(limit_forces);
   if (generalized_springs) out.push_back(generalized_springs);
   if (point_springs) out.push_back(point_springs);
+  if (bushings) out.push_back(bushings);
   return out;
 }
 
@@ -63,6 +64,7 @@ ForceTermSet buildForceTerms(const ModelDescription& d, const BuildResult& b, st
   std::vector<CoordinateLimitForceTerm::Limit> cl;
   std::vector<SpringGeneralizedForceTerm::Spring> gs;
   std::vector<PointToPointSpringTerm::Spring> ps;
+  std::vector<BushingForceTerm::Bushing> bu;
   for (size_t i = 0; i < d.forces.size(); ++i) {
     const ForceDesc& f = d.forces[i];
     if (!f.modelled || !(include ? include(f) : f.applies_force)) continue;
@@ -95,6 +97,10 @@ ForceTermSet buildForceTerms(const ModelDescription& d, const BuildResult& b, st
       const int b1 = body(f, f.body1), b2 = body(f, f.body2);
       if (b1 < -1 || b2 < -1) continue;
       ps.push_back({f.name, b1, b2, f.point1, f.point2, f.stiffness, f.rest_length});
+    } else if (cls == "BushingForce") {
+      const int b1 = body(f, f.body1), b2 = body(f, f.body2);
+      if (b1 < -1 || b2 < -1) continue;
+      bu.push_back({f.name, b1, b2, f.X_body1, f.X_body2, f.bushing_stiffness, f.bushing_damping});
     }
   }
   if (!ca.empty()) set.coordinate_actuators = std::make_shared<CoordinateActuatorTerm>(skel, std::move(ca));
@@ -103,6 +109,7 @@ ForceTermSet buildForceTerms(const ModelDescription& d, const BuildResult& b, st
   if (!cl.empty()) set.limit_forces = std::make_shared<CoordinateLimitForceTerm>(skel, std::move(cl));
   if (!gs.empty()) set.generalized_springs = std::make_shared<SpringGeneralizedForceTerm>(skel, std::move(gs));
   if (!ps.empty()) set.point_springs = std::make_shared<PointToPointSpringTerm>(skel, std::move(ps));
+  if (!bu.empty()) set.bushings = std::make_shared<BushingForceTerm>(skel, std::move(bu));
   return set;
 }
 

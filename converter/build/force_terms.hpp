@@ -4,6 +4,7 @@
 //   CoordinateActuator    CoordinateActuatorTerm          PointActuator   PointActuatorTerm
 //   TorqueActuator        TorqueActuatorTerm              CoordinateLimitForce  CoordinateLimitForceTerm
 //   SpringGeneralizedForce  SpringGeneralizedForceTerm    PointToPointSpring    PointToPointSpringTerm
+//   BushingForce          BushingForceTerm
 // CoordinateLimitForce's properties are in degrees for a Rotational coordinate (OpenSim's
 // extendConnectToModel): limits and transition times pi/180, stiffness and damping times 180/pi.
 // The reader (converter/osim_forces.cpp) has already refused unknown bodies and coordinates,
@@ -29,6 +30,7 @@ struct ForceTermSet {
   std::shared_ptr<const CoordinateLimitForceTerm> limit_forces;
   std::shared_ptr<const SpringGeneralizedForceTerm> generalized_springs;
   std::shared_ptr<const PointToPointSpringTerm> point_springs;
+  std::shared_ptr<const BushingForceTerm> bushings;
   /// index into ModelDescription::forces of each actuator of the three actuator terms, in the
   /// terms' order
   std::vector<int> coordinate_actuator_source, point_actuator_source, torque_actuator_source;

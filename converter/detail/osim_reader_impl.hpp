@@ -105,6 +105,7 @@ class OsimReader {
   /// the forces of a ForceSet element (the model's, or a force_set_files file's: source)
   void readForceSet(const XMLElement* set, const std::string& source);
   void readModelledForce(const XMLElement* e, ForceDesc& f);
+  void readBushing(const XMLElement* e, ForceDesc& f);
   const FrameNode& forceFrame(const XMLElement* e, const std::string& value, const std::string& what);
   void readPathForce(const XMLElement* e, const std::string& name, const std::string& cls,
                      bool is_muscle, bool applies);

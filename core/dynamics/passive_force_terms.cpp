@@ -1,5 +1,6 @@
 #include "core/dynamics/passive_force_terms.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/dynamics/body_loads.hpp"
@@ -148,6 +149,97 @@ double PointToPointSpringTerm::potentialEnergy(const Model&, const State&, const
   for (size_t k = 0; k < springs_.size(); ++k) {
     const double e = length(ctx.sk, static_cast<int>(k)) - springs_[k].rest_length;
     V += 0.5 * springs_[k].stiffness * e * e;
+  }
+  return V;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+// pose and twist (world angular velocity, world velocity of a body station) of a body; ground
+// at rest at the identity
+Mat4 poseOf(const SkeletonWorkspace& sk, int body) { return body < 0 ? Mat4(Mat4::Identity()) : sk.E_wi[body]; }
+Vec3 omegaOf(const SkeletonWorkspace& sk, int body) {
+  return body < 0 ? Vec3(Vec3::Zero()) : Vec3(sk.E_wi[body].topLeftCorner<3, 3>() * sk.phi[body].head<3>());
+}
+Vec3 stationVelocity(const SkeletonWorkspace& sk, int body, const Vec3& x_i) {
+  if (body < 0) return Vec3::Zero();
+  const Vec6& p = sk.phi[body];
+  return sk.E_wi[body].topLeftCorner<3, 3>() * (p.head<3>().cross(x_i) + p.tail<3>());
+}
+
+// W(theta): w_F = W thetadot for body-fixed x-y-z angles (R = Rx(a) Ry(b) Rz(c))
+Mat3 bodyXYZRateMatrix(const Vec3& t) {
+  const double ca = std::cos(t[0]), sa = std::sin(t[0]), cb = std::cos(t[1]), sb = std::sin(t[1]);
+  Mat3 W;
+  W << 1, 0, sb, 0, ca, -sa * cb, 0, sa, ca * cb;
+  return W;
+}
+
+}  // namespace
+
+BushingForceTerm::BushingForceTerm(const Model& model, std::vector<Bushing> bushings) : bushings_(std::move(bushings)) {
+  for (const Bushing& b : bushings_) {
+    const std::string what = "BushingForce '" + b.name + "'";
+    for (int x : {b.body1, b.body2})
+      if (x < -1 || x >= model.nb()) throw ModelError(what + ": body index " + std::to_string(x) + " outside the model");
+    if (b.body1 == b.body2) throw ModelError(what + ": frame1 and frame2 are fixed to the same body");
+    for (int i = 0; i < 6; ++i) {
+      checkNonNegative(what, "stiffness", b.stiffness[i]);
+      checkNonNegative(what, "damping", b.damping[i]);
+    }
+  }
+}
+
+void BushingForceTerm::calcDeflection(const SkeletonWorkspace& sk, int k, Vec6& q, Vec6* qdot) const {
+  const Bushing& b = bushings_[static_cast<size_t>(k)];
+  const Mat4 X_GF = poseOf(sk, b.body1) * b.X_1F, X_GM = poseOf(sk, b.body2) * b.X_2M;
+  const Mat3 R_GF = X_GF.topLeftCorner<3, 3>();
+  const Mat3 R = R_GF.transpose() * X_GM.topLeftCorner<3, 3>();  // R_FM
+  const Vec3 d = X_GM.topRightCorner<3, 1>() - X_GF.topRightCorner<3, 1>();
+  // body-fixed x-y-z angles of R_FM (Simbody's convertRotationToBodyFixedXYZ)
+  q[1] = std::asin(std::clamp(R(0, 2), -1.0, 1.0));
+  q[0] = std::atan2(-R(1, 2), R(2, 2));
+  q[2] = std::atan2(-R(0, 1), R(0, 0));
+  q.tail<3>() = R_GF.transpose() * d;
+  if (!qdot) return;
+  const Vec3 w1 = omegaOf(sk, b.body1), w2 = omegaOf(sk, b.body2);
+  const Vec3 vF = stationVelocity(sk, b.body1, b.X_1F.topRightCorner<3, 1>());
+  const Vec3 vM = stationVelocity(sk, b.body2, b.X_2M.topRightCorner<3, 1>());
+  qdot->head<3>() = bodyXYZRateMatrix(q.head<3>()).inverse() * (R_GF.transpose() * (w2 - w1));
+  // d/dt (R_GF^T d) = R_GF^T (ddot - w1 x d)
+  qdot->tail<3>() = R_GF.transpose() * (vM - vF - w1.cross(d));
+}
+
+void BushingForceTerm::addForce(const Model& model, const State&, const TermContext& ctx, VecX& f) const {
+  const SkeletonWorkspace& sk = ctx.sk;
+  for (size_t k = 0; k < bushings_.size(); ++k) {
+    const Bushing& b = bushings_[k];
+    Vec6 q, qdot;
+    calcDeflection(sk, static_cast<int>(k), q, &qdot);
+    const Vec6 g = -(b.stiffness.cwiseProduct(q) + b.damping.cwiseProduct(qdot));
+    const Mat4 X_GF = poseOf(sk, b.body1) * b.X_1F, X_GM = poseOf(sk, b.body2) * b.X_2M;
+    const Mat3 R_GF = X_GF.topLeftCorner<3, 3>();
+    const Vec3 d = X_GM.topRightCorner<3, 1>() - X_GF.topRightCorner<3, 1>();
+    // the wrenches whose power is g . qdot: a torque tau on body 2 and -tau on body 1 for the
+    // angles; F at M's origin on body 2, -F at F's origin on body 1 and -(d x F) on body 1 for
+    // the position (from qdot above)
+    const Vec3 tau = R_GF * (bodyXYZRateMatrix(q.head<3>()).inverse().transpose() * g.head<3>());
+    const Vec3 F = R_GF * g.tail<3>();
+    addBodyTorque(model, sk, b.body2, tau, f);
+    addBodyTorque(model, sk, b.body1, -tau - d.cross(F), f);
+    addPointForce(model, sk, b.body2, b.X_2M.topRightCorner<3, 1>(), F, f);
+    addPointForce(model, sk, b.body1, b.X_1F.topRightCorner<3, 1>(), -F, f);
+  }
+}
+
+double BushingForceTerm::potentialEnergy(const Model&, const State&, const TermContext& ctx) const {
+  double V = 0.0;
+  for (size_t k = 0; k < bushings_.size(); ++k) {
+    Vec6 q;
+    calcDeflection(ctx.sk, static_cast<int>(k), q, nullptr);
+    V += 0.5 * bushings_[k].stiffness.dot(q.cwiseProduct(q));
   }
   return V;
 }

@@ -11,6 +11,10 @@
 //   SpringGeneralizedForce  f = -k (q - q_rest) - c qdot;  V = k (q - q_rest)^2 / 2
 //   PointToPointSpring      tension k (L - L0) pulling the two body points together
 //                           (SimTK::Force::TwoPointLinearSpring);  V = k (L - L0)^2 / 2
+//   BushingForce            SimTK::Force::LinearBushing between frame F (on body1) and M (on
+//                           body2): q = (body-fixed x-y-z angles of M in F, position of M's origin
+//                           in F), f = -(k .* q + c .* qdot); applied as the wrenches whose power
+//                           is f . qdot (below);  V = sum k_i q_i^2 / 2
 // All are explicit (addStiffnessDamping adds nothing); the potentials let a simulation's energy
 // bookkeeping close.
 #include <string>
@@ -83,6 +87,30 @@ class PointToPointSpringTerm final : public ForceTerm {
 
  private:
   std::vector<Spring> springs_;
+};
+
+class BushingForceTerm final : public ForceTerm {
+ public:
+  struct Bushing {
+    std::string name;
+    int body1 = -1, body2 = -1;  ///< core bodies; -1: ground
+    Mat4 X_1F = Mat4::Identity(), X_2M = Mat4::Identity();  ///< frames F, M in their bodies
+    Vec6 stiffness = Vec6::Zero();  ///< rotational x, y, z (N m/rad), translational (N/m), >= 0
+    Vec6 damping = Vec6::Zero();    ///< the same order (N m s/rad, N s/m), >= 0
+  };
+  /// throws ModelError for a body outside the model, both frames on one body, negative or
+  /// non-finite parameters
+  BushingForceTerm(const Model& model, std::vector<Bushing> bushings);
+  std::string name() const override { return "bushing_forces"; }
+  void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
+  double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
+  const std::vector<Bushing>& bushings() const { return bushings_; }
+  /// bushing k's deflection q (angles, then position of M in F) at sk (Stage::Position), and with
+  /// Stage::Velocity its rate qdot
+  void calcDeflection(const SkeletonWorkspace& sk, int k, Vec6& q, Vec6* qdot) const;
+
+ private:
+  std::vector<Bushing> bushings_;
 };
 
 }  // namespace redmax

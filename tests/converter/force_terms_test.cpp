@@ -40,7 +40,11 @@ TEST(ForceTerms, ReadAndBuiltWithOpenSimsDefaultsAndUnits) {
                 "<SpringGeneralizedForce name=\"g\"><coordinate>qa</coordinate><stiffness>3</stiffness></SpringGeneralizedForce>\n"
                 "<PointToPointSpring name=\"s\"><socket_body1>/ground</socket_body1><socket_body2>/jointset/sb/b_off</socket_body2>"
                 "<point2>0 1 0</point2></PointToPointSpring>\n"
-                "<BushingForce name=\"bush\"/>\n"));
+                "<BushingForce name=\"bush\"><socket_frame1>a_off</socket_frame1><socket_frame2>/bodyset/b</socket_frame2>"
+                "<rotational_stiffness>1 2 3</rotational_stiffness><translational_damping>4 5 6</translational_damping>"
+                "<frames><PhysicalOffsetFrame name=\"a_off\"><socket_parent>/bodyset/a</socket_parent>"
+                "<translation>0.1 0.2 0.3</translation></PhysicalOffsetFrame></frames></BushingForce>\n"
+                "<ExpressionBasedCoordinateForce name=\"expr\"/>\n"));
   const ModelDescription d = readOsimModel(path);
   BuildOptions bo;
   const BuildResult b = buildCoreModel(d, bo);
@@ -82,10 +86,18 @@ TEST(ForceTerms, ReadAndBuiltWithOpenSimsDefaultsAndUnits) {
   EXPECT_EQ(s.body1, -1);
   EXPECT_EQ(s.body2, t.body_a);
   EXPECT_EQ(s.stiffness, 1.0);
-  EXPECT_EQ(set.passiveTerms().size(), 3u);
-  // BushingForce is not modelled: listed
+  // BushingForce: its own offset frame on body a, OpenSim's property order (rotational first)
+  ASSERT_TRUE(set.bushings);
+  const auto& bu = set.bushings->bushings()[0];
+  EXPECT_EQ(bu.body1, b.body_index[static_cast<size_t>(d.findBody("a"))]);
+  EXPECT_EQ(bu.body2, t.body_a);
+  EXPECT_EQ(Vec3(bu.X_1F.topRightCorner<3, 1>()), Vec3(0.1, 0.2, 0.3));
+  EXPECT_EQ(bu.stiffness, (Vec6() << 1, 2, 3, 0, 0, 0).finished());
+  EXPECT_EQ(bu.damping, (Vec6() << 0, 0, 0, 4, 5, 6).finished());
+  EXPECT_EQ(set.passiveTerms().size(), 4u);
+  // a class redmax does not model is listed
   bool listed = false;
-  for (const auto& u : d.unsupported) listed = listed || u.what.find("bush") != std::string::npos;
+  for (const auto& u : d.unsupported) listed = listed || u.what.find("'expr' (ExpressionBasedCoordinateForce)") != std::string::npos;
   EXPECT_TRUE(listed);
 }
 

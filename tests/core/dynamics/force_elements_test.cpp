@@ -193,9 +193,17 @@ TEST(PassiveForceTerms, SpringsAreMinusTheGradientOfTheirPotential) {
   const PointToPointSpringTerm ps(m, {{"p2p", 2, -1, Vec3(0.1, 0.2, 0.0), Vec3(0.5, 1.0, -0.2), 200.0, 0.3},
                                       {"p2p_bodies", 4, 1, Vec3(0.0, -0.1, 0.2), Vec3(0.2, 0.0, 0.0), 80.0, 0.05}});
   const CoordinateLimitForceTerm cl(m, {exampleLimit(0)});
+  BushingForceTerm::Bushing bb;
+  bb.name = "bush";
+  bb.body1 = 1;
+  bb.body2 = 3;
+  bb.X_1F.topRightCorner<3, 1>() = Vec3(0.1, -0.2, 0.05);
+  bb.X_2M.topLeftCorner<3, 3>() = Eigen::AngleAxisd(0.4, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  bb.stiffness << 20, 30, 40, 500, 600, 700;
+  const BushingForceTerm bu(m, {bb});
   s.q[0] = 0.25;  // inside the upper transition (10-15 deg)
   SkeletonWorkspace sk(m);
-  for (const ForceTerm* t : std::vector<const ForceTerm*>{&gs, &ps, &cl}) {
+  for (const ForceTerm* t : std::vector<const ForceTerm*>{&gs, &ps, &cl, &bu}) {
     const VecX f = termForce(m, *t, s, VecX());
     VecX fd(m.nr());
     const double h = 1e-6;
@@ -219,7 +227,41 @@ TEST(PassiveForceTerms, SpringsAreMinusTheGradientOfTheirPotential) {
   EXPECT_EQ(f.norm(), std::abs(f[3]));
 }
 
-// a spring and an undamped limit conserve energy in a simulation (kinetic + gravity + springs)
+// the bushing's damping: its generalized force has the power g . qdot of its deflection rate,
+// qdot by central differences of the deflection along the motion
+TEST(BushingForceTerm, DampingPowerIsGeneralizedForceTimesDeflectionRate) {
+  const Model m = scenes::randomTree(5, 37);
+  const State s = randomState(m, 9);
+  BushingForceTerm::Bushing bb;
+  bb.name = "bush";
+  bb.body1 = -1;
+  bb.body2 = 4;
+  bb.X_1F.topRightCorner<3, 1>() = Vec3(0.3, 0.1, 0.0);
+  bb.X_2M.topRightCorner<3, 1>() = Vec3(0.0, 0.2, -0.1);
+  bb.damping << 2, 3, 4, 50, 60, 70;
+  const BushingForceTerm bu(m, {bb});
+  SkeletonWorkspace sk(m);
+  calcKinematics(m, s, sk);
+  Vec6 q, qdot;
+  bu.calcDeflection(sk, 0, q, &qdot);
+  const double h = 1e-6;
+  State sp = s, sm = s;
+  sp.q += h * s.qdot;
+  sm.q -= h * s.qdot;
+  Vec6 qp, qm;
+  calcKinematics(m, sp, sk);
+  bu.calcDeflection(sk, 0, qp, nullptr);
+  calcKinematics(m, sm, sk);
+  bu.calcDeflection(sk, 0, qm, nullptr);
+  EXPECT_TRUE(nearRel(qdot, Vec6((qp - qm) / (2 * h)), 1e-7)) << qdot.transpose();
+  const VecX f = termForce(m, bu, s, VecX());
+  const double P = f.dot(s.qdot), Pg = -bb.damping.dot(qdot.cwiseProduct(qdot));
+  EXPECT_NEAR(P, Pg, 1e-10 * std::abs(Pg));
+  EXPECT_LT(Pg, -0.1);  // it dissipates
+}
+
+// springs, a bushing and an undamped limit conserve energy in a simulation (kinetic + gravity +
+// their potentials)
 TEST(PassiveForceTerms, UndampedSpringsAndLimitsConserveEnergyInSimulation) {
   const Model m = scenes::doublePendulum(1.0, 1.0);
   System sys(m);
@@ -232,6 +274,13 @@ TEST(PassiveForceTerms, UndampedSpringsAndLimitsConserveEnergyInSimulation) {
       m, std::vector<PointToPointSpringTerm::Spring>{{"p2p", 1, -1, Vec3(0.0, -0.5, 0.0), Vec3(0.8, -1.0, 0.3), 40.0, 0.4}}));
   sys.addTerm(std::make_shared<SpringGeneralizedForceTerm>(
       m, std::vector<SpringGeneralizedForceTerm::Spring>{{"gs", 0, 5.0, 0.3, 0.0}}));
+  BushingForceTerm::Bushing bb;
+  bb.name = "bush";
+  bb.body1 = -1;
+  bb.body2 = 0;
+  bb.X_2M.topRightCorner<3, 1>() = Vec3(0.0, -0.3, 0.0);
+  bb.stiffness << 1, 2, 3, 10, 20, 30;
+  sys.addTerm(std::make_shared<BushingForceTerm>(m, std::vector<BushingForceTerm::Bushing>{bb}));
   State s = sys.defaultState();
   s.q << 1.2, 0.4;
   DynamicsWorkspace ws(sys);
