@@ -241,10 +241,11 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
       throw ConvertError(m.source_file, m.line, m.class_name + " '" + m.name +
                                                     "': muscles in force_set_files are not supported by redmax's analyze");
   I.forces = buildForceTerms(dd, built, warnings_);
+  // (the model's own unmodelled forces are named by the ID tool's warnings)
   for (const ForceDesc& f : dd.forces)
-    if (f.applies_force && !f.modelled && f.class_name.find("Actuator") == std::string::npos)
-      warnings_.push_back((f.source_file.empty() ? setup_.model_file : f.source_file) + ":" + std::to_string(f.line) +
-                          ": " + f.class_name + " '" + f.name + "': OpenSim applies it, redmax does not model it");
+    if (f.applies_force && !f.modelled && !f.source_file.empty() && f.class_name.find("Actuator") == std::string::npos)
+      warnings_.push_back(f.source_file + ":" + std::to_string(f.line) + ": " + f.class_name + " '" + f.name +
+                          "': OpenSim applies it, redmax does not model it");
   // ForceDesc index -> (kind, index in its actuator term)
   std::map<int, std::pair<int, int>> term_of;
   for (size_t k = 0; k < I.forces.coordinate_actuator_source.size(); ++k)

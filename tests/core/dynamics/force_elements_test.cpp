@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 
@@ -93,6 +94,7 @@ TEST(PointActuatorTerm, ForceIsJacobianTransposeAndItsPowerIsForceTimesPointVelo
     // power: f . qdot = F . v with v by central differences of the point (measured 1e-10 relative)
     const double P = f.dot(s.qdot), Pv = F.dot(pointVelocityByDifferences(m, s, a.body, x_i));
     EXPECT_NEAR(P, Pv, 1e-7 * std::max(1.0, std::abs(P))) << a.name;
+    std::printf("PointActuator %s: power %.6g, |P - F.v| / |P| = %.2g\n", a.name.c_str(), P, std::abs(P - Pv) / std::abs(P));
     EXPECT_GT(std::abs(P), 1.0);
   }
 }
@@ -115,6 +117,7 @@ TEST(TorqueActuatorTerm, PowerIsTorqueTimesRelativeAngularVelocity) {
     const Vec3 w = angularVelocityByDifferences(m, s, a.body_a) - angularVelocityByDifferences(m, s, a.body_b);
     const double P = f.dot(s.qdot);
     EXPECT_NEAR(P, T.dot(w), 1e-7 * std::max(1.0, std::abs(P))) << a.name;
+    std::printf("TorqueActuator %s: power %.6g, |P - T.w| / |P| = %.2g\n", a.name.c_str(), P, std::abs(P - T.dot(w)) / std::abs(P));
     EXPECT_GT(std::abs(P), 1.0);
     EXPECT_TRUE(nearRel(term.axisInWorld(sk, k), Vec3(T / (-0.6 * a.optimal_force)), 1e-14));
   }
@@ -154,7 +157,8 @@ TEST(CoordinateLimitForceTerm, ElasticForceIsMinusTheDerivativeOfOpenSimsPotenti
     const double f = CoordinateLimitForceTerm::force(l, q, 0.0);
     worst = std::max(worst, std::abs(f - fd) / std::max(1.0, std::abs(f)));
   }
-  EXPECT_LT(worst, 1e-6);  // measured 1.2e-8 (central differences of V at h = 1e-7)
+  std::printf("CoordinateLimitForce: worst |f + dV/dq| / max(1, |f|) = %.2g\n", worst);
+  EXPECT_LT(worst, 1e-6);
   // closed forms: free between the limits; beyond a full transition a plain linear spring
   EXPECT_EQ(CoordinateLimitForceTerm::force(l, 0.0, 1.0), 0.0);
   EXPECT_EQ(CoordinateLimitForceTerm::potential(l, -5 * w), 0.0);
@@ -217,6 +221,7 @@ TEST(PassiveForceTerms, SpringsAreMinusTheGradientOfTheirPotential) {
       fd[k] = -(Vp - t->potentialEnergy(m, sm, sk)) / (2 * h);
     }
     EXPECT_TRUE(nearRel(f, fd, 1e-7)) << t->name() << "\n" << f.transpose() << "\n" << fd.transpose();
+    std::printf("%s: |f + grad V| / |f| = %.2g\n", t->name().c_str(), (f - fd).norm() / f.norm());
     EXPECT_GT(f.norm(), 0.1) << t->name();
   }
   // SpringGeneralizedForce closed form with viscosity
@@ -254,9 +259,11 @@ TEST(BushingForceTerm, DampingPowerIsGeneralizedForceTimesDeflectionRate) {
   calcKinematics(m, sm, sk);
   bu.calcDeflection(sk, 0, qm, nullptr);
   EXPECT_TRUE(nearRel(qdot, Vec6((qp - qm) / (2 * h)), 1e-7)) << qdot.transpose();
+  std::printf("Bushing: |qdot - FD| / |qdot| = %.2g\n", (qdot - (qp - qm) / (2 * h)).norm() / qdot.norm());
   const VecX f = termForce(m, bu, s, VecX());
   const double P = f.dot(s.qdot), Pg = -bb.damping.dot(qdot.cwiseProduct(qdot));
   EXPECT_NEAR(P, Pg, 1e-10 * std::abs(Pg));
+  std::printf("Bushing: damping power %.6g, |P - g.qdot| / |P| = %.2g\n", Pg, std::abs(P - Pg) / std::abs(Pg));
   EXPECT_LT(Pg, -0.1);  // it dissipates
 }
 
@@ -296,6 +303,8 @@ TEST(PassiveForceTerms, UndampedSpringsAndLimitsConserveEnergyInSimulation) {
     qmax = std::max(qmax, s.q[1]);
   }
   const double E1 = sys.kineticEnergy(s, ws) + sys.potentialEnergy(s, ws);
+  std::printf("springs, bushing, limit: energy %.10g -> %.10g J, drift %.2g relative; q2 in [%.3f, %.3f]\n", E0, E1,
+              std::abs(E1 - E0) / std::abs(E0), qmin, qmax);
   EXPECT_LT(std::abs(E1 - E0), 1e-7 * std::abs(E0)) << E0 << " -> " << E1;
   // the elbow went into both limits' transitions
   EXPECT_GT(qmax, l.upper_limit);
