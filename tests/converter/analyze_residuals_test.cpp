@@ -6,7 +6,9 @@
 // built here, independently of the tool.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "converter/analyze/analyze_tool.hpp"
@@ -104,20 +106,29 @@ TEST(AnalyzeResiduals, PointAndTorqueResidualsCarryThePelvisAtTheClosedForm) {
     // closed form: FY = m g, FX = 0; the tilt moment tau left after FY's shared by MZ and the
     // reserve as tau c_i / sum c_j^2 (exponent 2)
     const double tau = pb.b[0] - pb.A(0, 1) * (kMass * kG / 1000.0);
+    double worst_stationarity = 0.0, worst_equality = 0.0, worst_closed = 0.0;
     for (const auto& f : run.frames) {
       const VecX x = f.activation;
-      EXPECT_NEAR(x[1], 0.0, 1e-10) << f.time;
-      EXPECT_NEAR(x[2], kMass * kG / 1000.0, 1e-10) << f.time;
-      EXPECT_NEAR(x[3], tau * 100 / (100 * 100 + 50 * 50), 1e-9) << f.time;
-      EXPECT_NEAR(x[0], tau * 50 / (100 * 100 + 50 * 50), 1e-9) << f.time;
+      // measured: every control within 3e-17 of its closed form
+      EXPECT_NEAR(x[1], 0.0, 1e-14) << f.time;
+      EXPECT_NEAR(x[2], kMass * kG / 1000.0, 1e-14) << f.time;
+      EXPECT_NEAR(x[3], tau * 100 / (100 * 100 + 50 * 50), 1e-14) << f.time;
+      EXPECT_NEAR(x[0], tau * 50 / (100 * 100 + 50 * 50), 1e-14) << f.time;
       EXPECT_NEAR(f.force[3], 100 * x[3], 1e-12);
+      EXPECT_LT(f.constraint_violation, 1e-8);
       // KKT at the tool's optimum, on the program built here (controls reordered to its columns)
       VecX xr(4);
       xr << x[1], x[2], x[3], x[0];
       const OptimalityReport kkt = checkOptimality(pb, xr);
-      EXPECT_LT(kkt.stationarity, 1e-8) << f.time;  // measured ~1e-12
-      EXPECT_LT(kkt.equality, 1e-8 * pb.b.norm()) << f.time;
+      worst_stationarity = std::max(worst_stationarity, kkt.stationarity);
+      worst_equality = std::max(worst_equality, kkt.equality / pb.b.norm());
+      worst_closed = std::max({worst_closed, std::abs(x[3] - tau * 100 / 12500), std::abs(x[0] - tau * 50 / 12500)});
     }
+    std::printf("residuals%s: %zu frames, KKT stationarity %.2g, equality %.2g of |b|, closed form %.2g\n",
+                with_limit ? " with the limit" : "", run.frames.size(), worst_stationarity, worst_equality, worst_closed);
+    // measured: stationarity 0, equality 1.2e-16 of |b| (a square-plus-one program IPOPT solves exactly)
+    EXPECT_LT(worst_stationarity, 1e-12);
+    EXPECT_LT(worst_equality, 1e-14);
   }
 }
 
