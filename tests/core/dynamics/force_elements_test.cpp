@@ -29,32 +29,31 @@ State randomState(const Model& m, std::uint32_t seed) {
   return s;
 }
 
-// a body point's world velocity by central differences of its position along qdot
-Vec3 pointVelocityByDifferences(const Model& m, const State& s, int body, const Vec3& x_i) {
+// a body's pose at q + h qdot and at q - h qdot (h = 1e-6), for central differences along the motion
+std::pair<Mat4, Mat4> posesAlongMotion(const Model& m, const State& s, int body) {
   const double h = 1e-6;
   SkeletonWorkspace ws(m);
   State sp = s, sm = s;
   sp.q += h * s.qdot;
   sm.q -= h * s.qdot;
   calcKinematics(m, sp, ws);
-  const Vec3 xp = transformPoint(ws.E_wi[body], x_i);
+  const Mat4 Ep = ws.E_wi[body];
   calcKinematics(m, sm, ws);
-  return (xp - transformPoint(ws.E_wi[body], x_i)) / (2 * h);
+  return {Ep, ws.E_wi[body]};
+}
+
+// a body point's world velocity by central differences of its position along qdot
+Vec3 pointVelocityByDifferences(const Model& m, const State& s, int body, const Vec3& x_i) {
+  const auto [Ep, Em] = posesAlongMotion(m, s, body);
+  return (transformPoint(Ep, x_i) - transformPoint(Em, x_i)) / 2e-6;
 }
 
 // a body's world angular velocity by central differences of its rotation along qdot
 Vec3 angularVelocityByDifferences(const Model& m, const State& s, int body) {
   if (body < 0) return Vec3::Zero();
-  const double h = 1e-6;
-  SkeletonWorkspace ws(m);
-  State sp = s, sm = s;
-  sp.q += h * s.qdot;
-  sm.q -= h * s.qdot;
-  calcKinematics(m, sp, ws);
-  const Mat3 Rp = ws.E_wi[body].topLeftCorner<3, 3>();
-  calcKinematics(m, sm, ws);
-  const Mat3 A = Rp * ws.E_wi[body].topLeftCorner<3, 3>().transpose();  // I + [w] 2h + O(h^2)
-  return Vec3(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1)) / (4 * h);
+  const auto [Ep, Em] = posesAlongMotion(m, s, body);
+  const Mat3 A = Ep.topLeftCorner<3, 3>() * Em.topLeftCorner<3, 3>().transpose();  // I + [w] 2h + O(h^2)
+  return Vec3(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1)) / 4e-6;
 }
 
 VecX termForce(const Model& m, const ForceTerm& t, const State& s, const VecX& controls) {
