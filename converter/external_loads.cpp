@@ -6,6 +6,7 @@
 
 #include "converter/detail/xml_util.hpp"
 #include "converter/id_setup.hpp"
+#include "converter/signal/signal_error.hpp"
 
 namespace redmax::osim {
 namespace fs = std::filesystem;
@@ -159,6 +160,80 @@ InverseDynamicsSetup readInverseDynamicsSetup(const std::string& path) {
   if (s.model_file.empty()) s.warnings.push_back("the setup names no model_file");
   if (s.coordinates_file.empty()) s.warnings.push_back("the setup names no coordinates_file");
   return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// sources on a built model, sampled in time
+
+namespace {
+
+// a body name as ExternalLoads write it: "name", "/bodyset/name" or "/name"
+std::string loadBodyName(std::string n) {
+  if (n.rfind("/bodyset/", 0) == 0) n = n.substr(9);
+  if (!n.empty() && n[0] == '/') n = n.substr(1);
+  return n;
+}
+
+std::vector<double> columnOf(const MatX& data, int c) {
+  std::vector<double> v(static_cast<size_t>(data.rows()));
+  for (Eigen::Index r = 0; r < data.rows(); ++r) v[static_cast<size_t>(r)] = data(r, c);
+  return v;
+}
+
+}  // namespace
+
+std::vector<LoadSource> makeLoadSources(const ExternalLoads& el, const ModelDescription& d,
+                                        const std::vector<int>& body_index, std::vector<std::string>& warnings) {
+  auto coreBody = [&](const std::string& name, int line) -> int {
+    const std::string n = loadBodyName(name);
+    if (n == d.ground_name) return -1;
+    const int bi = d.findBody(n);
+    const int core = bi >= 0 && bi < static_cast<int>(body_index.size()) ? body_index[bi] : -1;
+    if (core < 0) throw ConvertError(el.source_file, line, "body '" + name + "' is not part of the core model");
+    return core;
+  };
+  std::vector<LoadSource> out;
+  const Storage& data = el.data;
+  for (const ExternalForceDesc& f : el.forces) {
+    if (!f.applies_force) continue;
+    LoadSource src;
+    src.name = f.name;
+    src.frame.body = coreBody(f.applied_to_body, f.line);
+    if (src.frame.body < 0) {
+      warnings.push_back("ExternalForce '" + f.name + "' is applied to ground: it has no effect");
+      continue;
+    }
+    src.frame.force_frame = coreBody(f.force_expressed_in_body, f.line);
+    src.frame.point_frame = coreBody(f.point_expressed_in_body, f.line);
+    src.frame.has_force = f.hasForce();
+    src.frame.has_point = f.hasForce() && f.hasPoint();
+    src.frame.has_torque = f.hasTorque();
+    try {
+      for (int k = 0; k < 3; ++k) {
+        if (f.hasForce()) src.force[k] = signal::LoadInterpolant(data.time, columnOf(data.data, f.force_columns[k]));
+        if (f.hasPoint()) src.point[k] = signal::LoadInterpolant(data.time, columnOf(data.data, f.point_columns[k]));
+        if (f.hasTorque())
+          src.torque[k] = signal::LoadInterpolant(data.time, columnOf(data.data, f.torque_columns[k]));
+      }
+    } catch (const signal::SignalError& e) {
+      throw ConvertError(el.datafile_path, 0, "ExternalForce '" + f.name + "': " + e.what());
+    }
+    out.push_back(std::move(src));
+  }
+  return out;
+}
+
+void sampleLoads(const std::vector<LoadSource>& sources, double t, std::vector<IdLoadSample>& out) {
+  out.clear();
+  for (const LoadSource& src : sources) {
+    IdLoadSample l = src.frame;
+    for (int k = 0; k < 3; ++k) {
+      if (l.has_force) l.force[k] = src.force[k].calcValue(t);
+      if (l.has_point) l.point[k] = src.point[k].calcValue(t);
+      if (l.has_torque) l.torque[k] = src.torque[k].calcValue(t);
+    }
+    out.push_back(l);
+  }
 }
 
 }  // namespace redmax::osim

@@ -7,7 +7,9 @@
 
 #include "converter/error.hpp"
 #include "converter/model_description.hpp"
+#include "converter/signal/load_interpolant.hpp"
 #include "converter/storage.hpp"
+#include "core/dynamics/id_engine.hpp"
 
 namespace redmax::osim {
 
@@ -49,5 +51,22 @@ ExternalLoads readExternalLoads(const std::string& xml_path, const std::string& 
 /// Check the loads against a model: an unknown applied_to_body is an error (ConvertError on the
 /// ExternalForce's line); an unknown expressed-in body falls back to ground with a warning.
 void checkExternalLoads(ExternalLoads& loads, const ModelDescription& model);
+
+/// One ExternalForce ready to sample: its bodies (core indices; -1 ground) and flags, and the
+/// interpolants of its columns.
+struct LoadSource {
+  std::string name;
+  IdLoadSample frame;  ///< bodies and flags (values are filled per sample)
+  std::array<signal::LoadInterpolant, 3> force, point, torque;
+};
+
+/// The loads of `loads` (checked against d with checkExternalLoads first) as sources on a built
+/// model (body_index: ModelDescription::bodies -> core body, BuildResult::body_index). Forces on
+/// ground are left out with a warning; a body the core model lacks is a ConvertError naming
+/// loads.source_file and the force's line; unusable data a ConvertError naming the data file.
+std::vector<LoadSource> makeLoadSources(const ExternalLoads& loads, const ModelDescription& d,
+                                        const std::vector<int>& body_index, std::vector<std::string>& warnings);
+/// the loads of every source at time t (OpenSim's interpolation, not filtered)
+void sampleLoads(const std::vector<LoadSource>& sources, double t, std::vector<IdLoadSample>& out);
 
 }  // namespace redmax::osim

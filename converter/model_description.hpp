@@ -241,6 +241,8 @@ struct PathForceDesc {
   std::vector<PathPointDesc> points;
   std::vector<PathWrapDesc> wraps;
   PathType path_type = PathType::I;
+  /// the force_set_files file it came from; "" for the model's own ForceSet
+  std::string source_file;
   int line = 0;
 };
 
@@ -250,11 +252,34 @@ struct ForceDesc {
   std::string class_name;
   bool applies_force = true;
   bool modelled = false;   ///< false: its force is not computed by redmax (see unsupported)
-  std::string coordinate;  ///< CoordinateActuator
+  std::string coordinate;  ///< CoordinateActuator, CoordinateLimitForce, SpringGeneralizedForce
   double optimal_force = 1.0;
   /// Actuator min_control / max_control (OpenSim's defaults: -inf, +inf)
   double min_control = -std::numeric_limits<double>::infinity();
   double max_control = std::numeric_limits<double>::infinity();
+  /// the bodies a force acts on, as description body names (ground: ModelDescription::
+  /// ground_name): PointActuator `body`; TorqueActuator bodyA, bodyB; PointToPointSpring body1,
+  /// body2 (the base bodies of their frames)
+  std::string body1, body2;
+  /// PointActuator: point (body frame, or ground with point_is_global) and direction (body frame,
+  /// or ground with force_is_global), as written. TorqueActuator: axis in direction (bodyA's
+  /// frame unless torque_is_global, kept in force_is_global). PointToPointSpring: point1, point2
+  /// in their bodies' frames.
+  Vec3 point1 = Vec3::Zero(), point2 = Vec3::Zero();
+  Vec3 direction = Vec3::UnitX();
+  bool point_is_global = false, force_is_global = false;
+  /// CoordinateLimitForce, as written (degrees for a Rotational coordinate: N m/deg, deg, ...)
+  double upper_stiffness = 1.0, upper_limit = 0.0, lower_stiffness = 1.0, lower_limit = 0.0;
+  double damping = 0.001, transition = 0.1;
+  /// SpringGeneralizedForce (stiffness, rest_length, viscosity) and PointToPointSpring
+  /// (stiffness, rest_length), SI
+  double stiffness = 0.0, rest_length = 0.0, viscosity = 0.0;
+  /// BushingForce: rotational then translational stiffness and damping (N m/rad, N/m, ...), and
+  /// frame1, frame2 as poses in body1, body2
+  Vec6 bushing_stiffness = Vec6::Zero(), bushing_damping = Vec6::Zero();
+  Mat4 X_body1 = Mat4::Identity(), X_body2 = Mat4::Identity();
+  /// the force_set_files file it came from; "" for the model's own ForceSet
+  std::string source_file;
   int line = 0;
 };
 

@@ -98,6 +98,14 @@ int quadrantAxis(const std::string& q, int& sign) {
   return -2;
 }
 
+// the forces whose properties readModelledForce reads and whose force redmax computes
+const std::set<std::string>& modelledForceClasses() {
+  static const std::set<std::string> s = {"CoordinateActuator",   "PointActuator",          "TorqueActuator",
+                                          "CoordinateLimitForce", "SpringGeneralizedForce", "PointToPointSpring",
+                                          "BushingForce"};
+  return s;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -159,6 +167,10 @@ void OsimReader::readForces() {
   // pre-2.0 files call the ForceSet an ActuatorSet
   const XMLElement* set = modelChild("ForceSet");
   if (!set) set = modelChild("ActuatorSet");
+  readForceSet(set, "");
+}
+
+void OsimReader::readForceSet(const XMLElement* set, const std::string& source) {
   std::set<std::string> names;
   // old class names OpenSim registers as aliases (RegisterTypes_osimActuators)
   static const std::map<std::string, std::string> renamed = {
@@ -177,6 +189,7 @@ void OsimReader::readForces() {
     applies = childBool(doc(), e, "appliesForce", applies);
     if (muscleClasses().count(cls) || pathForceClasses().count(cls)) {
       readPathForce(e, name, cls, muscleClasses().count(cls) > 0, applies);
+      d_.muscles.back().source_file = source;
       continue;
     }
     ForceDesc f;
@@ -184,13 +197,19 @@ void OsimReader::readForces() {
     f.class_name = cls;
     f.applies_force = applies;
     f.line = lineOf(e);
+    f.source_file = source;
     if (actuatorClasses().count(cls)) {
       f.coordinate = childText(e, "coordinate");
       f.optimal_force = childDouble(doc(), e, "optimal_force", 1.0);
       f.min_control = childDouble(doc(), e, "min_control", f.min_control);
       f.max_control = childDouble(doc(), e, "max_control", f.max_control);
-    } else if (applies) {
-      addUnsupported(e, "force '" + name + "' (" + cls + ") is listed but its force is not modelled");
+    }
+    if (modelledForceClasses().count(cls)) {
+      readModelledForce(e, f);
+    } else if (applies && !actuatorClasses().count(cls)) {
+      // a force_set_files entry names its file and line (the list's lines are the model's)
+      const std::string where = source.empty() ? std::string() : source + ":" + std::to_string(lineOf(e)) + ": ";
+      addUnsupported(e, where + "force '" + name + "' (" + cls + ") is listed but its force is not modelled");
     }
     d_.forces.push_back(f);
   }
@@ -201,6 +220,97 @@ void OsimReader::readForces() {
     fg.members = splitWords(childText(g, "members"));
     d_.force_groups.push_back(fg);
   }
+}
+
+// a body frame reference as OpenSim's forces look it up: a component path (ground, /bodyset/b,
+// an offset frame), else a BodySet name; its base body's name and the frame's pose in that body
+const FrameNode& OsimReader::forceFrame(const XMLElement* e, const std::string& value, const std::string& what) {
+  if (value.empty() || value == "Unassigned") fail(e, what + " names no body");
+  for (const std::string& p : {resolvePath("/", value), "/bodyset/" + value})
+    if (auto it = frames_.find(p); !p.empty() && it != frames_.end()) return it->second;
+  fail(e, what + ": '" + value + "' is not a body or frame of the model");
+}
+
+void OsimReader::readModelledForce(const XMLElement* e, ForceDesc& f) {
+  const std::string what = f.class_name + " '" + f.name + "'";
+  auto nonNegative = [&](const char* tag, double fallback) {
+    const double v = childDouble(doc(), e, tag, fallback);
+    if (!(v >= 0.0) || !std::isfinite(v))
+      fail(firstChild(e, tag) ? firstChild(e, tag) : e, what + ": " + tag + " must be finite and >= 0");
+    return v;
+  };
+  auto nonZero = [&](const char* tag, const Vec3& fallback) {
+    const Vec3 v = childVec3(doc(), e, tag, fallback);
+    if (!(v.norm() > 0.0) || !v.allFinite())
+      fail(firstChild(e, tag) ? firstChild(e, tag) : e, what + ": " + tag + " must be a non-zero vector");
+    return v;
+  };
+  auto coordinate = [&]() {
+    const XMLElement* c = firstChild(e, "coordinate");
+    f.coordinate = textOf(c);
+    if (f.coordinate.empty() || d_.findCoordinate(f.coordinate) < 0)
+      fail(c ? c : e, what + ": coordinate '" + f.coordinate + "' is not a coordinate of the model");
+  };
+  const std::string& cls = f.class_name;
+  if (cls == "CoordinateActuator") {
+    coordinate();
+  } else if (cls == "PointActuator") {
+    // body: a BodySet name (PointActuator::extendConnectToModel), never ground
+    const XMLElement* b = firstChild(e, "body");
+    f.body1 = textOf(b);
+    if (d_.findBody(f.body1) < 0)
+      fail(b ? b : e, what + ": body '" + f.body1 + "' is not a body of the model's BodySet");
+    f.point1 = childVec3(doc(), e, "point", Vec3::Zero());
+    f.point_is_global = childBool(doc(), e, "point_is_global", false);
+    f.direction = nonZero("direction", Vec3::UnitX());
+    f.force_is_global = childBool(doc(), e, "force_is_global", false);
+  } else if (cls == "TorqueActuator") {
+    const XMLElement* a = firstChild(e, "bodyA");
+    const XMLElement* b = firstChild(e, "bodyB");
+    const FrameNode& fa = forceFrame(a ? a : e, textOf(a), what + " bodyA");
+    const FrameNode& fb = forceFrame(b ? b : e, textOf(b), what + " bodyB");
+    f.body1 = fa.base_body;
+    f.body2 = fb.base_body;
+    f.force_is_global = childBool(doc(), e, "torque_is_global", true);
+    f.direction = nonZero("axis", Vec3::UnitZ());
+    // an axis in an offset frame of bodyA, re-expressed in its base body
+    if (!f.force_is_global) f.direction = fa.X_base.topLeftCorner<3, 3>() * f.direction;
+  } else if (cls == "CoordinateLimitForce") {
+    coordinate();
+    f.upper_stiffness = nonNegative("upper_stiffness", 1.0);
+    f.upper_limit = childDouble(doc(), e, "upper_limit", 0.0);
+    f.lower_stiffness = nonNegative("lower_stiffness", 1.0);
+    f.lower_limit = childDouble(doc(), e, "lower_limit", 0.0);
+    f.damping = nonNegative("damping", 0.001);
+    f.transition = childDouble(doc(), e, "transition", 0.1);
+    if (!(f.transition > 0.0) || !std::isfinite(f.transition))
+      fail(firstChild(e, "transition") ? firstChild(e, "transition") : e, what + ": transition must be positive");
+  } else if (cls == "SpringGeneralizedForce") {
+    coordinate();
+    f.stiffness = nonNegative("stiffness", 0.0);
+    f.rest_length = childDouble(doc(), e, "rest_length", 0.0);
+    f.viscosity = nonNegative("viscosity", 0.0);
+  } else if (cls == "PointToPointSpring") {
+    const std::string self = "/forceset/" + f.name;
+    const XMLElement* w1 = nullptr;
+    const XMLElement* w2 = nullptr;
+    const std::string s1 = frameReference(e, "body1", "body1", &w1);
+    const std::string s2 = frameReference(e, "body2", "body2", &w2);
+    const FrameNode& f1 = frameForSocket(self, s1, w1 ? w1 : e, what + " body1");
+    const FrameNode& f2 = frameForSocket(self, s2, w2 ? w2 : e, what + " body2");
+    if (f1.base_body == f2.base_body) fail(e, what + ": body1 and body2 are fixed to the same body '" + f1.base_body + "'");
+    f.body1 = f1.base_body;
+    f.body2 = f2.base_body;
+    // SimTK::Force::TwoPointLinearSpring on the frames' mobilized bodies: the points are stations
+    // of the base bodies, whatever offset the frames have
+    f.point1 = childVec3(doc(), e, "point1", Vec3::Zero());
+    f.point2 = childVec3(doc(), e, "point2", Vec3::Zero());
+    f.stiffness = nonNegative("stiffness", 1.0);
+    f.rest_length = nonNegative("rest_length", 0.0);
+  } else if (cls == "BushingForce") {
+    readBushing(e, f);
+  }
+  f.modelled = true;
 }
 
 void OsimReader::readPathForce(const XMLElement* e, const std::string& name,
@@ -348,6 +458,96 @@ void OsimReader::readMuscleParameters(const XMLElement* e, PathForceDesc& m) {
   }
 }
 
+// BushingForce (a TwoFrameLinker): frame1, frame2 are sockets, usually to offset frames the force
+// owns in its <frames>; before 30500 body_1/body_2 with location_ and orientation_body_1/2
+void OsimReader::readBushing(const XMLElement* e, ForceDesc& f) {
+  const std::string what = "BushingForce '" + f.name + "'";
+  auto vec = [&](const char* tag) {
+    const Vec3 v = childVec3(doc(), e, tag, Vec3::Zero());
+    for (int i = 0; i < 3; ++i)
+      if (!(v[i] >= 0.0) || !std::isfinite(v[i]))
+        fail(firstChild(e, tag) ? firstChild(e, tag) : e, what + ": " + tag + " must be finite and >= 0");
+    return v;
+  };
+  f.bushing_stiffness << vec("rotational_stiffness"), vec("translational_stiffness");
+  f.bushing_damping << vec("rotational_damping"), vec("translational_damping");
+  const std::string self = "/forceset/" + f.name;
+  // the force's own offset frames
+  for (const XMLElement* fr : childElements(firstChild(e, "frames"))) {
+    if (std::string(fr->Name()) != "PhysicalOffsetFrame") fail(fr, what + ": <" + fr->Name() + "> is not a PhysicalOffsetFrame");
+    std::set<std::string> none;
+    const std::string name = componentName(fr, none);
+    const XMLElement* w = nullptr;
+    const std::string parent = socketValue(fr, "parent", &w);
+    const FrameNode& p = frameForSocket(self + "/" + name, parent, w ? w : fr, what + " frame '" + name + "'");
+    FrameNode n;
+    n.kind = FrameNode::Kind::Offset;
+    n.name = name;
+    n.path = self + "/" + name;
+    n.base_body = p.base_body;
+    n.X_base = p.X_base * makePose(childVec3(doc(), fr, "translation", Vec3::Zero()),
+                                   childVec3(doc(), fr, "orientation", Vec3::Zero()));
+    n.state = 2;
+    n.elem = fr;
+    frames_[n.path] = n;
+  }
+  for (int k = 0; k < 2; ++k) {
+    const std::string socket = k == 0 ? "frame1" : "frame2";
+    const std::string legacy = k == 0 ? "body_1" : "body_2";
+    std::string& body = k == 0 ? f.body1 : f.body2;
+    Mat4& X = k == 0 ? f.X_body1 : f.X_body2;
+    if (const XMLElement* l = firstChild(e, legacy.c_str()); l && socketValue(e, socket, nullptr).empty()) {
+      const FrameNode& b = frameForSocket(self, legacyBodyPath(textOf(l)), l, what + " " + legacy);
+      body = b.base_body;
+      const std::string n = k == 0 ? "1" : "2";
+      X = b.X_base * makePose(childVec3(doc(), e, ("location_body_" + n).c_str(), Vec3::Zero()),
+                              childVec3(doc(), e, ("orientation_body_" + n).c_str(), Vec3::Zero()));
+      continue;
+    }
+    const XMLElement* w = nullptr;
+    const std::string v = socketValue(e, socket, &w);
+    const FrameNode& fr = frameForSocket(self, v, w ? w : e, what + " " + socket);
+    body = fr.base_body;
+    X = fr.X_base;
+  }
+  if (f.body1 == f.body2) fail(e, what + ": frame1 and frame2 are fixed to the same body '" + f.body1 + "'");
+}
+
+// a force_set_files file: its ForceSet read against `model`'s frames and coordinates, as
+// OpenSim's tools append it (ForceSet(file) then Model::updForceSet().append)
+void OsimReader::appendForceSetTo(ModelDescription& model) {
+  const XMLElement* root = doc_.root();
+  if (!root) fail(nullptr, "empty file");
+  const XMLElement* set = root;
+  version_ = 40000;
+  if (std::string(root->Name()) == "OpenSimDocument") {
+    if (const char* v = root->Attribute("Version")) version_ = std::atoi(v);
+    set = firstChild(root, "ForceSet");
+    if (!set) fail(root, "no <ForceSet> in <OpenSimDocument>: a force_set_files file holds a ForceSet");
+  } else if (std::string(root->Name()) != "ForceSet") {
+    fail(root, "root element is <" + std::string(root->Name()) + ">, expected <ForceSet> or <OpenSimDocument>");
+  }
+  d_ = model;  // a copy: a file that fails leaves the model as it was
+  // the model's frames and coordinate paths, resolved
+  auto add = [&](FrameNode::Kind kind, const std::string& name, const std::string& path, const std::string& base,
+                 const Mat4& X) {
+    FrameNode f;
+    f.kind = kind;
+    f.name = name;
+    f.path = path;
+    f.base_body = base;
+    f.X_base = X;
+    f.state = 2;
+    frames_[path] = f;
+  };
+  add(FrameNode::Kind::Ground, d_.ground_name, "/" + d_.ground_name, d_.ground_name, Mat4::Identity());
+  for (const BodyDesc& b : d_.bodies) add(FrameNode::Kind::Body, b.name, "/bodyset/" + b.name, b.name, Mat4::Identity());
+  for (const FrameDesc& f : d_.frames) add(FrameNode::Kind::Offset, f.name, f.path, f.base_body, f.X_base);
+  for (const CoordinateDesc& c : d_.coordinates) coordinate_paths_["/jointset/" + c.joint + "/" + c.name] = c.name;
+  readForceSet(set, doc_.path());
+  model = std::move(d_);
+}
+
 PathPointDesc OsimReader::readPathPoint(const XMLElement* e, const std::string& owner,
                                         std::set<std::string>& names) {
   PathPointDesc p;
@@ -420,3 +620,12 @@ PathPointDesc OsimReader::readPathPoint(const XMLElement* e, const std::string& 
 }
 
 }  // namespace redmax::osim::detail
+
+namespace redmax::osim {
+
+void appendForceSetFile(ModelDescription& model, const std::string& path) {
+  detail::OsimReader reader(path);
+  reader.appendForceSetTo(model);
+}
+
+}  // namespace redmax::osim

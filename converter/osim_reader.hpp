@@ -18,6 +18,13 @@ ModelDescription readOsimModel(const std::string& path);
 /// class's, so a check of the written class does not apply (`--muscle-class`).
 ModelDescription readOsimModel(const std::string& path, const std::string& muscle_class);
 
+/// Append the ForceSet of a force_set_files file (OpenSimDocument/ForceSet, or a bare ForceSet)
+/// to model's forces and muscles, as OpenSim's tools append it; each entry's source_file is
+/// `path`. Bodies, frames and coordinates are the model's; an unknown body or coordinate, a zero
+/// direction, a negative stiffness are errors at their line of that file (ConvertError); the model
+/// is then unchanged.
+void appendForceSetFile(ModelDescription& model, const std::string& path);
+
 /// Build the multibody tree as Simbody's MultibodyGraphMaker does for OpenSim (§3.1): fills
 /// d.tree, appends FreeJoints for unconnected bodies and loop-closure constraints, and reorders
 /// d.coordinates (with the joints' indices) into mobilizer order. Expects d.joints with resolved

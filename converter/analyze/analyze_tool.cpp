@@ -7,12 +7,15 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <sstream>
 
 #include "converter/analyze/static_optimization.hpp"
 #include "converter/atomic_file.hpp"
 #include "converter/build/build_core_model.hpp"
+#include "converter/build/force_terms.hpp"
+#include "converter/osim_reader.hpp"
 #include "converter/detail/xml_util.hpp"
 #include "converter/id/core_id_engine.hpp"
 #include "converter/id/inverse_dynamics_tool.hpp"
@@ -40,9 +43,6 @@ const std::set<std::string>& openSimAnalysisClasses() {
   return s;
 }
 
-bool isCoordinateActuator(const std::string& cls) {
-  return cls == "CoordinateActuator" || cls == "ActivationCoordinateActuator";
-}
 
 }  // namespace
 
@@ -123,31 +123,6 @@ AnalyzeSetup readAnalyzeSetup(const std::string& path) {
   return s;
 }
 
-std::vector<ActuatorEntry> readActuatorForceSet(const std::string& path) {
-  XmlDocument doc(path);
-  const XMLElement* el = toolRoot(doc, "ForceSet");
-  std::vector<ActuatorEntry> out;
-  for (const XMLElement* e : childElements(firstChild(el, "objects"))) {
-    std::string cls = e->Name();
-    if (cls == "GeneralizedForce") cls = "CoordinateActuator";
-    if (!isCoordinateActuator(cls))
-      doc.fail(e, "<" + cls + "> '" + attribute(e, "name") +
-                      "': only CoordinateActuators of force_set_files are modelled by redmax's analyze");
-    ActuatorEntry a;
-    a.name = attribute(e, "name");
-    a.source_file = path;
-    a.line = lineOf(e);
-    a.coordinate = childText(e, "coordinate");
-    if (a.coordinate.empty()) doc.fail(e, "CoordinateActuator '" + a.name + "' names no coordinate");
-    a.optimal_force = childDouble(doc, e, "optimal_force", 1.0);
-    a.min_control = childDouble(doc, e, "min_control", a.min_control);
-    a.max_control = childDouble(doc, e, "max_control", a.max_control);
-    a.applies_force = childBool(doc, e, "appliesForce", true);
-    out.push_back(a);
-  }
-  return out;
-}
-
 // ---------------------------------------------------------------------------------------------
 // the tool
 
@@ -157,9 +132,25 @@ struct Actuator {
   std::string name;
   int muscle = -1;      ///< index into the geometry model's muscles, or -1
   int coordinate = -1;  ///< core coordinate of a CoordinateActuator
+  int point = -1, torque = -1;  ///< index in ForceTermSet's PointActuatorTerm / TorqueActuatorTerm
   double optimal_force = 1.0;
   double lower = 0.0, upper = 1.0;
 };
+
+// a CoordinateActuator, PointActuator or TorqueActuator of the force set; term: (0 coordinate,
+// 1 point, 2 torque; index in that term), or (3, core coordinate) of an ActivationCoordinateActuator
+Actuator forceSetActuator(const ForceDesc& f, std::pair<int, int> term, const ForceTermSet& set) {
+  Actuator a;
+  a.name = f.name;
+  if (term.first == 0) a.coordinate = set.coordinate_actuators->actuators()[static_cast<size_t>(term.second)].coordinate;
+  if (term.first == 3) a.coordinate = term.second;  // the core coordinate itself
+  if (term.first == 1) a.point = term.second;
+  if (term.first == 2) a.torque = term.second;
+  a.optimal_force = f.optimal_force;
+  a.lower = f.min_control;
+  a.upper = f.max_control;
+  return a;
+}
 
 }  // namespace
 
@@ -172,6 +163,7 @@ struct AnalyzeTool::Impl {
   std::vector<signal::NaturalSpline> u_splines;  ///< per core coordinate (empty: no data)
   std::vector<MuscleKinematics> mk;             ///< columns each muscle's path depends on
   std::unique_ptr<MuscleForceTerm> force_term;  ///< the muscles with a force model, as forward applies them
+  ForceTermSet forces;  ///< the force set's actuators (columns) and passive forces (moved into b)
 };
 
 AnalyzeTool::~AnalyzeTool() = default;
@@ -206,8 +198,6 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   cfg.lowpass_cutoff_hz = setup_.lowpass_cutoff_frequency_for_coordinates;
   cfg.t0 = setup_.initial_time;
   cfg.t1 = setup_.final_time;
-  // the actuators are the program's unknowns; every other force is what ID leaves to them
-  cfg.forces_to_exclude = {"Actuators"};
   cfg.opensim_compat = true;
   cfg.muscle_mass = settings_.muscle_mass;
   if (settings_.muscle_class) {
@@ -216,6 +206,14 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
       throw ConvertError(where, 0, "--muscle-class " + *settings_.muscle_class + ": redmax has no such muscle model");
     cfg.muscle_class = *settings_.muscle_class;
   }
+  // the actuators are the program's unknowns; every other force is what ID leaves to them. The
+  // passive forces redmax models (converter/build/force_terms.hpp) are applied below, so ID
+  // leaves them out instead of naming them as unmodelled.
+  cfg.forces_to_exclude = {"Actuators"};
+  ModelDescription with_files = readOsimModel(setup_.model_file, cfg.muscle_class);
+  for (const std::string& file : setup_.force_set_files) appendForceSetFile(with_files, file);
+  for (const ForceDesc& f : with_files.forces)
+    if (f.modelled && f.class_name.find("Actuator") == std::string::npos) cfg.forces_to_exclude.push_back(f.name);
   I.id = std::make_unique<InverseDynamicsTool>(cfg);
   for (const auto& w : I.id->warnings()) warnings_.push_back(w);
   I.engine = std::make_unique<CoreIdEngine>(I.id->musculoskeletalModel(), I.id->engineOptions());
@@ -231,12 +229,44 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   bo.constraints = false;
   bo.muscles = true;
   BuildResult built = buildCoreModel(d, bo);
+  // the model's forces (all dropped with replace_force_set) and those of force_set_files, with
+  // the ID tool's model (muscle class) and the files' entries after them, as OpenSim appends them
+  ModelDescription dd = d;
+  if (setup_.replace_force_set)
+    for (ForceDesc& f : dd.forces) f.applies_force = false;
+  for (size_t k = 0; k < with_files.forces.size(); ++k)
+    if (!with_files.forces[k].source_file.empty()) dd.forces.push_back(with_files.forces[k]);
+  for (const PathForceDesc& m : with_files.muscles)
+    if (!m.source_file.empty() && m.applies_force)
+      throw ConvertError(m.source_file, m.line, m.class_name + " '" + m.name +
+                                                    "': muscles in force_set_files are not supported by redmax's analyze");
+  I.forces = buildForceTerms(dd, built, warnings_);
+  // (the model's own unmodelled forces are named by the ID tool's warnings)
+  for (const ForceDesc& f : dd.forces)
+    if (f.applies_force && !f.modelled && !f.source_file.empty() && f.class_name.find("Actuator") == std::string::npos)
+      warnings_.push_back(f.source_file + ":" + std::to_string(f.line) + ": " + f.class_name + " '" + f.name +
+                          "': OpenSim applies it, redmax does not model it");
+  // ForceDesc index -> (kind, index in its actuator term)
+  std::map<int, std::pair<int, int>> term_of;
+  for (size_t k = 0; k < I.forces.coordinate_actuator_source.size(); ++k)
+    term_of[I.forces.coordinate_actuator_source[k]] = {0, static_cast<int>(k)};
+  for (size_t k = 0; k < I.forces.point_actuator_source.size(); ++k)
+    term_of[I.forces.point_actuator_source[k]] = {1, static_cast<int>(k)};
+  for (size_t k = 0; k < I.forces.torque_actuator_source.size(); ++k)
+    term_of[I.forces.torque_actuator_source[k]] = {2, static_cast<int>(k)};
+  for (size_t i = 0; i < dd.forces.size(); ++i) {
+    // ActivationCoordinateActuator: its actuation is overridden, so it is a CoordinateActuator here
+    const ForceDesc& f = dd.forces[i];
+    if (f.class_name != "ActivationCoordinateActuator" || !f.applies_force) continue;
+    const int ci = d.findCoordinate(f.coordinate);
+    const int k = ci >= 0 ? built.coordinate_index[ci] : -1;
+    if (k < 0)
+      throw ConvertError(f.source_file.empty() ? setup_.model_file : f.source_file, f.line,
+                         f.class_name + " '" + f.name + "': no coordinate '" + f.coordinate + "'");
+    term_of[static_cast<int>(i)] = {3, k};
+  }
   I.geometry = std::move(built.model);
   const Model& skel = I.id->model();
-  auto coreCoordinate = [&](const std::string& name) {
-    const int ci = d.findCoordinate(name);
-    return ci >= 0 ? built.coordinate_index[ci] : -1;
-  };
 
   // the force set in OpenSim's order (the model's in file order, then force_set_files), those
   // with appliesForce false removed
@@ -279,19 +309,11 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
         a.upper = model->maxControl();
         model_acts.emplace_back(pf.line, a);
       }
-      for (const ForceDesc& f : d.forces) {
-        if (!f.applies_force) continue;
-        if (isCoordinateActuator(f.class_name)) {
-          Actuator a;
-          a.name = f.name;
-          a.coordinate = coreCoordinate(f.coordinate);
-          if (a.coordinate < 0)
-            throw ConvertError(setup_.model_file, f.line,
-                               f.class_name + " '" + f.name + "': no coordinate '" + f.coordinate + "'");
-          a.optimal_force = f.optimal_force;
-          a.lower = f.min_control;
-          a.upper = f.max_control;
-          model_acts.emplace_back(f.line, a);
+      for (size_t i = 0; i < dd.forces.size(); ++i) {
+        const ForceDesc& f = dd.forces[i];
+        if (!f.applies_force || !f.source_file.empty()) continue;
+        if (auto it = term_of.find(static_cast<int>(i)); it != term_of.end()) {
+          model_acts.emplace_back(f.line, forceSetActuator(f, it->second, I.forces));
         } else if (f.class_name.find("Actuator") != std::string::npos) {
           throw ConvertError(setup_.model_file, f.line,
                              f.class_name + " '" + f.name + "' is not modelled by redmax's static optimization");
@@ -301,20 +323,15 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
                        [](const auto& x, const auto& y) { return x.first < y.first; });
       for (auto& [line, a] : model_acts) acts.push_back(a);
     }
-    for (const std::string& file : setup_.force_set_files) {
-      for (const ActuatorEntry& e : readActuatorForceSet(file)) {
-        if (!e.applies_force) continue;
-        Actuator a;
-        a.name = e.name;
-        a.coordinate = coreCoordinate(e.coordinate);
-        if (a.coordinate < 0)
-          throw ConvertError(file, e.line, "CoordinateActuator '" + e.name + "': the model has no coordinate '" +
-                                               e.coordinate + "'");
-        a.optimal_force = e.optimal_force;
-        a.lower = e.min_control;
-        a.upper = e.max_control;
-        acts.push_back(a);
-      }
+    // force_set_files, in file order
+    for (size_t i = 0; i < dd.forces.size(); ++i) {
+      const ForceDesc& f = dd.forces[i];
+      if (!f.applies_force || f.source_file.empty()) continue;
+      if (auto it = term_of.find(static_cast<int>(i)); it != term_of.end())
+        acts.push_back(forceSetActuator(f, it->second, I.forces));
+      else if (f.class_name.find("Actuator") != std::string::npos)
+        throw ConvertError(f.source_file, f.line,
+                           f.class_name + " '" + f.name + "' is not modelled by redmax's static optimization");
     }
   }
   if (acts.empty()) throw ConvertError(setup_.model_file, 0, "static optimization: the force set has no actuators");
@@ -395,7 +412,7 @@ StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
   std::vector<Mat4> E;
   VecX length(nm), speed(nm);
   MatX dl(nm, nr);
-  VecX prev, dl_row;
+  VecX prev, dl_row, column;
   SkeletonWorkspace sk(skel);
   StaticOptimizationOptions opt;
   opt.convergence_tolerance = std::min(so.optimizer_convergence_criterion, 1e-8);
@@ -442,12 +459,12 @@ StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
       // muscles with a force model: the generalized force per unit tension as the forward
       // simulation applies it (MuscleForceTerm: OpenSim's straight segments with wrap tangent
       // points held in their surface's body), so both tools use one moment arm
+      State st;
+      st.t = fr.time;
+      st.q = q;
+      st.qdot = v;
+      calcKinematics(skel, st, sk);
       if (I.force_term) {
-        State st;
-        st.t = fr.time;
-        st.q = q;
-        st.qdot = v;
-        calcKinematics(skel, st, sk);
         for (int m = 0, k = 0; m < nm; ++m) {
           if (!I.geometry.muscleModels()[m]) continue;
           if (muscle_used[static_cast<size_t>(m)]) {
@@ -463,7 +480,12 @@ StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
       StaticOptimizationProblem pb;
       pb.A = MatX::Zero(nrow, na);
       pb.b.resize(nrow);
-      for (int r = 0; r < nrow; ++r) pb.b[r] = tau[I.rows[r]];
+      // the passive forces (CoordinateLimitForce, springs) act at (q, u) whatever the controls:
+      // OpenSim's StaticOptimizationTarget sees them in the accelerations at zero actuation, so
+      // the actuators supply what they leave (b = tau - f_passive)
+      VecX f_passive = VecX::Zero(nr);
+      for (const auto& term : I.forces.passiveTerms()) term->addForce(skel, st, TermContext(sk), f_passive);
+      for (int r = 0; r < nrow; ++r) pb.b[r] = tau[I.rows[r]] - f_passive[I.rows[r]];
       pb.lower.resize(na);
       pb.upper.resize(na);
       VecX fopt(na);
@@ -477,6 +499,13 @@ StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
                               {length[a.muscle], speed[a.muscle], 0.0}, 1.0)
                         : a.optimal_force;
           for (int r = 0; r < nrow; ++r) pb.A(r, j) = -fopt[j] * dl(a.muscle, I.rows[r]);
+        } else if (a.point >= 0 || a.torque >= 0) {
+          // a residual: its generalized force at the optimal force, through the body Jacobians
+          fopt[j] = a.optimal_force;
+          column.setZero(nr);
+          if (a.point >= 0) I.forces.point_actuators->addActuation(skel, sk, a.point, fopt[j], column);
+          else I.forces.torque_actuators->addActuation(skel, sk, a.torque, fopt[j], column);
+          for (int r = 0; r < nrow; ++r) pb.A(r, j) = column[I.rows[r]];
         } else {
           fopt[j] = a.optimal_force;
           if (row_of[static_cast<size_t>(a.coordinate)] >= 0) pb.A(row_of[static_cast<size_t>(a.coordinate)], j) = fopt[j];

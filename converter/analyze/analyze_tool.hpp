@@ -49,16 +49,6 @@ struct StaticOptimizationSettings {
   int line = 0;
 };
 
-/// A CoordinateActuator read from a force_set_files file (or the model).
-struct ActuatorEntry {
-  std::string name, coordinate, source_file;
-  double optimal_force = 1.0;
-  double min_control = -std::numeric_limits<double>::infinity();
-  double max_control = std::numeric_limits<double>::infinity();
-  bool applies_force = true;
-  int line = 0;
-};
-
 struct AnalyzeSetup {
   std::string name, source_file, directory;
   std::string model_file, coordinates_file, states_file, speeds_file, external_loads_file;
@@ -78,10 +68,6 @@ struct AnalyzeSetup {
 /// ("FILE:LINE: what") on malformed input, an AnalysisSet that is empty or holds no analysis
 /// that is on.
 AnalyzeSetup readAnalyzeSetup(const std::string& path);
-
-/// The CoordinateActuators of a ForceSet file (force_set_files). Throws ConvertError for other
-/// classes (their forces are not modelled) and malformed input.
-std::vector<ActuatorEntry> readActuatorForceSet(const std::string& path);
 
 struct AnalyzeToolSettings {
   std::string setup_file;

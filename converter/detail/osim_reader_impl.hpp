@@ -41,6 +41,8 @@ class OsimReader {
  public:
   explicit OsimReader(const std::string& path);
   ModelDescription read();
+  /// append the ForceSet of this reader's file (a force_set_files file) to `model`'s forces
+  void appendForceSetTo(ModelDescription& model);
   /// read every muscle as this class (renameType); "" = as written
   void setMuscleClass(std::string cls) { muscle_class_ = std::move(cls); }
 
@@ -100,6 +102,11 @@ class OsimReader {
   void readWrapObjects();
   void readWrapObjectSet(const XMLElement* set, const FrameNode& frame);
   void readForces();
+  /// the forces of a ForceSet element (the model's, or a force_set_files file's: source)
+  void readForceSet(const XMLElement* set, const std::string& source);
+  void readModelledForce(const XMLElement* e, ForceDesc& f);
+  void readBushing(const XMLElement* e, ForceDesc& f);
+  const FrameNode& forceFrame(const XMLElement* e, const std::string& value, const std::string& what);
   void readPathForce(const XMLElement* e, const std::string& name, const std::string& cls,
                      bool is_muscle, bool applies);
   void readMuscleParameters(const XMLElement* e, PathForceDesc& m);

@@ -24,19 +24,6 @@ std::string lower(std::string s) {
 
 using detail::joinNames;
 
-std::vector<double> columnOf(const MatX& data, int c) {
-  std::vector<double> v(static_cast<size_t>(data.rows()));
-  for (Eigen::Index r = 0; r < data.rows(); ++r) v[static_cast<size_t>(r)] = data(r, c);
-  return v;
-}
-
-// a body name as ExternalLoads write it: "name", "/bodyset/name" or "/name"
-std::string bodyName(std::string n) {
-  if (n.rfind("/bodyset/", 0) == 0) n = n.substr(9);
-  if (!n.empty() && n[0] == '/') n = n.substr(1);
-  return n;
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -289,43 +276,8 @@ void InverseDynamicsTool::prepareLoads() {
   checkExternalLoads(el, description_);
   for (const auto& w : el.warnings) warnings_.push_back(config_.external_loads_file + ": " + w);
 
-  auto coreBody = [&](const std::string& name, int line) -> int {
-    const std::string n = bodyName(name);
-    if (n == description_.ground_name) return -1;
-    const int bi = description_.findBody(n);
-    const int core = bi >= 0 ? build_->body_index[bi] : -1;
-    if (core < 0)
-      throw ConvertError(config_.external_loads_file, line,
-                         "body " + quoted(name) + " is not part of the core model");
-    return core;
-  };
+  loads_ = makeLoadSources(el, description_, build_->body_index, warnings_);
   const Storage& data = el.data;
-  for (const ExternalForceDesc& f : el.forces) {
-    if (!f.applies_force) continue;
-    IdLoadSource src;
-    src.name = f.name;
-    src.frame.body = coreBody(f.applied_to_body, f.line);
-    if (src.frame.body < 0) {
-      warnings_.push_back("ExternalForce " + quoted(f.name) + " is applied to ground: it has no effect");
-      continue;
-    }
-    src.frame.force_frame = coreBody(f.force_expressed_in_body, f.line);
-    src.frame.point_frame = coreBody(f.point_expressed_in_body, f.line);
-    src.frame.has_force = f.hasForce();
-    src.frame.has_point = f.hasForce() && f.hasPoint();
-    src.frame.has_torque = f.hasTorque();
-    try {
-      for (int k = 0; k < 3; ++k) {
-        if (f.hasForce()) src.force[k] = signal::LoadInterpolant(data.time, columnOf(data.data, f.force_columns[k]));
-        if (f.hasPoint()) src.point[k] = signal::LoadInterpolant(data.time, columnOf(data.data, f.point_columns[k]));
-        if (f.hasTorque())
-          src.torque[k] = signal::LoadInterpolant(data.time, columnOf(data.data, f.torque_columns[k]));
-      }
-    } catch (const signal::SignalError& e) {
-      throw ConvertError(el.datafile_path, 0, "ExternalForce " + quoted(f.name) + ": " + e.what());
-    }
-    loads_.push_back(std::move(src));
-  }
   // (accumulated resampling times may step a rounding error outside, e.g. -5e-7 s in set F)
   constexpr double kSlack = 1e-6;
   if (!data.time.empty() && numFrames() > 0 &&
@@ -364,16 +316,7 @@ void InverseDynamicsTool::calcInputs(double t, VecX& q, VecX& v, VecX& vdot,
     v[k] = d[1];
     vdot[k] = d[2];
   }
-  loads.clear();
-  for (const IdLoadSource& src : loads_) {
-    IdLoadSample l = src.frame;
-    for (int k = 0; k < 3; ++k) {
-      if (l.has_force) l.force[k] = src.force[k].calcValue(t);
-      if (l.has_point) l.point[k] = src.point[k].calcValue(t);
-      if (l.has_torque) l.torque[k] = src.torque[k].calcValue(t);
-    }
-    loads.push_back(l);
-  }
+  sampleLoads(loads_, t, loads);
 }
 
 Storage InverseDynamicsTool::run(IdEngine& engine, const std::function<void(int, int)>& progress) const {

@@ -91,12 +91,8 @@ struct IdCoordinateSource {
   bool converted = false; ///< the column was multiplied by pi/180 (degrees file, Rotational)
 };
 
-/// One ExternalForce, ready to sample.
-struct IdLoadSource {
-  std::string name;
-  IdLoadSample frame;  ///< bodies and flags (values are filled per sample)
-  std::array<signal::LoadInterpolant, 3> force, point, torque;
-};
+/// One ExternalForce, ready to sample (converter/external_loads.hpp).
+using IdLoadSource = LoadSource;
 
 class InverseDynamicsTool {
  public:

@@ -35,6 +35,14 @@ struct ExternalLoads {
   }
 };
 
+/// add the generalized force of a wrench on `body` (body frame: torque then force through the
+/// origin) to f, J_mr^T w [D Eq. 3.14]; nothing for the world (body < 0). Needs Stage::Position.
+void addBodyWrench(const Model& model, const SkeletonWorkspace& ws, int body, const Vec6& wrench_i, VecX& f);
+/// the same for a world force at a body point (body frame) and for a pure world torque
+void addPointForce(const Model& model, const SkeletonWorkspace& ws, int body, const Vec3& point_i,
+                   const Vec3& force_w, VecX& f);
+void addBodyTorque(const Model& model, const SkeletonWorkspace& ws, int body, const Vec3& torque_w, VecX& f);
+
 /// add the generalized force of `loads` to f (nr or more entries; needs Stage::Position)
 void addExternalLoads(const Model& model, const SkeletonWorkspace& ws, const ExternalLoads& loads, VecX& f);
 /// potential of constant world forces: -sum f_w . x_w (torques have no potential in general;

@@ -1,7 +1,8 @@
 // `redmax forward` and `redmax simulate --controls` end to end: a ForwardTool setup on the
 // double pendulum with CoordinateActuators driven by a ControlSet (states and controls written
 // under OpenSim 4 names, results_directory and --out-dir), and bad input (exit 2, an `error:` line
-// naming the file, nothing written).
+// naming the file, nothing written); force_set_files (PointActuator, TorqueActuator,
+// CoordinateLimitForce, PointToPointSpring), replace_force_set and external_loads_file.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -125,6 +126,113 @@ TEST_F(ForwardCli, BadInputExitsTwoAndWritesNothing) {
     EXPECT_FALSE(fs::exists(dir_ / "res")) << c.what;
     EXPECT_FALSE(fs::exists(dir_ / "x.sto")) << c.what;
   }
+}
+
+// a ForceSet file for the double pendulum (rod1, rod2; q1, q2)
+std::string forceSet(const std::string& objects) {
+  return "<OpenSimDocument Version=\"40000\">\n<ForceSet name=\"extra\">\n<objects>\n" + objects +
+         "</objects>\n</ForceSet>\n</OpenSimDocument>\n";
+}
+
+const char* kPushActuator =
+    "<PointActuator name=\"push\">\n<body>rod2</body>\n<point>0 0.1 0</point>\n<point_is_global>false</point_is_global>\n"
+    "<direction>3 0 4</direction>\n<force_is_global>true</force_is_global>\n<optimal_force>5</optimal_force>\n"
+    "</PointActuator>\n";
+
+// An external load and a PointActuator that apply the same force give the same motion: the
+// ExternalLoads path (sampled in time) and force_set_files' PointActuator check each other.
+TEST_F(ForwardCli, ForceSetPointActuatorEqualsTheSameExternalLoad) {
+  write("push.xml", "<ControlSet><objects><ControlLinear name=\"push\"><x_nodes>\n"
+                    "<ControlLinearNode><t>0</t><value>1</value></ControlLinearNode>\n"
+                    "<ControlLinearNode><t>1</t><value>1</value></ControlLinearNode>\n"
+                    "</x_nodes></ControlLinear></objects></ControlSet>\n");
+  write("fs.xml", forceSet(kPushActuator));
+  // F = 5 (0.6, 0, 0.8) N, in ground, at rod2's station (0, 0.1, 0), every time
+  write("grf.mot", "grf\nversion=1\nnRows=2\nnColumns=7\ninDegrees=no\nendheader\n"
+                   "time\tf_vx\tf_vy\tf_vz\tp_px\tp_py\tp_pz\n"
+                   "0\t3\t0\t4\t0\t0.1\t0\n1\t3\t0\t4\t0\t0.1\t0\n");
+  write("loads.xml", "<OpenSimDocument Version=\"40000\"><ExternalLoads name=\"l\"><objects>\n"
+                     "<ExternalForce name=\"f\"><applied_to_body>rod2</applied_to_body>\n"
+                     "<force_expressed_in_body>ground</force_expressed_in_body>\n"
+                     "<point_expressed_in_body>rod2</point_expressed_in_body>\n"
+                     "<force_identifier>f_v</force_identifier><point_identifier>p_p</point_identifier>\n"
+                     "</ExternalForce></objects><datafile>grf.mot</datafile></ExternalLoads></OpenSimDocument>\n");
+  const std::string with_actuator = setup("<force_set_files>fs.xml</force_set_files>\n", "push.xml", "a.xml");
+  const std::string with_loads = setup("<external_loads_file>loads.xml</external_loads_file>\n", "push.xml", "b.xml");
+  ASSERT_EQ(runRedmax(dir_, "forward --quiet --setup " + with_actuator + " --out-dir " + (dir_ / "a").string()).code, 0);
+  const CmdResult rb = runRedmax(dir_, "forward --setup " + with_loads + " --out-dir " + (dir_ / "b").string());
+  ASSERT_EQ(rb.code, 0) << rb.err;
+  const Storage a = readStorage((dir_ / "a" / "pend_states.sto").string());
+  const Storage b = readStorage((dir_ / "b" / "pend_states.sto").string());
+  const Storage c = readStorage((dir_ / "a" / "pend_controls.sto").string());
+  EXPECT_EQ(c.labels, (std::vector<std::string>{"Torq1", "Torq2", "push"}));
+  ASSERT_EQ(a.numRows(), b.numRows());
+  double worst = 0.0;
+  for (int r = 0; r < a.numRows(); ++r)
+    for (int j = 0; j < 4; ++j) worst = std::max(worst, std::abs(a.data(r, j) - b.data(r, j)));
+  EXPECT_LT(worst, 1e-6);  // the same right-hand side: measured 0 (bitwise)
+  // and the force does something: the run without it differs
+  ASSERT_EQ(runRedmax(dir_, "forward --quiet --setup " + setup("", "push.xml", "c.xml") + " --out-dir " + (dir_ / "c").string()).code, 0);
+  const Storage n = readStorage((dir_ / "c" / "pend_states.sto").string());
+  EXPECT_GT(std::abs(n.data(n.numRows() - 1, 0) - a.data(a.numRows() - 1, 0)), 1e-3);
+}
+
+TEST_F(ForwardCli, ReplaceForceSetKeepsOnlyTheFilesForces) {
+  writeControls();
+  write("fs.xml", forceSet(std::string(kPushActuator) +
+                           "<TorqueActuator name=\"twist\"><bodyA>rod1</bodyA><bodyB>ground</bodyB>\n"
+                           "<axis>0 0 1</axis><torque_is_global>true</torque_is_global><optimal_force>2</optimal_force></TorqueActuator>\n"
+                           "<CoordinateLimitForce name=\"lim\"><coordinate>q2</coordinate><upper_stiffness>1</upper_stiffness>\n"
+                           "<upper_limit>10</upper_limit><lower_stiffness>1</lower_stiffness><lower_limit>-10</lower_limit>\n"
+                           "<damping>0.01</damping><transition>5</transition></CoordinateLimitForce>\n"
+                           "<PointToPointSpring name=\"spr\"><socket_body1>/ground</socket_body1><socket_body2>/bodyset/rod2</socket_body2>\n"
+                           "<point1>0 0 0</point1><point2>0 0 0</point2><stiffness>10</stiffness><rest_length>0.5</rest_length></PointToPointSpring>\n"));
+  const std::string s = setup("<replace_force_set>true</replace_force_set>\n<force_set_files>fs.xml</force_set_files>\n");
+  const CmdResult r = runRedmax(dir_, "forward --setup " + s);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Storage c = readStorage((dir_ / "res" / "pend_controls.sto").string());
+  EXPECT_EQ(c.labels, (std::vector<std::string>{"push", "twist"}));
+  // the controls file's Torq1, Torq2 drive nothing now: named
+  EXPECT_NE(r.err.find("Torq1"), std::string::npos) << r.err;
+}
+
+TEST_F(ForwardCli, BadForceSetFilesExitTwoWithFileAndLine) {
+  writeControls();
+  struct Case {
+    const char* what;
+    std::string objects;
+    std::string expect;
+  };
+  const Case cases[] = {
+      {"unknown body", "<PointActuator name=\"p\">\n<body>femur</body>\n</PointActuator>\n", "bad.xml:5:"},
+      {"zero direction", "<PointActuator name=\"p\"><body>rod1</body>\n<direction>0 0 0</direction>\n</PointActuator>\n",
+       "bad.xml:5:"},
+      {"zero axis", "<TorqueActuator name=\"t\"><bodyA>rod1</bodyA><bodyB>ground</bodyB>\n<axis>0 0 0</axis>\n</TorqueActuator>\n",
+       "bad.xml:5:"},
+      {"unknown torque body", "<TorqueActuator name=\"t\">\n<bodyA>nope</bodyA><bodyB>ground</bodyB></TorqueActuator>\n",
+       "bad.xml:5:"},
+      {"negative stiffness", "<CoordinateLimitForce name=\"l\"><coordinate>q2</coordinate>\n<upper_stiffness>-3</upper_stiffness>\n"
+                             "</CoordinateLimitForce>\n", "bad.xml:5:"},
+      {"unknown coordinate", "<SpringGeneralizedForce name=\"g\">\n<coordinate>q9</coordinate></SpringGeneralizedForce>\n",
+       "bad.xml:5:"},
+      {"spring on one body", "<PointToPointSpring name=\"s\"><socket_body1>/bodyset/rod1</socket_body1>\n"
+                             "<socket_body2>/bodyset/rod1</socket_body2></PointToPointSpring>\n", "bad.xml:4:"},
+  };
+  for (const Case& c : cases) {
+    write("bad.xml", forceSet(c.objects));
+    fs::remove_all(dir_ / "res");
+    const CmdResult r = runRedmax(dir_, "forward --setup " + setup("<force_set_files>bad.xml</force_set_files>\n", "controls.xml", "sb.xml"));
+    EXPECT_EQ(r.code, 2) << c.what << ": " << r.err;
+    EXPECT_NE(r.err.find("error: "), std::string::npos) << c.what << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.what << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "res")) << c.what;
+  }
+  // a force_set_files file that does not exist
+  const CmdResult r = runRedmax(dir_, "forward --setup " + setup("<force_set_files>absent_fs.xml</force_set_files>\n", "controls.xml", "sm.xml"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("error: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("absent_fs.xml"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "res"));
 }
 
 }  // namespace

@@ -7,9 +7,12 @@
 #include <set>
 #include <sstream>
 
+#include "converter/build/force_terms.hpp"
+#include "converter/external_loads.hpp"
 #include "converter/build/functions_to_core.hpp"
+#include "converter/osim_reader.hpp"
+#include "core/dynamics/sampled_loads.hpp"
 #include "core/dynamics/controller.hpp"
-#include "core/dynamics/coordinate_actuator_term.hpp"
 #include "core/dynamics/muscle_force_term.hpp"
 #include "core/muscles/hill/muscle_model.hpp"
 
@@ -96,12 +99,19 @@ void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vect
   }
 }
 
-void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings) {
+void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces) {
   auto sys = std::make_shared<System>(*m.system);
   const MusculoskeletalModel& model = m.build.model;
-  const auto models = muscleModelsOf(model);
+  auto models = muscleModelsOf(model);
   bool any = false;
   for (size_t k = 0; k < models.size(); ++k) {
+    // without the model's own forces (replace_force_set) only the muscles of force_set_files pull
+    const int src = k < m.build.muscle_source.size() ? m.build.muscle_source[k] : -1;
+    const bool from_file = src >= 0 && !m.description.muscles[static_cast<size_t>(src)].source_file.empty();
+    if (!model_forces && !from_file) {
+      models[k] = nullptr;
+      continue;
+    }
     if (models[k]) {
       any = true;
       continue;
@@ -111,26 +121,14 @@ void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings) {
                        "): no force model, it exerts no force");
   }
   if (any) sys->addTerm(std::make_shared<MuscleForceTerm>(model.skeleton(), model.muscles(), models));
-  // CoordinateActuators; the other actuator classes are listed as not modelled
-  std::vector<CoordinateActuatorTerm::Actuator> acts;
-  for (const osim::ForceDesc& f : m.description.forces) {
-    if (!f.applies_force) continue;
-    if (f.class_name == "CoordinateActuator") {
-      int index = -1;
-      for (size_t k = 0; k < m.description.coordinates.size(); ++k)
-        if (m.description.coordinates[k].name == f.coordinate && k < m.build.coordinate_index.size())
-          index = m.build.coordinate_index[k];
-      if (index < 0) {
-        warnings.push_back("CoordinateActuator '" + f.name + "': coordinate '" + f.coordinate +
-                           "' is not in the built model; ignored");
-        continue;
-      }
-      acts.push_back({f.name, index, f.optimal_force});
-    } else if (f.class_name.find("Actuator") != std::string::npos) {
+  // the actuators and passive forces (converter/build/force_terms.hpp); other classes are named
+  auto include = [&](const osim::ForceDesc& f) { return f.applies_force && (model_forces || !f.source_file.empty()); };
+  const osim::ForceTermSet terms = osim::buildForceTerms(m.description, m.build, warnings, include);
+  for (const auto& t : terms.actuatorTerms()) sys->addTerm(t);
+  for (const auto& t : terms.passiveTerms()) sys->addTerm(t);
+  for (const osim::ForceDesc& f : m.description.forces)
+    if (include(f) && !f.modelled)
       warnings.push_back(f.class_name + " '" + f.name + "' is not modelled in forward simulation; ignored");
-    }
-  }
-  if (!acts.empty()) sys->addTerm(std::make_shared<CoordinateActuatorTerm>(model.skeleton(), std::move(acts)));
   m.system = sys;
 }
 
@@ -236,15 +234,22 @@ ForwardTool::ForwardTool(ForwardToolSettings settings) : settings_(std::move(set
   warnings_ = setup_.warnings;
   const std::string& sf = setup_.source_file;
   if (setup_.model_file.empty()) throw osim::ConvertError(sf, 0, "the setup names no model_file");
-  if (!setup_.force_set_files.empty())
-    throw osim::ConvertError(sf, 0, "force_set_files are not supported yet (docs/forward.md)");
-  if (!setup_.external_loads_file.empty())
-    throw osim::ConvertError(sf, 0, "external_loads_file is not supported yet in forward simulation (docs/forward.md)");
   if (!(settings_.report_interval > 0.0) || !std::isfinite(settings_.report_interval))
     throw std::invalid_argument("the report interval must be positive");
   SimulationModelOptions mo;
   mo.muscle_mass = settings_.muscle_mass;
-  model_ = loadSimulationModel(setup_.model_file, mo);
+  // the model, then force_set_files appended (OpenSim's ForwardTool::loadModel + updateModelForces);
+  // replace_force_set drops the model's own forces
+  osim::ModelDescription d = osim::readOsimModel(setup_.model_file);
+  if (setup_.replace_force_set)
+    for (osim::ForceDesc& f : d.forces) f.applies_force = false;
+  for (const std::string& file : setup_.force_set_files) osim::appendForceSetFile(d, file);
+  for (const osim::UnsupportedItem& u : d.unsupported)
+    if (u.what.rfind("force ", 0) == 0)  // the model's (force_set_files entries name their file)
+      warnings_.push_back(setup_.model_file + ":" + std::to_string(u.line) + ": " + u.what + "; ignored");
+    else if (u.what.find(": force '") != std::string::npos)
+      warnings_.push_back(u.what + "; ignored");
+  model_ = makeSimulationModel(d, mo);
   for (const std::string& w : model_.build.warnings) warnings_.push_back(w);
   if (!settings_.muscle_class.empty()) {
     // OpenSim's Object::renameType on every muscle: the models follow the class
@@ -252,8 +257,22 @@ ForwardTool::ForwardTool(ForwardToolSettings settings) : settings_(std::move(set
     b.overrideMuscleClass(settings_.muscle_class);
     model_.build.model = b.finalize();
   }
-  // replace_force_set without force_set_files leaves the model without forces (OpenSim)
-  if (!setup_.replace_force_set) addActuatorTerms(model_, warnings_);
+  // replace_force_set: only the forces of force_set_files act (OpenSim)
+  addActuatorTerms(model_, warnings_, !setup_.replace_force_set);
+  if (!setup_.external_loads_file.empty()) {
+    // OpenSim's ExternalLoads, the data looked up from the setup's folder first (as the ID tool)
+    osim::ExternalLoads el = osim::readExternalLoads(setup_.external_loads_file, setup_.directory);
+    osim::checkExternalLoads(el, model_.description);
+    for (const auto& w : el.warnings) warnings_.push_back(setup_.external_loads_file + ": " + w);
+    auto sources = std::make_shared<const std::vector<osim::LoadSource>>(
+        osim::makeLoadSources(el, model_.description, model_.build.body_index, warnings_));
+    if (!sources->empty()) {
+      auto sys = std::make_shared<System>(*model_.system);
+      sys->addTerm(std::make_shared<SampledLoadsTerm>(
+          [sources](double t, std::vector<IdLoadSample>& loads) { osim::sampleLoads(*sources, t, loads); }));
+      model_.system = sys;
+    }
+  }
   System& sys = *model_.system;
   addSetupControllers(sys, setup_, warnings_);
   if (!setup_.controls_file.empty()) addControlsFile(sys, setup_.controls_file, warnings_);

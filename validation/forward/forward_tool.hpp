@@ -38,10 +38,13 @@ void addControlsFile(System& sys, const std::string& file, std::vector<std::stri
 /// file, a function that cannot be evaluated, more functions than actuators).
 void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vector<std::string>& warnings);
 
-/// The muscles' force terms and actuators of a loaded model, added to its system: MuscleForceTerm
-/// over the muscles that have a muscle model, CoordinateActuatorTerm over the model's
-/// CoordinateActuators. Unsupported actuators go to warnings.
-void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings);
+/// The muscles' force terms, actuators and passive forces of a loaded model, added to its
+/// system: MuscleForceTerm over the muscles that have a muscle model, then the ForceSet's
+/// CoordinateActuators, PointActuators, TorqueActuators (controls in that order), then its
+/// CoordinateLimitForces, SpringGeneralizedForces and PointToPointSprings
+/// (converter/build/force_terms.hpp). model_forces false (replace_force_set): only the forces
+/// that came from force_set_files. Forces whose class is not modelled go to warnings.
+void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces = true);
 
 /// A state of m's system from a states table: the closest row at or before `time` (the first row
 /// when none is), every coordinate, speed and auxiliary state the table names (OpenSim 4 paths or

@@ -1,0 +1,128 @@
+// The ForceSet's actuators and passive forces read from .osim and built as core terms
+// (converter/osim_forces.cpp, converter/build/force_terms.hpp): OpenSim's property names and
+// defaults, CoordinateLimitForce's degrees, frames resolved to their base bodies, and bad values
+// refused at their line.
+#include "converter/build/force_terms.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "converter/osim_reader.hpp"
+#include "tests/converter/converter_test_util.hpp"
+
+namespace redmax::osim {
+namespace {
+
+std::string twoBodies(const std::string& forces) {
+  const std::string bodies = test::bodyXml("a") + test::bodyXml("b");
+  const std::string joints =
+      test::pinXml("pa", "/ground", "/bodyset/a", "qa") +
+      "<SliderJoint name=\"sb\"><socket_parent_frame>/bodyset/a</socket_parent_frame>"
+      "<socket_child_frame>/bodyset/b</socket_child_frame><coordinates><Coordinate name=\"xb\"/></coordinates>"
+      "<frames><PhysicalOffsetFrame name=\"b_off\"><socket_parent>/bodyset/b</socket_parent>"
+      "<translation>0 0.5 0</translation><orientation>0 0 1.5707963267948966</orientation></PhysicalOffsetFrame>"
+      "</frames></SliderJoint>\n";
+  return test::modernOsim(bodies, joints, "<ForceSet><objects>\n" + forces + "</objects></ForceSet>\n");
+}
+
+TEST(ForceTerms, ReadAndBuiltWithOpenSimsDefaultsAndUnits) {
+  test::TempDir dir;
+  const std::string path = dir.write(
+      "m.osim",
+      twoBodies("<CoordinateLimitForce name=\"lim_rot\"><coordinate>qa</coordinate><upper_stiffness>2</upper_stiffness>"
+                "<upper_limit>30</upper_limit><lower_limit>-45</lower_limit></CoordinateLimitForce>\n"
+                "<CoordinateLimitForce name=\"lim_slide\"><coordinate>xb</coordinate><upper_limit>0.2</upper_limit>"
+                "</CoordinateLimitForce>\n"
+                "<PointActuator name=\"p\"><body>b</body></PointActuator>\n"
+                "<TorqueActuator name=\"t\"><bodyA>/jointset/sb/b_off</bodyA><bodyB>ground</bodyB>"
+                "<axis>1 0 0</axis><torque_is_global>false</torque_is_global></TorqueActuator>\n"
+                "<SpringGeneralizedForce name=\"g\"><coordinate>qa</coordinate><stiffness>3</stiffness></SpringGeneralizedForce>\n"
+                "<PointToPointSpring name=\"s\"><socket_body1>/ground</socket_body1><socket_body2>/jointset/sb/b_off</socket_body2>"
+                "<point2>0 1 0</point2></PointToPointSpring>\n"
+                "<BushingForce name=\"bush\"><socket_frame1>a_off</socket_frame1><socket_frame2>/bodyset/b</socket_frame2>"
+                "<rotational_stiffness>1 2 3</rotational_stiffness><translational_damping>4 5 6</translational_damping>"
+                "<frames><PhysicalOffsetFrame name=\"a_off\"><socket_parent>/bodyset/a</socket_parent>"
+                "<translation>0.1 0.2 0.3</translation></PhysicalOffsetFrame></frames></BushingForce>\n"
+                "<ExpressionBasedCoordinateForce name=\"expr\"/>\n"));
+  const ModelDescription d = readOsimModel(path);
+  BuildOptions bo;
+  const BuildResult b = buildCoreModel(d, bo);
+  std::vector<std::string> warnings;
+  const ForceTermSet set = buildForceTerms(d, b, warnings);
+  EXPECT_TRUE(warnings.empty());
+  // CoordinateLimitForce: OpenSim's defaults (stiffness 1, damping 0.001, transition 0.1), and
+  // degrees for a rotational coordinate, SI for a translational one
+  ASSERT_TRUE(set.limit_forces);
+  const auto& lr = set.limit_forces->limits()[0];
+  const double w = M_PI / 180.0;
+  EXPECT_DOUBLE_EQ(lr.upper_limit, 30 * w);
+  EXPECT_DOUBLE_EQ(lr.lower_limit, -45 * w);
+  EXPECT_DOUBLE_EQ(lr.upper_stiffness, 2 / w);
+  EXPECT_DOUBLE_EQ(lr.lower_stiffness, 1 / w);
+  EXPECT_DOUBLE_EQ(lr.damping, 0.001 / w);
+  EXPECT_DOUBLE_EQ(lr.transition, 0.1 * w);
+  const auto& ls = set.limit_forces->limits()[1];
+  EXPECT_EQ(ls.upper_limit, 0.2);
+  EXPECT_EQ(ls.upper_stiffness, 1.0);
+  EXPECT_EQ(ls.transition, 0.1);
+  // PointActuator: point 0, direction (1, 0, 0), both in the body, optimal force 1
+  ASSERT_TRUE(set.point_actuators);
+  const auto& p = set.point_actuators->actuators()[0];
+  EXPECT_EQ(p.direction, Vec3::UnitX());
+  EXPECT_FALSE(p.point_is_global || p.force_is_global);
+  EXPECT_EQ(p.optimal_force, 1.0);
+  // TorqueActuator on an offset frame: its base body, the axis re-expressed there (frame turned
+  // 90 deg about z: x -> y); bodyB ground
+  ASSERT_TRUE(set.torque_actuators);
+  const auto& t = set.torque_actuators->actuators()[0];
+  EXPECT_EQ(t.body_a, b.body_index[static_cast<size_t>(d.findBody("b"))]);
+  EXPECT_EQ(t.body_b, -1);
+  EXPECT_NEAR((t.axis - Vec3::UnitY()).norm(), 0.0, 1e-15);
+  EXPECT_EQ(set.actuatorTerms().size(), 2u);
+  EXPECT_EQ(set.generalized_springs->springs()[0].stiffness, 3.0);
+  // PointToPointSpring: the frame's base body; stiffness 1 by default
+  const auto& s = set.point_springs->springs()[0];
+  EXPECT_EQ(s.body1, -1);
+  EXPECT_EQ(s.body2, t.body_a);
+  EXPECT_EQ(s.stiffness, 1.0);
+  // BushingForce: its own offset frame on body a, OpenSim's property order (rotational first)
+  ASSERT_TRUE(set.bushings);
+  const auto& bu = set.bushings->bushings()[0];
+  EXPECT_EQ(bu.body1, b.body_index[static_cast<size_t>(d.findBody("a"))]);
+  EXPECT_EQ(bu.body2, t.body_a);
+  EXPECT_EQ(Vec3(bu.X_1F.topRightCorner<3, 1>()), Vec3(0.1, 0.2, 0.3));
+  EXPECT_EQ(bu.stiffness, (Vec6() << 1, 2, 3, 0, 0, 0).finished());
+  EXPECT_EQ(bu.damping, (Vec6() << 0, 0, 0, 4, 5, 6).finished());
+  EXPECT_EQ(set.passiveTerms().size(), 4u);
+  // a class redmax does not model is listed
+  bool listed = false;
+  for (const auto& u : d.unsupported) listed = listed || u.what.find("'expr' (ExpressionBasedCoordinateForce)") != std::string::npos;
+  EXPECT_TRUE(listed);
+}
+
+TEST(ForceTerms, BadValuesAreErrorsAtTheirLine) {
+  test::expectReadError(twoBodies("<PointActuator name=\"p\">\n<body>c</body>\n</PointActuator>\n"), "<body>c</body>",
+                        "body 'c' is not a body");
+  test::expectReadError(twoBodies("<PointActuator name=\"p\"><body>a</body>\n<direction>0 0 0</direction>\n</PointActuator>\n"),
+                        "<direction>0 0 0", "direction must be a non-zero vector");
+  test::expectReadError(
+      twoBodies("<CoordinateLimitForce name=\"l\"><coordinate>qa</coordinate>\n<damping>-1</damping>\n</CoordinateLimitForce>\n"),
+      "<damping>-1", "damping must be finite and >= 0");
+  test::expectReadError(
+      twoBodies("<CoordinateLimitForce name=\"l\"><coordinate>qa</coordinate>\n<transition>0</transition>\n</CoordinateLimitForce>\n"),
+      "<transition>0", "transition must be positive");
+  test::expectReadError(twoBodies("<SpringGeneralizedForce name=\"g\">\n<coordinate>zz</coordinate>\n</SpringGeneralizedForce>\n"),
+                        "<coordinate>zz", "coordinate 'zz' is not a coordinate");
+  test::expectReadError(
+      twoBodies("<PointToPointSpring name=\"s\"><socket_body1>/ground</socket_body1>\n<socket_body2>/bodyset/nope</socket_body2>\n"
+                "</PointToPointSpring>\n"),
+      "<socket_body2>/bodyset/nope", "does not name a frame");
+  test::expectReadError(
+      twoBodies("<PointToPointSpring name=\"s\"><socket_body1>/ground</socket_body1><socket_body2>/bodyset/a</socket_body2>\n"
+                "<stiffness>-5</stiffness>\n</PointToPointSpring>\n"),
+      "<stiffness>-5", "stiffness must be finite and >= 0");
+}
+
+}  // namespace
+}  // namespace redmax::osim
