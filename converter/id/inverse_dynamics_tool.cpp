@@ -215,7 +215,7 @@ void InverseDynamicsTool::checkForces() {
 
 void InverseDynamicsTool::prepareCoordinates() {
   const std::string& file = config_.coordinates_file;
-  coordinates_ = readStorage(file);
+  coordinates_ = config_.coordinates_table ? *config_.coordinates_table : readStorage(file);
   for (const auto& w : coordinates_.warnings) warnings_.push_back(file + ": " + w);
   if (coordinates_.numRows() == 0) throw ConvertError(file, 0, "the coordinates file has no rows");
 
