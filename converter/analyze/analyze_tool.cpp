@@ -407,6 +407,7 @@ double AnalyzeTool::muscleMass() const { return impl_->engine->muscleMass(); }
 std::string AnalyzeTool::muscleMassSummary() const { return describeMuscleMass(impl_->id->muscleMassPlan()); }
 
 StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
+  if (!runsStaticOptimization()) return {};
   const Impl& I = *impl_;
   const StaticOptimizationSettings& so = setup_.static_optimization;
   const Model& skel = I.id->model();

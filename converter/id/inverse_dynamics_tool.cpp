@@ -249,7 +249,7 @@ void InverseDynamicsTool::prepareCoordinates() {
   // OpenSim would solve with every coordinate at its default; that is almost surely not what the
   // user meant, so it is an input error here
   if (used.empty())
-    throw ConvertError(file, 0, "none of the model's " + std::to_string(m.nr()) +
+    throw ConvertError(file, coordinates_.label_line, "none of the model's " + std::to_string(m.nr()) +
                                     " coordinates is a column of this file (columns: " +
                                     joinNames(coordinates_.labels) + ")" +
                                     (path_labels.empty() ? std::string()

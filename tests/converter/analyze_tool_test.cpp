@@ -269,7 +269,7 @@ TEST(AnalyzeTool, BadInputIsNamed) {
   // a coordinates file without the model's coordinate: FILE:LINE of its column labels
   dir.write("q.mot", constantMotion("other"));
   const std::string no_column = message(setupXml(staticOptimizationXml()));
-  EXPECT_NE(no_column.find("q.mot:7: no column for coordinate(s) q"), std::string::npos) << no_column;
+  EXPECT_NE(no_column.find("q.mot:7: none of the model's 1 coordinates is a column"), std::string::npos) << no_column;
   dir.write("q.mot", constantMotion());
   // min_control above max_control
   dir.write("m.osim", pendulumModel("<min_control>0.5</min_control><max_control>0.2</max_control>"));
