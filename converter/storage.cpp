@@ -148,6 +148,7 @@ Storage readStorage(const std::string& path) {
     if (li >= lines.size())
       throw ConvertError(path, static_cast<int>(li), "no column labels after endheader");
     const int label_line = static_cast<int>(li + 1);
+    s.label_line = label_line;
     std::vector<std::string> labels = splitAny(lines[li], " \t\r\n");
     ++li;
     if (nc >= 1 && static_cast<int>(labels.size()) != nc)
@@ -228,6 +229,7 @@ Storage readStorage(const std::string& path) {
     if (li >= lines.size())
       throw ConvertError(path, static_cast<int>(li), "no column labels after endheader");
     const int label_line = static_cast<int>(li + 1);
+    s.label_line = label_line;
     std::vector<std::string> labels = splitAny(lines[li], "\t");
     for (auto& l : labels) l = trimWs(l);
     if (labels.size() == 1) labels = splitAny(lines[li], " \t");

@@ -23,6 +23,7 @@ struct Storage {
   /// as (key, value) pairs in file order (e.g. SIMM "range", "DataType", description lines)
   std::vector<std::pair<std::string, std::string>> header;
   std::vector<std::string> warnings;  ///< tolerated oddities (OpenSim only warns on these)
+  int label_line = 0;                 ///< the file's line of column labels (0: not read from a file)
 
   int numRows() const { return static_cast<int>(time.size()); }
   int numColumns() const { return static_cast<int>(labels.size()); }

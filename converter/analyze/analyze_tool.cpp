@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "converter/analyze/states_file.hpp"
 #include "converter/analyze/static_optimization.hpp"
 #include "converter/atomic_file.hpp"
 #include "converter/build/build_core_model.hpp"
@@ -115,6 +116,28 @@ AnalyzeSetup readAnalyzeSetup(const std::string& path) {
         doc.fail(firstChild(a, "optimizer_max_iterations"), "optimizer_max_iterations must be >= 1");
       so.use_model_force_set = childBool(doc, a, "use_model_force_set", true);
     }
+    if ((e.class_name == "MuscleAnalysis" || e.class_name == "Actuation") && e.on) {
+      const bool ma = e.class_name == "MuscleAnalysis";
+      if (ma ? s.muscle_analysis.present : s.actuation.present)
+        doc.fail(a, "a second " + e.class_name + " that is on: redmax runs one");
+      int step = 1;
+      if (const XMLElement* c = firstChild(a, "step_interval"); c && !textOf(c).empty()) step = parseInt(doc, c);
+      if (step < 1) doc.fail(firstChild(a, "step_interval"), "step_interval must be >= 1");
+      if (ma) {
+        MuscleAnalysisSettings& m = s.muscle_analysis;
+        m.present = true;
+        m.name = e.name;
+        m.line = e.line;
+        m.step_interval = step;
+        if (const XMLElement* c = firstChild(a, "muscle_list"); c && !textOf(c).empty())
+          m.muscle_list = splitWords(textOf(c));
+        if (const XMLElement* c = firstChild(a, "moment_arm_coordinate_list"); c && !textOf(c).empty())
+          m.coordinate_list = splitWords(textOf(c));
+        m.compute_moments = childBool(doc, a, "compute_moments", true);
+      } else {
+        s.actuation = {true, e.name, step, e.line};
+      }
+    }
     s.analyses.push_back(e);
   }
   if (s.analyses.empty()) doc.fail(set ? set : el, "the AnalysisSet has no analyses (OpenSim refuses to run)");
@@ -164,6 +187,12 @@ struct AnalyzeTool::Impl {
   std::vector<MuscleKinematics> mk;             ///< columns each muscle's path depends on
   std::unique_ptr<MuscleForceTerm> force_term;  ///< the muscles with a force model, as forward applies them
   ForceTermSet forces;  ///< the force set's actuators (columns) and passive forces (moved into b)
+  std::unique_ptr<AnalyzeStatesFile> states;    ///< the states_file, when the setup gives one
+  std::vector<int> coordinate_desc;             ///< per core coordinate: its description index (-1: none)
+  std::vector<int> muscle_source;               ///< per geometry muscle: its description index
+  std::vector<int> coordinate_index;            ///< per description coordinate: its core index (-1: none)
+  MuscleAnalysisColumns ma_columns;             ///< MuscleAnalysis's muscles and coordinates
+  std::vector<ActuationColumn> act_columns;     ///< Actuation's actuators
 };
 
 AnalyzeTool::~AnalyzeTool() = default;
@@ -174,18 +203,18 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   const std::string& where = settings_.setup_file;
   out_dir_ = settings_.out_dir ? *settings_.out_dir : setup_.results_directory;
   for (const AnalysisEntry& a : setup_.analyses)
-    if (a.on && a.class_name != "StaticOptimization")
+    if (a.on && a.class_name != "StaticOptimization" && a.class_name != "MuscleAnalysis" &&
+        a.class_name != "Actuation")
       unsupported_.push_back(a.name + " (" + a.class_name + ")");
   const StaticOptimizationSettings& so = setup_.static_optimization;
-  if (!so.present)
+  if (!so.present && !runsMuscleAnalyses())
     throw ConvertError(where, 0,
-                       "no analysis redmax runs is on (redmax runs StaticOptimization" +
+                       "no analysis redmax runs is on (redmax runs StaticOptimization, MuscleAnalysis, Actuation" +
                            (unsupported_.empty() ? std::string(")")
                                                  : "; not supported: " + joinNames(unsupported_) + ")"));
   if (setup_.model_file.empty()) throw ConvertError(where, 0, "the setup names no model_file");
-  if (!setup_.states_file.empty())
-    throw ConvertError(where, 0, "states_file is not supported by redmax's analyze: give a coordinates_file");
-  if (setup_.coordinates_file.empty()) throw ConvertError(where, 0, "the setup names no coordinates_file");
+  if (setup_.states_file.empty() && setup_.coordinates_file.empty())
+    throw ConvertError(where, 0, "the setup names neither a states_file nor a coordinates_file");
 
   impl_ = std::make_unique<Impl>();
   Impl& I = *impl_;
@@ -193,9 +222,17 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   cfg.setup_file = where;
   cfg.model_file = setup_.model_file;
   cfg.coordinates_file = setup_.coordinates_file;
+  if (!setup_.states_file.empty()) {
+    // AnalyzeTool::loadStatesFromFile: the states file wins, unfiltered
+    I.states = std::make_unique<AnalyzeStatesFile>(setup_.states_file);
+    if (!setup_.coordinates_file.empty())
+      warnings_.push_back("coordinates_file is ignored since states_file is also set (as OpenSim does)");
+    cfg.coordinates_file = setup_.states_file;
+    cfg.coordinates_table = I.states->coordinatesTable();
+  }
   cfg.external_loads_file = setup_.external_loads_file;
   cfg.loads_working_dir = setup_.directory;
-  cfg.lowpass_cutoff_hz = setup_.lowpass_cutoff_frequency_for_coordinates;
+  cfg.lowpass_cutoff_hz = I.states ? -1.0 : setup_.lowpass_cutoff_frequency_for_coordinates;
   cfg.t0 = setup_.initial_time;
   cfg.t1 = setup_.final_time;
   cfg.opensim_compat = true;
@@ -267,6 +304,19 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   }
   I.geometry = std::move(built.model);
   const Model& skel = I.id->model();
+  auto coreCoordinate = [&](const std::string& name) {
+    const int ci = d.findCoordinate(name);
+    return ci >= 0 ? built.coordinate_index[ci] : -1;
+  };
+  for (int k = 0; k < skel.nr(); ++k) I.coordinate_desc.push_back(d.findCoordinate(skel.coordinates()[k].name));
+  I.muscle_source = built.muscle_source;
+  I.coordinate_index = built.coordinate_index;
+  if (I.states) I.states->bind(d, skel, I.coordinate_desc, I.geometry, warnings_);
+  I.mk.resize(I.geometry.muscles().size());
+  for (size_t m = 0; m < I.mk.size(); ++m) initMuscleKinematics(skel, I.geometry.muscles()[m], I.mk[m]);
+  I.force_term = std::make_unique<MuscleForceTerm>(skel, I.geometry.muscles(), I.geometry.muscleModels());
+  if (runsMuscleAnalyses()) prepareMuscleAnalyses();
+  if (!so.present) return;
 
   // the force set in OpenSim's order (the model's in file order, then force_set_files), those
   // with appliesForce false removed
@@ -351,7 +401,7 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
     if (sources[k].spline < 0) missing.push_back(skel.coordinates()[k].name);
   }
   if (!missing.empty())
-    throw ConvertError(setup_.coordinates_file, 0,
+    throw ConvertError(I.id->config().coordinates_file, I.id->coordinatesData().label_line,
                        "no column for coordinate(s) " + joinNames(missing) +
                            ", which static optimization must drive (OpenSim would use 0)");
   if (static_cast<int>(acts.size()) < static_cast<int>(I.rows.size()))
@@ -368,11 +418,9 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
     if (sources[k].spline < 0) continue;
     const auto& s = P.splines[static_cast<size_t>(sources[k].spline)];
     for (size_t r = 0; r < P.time.size(); ++r) u[r] = s.calcDerivative(1, P.time[r]);
+    if (I.states) u = I.states->speedColumn(k);  // the states' own u
     I.u_splines[static_cast<size_t>(k)] = signal::NaturalSpline(5, P.time, u);
   }
-  I.mk.resize(I.geometry.muscles().size());
-  for (size_t m = 0; m < I.mk.size(); ++m) initMuscleKinematics(skel, I.geometry.muscles()[m], I.mk[m]);
-  I.force_term = std::make_unique<MuscleForceTerm>(skel, I.geometry.muscles(), I.geometry.muscleModels());
 }
 
 double AnalyzeTool::muscleMass() const { return impl_->engine->muscleMass(); }
@@ -380,6 +428,7 @@ double AnalyzeTool::muscleMass() const { return impl_->engine->muscleMass(); }
 std::string AnalyzeTool::muscleMassSummary() const { return describeMuscleMass(impl_->id->muscleMassPlan()); }
 
 StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
+  if (!runsStaticOptimization()) return {};
   const Impl& I = *impl_;
   const StaticOptimizationSettings& so = setup_.static_optimization;
   const Model& skel = I.id->model();
@@ -427,6 +476,7 @@ StaticOptimizationRun AnalyzeTool::runStaticOptimization() const {
     fr.force = fr.activation;
     try {
       I.id->calcInputs(fr.time, q, v, vdot, loads);
+      if (I.states) I.states->stateAt(i, q, q, v);
       for (int k = 0; k < nr; ++k)
         vdot[k] = I.u_splines[static_cast<size_t>(k)].size() > 0
                       ? I.u_splines[static_cast<size_t>(k)].calcDerivative(1, fr.time)
@@ -570,6 +620,201 @@ std::vector<std::string> AnalyzeTool::writeStaticOptimization(const StaticOptimi
   writeStorage(a_path, act, wo);
   writeStorage(f_path, force, wo);
   return {a_path, f_path};
+}
+
+// ---------------------------------------------------------------------------------------------
+// MuscleAnalysis and Actuation
+
+void AnalyzeTool::prepareMuscleAnalyses() {
+  Impl& I = *impl_;
+  const ModelDescription& d = I.id->description();
+  std::vector<int> geometry_of(d.muscles.size(), -1);
+  for (size_t m = 0; m < I.muscle_source.size(); ++m) geometry_of[static_cast<size_t>(I.muscle_source[m])] = static_cast<int>(m);
+  // replace_force_set takes the model's forces away, muscles included (AbstractTool::updateModelForces)
+  const bool model_forces = !setup_.replace_force_set;
+
+  if (const MuscleAnalysisSettings& ma = setup_.muscle_analysis; ma.present) {
+    MuscleAnalysisColumns& c = I.ma_columns;
+    std::vector<int> muscles;  // the force set's Muscles, file order
+    if (model_forces)
+      for (size_t k = 0; k < d.muscles.size(); ++k)
+        if (d.muscles[k].is_muscle && geometry_of[k] >= 0) muscles.push_back(geometry_of[k]);
+    const bool all = ma.muscle_list.size() == 1 && ma.muscle_list[0] == "all";
+    std::vector<std::string> absent, no_model;
+    if (all) {
+      c.muscle_index = muscles;
+    } else {
+      for (const std::string& name : ma.muscle_list) {
+        int found = -1;
+        for (int m : muscles)
+          if (I.geometry.muscles()[static_cast<size_t>(m)].name == name) found = m;
+        if (found >= 0) c.muscle_index.push_back(found);
+        else absent.push_back(name);
+      }
+    }
+    for (int m : c.muscle_index) {
+      c.muscles.push_back(I.geometry.muscles()[static_cast<size_t>(m)].name);
+      if (!I.geometry.muscleModels()[static_cast<size_t>(m)]) no_model.push_back(c.muscles.back());
+    }
+    if (!absent.empty())
+      warnings_.push_back(ma.name + ": muscle_list names no muscle of the force set: " + joinNames(absent) +
+                          " (dropped, as OpenSim drops them)");
+    if (!no_model.empty())
+      warnings_.push_back(ma.name + ": no force model for " + joinNames(no_model) +
+                          ": lengths and moment arms only, the other quantities nan");
+    if (ma.compute_moments) {
+      if (!ma.coordinate_list.empty() && toLower(ma.coordinate_list[0]) == "all") {
+        for (size_t ci = 0; ci < d.coordinates.size(); ++ci)
+          if (I.coordinate_index[ci] >= 0) {
+            c.coordinates.push_back(d.coordinates[ci].name);
+            c.coordinate_index.push_back(I.coordinate_index[ci]);
+          }
+      } else {
+        std::vector<std::string> unknown;
+        for (const std::string& name : ma.coordinate_list) {
+          const int ci = d.findCoordinate(name);
+          const int k = ci >= 0 ? I.coordinate_index[static_cast<size_t>(ci)] : -1;
+          if (k < 0) {
+            unknown.push_back(name);
+            continue;
+          }
+          c.coordinates.push_back(name);
+          c.coordinate_index.push_back(k);
+        }
+        if (!unknown.empty())
+          warnings_.push_back(ma.name + ": moment_arm_coordinate_list: coordinate(s) " + joinNames(unknown) +
+                              " not part of the model (dropped, as OpenSim drops them)");
+      }
+      if (!d.constraints.empty())
+        warnings_.push_back(ma.name + ": moment arms are -dl/dq per coordinate; the model's constraints "
+                                      "(OpenSim's MomentArmSolver accounts for them) are not");
+    }
+  }
+
+  if (setup_.actuation.present) {
+    std::vector<std::pair<int, ActuationColumn>> model_acts;
+    std::vector<std::string> unmodelled;
+    if (model_forces) {
+      for (size_t k = 0; k < d.muscles.size(); ++k) {
+        const PathForceDesc& pf = d.muscles[k];
+        if (!pf.applies_force || !(pf.is_muscle || pf.class_name.find("Actuator") != std::string::npos)) continue;
+        ActuationColumn a;
+        a.name = pf.name;
+        a.path = geometry_of[k];
+        a.muscle = pf.is_muscle;
+        model_acts.emplace_back(pf.line, a);
+      }
+      for (const ForceDesc& f : d.forces) {
+        if (!f.applies_force || f.class_name.find("Actuator") == std::string::npos) continue;
+        ActuationColumn a;
+        a.name = f.name;
+        if (isCoordinateActuator(f.class_name)) {
+          const int ci = d.findCoordinate(f.coordinate);
+          a.coordinate = ci >= 0 ? I.coordinate_index[static_cast<size_t>(ci)] : -1;
+        } else {
+          unmodelled.push_back(f.name + " (" + f.class_name + ")");
+        }
+        model_acts.emplace_back(f.line, a);
+      }
+      std::stable_sort(model_acts.begin(), model_acts.end(),
+                       [](const auto& x, const auto& y) { return x.first < y.first; });
+    }
+    for (auto& [line, a] : model_acts) I.act_columns.push_back(a);
+    for (const std::string& file : setup_.force_set_files)
+      for (const ActuatorEntry& e : readActuatorForceSet(file)) {
+        if (!e.applies_force) continue;
+        ActuationColumn a;
+        a.name = e.name;
+        const int ci = d.findCoordinate(e.coordinate);
+        a.coordinate = ci >= 0 ? I.coordinate_index[static_cast<size_t>(ci)] : -1;
+        if (a.coordinate < 0)
+          throw ConvertError(file, e.line, "CoordinateActuator '" + e.name + "': the model has no coordinate '" +
+                                               e.coordinate + "'");
+        I.act_columns.push_back(a);
+      }
+    if (!unmodelled.empty())
+      warnings_.push_back(setup_.actuation.name + ": force 0 (no controller) but speed and power nan for " +
+                          joinNames(unmodelled) + ": redmax does not model these actuators");
+    if (I.act_columns.empty())
+      warnings_.push_back(setup_.actuation.name + ": the force set has no actuators (OpenSim cancels the analysis)");
+  }
+}
+
+MuscleAnalysisRun AnalyzeTool::runMuscleAnalyses() const {
+  const Impl& I = *impl_;
+  MuscleAnalysisRun run;
+  run.columns = I.ma_columns;
+  run.actuators = I.act_columns;
+  if (!runsMuscleAnalyses()) return run;
+  const MuscleFrameEvaluator eval(I.id->model(), I.geometry);
+  const signal::TimeWindow& w = I.id->window();
+  const auto& P = I.id->processed();
+  const int ma_step = setup_.muscle_analysis.step_interval, act_step = setup_.actuation.step_interval;
+  VecX q, v, vdot;
+  std::vector<IdLoadSample> loads;
+  for (int i = w.first_row; i <= w.last_row; ++i) {
+    // Analysis::proceed: begin (first row), end (last row) and every step_interval-th step
+    const bool ends = i == w.first_row || i == w.last_row;
+    const bool ma = setup_.muscle_analysis.present && (ends || i % ma_step == 0);
+    const bool act = setup_.actuation.present && (ends || i % act_step == 0);
+    if (!ma && !act) continue;
+    MuscleFrameInput in;
+    in.time = P.time[static_cast<size_t>(i)];
+    I.id->calcInputs(in.time, q, v, vdot, loads);
+    if (I.states) {
+      I.states->stateAt(i, q, q, v);
+      in.z_given = I.states->muscleStatesAt(i);
+    }
+    in.q = q;
+    in.u = v;
+    run.frames.push_back(eval.evaluate(in, setup_.solve_for_equilibrium_for_auxiliary_states));
+    run.muscle_analysis.push_back(ma);
+    run.actuation.push_back(act);
+    for (const std::string& f : run.frames.back().failures) {
+      std::ostringstream os;
+      os.precision(10);
+      os << "t = " << in.time << ": " << f;
+      run.failures.push_back(os.str());
+    }
+  }
+  return run;
+}
+
+std::vector<std::string> AnalyzeTool::writeMuscleAnalyses(const MuscleAnalysisRun& run) const {
+  // every table is made before any file is written, so a failure leaves no partial set behind
+  std::vector<std::pair<std::string, std::string>> files;  // path, contents
+  StorageWriteOptions wo;
+  wo.decimals = setup_.output_precision;
+  auto add = [&](const std::string& stem, const std::vector<Storage>& tables, const std::vector<std::string>& suffixes,
+                 const std::string& description) {
+    wo.description = description;
+    for (size_t k = 0; k < tables.size(); ++k)
+      files.emplace_back((fs::path(out_dir_) / (setup_.name + "_" + stem + "_" + suffixes[k] + ".sto")).string(),
+                         formatStorage(tables[k], wo));
+  };
+  auto recorded = [&](const std::vector<char>& mask) {
+    std::vector<const MuscleFrame*> f;
+    for (size_t k = 0; k < run.frames.size(); ++k)
+      if (mask[k]) f.push_back(&run.frames[k]);
+    return f;
+  };
+  if (setup_.muscle_analysis.present) {
+    const auto tables = muscleAnalysisTables(setup_.muscle_analysis, run.columns, recorded(run.muscle_analysis));
+    std::vector<std::string> names;
+    for (const Storage& t : tables) names.push_back(t.name);
+    add(setup_.muscle_analysis.name, tables, names, muscleAnalysisDescription());
+  }
+  if (setup_.actuation.present && !run.actuators.empty())
+    add(setup_.actuation.name, actuationTables(run.actuators, recorded(run.actuation)), {"force", "speed", "power"},
+        actuationDescription());
+  std::error_code ec;
+  fs::create_directories(out_dir_, ec);
+  std::vector<std::string> paths;
+  for (const auto& [path, text] : files) {
+    writeFileAtomic(path, text);
+    paths.push_back(path);
+  }
+  return paths;
 }
 
 }  // namespace redmax::osim

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "converter/analyze/muscle_analysis.hpp"
 #include "converter/build/muscle_mass.hpp"
 #include "converter/error.hpp"
 #include "converter/storage.hpp"
@@ -61,6 +62,8 @@ struct AnalyzeSetup {
   int output_precision = 8;
   std::vector<AnalysisEntry> analyses;
   StaticOptimizationSettings static_optimization;
+  MuscleAnalysisSettings muscle_analysis;
+  ActuationSettings actuation;
   std::vector<std::string> warnings;
 };
 
@@ -94,12 +97,22 @@ struct StaticOptimizationRun {
   int failed = 0;  ///< frames that did not converge
 };
 
+/// The recorded frames of MuscleAnalysis and Actuation (one evaluation per row either records).
+struct MuscleAnalysisRun {
+  std::vector<MuscleFrame> frames;
+  std::vector<char> muscle_analysis, actuation;  ///< per frame: recorded by that analysis
+  MuscleAnalysisColumns columns;
+  std::vector<ActuationColumn> actuators;
+  std::vector<std::string> failures;  ///< "t = T: muscle: why" (equilibrium failures OpenSim warns of)
+};
+
 class AnalyzeTool {
  public:
   /// Reads and checks everything (model, force set files, coordinates, external loads, muscle
-  /// class, muscle mass). Throws ConvertError for bad input: an analysis redmax does not run, a
-  /// coordinate the actuators must drive that the coordinates file lacks, an actuator class it
-  /// does not model, a states_file (not supported), bounds with min > max.
+  /// class, muscle mass, states file). Throws ConvertError for bad input: a setup with no analysis
+  /// redmax runs, a coordinate the actuators must drive that the coordinates file lacks (at the
+  /// file's label line), an actuator class static optimization does not model, bounds with
+  /// min > max.
   explicit AnalyzeTool(AnalyzeToolSettings settings);
   ~AnalyzeTool();
   AnalyzeTool(const AnalyzeTool&) = delete;
@@ -114,6 +127,16 @@ class AnalyzeTool {
   double muscleMass() const;
   std::string muscleMassSummary() const;
 
+  bool runsStaticOptimization() const { return setup_.static_optimization.present; }
+  bool runsMuscleAnalyses() const { return setup_.muscle_analysis.present || setup_.actuation.present; }
+
+  /// MuscleAnalysis and Actuation (docs/analyze.md §4-5): the muscles at each recorded row after
+  /// equilibrium (with solve_for_equilibrium_for_auxiliary_states).
+  MuscleAnalysisRun runMuscleAnalyses() const;
+  /// `<name>_<MuscleAnalysis>_<quantity>.sto` and `<name>_<Actuation>_force/speed/power.sto`,
+  /// formatted first, then each written atomically; returns the paths.
+  std::vector<std::string> writeMuscleAnalyses(const MuscleAnalysisRun& run) const;
+
   /// Every recorded frame. A frame that does not converge is kept with converged = false.
   StaticOptimizationRun runStaticOptimization() const;
 
@@ -123,6 +146,7 @@ class AnalyzeTool {
 
  private:
   struct Impl;
+  void prepareMuscleAnalyses();
   AnalyzeSetup setup_;
   AnalyzeToolSettings settings_;
   std::string out_dir_;

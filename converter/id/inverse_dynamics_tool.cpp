@@ -202,7 +202,7 @@ void InverseDynamicsTool::checkForces() {
 
 void InverseDynamicsTool::prepareCoordinates() {
   const std::string& file = config_.coordinates_file;
-  coordinates_ = readStorage(file);
+  coordinates_ = config_.coordinates_table ? *config_.coordinates_table : readStorage(file);
   for (const auto& w : coordinates_.warnings) warnings_.push_back(file + ": " + w);
   if (coordinates_.numRows() == 0) throw ConvertError(file, 0, "the coordinates file has no rows");
 
@@ -236,7 +236,7 @@ void InverseDynamicsTool::prepareCoordinates() {
   // OpenSim would solve with every coordinate at its default; that is almost surely not what the
   // user meant, so it is an input error here
   if (used.empty())
-    throw ConvertError(file, 0, "none of the model's " + std::to_string(m.nr()) +
+    throw ConvertError(file, coordinates_.label_line, "none of the model's " + std::to_string(m.nr()) +
                                     " coordinates is a column of this file (columns: " +
                                     joinNames(coordinates_.labels) + ")" +
                                     (path_labels.empty() ? std::string()

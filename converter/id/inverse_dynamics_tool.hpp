@@ -58,6 +58,9 @@ struct IdToolConfig {
   std::string setup_file;
   std::string model_file;
   std::string coordinates_file;
+  /// the coordinates table already read (e.g. the value columns of an AnalyzeTool states_file,
+  /// relabelled by coordinate name); coordinates_file then only names it in messages
+  std::optional<Storage> coordinates_table;
   std::string external_loads_file;  ///< "" = none
   /// where an ExternalLoads datafile is looked up first (OpenSim's working directory: the setup
   /// file's folder; "" = the current directory)

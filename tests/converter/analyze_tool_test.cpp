@@ -261,14 +261,15 @@ TEST(AnalyzeTool, BadInputIsNamed) {
   EXPECT_NE(message(setupXml("<StaticOptimisation name=\"x\"/>\n")).find("bad.xml:4: unknown analysis <StaticOptimisation>"),
             std::string::npos);
   // OpenSim analyses redmax does not run are listed, and alone they are an error
-  EXPECT_NE(message(setupXml("<MuscleAnalysis name=\"ma\"><on>true</on></MuscleAnalysis>\n"))
-                .find("not supported: ma (MuscleAnalysis)"),
+  EXPECT_NE(message(setupXml("<BodyKinematics name=\"bk\"><on>true</on></BodyKinematics>\n"))
+                .find("not supported: bk (BodyKinematics)"),
             std::string::npos);
-  s.setup_file = dir.write("both.xml", setupXml("<MuscleAnalysis name=\"ma\"/>\n" + staticOptimizationXml()));
-  EXPECT_EQ(AnalyzeTool(s).unsupportedAnalyses(), (std::vector<std::string>{"ma (MuscleAnalysis)"}));
-  // a coordinates file without the model's coordinate
+  s.setup_file = dir.write("both.xml", setupXml("<BodyKinematics name=\"bk\"/>\n" + staticOptimizationXml()));
+  EXPECT_EQ(AnalyzeTool(s).unsupportedAnalyses(), (std::vector<std::string>{"bk (BodyKinematics)"}));
+  // a coordinates file without the model's coordinate: FILE:LINE of its column labels
   dir.write("q.mot", constantMotion("other"));
-  EXPECT_NE(message(setupXml(staticOptimizationXml())).find("q.mot"), std::string::npos);
+  const std::string no_column = message(setupXml(staticOptimizationXml()));
+  EXPECT_NE(no_column.find("q.mot:7: none of the model's 1 coordinates is a column"), std::string::npos) << no_column;
   dir.write("q.mot", constantMotion());
   // min_control above max_control
   dir.write("m.osim", pendulumModel("<min_control>0.5</min_control><max_control>0.2</max_control>"));
