@@ -445,6 +445,7 @@ py::dict forward(std::vector<std::string> flags) {
   out["rhs_evals"] = r.stats.rhs_evals;
   out["failed_steps"] = r.stats.failed_steps;
   out["wall_s"] = r.wall_s;
+  out["decimals"] = std::max(8, tool->setup().output_precision);  // as ForwardTool::write: %.{decimals}e
   out["files"] = s.out_dir ? std::vector<std::string>{tool->statesPath(), tool->controlsPath()} : std::vector<std::string>{};
   out["states"] = toPython(std::move(r.states));
   out["controls"] = toPython(std::move(r.controls));
@@ -496,6 +497,7 @@ py::dict analyze(std::vector<std::string> flags) {
   out["status"] = status;
   out["failed"] = run.failed;
   out["muscle_mass"] = tool->muscleMass();
+  out["decimals"] = tool->setup().output_precision;  // as writeStaticOptimization: %.{decimals}f
   out["warnings"] = tool->warnings();
   out["unsupported_analyses"] = tool->unsupportedAnalyses();
   out["files"] = files;

@@ -226,7 +226,9 @@ def path_lengths(model, coordinates, wrap="exact"):
 class ForwardResult:
     """What `redmax.forward` returns: `states` and `controls` (Tables, the columns `redmax forward`
     writes), `name`, integrator statistics `steps`, `rhs_evals`, `failed_steps`, `wall_s`,
-    `warnings` (what the CLI prints as warnings) and `files` (written only with out_dir)."""
+    `warnings` (what the CLI prints as warnings), `files` (written only with out_dir) and
+    `decimals`, the digits the files carry (%.{decimals}e: `states.write(p, decimals=f.decimals,
+    scientific=True)` prints the CLI's numbers)."""
 
     def __init__(self, d):
         self.states, self.controls = Table(*d.pop("states")), Table(*d.pop("controls"))
@@ -248,7 +250,8 @@ class AnalyzeResult:
     """What `redmax.analyze` returns: `activation` and `force` (Tables: time x actuators, OpenSim's
     force-set order, rows of failed frames nan), per frame `iterations`, `constraint_violation`
     (max |A x - b|), `converged`, `status`; `failed` (frames that did not converge), `muscle_mass`
-    (kg), `warnings`, `unsupported_analyses`, `is_muscle`, `files` (written only with out_dir)."""
+    (kg), `warnings`, `unsupported_analyses`, `is_muscle`, `files` (written only with out_dir),
+    `decimals` (the setup's output_precision: the files' %.{decimals}f)."""
 
     def __init__(self, d):
         name, labels, time = d["name"], d["labels"], d["time"]

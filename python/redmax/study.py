@@ -132,7 +132,8 @@ def load_study(path):
     return trials, flags, cells
 
 
-_HELP_OPTION = re.compile(r"^\s*(--out-dir|--out|--report)(?:\s+([A-Za-z0-9_.|]+))?", re.M)
+# the option's own line: "--out" then a space or the line's end (not "--output-dt"), and its type name
+_HELP_OPTION = re.compile(r"^\s*(--out-dir|--out|--report)(?=\s|$)(?:[ \t]+([A-Za-z0-9_.|]+))?", re.M)
 
 
 def output_flag(redmax, command):
@@ -141,7 +142,9 @@ def output_flag(redmax, command):
         text = subprocess.run([redmax, command, "--help"], capture_output=True, text=True, timeout=60).stdout
     except (OSError, subprocess.TimeoutExpired):
         return None
-    found = {m.group(1): (m.group(2) or "") for m in _HELP_OPTION.finditer(text)}
+    found = {}
+    for m in _HELP_OPTION.finditer(text):
+        found.setdefault(m.group(1), m.group(2) or "")
     for flag in ("--out-dir", "--out", "--report"):
         if flag in found:
             kind = found[flag]

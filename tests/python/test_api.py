@@ -77,8 +77,18 @@ def test_id_of_arrays_refuses_bad_input():
         redmax.inverse_dynamics(LEG, q=q, qdot=q, qddot=q, lowpass=6)
     with pytest.raises(ValueError, match="no such body"):
         redmax.inverse_dynamics(LEG, q=q, qdot=q, qddot=q, loads=[{"body": "nose", "force": numpy.zeros((3, 3))}])
-    with pytest.raises(redmax.ConvertError, match=r"nope\.osim"):
+    with pytest.raises(ValueError, match=r"nope\.osim: no such file"):  # the CLI's --model check
         redmax.inverse_dynamics(os.path.join(MODELS, "nope.osim"), q=q, qdot=q, qddot=q)
+
+
+def test_id_of_arrays_malformed_model(tmp_path):
+    bad = tmp_path / "bad.osim"
+    bad.write_text("<OpenSimDocument Version=\"40000\">\n<Model name=\"x\">\n<BodySet>\n</Model>\n")
+    q = numpy.zeros((1, 1))
+    with pytest.raises(redmax.ConvertError, match=r"bad\.osim:\d+"):
+        redmax.inverse_dynamics(bad, q=q, qdot=q, qddot=q)
+    with pytest.raises(redmax.ConvertError, match=r"bad\.osim:\d+"):
+        redmax.mass_points(bad, q, muscle_mass="physiological")
 
 
 # --- mass points -------------------------------------------------------------------------
@@ -133,7 +143,8 @@ def test_forward_equals_cli(tmp_path, redmax_exe):
     assert f"{f.steps} steps, {f.rhs_evals} rhs" in p.stdout  # the same integration
     for table, name in ((f.states, "arm26_states.sto"), (f.controls, "arm26_controls.sto")):
         # the returned arrays print as the CLI's file: every digit the CLI writes (%.8e)
-        table.write(tmp_path / name, decimals=8, scientific=True)
+        assert f.decimals == 8
+        table.write(tmp_path / name, decimals=f.decimals, scientific=True)
         assert data_lines(tmp_path / name) == data_lines(tmp_path / "cli" / name)
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
     # without out_dir nothing is written
@@ -150,7 +161,8 @@ def test_analyze_equals_cli(tmp_path, redmax_exe):
     assert a.labels == ["TRIlong", "TRIlat", "TRImed", "BIClong", "BICshort", "BRA"]
     for table, name in ((a.activation, "arm26_StaticOptimization_activation.sto"),
                         (a.force, "arm26_StaticOptimization_force.sto")):
-        table.write(tmp_path / name, decimals=8)  # the setup's output_precision, %.8f
+        assert a.decimals == 20  # the setup's output_precision: %.20f, every digit of a double here
+        table.write(tmp_path / name, decimals=a.decimals)
         assert data_lines(tmp_path / name) == data_lines(tmp_path / "cli" / name)
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
     # the forces are the activations times the muscles' forces: at most 1 in activation

@@ -167,6 +167,8 @@ def test_summary_report_and_parquet(tmp_path, redmax_exe):
     res = rb.batch(str(study), str(out), serial=True, progress=None)
     assert res.errors == 0
     rows = read_table(out / "results.csv")
+    # --out STATES.sto read from simulate's --help (not its --output-dt)
+    assert all(r["output"].endswith("/states.sto") and (out / r["output"]).is_file() for r in rows)
     # the simulate summary's figures: steps, rhs evaluations, failed steps, energy (J), drift
     assert {"steps", "rhs", "failed", "J", "relative"} <= set(rows[0])
     md = (out / "report.md").read_text()

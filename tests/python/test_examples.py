@@ -25,7 +25,7 @@ def test_example_runs(name, tmp_path, redmax_exe):
         args.append(SHARED)
     elif name != "arrays.py":
         args.append(str(tmp_path / "out"))
-    p = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    p = subprocess.run(args, capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert p.returncode == 0, p.stdout + p.stderr
     last = p.stdout.strip().splitlines()[-1]
     stem = name[:-3]
