@@ -402,6 +402,7 @@ def write_parquet(csv_path):
 
 
 def main(argv=None):
+    """`redmax batch`'s command line (what cli/cmd_batch.cpp execs); returns the exit code."""
     ap = argparse.ArgumentParser(prog="redmax batch", description="run a study on Dask")
     ap.add_argument("study", metavar="STUDY.json")
     ap.add_argument("--scheduler", metavar="ADDRESS")

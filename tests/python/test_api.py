@@ -48,6 +48,8 @@ def test_id_of_arrays_equals_the_trial():
                                      muscle_mass="physiological", muscles="top:3")
     assert arrays.labels == trial.labels
     assert numpy.array_equal(arrays.values, trial.values)  # bit for bit
+    # the library's buffers, not copies: a column is a view of the values
+    assert not trial.values.flags.owndata and numpy.shares_memory(trial["knee_angle_r_moment"], trial.values)
     # the same arrays without muscle mass differ (the mass points are in the arrays' run)
     bare = redmax.inverse_dynamics(LEG, q=i["q"], qdot=i["qdot"], qddot=i["qddot"])
     assert not numpy.array_equal(bare.values, trial.values)
@@ -202,3 +204,26 @@ def test_keywords_are_the_cli_flags(tmp_path):
     with pytest.raises(redmax.ConvertError, match=r"arm26\.osim:1122: Thelen2003Muscle muscle 'TRIlong'"):
         redmax.analyze(setup=setup, muscle_class="Thelen2003Muscle", out_dir=tmp_path / "bad")
     assert not (tmp_path / "bad").exists()
+
+
+def test_a_diverging_forward_run_raises_error(tmp_path, redmax_exe):
+    pendulum = shared("opensim-models/Models/DoublePendulum/double_pendulum.osim")
+    (tmp_path / "controls.xml").write_text(
+        '<ControlSet><objects><ControlLinear name="Torq1"><x_nodes>\n'
+        '<ControlLinearNode><t>0</t><value>1e200</value></ControlLinearNode>\n'
+        '</x_nodes></ControlLinear></objects></ControlSet>\n')
+    setup = tmp_path / "setup.xml"
+    setup.write_text('<OpenSimDocument Version="40000">\n<ForwardTool name="pend">\n'
+                     f'<model_file>{pendulum}</model_file>\n<results_directory>res</results_directory>\n'
+                     '<initial_time>0</initial_time>\n<final_time>0.2</final_time>\n'
+                     '<ControllerSet><objects><ControlSetController name="c">\n'
+                     '<controls_file>controls.xml</controls_file>\n'
+                     '</ControlSetController></objects></ControllerSet>\n</ForwardTool>\n</OpenSimDocument>\n')
+    p = run(redmax_exe, "forward", "--setup", str(setup), "--integrator", "euler")
+    assert p.returncode == 1
+    message = p.stderr.split("error: ", 1)[1].strip()
+    with pytest.raises(redmax.Error) as e:
+        redmax.forward(setup=str(setup), integrator="euler", out_dir=tmp_path / "out")
+    assert str(e.value) == message  # "setup.xml: euler: diverged: q[0] = ... at t = 0.001 ..."
+    assert "diverged" in message and "t = 0.001" in message
+    assert not (tmp_path / "out").exists() and not (tmp_path / "res").exists()  # nothing written

@@ -101,3 +101,23 @@ def test_threads_run_with_the_gil_released():
     for t in threads:
         t.join()
     assert all(numpy.array_equal(results[0], x) for x in results[1:])
+
+
+def test_every_public_function_has_a_docstring():
+    import inspect
+    import redmax.report
+    import redmax.study
+    missing = []
+    for mod in (redmax, redmax.study, redmax.report):
+        for name, obj in vars(mod).items():
+            if name.startswith("_") or getattr(obj, "__module__", "") != mod.__name__:
+                continue
+            if inspect.isfunction(obj) or inspect.isclass(obj):
+                if not inspect.getdoc(obj):
+                    missing.append(f"{mod.__name__}.{name}")
+            if inspect.isclass(obj):
+                for m, f in vars(obj).items():
+                    if not m.startswith("_") and (inspect.isfunction(f) or isinstance(f, property)) \
+                            and not inspect.getdoc(f):
+                        missing.append(f"{mod.__name__}.{name}.{m}")
+    assert missing == []
