@@ -35,6 +35,15 @@ L = redmax.path_lengths(m, SWING)
 L.write(os.path.join(out, "len.sto"))
 print("lengths: " + ", ".join(f"{c} {L[c].min():.4f}-{L[c].max():.4f} m" for c in L.labels))
 
+# `redmax validate`: the core against Simbody at zero muscle mass, then the tibia transfer sweep
+# (no_plots: the figures are gnuplot's; the numbers are in summary.json either way)
+v = redmax.validate(m, SWING, report=os.path.join(out, "zero_mass"), no_plots=True)
+worst = max(c["worst_column"]["rms_rel"] for c in v.summary["comparisons"])
+print(f"validate: {'PASS' if v.passed else 'FAIL'}, core vs Simbody worst rms/peak {worst:.3g}")
+s = redmax.validate(m, SWING, report=os.path.join(out, "tibia_sweep"), no_plots=True, muscle_mass="transfer",
+                    transfer_body="tibia_r", mass_sweep=[0, 0.2, 0.4, 0.6, 0.8])
+print(f"sweep: {'PASS' if s.passed else 'FAIL'}, {len(s.summary['mass_sweep']['values'])} transfer fractions")
+
 # pandas, where python3-pandas is installed
 try:
     df = rm.to_pandas()
