@@ -66,9 +66,13 @@ def test_id_of_arrays_with_loads_equals_set_e():
     arrays = redmax.inverse_dynamics(model, q=i["q"], qdot=i["qdot"], qddot=i["qddot"], time=trial.time,
                                      loads=i["loads"])
     assert numpy.array_equal(arrays.values, trial.values)
-    # the loads matter: the pelvis residuals change by the ground reactions' size without them
+    # the loads as arrays act as forces should: the pelvis translations' residuals (ground axes)
+    # without them exceed the trial's by the summed ground reactions (peak 924 N vertical), to
+    # 1e-12 N (measured 5.7e-13 N)
     without = redmax.inverse_dynamics(model, q=i["q"], qdot=i["qdot"], qddot=i["qddot"], time=trial.time)
-    assert numpy.abs(without["pelvis_ty_force"] - trial["pelvis_ty_force"]).max() > 100.0
+    for axis, c in enumerate(("pelvis_tx_force", "pelvis_ty_force", "pelvis_tz_force")):
+        f = sum(ld["force"][:, axis] for ld in i["loads"])
+        assert numpy.abs(without[c] - trial[c] - f).max() < 1e-12
 
 
 def test_id_of_arrays_refuses_bad_input():
@@ -116,18 +120,21 @@ def test_mass_points_lie_on_the_path():
         assert numpy.allclose(numpy.diff(mp.alpha), mp.alpha[1] - mp.alpha[0], rtol=0, atol=1e-15)
         assert mp.mass.sum() > 0
         for k in range(len(q)):
+            span = mp.alpha[-1] - mp.alpha[0]
             if mp.path_type in ("I", "II"):
-                # straight and via-point paths: each point at its arc fraction of the polyline,
-                # measured 2e-16 m; the polyline's length is `redmax lengths`' to 1e-15 m
+                # straight and via-point paths: each point at its arc fraction of the polyline
+                # (measured 5.6e-17 m), and the polyline is `redmax lengths`' path (measured 0)
                 for a, x in zip(mp.alpha, mp.points[k]):
-                    assert numpy.abs(x - polyline_point(mp.path[k], a)).max() < 1e-12
+                    assert numpy.abs(x - polyline_point(mp.path[k], a)).max() < 5e-16
                 L = numpy.linalg.norm(numpy.diff(mp.path[k], axis=0), axis=1).sum()
-                assert abs(L - lengths[name][10 * k]) < 1e-12
+                assert abs(L - lengths[name][10 * k]) <= 2e-16
             else:
-                # wrapping: the points leave the straight polyline for the surface (smooth model),
-                # but stay between the end points, in order along the path
+                # wrapping: the points leave the straight polyline for the surface (smooth model);
+                # the chords between them add up to their share of OpenSim's exact wrapped length,
+                # (alpha_N - alpha_1) L, to 1e-5 (measured 4.5e-6 over all 81 frames: the smooth
+                # model's blend and chords against arcs)
                 d = numpy.linalg.norm(numpy.diff(mp.points[k], axis=0), axis=1)
-                assert (d > 0).all() and d.sum() < lengths[name][10 * k]
+                assert (d > 0).all() and abs(d.sum() / (span * lengths[name][10 * k]) - 1) < 1e-5
     # without muscle mass no muscle carries points
     assert redmax.mass_points(LEG, q) == {}
 
