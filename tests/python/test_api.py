@@ -9,16 +9,11 @@ import subprocess
 import numpy
 import pytest
 
-from conftest import MODELS, shared
+from conftest import LEG, MODELS, SWING, shared, skip_module_without_core
 
 import redmax
 
-if redmax._core is None:
-    pytest.skip("redmax._core not built (pybind11-dev / python3-dev missing): " + redmax._core_missing,
-                allow_module_level=True)
-
-LEG = os.path.join(MODELS, "running_leg.osim")
-SWING = os.path.join(MODELS, "running_leg_swing.mot")
+skip_module_without_core()
 E = "opensim-models/Pipelines/Gait2392_Simbody/"
 FORWARD_SETUP = "opensim-core/Applications/Forward/tests/resources/arm26_Setup_Forward.xml"
 ANALYZE_SETUP = "opensim-core/Applications/Analyze/tests/resources/arm26_Setup_StaticOptimization.xml"

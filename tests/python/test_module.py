@@ -1,22 +1,16 @@
 """The redmax module (pybind11): the README's tour in Python, and inverse dynamics equal to the CLI's
 `redmax id --full-precision` on sets A, E, F to the last digit (docs/python.md §2)."""
-import os
 import subprocess
 import threading
 
 import numpy
 import pytest
 
-from conftest import MODELS, shared
+from conftest import LEG, SWING, shared, skip_module_without_core
 
 import redmax
 
-if redmax._core is None:
-    pytest.skip("redmax._core not built (pybind11-dev / python3-dev missing): " + redmax._core_missing,
-                allow_module_level=True)
-
-LEG = os.path.join(MODELS, "running_leg.osim")
-SWING = os.path.join(MODELS, "running_leg_swing.mot")
+skip_module_without_core()
 
 CMC = "Tutorials/Computed_Muscle_Control/OutputReference/"
 E = "Pipelines/Gait2392_Simbody/"
