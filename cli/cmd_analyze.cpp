@@ -8,25 +8,14 @@
 #include <memory>
 #include <string>
 
-#include "cli/muscle_mass_flags.hpp"
+#include "cli/analyze_flags.hpp"
 #include "converter/analyze/analyze_tool.hpp"
-#include "core/muscles/hill/factory.hpp"
 
 namespace redmax::cli {
 namespace {
 
-struct AnalyzeFlags {
-  std::string setup, out_dir, muscle_class;
-  bool quiet = false;
-  MuscleMassFlags muscle_mass;
-};
-
 int runAnalyze(const AnalyzeFlags& f, const CLI::App& app) {
-  osim::AnalyzeToolSettings settings;
-  settings.setup_file = f.setup;
-  if (given(app, "--out-dir")) settings.out_dir = f.out_dir;
-  if (given(app, "--muscle-class")) settings.muscle_class = f.muscle_class;
-  settings.muscle_mass = parseMuscleMassFlags(f.muscle_mass);
+  const osim::AnalyzeToolSettings settings = parseAnalyzeFlags(f, app);
   const bool with_mass = settings.muscle_mass.source != osim::MuscleMassOptions::Source::None;
 
   std::unique_ptr<osim::AnalyzeTool> tool;
@@ -106,18 +95,7 @@ int runAnalyze(const AnalyzeFlags& f, const CLI::App& app) {
 CommandRegistration reg(
     {"analyze", "OpenSim's AnalyzeTool: static optimization, muscle analysis, actuation; with or without muscle mass", [](CLI::App& app) {
        auto f = std::make_shared<AnalyzeFlags>();
-       app.add_option("--setup", f->setup, "an AnalyzeTool setup (paths relative to it)")
-           ->type_name("ANALYZE_SETUP.xml")
-           ->required()
-           ->check(existingFile());
-       app.add_option("--out-dir", f->out_dir, "where the result files go (default: the setup's results_directory)")
-           ->type_name("DIR");
-       app.add_option("--muscle-class", f->muscle_class,
-                      "read every muscle as CLASS (OpenSim's Object::renameType)")
-           ->type_name("CLASS")
-           ->check(oneOf(hill::muscleModelClasses()));
-       app.add_flag("--quiet", f->quiet, "no summary line");
-       addMuscleMassFlags(app, f->muscle_mass);
+       addAnalyzeFlags(app, *f);
        app.footer(std::string(
            "usage: redmax analyze --setup ANALYZE_SETUP.xml [--out-dir DIR] [--muscle-class CLASS]\n"
            "                      [--quiet] [MUSCLE-MASS OPTIONS]\n"

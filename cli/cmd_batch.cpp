@@ -1,7 +1,7 @@
 // `redmax batch`: a study of many redmax runs on a Dask cluster. The work is Python
-// (python/redmax/study.py, over Debian's python3-distributed); this command checks the flags and
-// execs it with the Python interpreter, passing this executable as $REDMAX_EXE so the tasks run the
-// same build. docs/python.md §3 has the study contract.
+// (python/redmax/study.py over Debian's python3-distributed, its report python/redmax/report.py);
+// this command checks the flags and execs it with the Python interpreter, passing this executable
+// as $REDMAX_EXE so the tasks run the same build. docs/python.md §3 has the study contract.
 #include <unistd.h>
 
 #include <cerrno>
@@ -97,7 +97,9 @@ CommandRegistration reg(
            "study file); the grid's flags are crossed and appended; the command's output flag\n"
            "(--out-dir, --out or --report) is added, pointing into DIR/<trial>/<cell>/. Each cell is a\n"
            "Dask task. DIR/results.csv: trial, cell, each grid flag, status (ok|error), error, wall_s,\n"
-           "output, then the summary figures the commands print. Outputs are written atomically; a\n"
+           "output, then the summary figures the commands print (and results.parquet where pyarrow\n"
+           "is installed). DIR/report.md: every cell, and SVG figures (gnuplot) of the numeric\n"
+           "columns against each grid flag in DIR/report/. Outputs are written atomically; a\n"
            "rerun skips complete cells. Progress on stderr. Runs python/redmax/study.py with\n"
            "$REDMAX_PYTHON (default " REDMAX_PYTHON ").\n"
            "Exit codes: 0 every cell ok, 1 some cell failed (the rest complete), 2 bad input or usage.");

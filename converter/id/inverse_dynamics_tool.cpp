@@ -77,6 +77,33 @@ IdToolConfig resolveIdSettings(const IdToolSettings& s) {
 }
 
 // ---------------------------------------------------------------------------------------------
+IdEngineOptions idEngineOptions(const ModelDescription& d, const BuildResult& build, bool opensim_compat) {
+  IdEngineOptions o;
+  // OpenSim's u for Ball/Free/Ellipsoid joints: the data's rates read as angular velocity in F
+  o.rates_as_u.assign(build.model.skeleton().nb(), false);
+  if (opensim_compat) {
+    for (const JointDesc& j : d.joints) {
+      if (j.kind != JointKind::Ball && j.kind != JointKind::Free && j.kind != JointKind::Ellipsoid &&
+          j.kind != JointKind::Scapulothoracic)
+        continue;
+      if (j.coordinates.empty()) continue;
+      const int k = build.coordinate_index[j.coordinates.front()];
+      o.rates_as_u[build.model.skeleton().coordinates()[k].joint] = true;
+    }
+  }
+  return o;
+}
+
+std::vector<std::string> idOutputLabels(const ModelDescription& d, const Model& model) {
+  std::vector<std::string> labels;
+  for (const Coordinate& c : model.coordinates()) {
+    const int ci = d.findCoordinate(c.name);
+    const bool rot = ci >= 0 && d.coordinates[ci].motion_type == MotionType::Rotational;
+    labels.push_back(c.name + (rot ? "_moment" : "_force"));
+  }
+  return labels;
+}
+
 InverseDynamicsTool::InverseDynamicsTool(IdToolConfig config) : config_(std::move(config)) {
   warnings_ = config_.warnings;
   description_ = readOsimModel(config_.model_file, config_.muscle_class);
@@ -105,18 +132,7 @@ InverseDynamicsTool::InverseDynamicsTool(IdToolConfig config) : config_(std::mov
                            " is not modelled by the core, so its generalized force cannot be computed");
   }
 
-  // OpenSim's u for Ball/Free/Ellipsoid joints: the data's rates read as angular velocity in F
-  engine_options_.rates_as_u.assign(model().nb(), false);
-  if (config_.opensim_compat) {
-    for (const JointDesc& j : description_.joints) {
-      if (j.kind != JointKind::Ball && j.kind != JointKind::Free && j.kind != JointKind::Ellipsoid &&
-          j.kind != JointKind::Scapulothoracic)
-        continue;
-      if (j.coordinates.empty()) continue;
-      const int k = build_->coordinate_index[j.coordinates.front()];
-      engine_options_.rates_as_u[model().coordinates()[k].joint] = true;
-    }
-  }
+  engine_options_ = idEngineOptions(description_, *build_, config_.opensim_compat);
 
   checkForces();
   prepareCoordinates();
@@ -287,15 +303,7 @@ void InverseDynamicsTool::prepareLoads() {
 }
 
 // ---------------------------------------------------------------------------------------------
-std::vector<std::string> InverseDynamicsTool::outputLabels() const {
-  std::vector<std::string> labels;
-  for (const Coordinate& c : model().coordinates()) {
-    const int ci = description_.findCoordinate(c.name);
-    const bool rot = ci >= 0 && description_.coordinates[ci].motion_type == MotionType::Rotational;
-    labels.push_back(c.name + (rot ? "_moment" : "_force"));
-  }
-  return labels;
-}
+std::vector<std::string> InverseDynamicsTool::outputLabels() const { return idOutputLabels(description_, model()); }
 
 void InverseDynamicsTool::calcInputs(double t, VecX& q, VecX& v, VecX& vdot,
                                      std::vector<IdLoadSample>& loads) const {

@@ -85,6 +85,15 @@ struct IdToolConfig {
 /// t0 > t1, or non-finite values.
 IdToolConfig resolveIdSettings(const IdToolSettings& settings);
 
+/// The velocity convention an engine must use for a model built from `d` (IdToolConfig::
+/// opensim_compat: rates_as_u for Ball/Free/Ellipsoid joints), as the tool gives it
+/// (engineOptions()); for callers that build the model themselves (redmax.inverse_dynamics of arrays).
+IdEngineOptions idEngineOptions(const ModelDescription& d, const BuildResult& build, bool opensim_compat);
+
+/// The output column labels for `model` built from `d`: <coord>_moment (Rotational) or
+/// <coord>_force, in q order (InverseDynamicsTool::outputLabels).
+std::vector<std::string> idOutputLabels(const ModelDescription& d, const Model& model);
+
 /// One coordinate's source of q(t).
 struct IdCoordinateSource {
   std::string name;       ///< the coordinate

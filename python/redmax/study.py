@@ -32,10 +32,16 @@ import sys
 import time
 import uuid
 
+try:
+    from . import report as _report
+except ImportError:  # run as a script (what `redmax batch` execs): report.py sits beside it
+    import report as _report
+
 RESULTS = "results.csv"
 CELL_FILE = "cell.json"
 BASE_COLUMNS = ["trial", "cell"]
 TAIL_COLUMNS = ["status", "error", "wall_s", "output"]
+RESERVED = (RESULTS, "results.parquet", _report.REPORT, _report.FIGURE_DIR)  # DIR's own entries
 
 
 class StudyError(ValueError):
@@ -45,10 +51,17 @@ class StudyError(ValueError):
 # --- the study -------------------------------------------------------------------------------
 
 def find_redmax():
-    """The redmax executable: $REDMAX_EXE, else build/cli/redmax beside this source tree, else PATH."""
+    """The redmax executable: $REDMAX_EXE, else the build a `pip install` recorded, else
+    build/cli/redmax beside this source tree, else PATH."""
     env = os.environ.get("REDMAX_EXE")
     if env:
         return env
+    try:
+        from ._build_info import REDMAX_EXE as recorded
+        if os.access(recorded, os.X_OK):
+            return recorded
+    except ImportError:
+        pass
     here = os.path.dirname(os.path.abspath(__file__))
     for cand in (os.path.join(here, "..", "..", "build", "cli", "redmax"),
                  os.path.join(here, "..", "..", "cli", "redmax")):
@@ -100,6 +113,8 @@ def load_study(path):
         name = t["name"]
         if not re.fullmatch(r"[A-Za-z0-9._+-]+", name) or name in names:
             raise StudyError(f"{path}: trial name '{name}' must be unique and a plain file name")
+        if name in RESERVED or name.startswith("."):
+            raise StudyError(f"{path}: trial name '{name}' is taken by the study's own files ({', '.join(RESERVED)})")
         names.add(name)
         args = t.get("args", [])
         if not isinstance(args, list):
@@ -117,7 +132,8 @@ def load_study(path):
     return trials, flags, cells
 
 
-_HELP_OPTION = re.compile(r"^\s*(--out-dir|--out|--report)(?:\s+([A-Za-z0-9_.|]+))?", re.M)
+# the option's own line: "--out" then a space or the line's end (not "--output-dt"), and its type name
+_HELP_OPTION = re.compile(r"^\s*(--out-dir|--out|--report)(?=\s|$)(?:[ \t]+([A-Za-z0-9_.|]+))?", re.M)
 
 
 def output_flag(redmax, command):
@@ -126,7 +142,9 @@ def output_flag(redmax, command):
         text = subprocess.run([redmax, command, "--help"], capture_output=True, text=True, timeout=60).stdout
     except (OSError, subprocess.TimeoutExpired):
         return None
-    found = {m.group(1): (m.group(2) or "") for m in _HELP_OPTION.finditer(text)}
+    found = {}
+    for m in _HELP_OPTION.finditer(text):
+        found.setdefault(m.group(1), m.group(2) or "")
     for flag in ("--out-dir", "--out", "--report"):
         if flag in found:
             kind = found[flag]
@@ -260,16 +278,21 @@ def _clean_stale(out_dir):
 # --- the study on Dask -----------------------------------------------------------------------
 
 class BatchResult:
-    """What `batch` returns: the rows (dicts, study order), the grid flags, the table's path."""
+    """What `batch` returns: `rows` (dicts, study order: trial, cell, grid, status, error, wall_s,
+    output, figures), the grid `flags`, the paths `csv_path`, `parquet_path` (None without
+    python3-pyarrow), `report_path` and `figures` (the report's SVGs)."""
 
-    def __init__(self, rows, flags, csv_path):
+    def __init__(self, rows, flags, csv_path, parquet_path=None, report_path=None, figures=()):
         self.rows, self.flags, self.csv_path = rows, flags, csv_path
+        self.parquet_path, self.report_path, self.figures = parquet_path, report_path, list(figures)
 
     @property
     def errors(self):
+        """The number of cells whose status is not ok."""
         return sum(r["status"] != "ok" for r in self.rows)
 
     def to_pandas(self):
+        """results.csv as a pandas.DataFrame of strings (needs python3-pandas)."""
         import pandas
         return pandas.read_csv(self.csv_path, dtype=str, keep_default_na=False)
 
@@ -351,22 +374,35 @@ def batch(study, out, scheduler=None, workers=None, client=None, serial=False, r
                 x.close()
     csv_path = os.path.join(out, RESULTS)
     _write_atomic(csv_path, results_table(rows, flags))
-    try:  # Parquet beside the CSV where python3-pyarrow exists
-        import pyarrow  # noqa: F401
-        import pandas
-        df = pandas.read_csv(csv_path, dtype=str, keep_default_na=False)
-        df.to_parquet(csv_path[:-4] + ".parquet.tmp")
-        os.replace(csv_path[:-4] + ".parquet.tmp", csv_path[:-4] + ".parquet")
-    except ImportError:
-        pass
+    parquet_path = write_parquet(csv_path)
+    el = time.perf_counter() - start
+    figures = _report.write_report(out, rows, flags, elapsed_s=el)
     if progress is not None:
-        el = time.perf_counter() - start
         progress.write(f"batch: {len(cells)} cells, {errors} errors, {skipped} skipped, {el:.2f} s wall"
-                       f" -> {csv_path}\n")
-    return BatchResult(rows, flags, csv_path)
+                       f" -> {csv_path}, {os.path.join(out, _report.REPORT)}\n")
+    return BatchResult(rows, flags, csv_path, parquet_path, os.path.join(out, _report.REPORT), figures)
+
+
+def write_parquet(csv_path):
+    """results.parquet beside results.csv (the same columns, as strings) where python3-pyarrow is
+    installed, written atomically; returns its path, or None (and writes nothing) without pyarrow."""
+    try:
+        import pyarrow
+        import pyarrow.parquet
+    except ImportError:
+        return None
+    with open(csv_path, newline="") as fh:
+        table = list(csv.reader(fh))
+    header, body = table[0], table[1:]
+    cols = {h: [r[i] for r in body] for i, h in enumerate(header)}
+    path = csv_path[:-4] + ".parquet"
+    pyarrow.parquet.write_table(pyarrow.table(cols), path + ".tmp")
+    os.replace(path + ".tmp", path)
+    return path
 
 
 def main(argv=None):
+    """`redmax batch`'s command line (what cli/cmd_batch.cpp execs); returns the exit code."""
     ap = argparse.ArgumentParser(prog="redmax batch", description="run a study on Dask")
     ap.add_argument("study", metavar="STUDY.json")
     ap.add_argument("--scheduler", metavar="ADDRESS")

@@ -30,3 +30,15 @@ def shared(*parts):
     if not os.path.exists(p):
         pytest.skip(f"../shared/opensim absent ({p}): docs/shared_data.md")
     return p
+
+
+LEG = os.path.join(MODELS, "running_leg.osim")
+SWING = os.path.join(MODELS, "running_leg_swing.mot")
+
+
+def skip_module_without_core():
+    """At a test module's top: skip the module, with the reason, when redmax._core was not built."""
+    import redmax
+    if redmax._core is None:
+        pytest.skip("redmax._core not built (pybind11-dev / python3-dev missing): " + redmax._core_missing,
+                    allow_module_level=True)

@@ -151,3 +151,58 @@ def test_worker_killed_mid_study(tmp_path, redmax_exe):
     assert without_wall(a) == without_wall(b)
     for r in a:  # every output bit for bit
         assert (tmp_path / "serial" / r["output"]).read_bytes() == (tmp_path / "dask" / r["output"]).read_bytes()
+
+
+def test_summary_report_and_parquet(tmp_path, redmax_exe):
+    from redmax import report
+    sim = {"name": "pend", "command": "simulate",
+           "args": ["--model", "data/double_pendulum_straight.osim", "--duration", "0.2"]}
+    os.makedirs(tmp_path / "data")
+    shutil.copy(os.path.join(MODELS, "double_pendulum_straight.osim"), tmp_path / "data")
+    study = tmp_path / "study.json"
+    study.write_text(json.dumps({"trials": [sim], "grid": {"--integrator": ["rk45", "euler"],
+                                                         "--muscle-mass-kg": ["straight_muscle=0.5",
+                                                                              "straight_muscle=1"]}}))
+    out = tmp_path / "out"
+    res = rb.batch(str(study), str(out), serial=True, progress=None)
+    assert res.errors == 0
+    rows = read_table(out / "results.csv")
+    # --out STATES.sto read from simulate's --help (not its --output-dt)
+    assert all(r["output"].endswith("/states.sto") and (out / r["output"]).is_file() for r in rows)
+    # the simulate summary's figures: steps, rhs evaluations, failed steps, energy (J), drift
+    assert {"steps", "rhs", "failed", "J", "relative"} <= set(rows[0])
+    md = (out / "report.md").read_text()
+    assert "4 cells: 4 ok, 0 errors" in md
+    for r in rows:  # one table row per cell with its figures
+        assert f"| pend | {r['--integrator']} | {r['--muscle-mass-kg']} | ok |" in md and r["steps"] in md
+    # one figure per numeric column that varies and grid flag, each a complete SVG
+    cols = report.numeric_columns(res.rows)
+    assert "steps" in cols and "frames" not in cols
+    if report.find_gnuplot() is None:
+        assert "gnuplot not found" in md
+    else:
+        assert len(res.figures) == 2 * len(cols)
+        for f in res.figures:
+            text = open(f).read()
+            assert text.startswith("<?xml") and text.rstrip().endswith("</svg>")
+            assert os.path.relpath(f, out) in md
+    # what a figure plots is the table's numbers: steps against the integrator, per trial
+    labels, series = report.figure_data(res.rows, res.flags, "steps", "--integrator")
+    assert labels == ["rk45", "euler"]
+    assert sorted(series["pend"]) == sorted(([0, 1][r["--integrator"] == "euler"], float(r["steps"])) for r in rows)
+    # euler's fixed 1 ms steps: 200 in 0.2 s
+    assert all(y == 200.0 for x, y in series["pend"] if x == 1)
+    # Parquet where python3-pyarrow is installed, nothing otherwise
+    try:
+        import pyarrow.parquet
+    except ImportError:
+        assert res.parquet_path is None and not (out / "results.parquet").exists()
+    else:
+        t = pyarrow.parquet.read_table(res.parquet_path).to_pylist()
+        assert t == rows
+
+
+def test_reserved_trial_names(tmp_path):
+    study = make_study(str(tmp_path), [dict(id_trial(), name="report")], {})
+    with pytest.raises(rb.StudyError, match="'report' is taken"):
+        rb.load_study(study)

@@ -1,22 +1,16 @@
 """The redmax module (pybind11): the README's tour in Python, and inverse dynamics equal to the CLI's
 `redmax id --full-precision` on sets A, E, F to the last digit (docs/python.md §2)."""
-import os
 import subprocess
 import threading
 
 import numpy
 import pytest
 
-from conftest import MODELS, shared
+from conftest import LEG, SWING, shared, skip_module_without_core
 
 import redmax
 
-if redmax._core is None:
-    pytest.skip("redmax._core not built (pybind11-dev / python3-dev missing): " + redmax._core_missing,
-                allow_module_level=True)
-
-LEG = os.path.join(MODELS, "running_leg.osim")
-SWING = os.path.join(MODELS, "running_leg_swing.mot")
+skip_module_without_core()
 
 CMC = "Tutorials/Computed_Muscle_Control/OutputReference/"
 E = "Pipelines/Gait2392_Simbody/"
@@ -101,3 +95,23 @@ def test_threads_run_with_the_gil_released():
     for t in threads:
         t.join()
     assert all(numpy.array_equal(results[0], x) for x in results[1:])
+
+
+def test_every_public_function_has_a_docstring():
+    import inspect
+    import redmax.report
+    import redmax.study
+    missing = []
+    for mod in (redmax, redmax.study, redmax.report):
+        for name, obj in vars(mod).items():
+            if name.startswith("_") or getattr(obj, "__module__", "") != mod.__name__:
+                continue
+            if inspect.isfunction(obj) or inspect.isclass(obj):
+                if not inspect.getdoc(obj):
+                    missing.append(f"{mod.__name__}.{name}")
+            if inspect.isclass(obj):
+                for m, f in vars(obj).items():
+                    if not m.startswith("_") and (inspect.isfunction(f) or isinstance(f, property)) \
+                            and not inspect.getdoc(f):
+                        missing.append(f"{mod.__name__}.{name}.{m}")
+    assert missing == []
