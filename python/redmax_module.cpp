@@ -465,8 +465,18 @@ py::dict analyze(std::vector<std::string> flags) {
   {
     py::gil_scoped_release release;
     tool = namedBySetup(f.setup, [&] { return std::make_unique<osim::AnalyzeTool>(s); });
-    run = tool->runStaticOptimization();
-    if (s.out_dir) files = tool->writeStaticOptimization(run);
+    // MuscleAnalysis / Actuation: written as the CLI writes them (files only with out_dir)
+    if (tool->runsMuscleAnalyses()) {
+      const osim::MuscleAnalysisRun mrun = tool->runMuscleAnalyses();
+      if (s.out_dir) files = tool->writeMuscleAnalyses(mrun);
+    }
+    if (tool->runsStaticOptimization()) {
+      run = tool->runStaticOptimization();
+      if (s.out_dir) {
+        const std::vector<std::string> so_files = tool->writeStaticOptimization(run);
+        files.insert(files.end(), so_files.begin(), so_files.end());
+      }
+    }
   }
   const auto nf = static_cast<Eigen::Index>(run.frames.size()), na = static_cast<Eigen::Index>(run.actuators.size());
   MatX act(nf, na), force(nf, na);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -44,6 +45,11 @@ const std::set<std::string>& openSimAnalysisClasses() {
   return s;
 }
 
+
+
+bool isCoordinateActuator(const std::string& cls) {
+  return cls == "CoordinateActuator" || cls == "ActivationCoordinateActuator";
+}
 
 }  // namespace
 
@@ -694,6 +700,22 @@ void AnalyzeTool::prepareMuscleAnalyses() {
   if (setup_.actuation.present) {
     std::vector<std::pair<int, ActuationColumn>> model_acts;
     std::vector<std::string> unmodelled;
+    // an actuator of the force set as an Actuation column; others (springs, limits) are not actuators
+    auto actuationColumn = [&](const ForceDesc& f) -> std::optional<ActuationColumn> {
+      if (!f.applies_force || f.class_name.find("Actuator") == std::string::npos) return std::nullopt;
+      ActuationColumn a;
+      a.name = f.name;
+      if (isCoordinateActuator(f.class_name)) {
+        const int ci = d.findCoordinate(f.coordinate);
+        a.coordinate = ci >= 0 ? I.coordinate_index[static_cast<size_t>(ci)] : -1;
+        if (a.coordinate < 0 && !f.source_file.empty())
+          throw ConvertError(f.source_file, f.line, f.class_name + " '" + f.name +
+                                                        "': the model has no coordinate '" + f.coordinate + "'");
+      } else {
+        unmodelled.push_back(f.name + " (" + f.class_name + ")");
+      }
+      return a;
+    };
     if (model_forces) {
       for (size_t k = 0; k < d.muscles.size(); ++k) {
         const PathForceDesc& pf = d.muscles[k];
@@ -704,34 +726,18 @@ void AnalyzeTool::prepareMuscleAnalyses() {
         a.muscle = pf.is_muscle;
         model_acts.emplace_back(pf.line, a);
       }
-      for (const ForceDesc& f : d.forces) {
-        if (!f.applies_force || f.class_name.find("Actuator") == std::string::npos) continue;
-        ActuationColumn a;
-        a.name = f.name;
-        if (isCoordinateActuator(f.class_name)) {
-          const int ci = d.findCoordinate(f.coordinate);
-          a.coordinate = ci >= 0 ? I.coordinate_index[static_cast<size_t>(ci)] : -1;
-        } else {
-          unmodelled.push_back(f.name + " (" + f.class_name + ")");
-        }
-        model_acts.emplace_back(f.line, a);
-      }
+      for (const ForceDesc& f : d.forces)
+        if (auto a = actuationColumn(f)) model_acts.emplace_back(f.line, *a);
       std::stable_sort(model_acts.begin(), model_acts.end(),
                        [](const auto& x, const auto& y) { return x.first < y.first; });
     }
     for (auto& [line, a] : model_acts) I.act_columns.push_back(a);
-    for (const std::string& file : setup_.force_set_files)
-      for (const ActuatorEntry& e : readActuatorForceSet(file)) {
-        if (!e.applies_force) continue;
-        ActuationColumn a;
-        a.name = e.name;
-        const int ci = d.findCoordinate(e.coordinate);
-        a.coordinate = ci >= 0 ? I.coordinate_index[static_cast<size_t>(ci)] : -1;
-        if (a.coordinate < 0)
-          throw ConvertError(file, e.line, "CoordinateActuator '" + e.name + "': the model has no coordinate '" +
-                                               e.coordinate + "'");
-        I.act_columns.push_back(a);
-      }
+    // force_set_files, read by the same reader the force set of static optimization uses
+    ModelDescription files = d;
+    files.forces.clear();
+    for (const std::string& file : setup_.force_set_files) appendForceSetFile(files, file);
+    for (const ForceDesc& f : files.forces)
+      if (auto a = actuationColumn(f)) I.act_columns.push_back(*a);
     if (!unmodelled.empty())
       warnings_.push_back(setup_.actuation.name + ": force 0 (no controller) but speed and power nan for " +
                           joinNames(unmodelled) + ": redmax does not model these actuators");
