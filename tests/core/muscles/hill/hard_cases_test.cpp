@@ -45,7 +45,9 @@ TEST(HillHardCases, ActivationNearZeroKeepsRatesFiniteAndTheFibreGivesWay) {
           ASSERT_TRUE(finiteOutput(out, zd, 2)) << cls << " a " << a << " lN " << lN << " e " << strain;
           // nearly no active force against a stretched tendon: the fibre lengthens (passive
           // force alone cannot hold a 2% or 5% tendon strain below lN 1.4)
-          if (strain >= 0.02 && lN < 1.4) EXPECT_GT(zd[1], 0.0) << cls << " a " << a << " lN " << lN;
+          if (strain >= 0.02 && lN < 1.4) {
+            EXPECT_GT(zd[1], 0.0) << cls << " a " << a << " lN " << lN;
+          }
         }
   }
 }
@@ -56,10 +58,11 @@ TEST(HillHardCases, FibreAtItsMinimumLengthIsHeld) {
   const double l_min = th.pennation().minFiberLength();
   // a short path (slack tendon), full excitation: the fibre would shorten; at and below l_min it
   // is held (OpenSim's clamp in calcMuscleLengthInfo and calcFiberVelocityInfo)
+  const double L = 0.143 * 0.95 + 0.1 * l_min;
   for (double lf : {l_min, 0.5 * l_min, 1e-9}) {
     double z[2] = {1.0, lf}, zd[2];
     MuscleOutput out;
-    m->calc(z, {0.143 + 0.5 * l_min, 0.0, 1.0}, out, zd);
+    m->calc(z, {L, 0.0, 1.0}, out, zd);
     ASSERT_TRUE(finiteOutput(out, zd, 2)) << lf;
     EXPECT_EQ(zd[1], 0.0) << lf;
     EXPECT_EQ(out.active_fiber_force, 0.0) << lf;
@@ -68,7 +71,7 @@ TEST(HillHardCases, FibreAtItsMinimumLengthIsHeld) {
   // just above it the fibre shortens again
   double z[2] = {1.0, 1.05 * l_min}, zd[2];
   MuscleOutput out;
-  m->calc(z, {0.143 + 0.5 * l_min, 0.0, 1.0}, out, zd);
+  m->calc(z, {L, 0.0, 1.0}, out, zd);
   EXPECT_LT(zd[1], 0.0);
   // Millard: its equilibrium stops at its minimum length rather than failing
   const auto mil = makeMuscleModel("Millard2012EquilibriumMuscle", test::triLong());
@@ -114,7 +117,7 @@ TEST(HillHardCases, PennationNearNinetyDegrees) {
 TEST(HillHardCases, StiffTendonsConvergeToTheRigidTendon) {
   // Millard, elastic tendon with strain_at_one_norm_force e0 -> 0, against the same muscle with
   // ignore_tendon_compliance: the equilibrium tendon force converges, the difference about
-  // proportional to e0 (the tendon's share of the path length is ~ e0 l_s)
+  // bounded by 0.2 e0 (the tendon's share of the path length is ~ e0 l_s)
   MuscleParameters rigid = test::triLong();
   rigid.set("ignore_tendon_compliance", 1);
   const auto r = makeMuscleModel("Millard2012EquilibriumMuscle", rigid);
@@ -136,7 +139,8 @@ TEST(HillHardCases, StiffTendonsConvergeToTheRigidTendon) {
     std::printf("[ measured ] e0 %.4f: elastic %.4f N, rigid %.4f N, relative difference %.3e\n", e0,
                 out.tendon_force, ro.tendon_force, diff);
     EXPECT_LT(diff, previous);
-    if (e0 <= 0.002) EXPECT_LT(diff, 30 * e0);
+    // measured diff / e0: 0.13, 0.073, 0.029, 0.020 (faster than linear)
+    EXPECT_LT(diff, 0.2 * e0);
     previous = diff;
   }
 }

@@ -141,9 +141,10 @@ TEST(Schutte1993Muscle, ActivationAndFibreVelocityClosedForms) {
       const double v = s.fiberVelocity(1.0, Fa, Fv);
       const double back = v <= 0 ? Fa * kv * (1 + v) / (kv - v) + d * v : Fa * (alpha + 1.4 * v) / (alpha + v) + d * v;
       worst = std::max(worst, std::abs(back - Fv));
-      EXPECT_EQ(v > 0, Fv > Fa) << Fa << " " << Fv;
+      if (std::abs(Fv - Fa) > 1e-9) EXPECT_EQ(v > 0, Fv > Fa) << Fa << " " << Fv;
     }
-  EXPECT_LE(worst, 1e-13);  // measured 2.2e-16 .. 5.6e-16
+  std::printf("[ measured ] Schutte inverse force-velocity residual %.2e\n", worst);
+  EXPECT_LE(worst, 2e-14);  // measured 3.2e-15
   EXPECT_EQ(s.fiberVelocity(1.0, 0.6, 0.6), 0.0);
   // default passive curve: exp(8 (l - 1)) / exp(4), 1 at l = 1.5
   EXPECT_NEAR(s.passiveForce(1.5), 1.0, 1e-15);
@@ -176,7 +177,7 @@ TEST(Schutte1993Muscle, RatesFollowTheForceBalance) {
 
 TEST(Schutte1993Muscle, EquilibriumWithinOpenSimsLimit) {
   const auto m = makeMuscleModel("Schutte1993Muscle_Deprecated", schutte());
-  double worst = 0;
+  double worst = 0, worst_rate = 0;
   for (double L : {0.28, 0.3, 0.32})
     for (double a : {0.05, 0.5, 1.0}) {
       double z[2] = {a, 0.0}, zd[2];
@@ -188,10 +189,12 @@ TEST(Schutte1993Muscle, EquilibriumWithinOpenSimsLimit) {
       const double fpe = std::exp(8 * (lN - 1)) / std::exp(4.0);
       const double resid = out.tendon_force - (a * fal + fpe) * 500 * std::cos(out.pennation_angle);
       worst = std::max(worst, std::abs(resid));
-      // isometric: the fibre rate there is small against l_opt / time_scale = 1 m/s
-      EXPECT_LE(std::abs(zd[1]), 2e-4) << L << " " << a;
+      worst_rate = std::max(worst_rate, std::abs(zd[1]));
     }
-  EXPECT_LE(worst, 0.01);
+  std::printf("[ measured ] Schutte equilibrium residual %.2e N, fibre rate %.2e m/s\n", worst, worst_rate);
+  EXPECT_LE(worst, 0.01);  // OpenSim's ERROR_LIMIT
+  // isometric: the fibre rate there is small against l_opt / time_scale = 1 m/s
+  EXPECT_LE(worst_rate, 5e-5);  // measured 1.0e-5
 }
 
 TEST(Schutte1993Muscle, CurveDerivativesAreTheCurves) {
