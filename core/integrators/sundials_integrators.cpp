@@ -300,13 +300,15 @@ struct SundialsSolver {
                                                  : CVode(mem, t_out, y, &tret, CV_ONE_STEP);
       if (flag >= 0 && !rhs_exception) break;
       // rk45: a stage the dynamics refused; retry from the step's start with a quarter of the
-      // step (kMaxRetries quarterings: 4^-25 ~ 1e-15 of it), as Simbody's integrators shrink a
-      // step whose evaluation failed
+      // step, as Simbody's integrators shrink a step whose evaluation failed. A refusal that
+      // persists (a NaN from some time on) ends when the step falls below 1e-10 (1 + |t|): the
+      // accepted steps creep up to the bad time and fail there
       constexpr int kMaxRetries = 25;
       sunrealtype h = 0.0;
       if (kind == SundialsKind::Erk) ERKStepGetCurrentStep(mem, &h);
+      const double h_min = 1e-10 * (1.0 + std::abs(t_cur));
       if (kind != SundialsKind::Erk || rhs_exception || !rhs_recoverable || retry >= kMaxRetries ||
-          !(h > 0.0))
+          !(0.25 * h > h_min))
         fail("step failed", flag);
       syncStats(st);
       ++st.failed_steps;
