@@ -50,10 +50,10 @@ struct SundialsSolver {
   std::exception_ptr rhs_exception;  // thrown inside the RHS (never propagated through C frames)
   std::string rhs_error;             // why the RHS refused (non-finite input or output)
   double rhs_error_t = 0.0;          // at which time
-  // The RHS refused a trial stage (non-finite state, acceleration or rate): recoverable, a smaller
-  // step may stay inside the model's domain (a muscle's fibre pushed far beyond its curves by one
-  // long stage, docs/forward.md §1). CVODE retries such a step itself; ERKStep treats every RHS
-  // error as fatal, so step() retries it from the last accepted state with a quarter of the step.
+  // The RHS refused a trial stage (non-finite state, acceleration or rate): a smaller step may
+  // stay inside the model's domain (a muscle's fibre pushed far beyond its curves by one long
+  // stage, docs/forward.md §1). ERKStep treats every RHS error as fatal, so for rk45 step()
+  // retries it from the last accepted state with a quarter of the step.
   bool rhs_recoverable = false;
   N_Vector y_accepted = nullptr;     // y at t_cur, the start of the step being tried (rk45)
   std::string sun_message;           // last error reported by SUNDIALS
@@ -127,13 +127,14 @@ struct SundialsSolver {
     if (flag < 0) fail(std::string(call) + " failed", flag);
   }
 
-  /// a non-finite input or output of the dynamics: recoverable (a smaller step may avoid it; a
-  /// singular mass matrix stays singular and fails after the retries)
+  /// a non-finite input or output of the dynamics: rk45 retries the step (step(); a singular mass
+  /// matrix stays singular and fails after the retries); cvode stops (its own recoverable-error
+  /// retries creep up to a persisting NaN for minutes)
   int refuse(const std::string& why, double t) {
     rhs_error = why;
     rhs_error_t = t;
     rhs_recoverable = true;
-    return 1;
+    return -1;
   }
 
   static int rhs(sunrealtype t, N_Vector yv, N_Vector ydot, void* user) {

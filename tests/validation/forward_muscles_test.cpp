@@ -108,10 +108,10 @@ TEST(ForwardMuscles, Arm26OwnThelenClassCompletesUnderRk45AndAgreesWithCvode) {
   std::printf(", fibre lengths %.2e (%s)", lf, which.c_str());
   const double a = worstRms(run[0].states, run[1].states, "activation", &which);
   std::printf(", activations %.2e (%s)\n", a, which.c_str());
-  EXPECT_LE(q, 1e-3);
-  EXPECT_LE(u, 1e-2);
-  EXPECT_LE(lf, 1e-4);
-  EXPECT_LE(a, 1e-5);
+  EXPECT_LE(q, 1e-3);   // measured 1.9e-4
+  EXPECT_LE(u, 3e-3);   // measured 7.7e-4 (rk45 1e-5 against cvode 1e-8)
+  EXPECT_LE(lf, 3e-5);  // measured 7.6e-6
+  EXPECT_LE(a, 1e-5);   // measured 1.5e-6
   // the run passes where it stopped before (t = 0.184 s); TRImed's fibre stays physical
   const int c = column(run[0].states, "/forceset/TRImed/fiber_length");
   ASSERT_GE(c, 0);
