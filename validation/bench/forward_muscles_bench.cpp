@@ -4,7 +4,7 @@
 //                     1e-5, read as Thelen2003Muscle_Deprecated (the standard's class)
 //   arm26_thelen      the same setup with the model's own Thelen2003Muscle, rk45 and cvode
 //   gait2354_<mass>   gait2354 (23 DoF, 54 Thelen2003Muscle), every muscle at excitation 0.2 from
-//                     equilibrium, 0.1 s, cvode at 1e-4; lumped and with physiological muscle mass
+//                     equilibrium, 0.1 s, at 1e-4: cvode lumped and with physiological muscle mass, rk45 lumped
 // Reported as the counter sim_per_wall (simulated s / wall s, higher is faster) beside steps and
 // right-hand sides. OpenSim's ForwardTool is not run here (no OpenSim on this machine): there is
 // no ratio against it. Needs ../shared (REDMAX_SHARED_DIR); not run by ctest.
@@ -83,12 +83,12 @@ void Arm26(benchmark::State& st, std::string muscle_class, std::string integrato
   runTool(st, s);
 }
 
-void Gait2354(benchmark::State& st, bool with_mass) {
+void Gait2354(benchmark::State& st, bool with_mass, std::string integrator) {
   static const std::string setup =
       constantExcitationSetup(shared("opensim-models/Models/Gait2354_Simbody/gait2354_simbody.osim"), 0.1, 0.2, 1e-4);
   ForwardToolSettings s;
   s.setup_file = setup;
-  s.integrator = "cvode";
+  s.integrator = integrator;
   if (with_mass) s.muscle_mass.source = redmax::osim::MuscleMassOptions::Source::Physiological;
   runTool(st, s);
 }
@@ -97,8 +97,10 @@ BENCHMARK_CAPTURE(Arm26, standard_deprecated_rk45, std::string("Thelen2003Muscle
     ->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(Arm26, thelen_rk45, std::string(""), std::string("rk45"))->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(Arm26, thelen_cvode, std::string(""), std::string("cvode"))->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK_CAPTURE(Gait2354, lumped, false)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK_CAPTURE(Gait2354, physiological_mass, true)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(Gait2354, lumped_cvode, false, std::string("cvode"))->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(Gait2354, physiological_mass_cvode, true, std::string("cvode"))
+    ->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(Gait2354, lumped_rk45, false, std::string("rk45"))->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 
