@@ -6,7 +6,6 @@
 //   - the wrist (25 Schutte1993Muscle_Deprecated with their SimmSpline curves) stays finite;
 //   - a run that needs cvode: rk45 takes thousands of steps where cvode takes tens (docs/forward.md §5).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -15,6 +14,7 @@
 #include <sstream>
 
 #include "converter/osim_reader.hpp"
+#include "tests/converter/converter_test_util.hpp"
 #include "validation/forward/forward_tool.hpp"
 
 namespace redmax::validation {
@@ -23,19 +23,6 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string shared(const std::string& rel) { return std::string(REDMAX_SHARED_DIR) + "/opensim/" + rel; }
-
-struct TempDir {
-  TempDir() : path(fs::temp_directory_path() / ("redmax_forward_muscles_" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(path / name) << text;
-    return (path / name).string();
-  }
-  fs::path path;
-};
 
 /// a ForwardTool setup for `model` from t0 to t1, every muscle at a constant excitation
 std::string constantExcitationSetup(const std::string& model, double t1, double excitation, double tolerance) {
@@ -124,7 +111,7 @@ TEST(ForwardMuscles, Arm26OwnThelenClassCompletesUnderRk45AndAgreesWithCvode) {
 TEST(ForwardMuscles, WristSchutteMusclesStayFinite) {
   const std::string model = shared("opensim-models/Models/WristModel/wrist.osim");
   if (!fs::exists(model)) GTEST_SKIP() << "shared OpenSim data not found: " << model;
-  TempDir dir;
+  osim::test::TempDir dir;
   ForwardToolSettings s;
   s.setup_file = dir.write("setup.xml", constantExcitationSetup(model, 0.1, 0.3, 1e-5));
   s.report_interval = 0.01;
