@@ -5,6 +5,7 @@
 #include <map>
 
 #include "converter/detail/osim_functions.hpp"
+#include "converter/build/muscle_curves.hpp"
 #include "converter/detail/osim_reader_impl.hpp"
 #include "core/muscles/hill/factory.hpp"
 
@@ -428,6 +429,16 @@ void OsimReader::readMuscleParameters(const XMLElement* e, PathForceDesc& m) {
       m.parameter_lines[tag] = lineOf(c);
     }
   }
+  // Function-valued curves (RigidTendonMuscle, Schutte1993Muscle_Deprecated, read for every class
+  // so that --muscle-class finds them); their absent ones are the class's default SimmSplines
+  for (const char* key : {"active_force_length_curve", "passive_force_length_curve", "force_velocity_curve",
+                          "tendon_force_length_curve"}) {
+    if (auto f = findFunctionProperty(doc(), e, key)) {
+      p.curves[key] = muscleCurve(*f, doc().path(), m.class_name + " '" + m.name + "' " + key);
+      m.parameter_lines[key] = f->line;
+    }
+  }
+  p.simm_spline = muscleSplineFactory();
   // pennation_angle: the <= 20301 spelling (Muscle::updateFromXMLNode)
   if (!p.has("pennation_angle_at_optimal"))
     if (const XMLElement* c = firstChild(e, "pennation_angle"); c && !textOf(c).empty()) {

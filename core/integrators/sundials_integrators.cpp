@@ -50,6 +50,12 @@ struct SundialsSolver {
   std::exception_ptr rhs_exception;  // thrown inside the RHS (never propagated through C frames)
   std::string rhs_error;             // why the RHS refused (non-finite input or output)
   double rhs_error_t = 0.0;          // at which time
+  // The RHS refused a trial stage (non-finite state, acceleration or rate): a smaller step may
+  // stay inside the model's domain (a muscle's fibre pushed far beyond its curves by one long
+  // stage, docs/forward.md §1). ERKStep treats every RHS error as fatal, so for rk45 step()
+  // retries it from the last accepted state with a quarter of the step.
+  bool rhs_recoverable = false;
+  N_Vector y_accepted = nullptr;     // y at t_cur, the start of the step being tried (rk45)
   std::string sun_message;           // last error reported by SUNDIALS
 
   // where the internal solution is, and what the last advance() returned
@@ -71,6 +77,8 @@ struct SundialsSolver {
     if (A) SUNMatDestroy(A);
     if (y) N_VDestroy(y);
     if (yout) N_VDestroy(yout);
+    if (y_accepted) N_VDestroy(y_accepted);
+    y_accepted = nullptr;
     if (ctx) SUNContext_Free(&ctx);
     mem = nullptr;
     LS = nullptr;
@@ -119,6 +127,16 @@ struct SundialsSolver {
     if (flag < 0) fail(std::string(call) + " failed", flag);
   }
 
+  /// a non-finite input or output of the dynamics: rk45 retries the step (step(); a singular mass
+  /// matrix stays singular and fails after the retries); cvode stops (its own recoverable-error
+  /// retries creep up to a persisting NaN for minutes)
+  int refuse(const std::string& why, double t) {
+    rhs_error = why;
+    rhs_error_t = t;
+    rhs_recoverable = true;
+    return -1;
+  }
+
   static int rhs(sunrealtype t, N_Vector yv, N_Vector ydot, void* user) {
     auto* self = static_cast<SundialsSolver*>(user);
     try {
@@ -129,9 +147,7 @@ struct SundialsSolver {
       if (!Y.allFinite()) {
         std::ostringstream os;
         os << "non-finite state passed to the dynamics at t = " << t;
-        self->rhs_error = os.str();
-        self->rhs_error_t = t;
-        return -1;
+        return self->refuse(os.str(), t);
       }
       State& s = self->scratch;
       s.t = t;
@@ -143,9 +159,7 @@ struct SundialsSolver {
         if (!std::isfinite(qddot[k])) {
           std::ostringstream os;
           os << "non-finite qddot[" << k << "] = " << qddot[k] << " at t = " << t;
-          self->rhs_error = os.str();
-          self->rhs_error_t = t;
-          return -1;  // unrecoverable: no smaller step fixes a singular mass matrix
+          return self->refuse(os.str(), t);
         }
       }
       for (int k = 0; k < nz; ++k) {
@@ -154,9 +168,7 @@ struct SundialsSolver {
           os << "non-finite rate of state "
              << (k < static_cast<int>(self->z_names.size()) ? self->z_names[k] : "z[" + std::to_string(k) + "]")
              << " = " << self->ws->zdot[k] << " at t = " << t;
-          self->rhs_error = os.str();
-          self->rhs_error_t = t;
-          return -1;
+          return self->refuse(os.str(), t);
         }
       }
       Yd.head(n) = s.qdot;
@@ -184,7 +196,8 @@ struct SundialsSolver {
     N = n2;
     y = N_VNew_Serial(N, ctx);
     yout = N_VNew_Serial(N, ctx);
-    if (!y || !yout) fail("N_VNew_Serial failed", 0);
+    y_accepted = N_VNew_Serial(N, ctx);
+    if (!y || !yout || !y_accepted) fail("N_VNew_Serial failed", 0);
   }
 
   /// (re)initialise the solver at (t0, y); keeps all options
@@ -200,6 +213,7 @@ struct SundialsSolver {
         if (opt.max_step > 0.0) check(ERKStepSetMaxStep(mem, opt.max_step), "ERKStepSetMaxStep");
         if (opt.initial_step > 0.0) check(ERKStepSetInitStep(mem, opt.initial_step), "ERKStepSetInitStep");
       } else {
+        check(ERKStepSetInitStep(mem, opt.initial_step), "ERKStepSetInitStep");
         check(ERKStepReInit(mem, &SundialsSolver::rhs, t0, y), "ERKStepReInit");
       }
     } else {
@@ -276,13 +290,34 @@ struct SundialsSolver {
   }
 
   /// one internal step towards t_out; returns the new internal time
-  double step(double t_out) {
+  double step(double t_out, IntegratorStats& st) {
     sunrealtype tret = t_cur;
-    rhs_error.clear();
-    sun_message.clear();
-    const int flag = kind == SundialsKind::Erk ? ERKStepEvolve(mem, t_out, y, &tret, ARK_ONE_STEP)
-                                               : CVode(mem, t_out, y, &tret, CV_ONE_STEP);
-    if (flag < 0 || rhs_exception) fail("step failed", flag);
+    if (kind == SundialsKind::Erk) N_VScale(1.0, y, y_accepted);
+    for (int retry = 0;; ++retry) {
+      rhs_error.clear();
+      sun_message.clear();
+      rhs_recoverable = false;
+      const int flag = kind == SundialsKind::Erk ? ERKStepEvolve(mem, t_out, y, &tret, ARK_ONE_STEP)
+                                                 : CVode(mem, t_out, y, &tret, CV_ONE_STEP);
+      if (flag >= 0 && !rhs_exception) break;
+      // rk45: a stage the dynamics refused; retry from the step's start with a quarter of the
+      // step, as Simbody's integrators shrink a step whose evaluation failed. A refusal that
+      // persists (a NaN from some time on) ends when the step falls below 1e-10 (1 + |t|): the
+      // accepted steps creep up to the bad time and fail there
+      constexpr int kMaxRetries = 25;
+      sunrealtype h = 0.0;
+      if (kind == SundialsKind::Erk) ERKStepGetCurrentStep(mem, &h);
+      const double h_min = 1e-10 * (1.0 + std::abs(t_cur));
+      if (kind != SundialsKind::Erk || rhs_exception || !rhs_recoverable || retry >= kMaxRetries ||
+          !(0.25 * h > h_min))
+        fail("step failed", flag);
+      syncStats(st);
+      ++st.failed_steps;
+      N_VScale(1.0, y_accepted, y);
+      check(ERKStepSetInitStep(mem, 0.25 * h), "ERKStepSetInitStep");
+      check(ERKStepReInit(mem, &SundialsSolver::rhs, t_cur, y), "ERKStepReInit");
+      resetCounterBaseline();
+    }
     t_cur = tret;
     return tret;
   }
@@ -400,7 +435,7 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
            << " with step h = " << S.lastStep() << " (stiff or singular dynamics?)";
         throw SimulationError(os.str(), S.t_cur, S.lastStep());
       }
-      const double t = S.step(t_out);
+      const double t = S.step(t_out, stats_);
       S.syncStats(stats_);
       toState(S.y, n, nz, t, internal);
       checkFinite(internal, S.lastStep(), who.c_str(), z_names);

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/muscles/hill/curve.hpp"
 #include "core/muscles/hill/muscle_model.hpp"
 
 namespace redmax::hill {
@@ -29,12 +30,20 @@ class MuscleParameterError : public MuscleModelError {
 struct MuscleParameters {
   std::string name;                      ///< the muscle's name, for messages
   std::map<std::string, double> values;  ///< property name -> value
+  /// Function-valued properties as written (e.g. "active_force_length_curve"), built by the reader
+  std::map<std::string, CurvePtr> curves;
+  /// makes a class's default SimmSpline curves (absent function properties); may be empty when no
+  /// class that needs one is built
+  SplineFactory simm_spline;
 
   bool has(const std::string& key) const { return values.count(key) > 0; }
   /// the property's value, or `fallback` when absent
   double get(const std::string& key, double fallback) const;
   bool flag(const std::string& key, bool fallback) const { return get(key, fallback ? 1 : 0) != 0; }
   void set(const std::string& key, double v) { values[key] = v; }
+  /// the curve written as `key`, else OpenSim's default SimmSpline through (x, y); throws
+  /// MuscleParameterError(key) when it is absent and no simm_spline factory is given
+  CurvePtr curveOr(const std::string& key, const std::vector<double>& x, const std::vector<double>& y) const;
 };
 
 /// A model's parameters as it uses them (after defaults), for reports: (name, value) in a fixed

@@ -3,6 +3,7 @@
 // model, clamped first-order activation and an extrapolated force-velocity inverse) and
 // Thelen2003Muscle_Deprecated (the 1.x-3.x code the arm26 ForwardTool standard was made with).
 // States (activation, fiber_length) in that order; docs/muscle_dynamics.md gives the equations.
+#include "core/muscles/hill/deprecated_muscle.hpp"
 #include "core/muscles/hill/muscle_model.hpp"
 #include "core/muscles/hill/muscle_properties.hpp"
 #include "core/muscles/hill/parameters.hpp"
@@ -75,9 +76,8 @@ class Thelen2003MuscleDeprecated final : public MuscleWithProperties {
  private:
   /// the 2.x pennation: asin(l_opt sin(phi_opt) / l_f), 0 and pi/2 at its ends
   double pennation(double l_f, double l_opt) const;
-  /// computeIsometricForce: the tendon force (N) of the iteration at activation a; the fibre
-  /// length it ends at goes to *fiber_length
-  double isometricForce(const MusculotendonInput& in, double a, double* fiber_length) const;
+  /// the curves computeIsometricForce iterates on (deprecated_muscle.hpp)
+  IsometricCurves isometricCurves() const;
 
   Thelen2003DeprecatedCurves c_;
   double tau_act_ = 0.01, tau_deact_ = 0.04, Vmax_ = 10.0, Vmax0_ = 5.0;
