@@ -85,10 +85,11 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   const VecX& l = mk.l;
   const VecX& ld = mk.ldot;
   const VecX& s = mk.s;
+  // L (n x n, row r: internal point r + 1): sub(r) = -l[r+1], diag(r) = l[r] + l[r+1], super(r) = -l[r]
+  auto Lsub = [&](int r) { return -l[r + 1]; };
+  auto Ldiag = [&](int r) { return l[r] + l[r + 1]; };
+  auto Lsuper = [&](int r) { return -l[r]; };
   if (n > 0) {
-    auto Lsub = [&](int r) { return -l[r + 1]; };
-    auto Ldiag = [&](int r) { return l[r] + l[r + 1]; };
-    auto Lsuper = [&](int r) { return -l[r]; };
     // (DeltaS v)_r = -Delta s_{r+1} v_r + Delta s_r v_{r+1}   (row r: internal point r + 1)
     auto dS = [&](const auto& v, int r) { return -(s[r + 2] - s[r + 1]) * v[r] + (s[r + 1] - s[r]) * v[r + 1]; };
     // L sdot = -DeltaS ldot
@@ -156,8 +157,8 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   // 3. Eulerian forces onto the path points: J_sx^T g = -DeltaXbar^T DeltaS^T L^-T g
   if (n > 0) {
     sc.rhs = sc.force_s.segment(1, n);
-    solveTridiagonal(n, [&](int r) { return -l[r]; }, [&](int r) { return l[r] + l[r + 1]; },
-                     [&](int r) { return -l[r + 2]; }, sc.rhs, sc.tri_c);
+    // L^T: sub(r) = L(r-1, r) = -l[r-1], super(r) = L(r+1, r) = -l[r+2]
+    solveTridiagonal(n, [&](int r) { return -l[r - 1]; }, Ldiag, [&](int r) { return -l[r + 2]; }, sc.rhs, sc.tri_c);
     for (int i = 0; i < ns; ++i) {
       double k = 0.0;  // (DeltaS^T h)_i
       if (i < n) k -= (s[i + 2] - s[i + 1]) * sc.rhs[i];
