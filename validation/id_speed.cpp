@@ -11,6 +11,7 @@
 
 #include "converter/id/core_id_engine.hpp"
 #include "converter/storage.hpp"
+#include "core/dynamics/skeleton_dynamics.hpp"
 #include "plugin/simbody/id_engine.hpp"
 #include "plugin/simbody/simbody_options.hpp"
 #include "validation/simbody_cross_check.hpp"
@@ -90,9 +91,46 @@ IdSpeedResult timeIdEngines(const IdSpeedOptions& options) {
     r.simbody_note = "not requested";
   }
   osim::CoreIdEngine core(model, tool.engineOptions());
+  osim::CoreIdEngine core_m(model, tool.engineOptions());
+  core_m.setRoute(osim::CoreIdEngine::Route::MassMatrix);
   const double n = std::max(1, r.frames);
   r.core_us_per_frame = 1e6 * timeEngine(core, frames, batches) / n;
+  r.core_mass_matrix_us = 1e6 * timeEngine(core_m, frames, batches) / n;
   if (simbody) r.simbody_us_per_frame = 1e6 * timeEngine(*simbody, frames, batches) / n;
+  {
+    // the floor: Newton-Euler on the same tree and frames, nothing else
+    RecursiveIdWorkspace ws(model);
+    State st;
+    VecX tau;
+    double best = std::numeric_limits<double>::infinity();
+    for (int b = 0; b < batches; ++b) {
+      const auto t0 = Clock::now();
+      for (const Frame& f : frames) {
+        st.q = f.q;
+        st.qdot = f.v;
+        inverseDynamicsRecursive(model, st, f.vdot, ws, tau);
+      }
+      best = std::min(best, since(t0));
+    }
+    r.bare_recursive_us = 1e6 * best / n;
+  }
+  if (options.muscle_mass.source != osim::MuscleMassOptions::Source::None) {
+    // the same frames with muscle mass: the tool moves mass from the bones into the muscles
+    osim::IdToolSettings s = options.settings;
+    s.muscle_mass = options.muscle_mass;
+    const osim::InverseDynamicsTool mtool(osim::resolveIdSettings(s));
+    osim::CoreIdEngine rec(mtool.musculoskeletalModel(), mtool.engineOptions());
+    osim::CoreIdEngine ref(mtool.musculoskeletalModel(), mtool.engineOptions());
+    ref.setRoute(osim::CoreIdEngine::Route::MassMatrix);
+    r.muscle_mass_kg = rec.muscleMass();
+    for (const Muscle& m : mtool.musculoskeletalModel().muscles())
+      if (m.mass_points.size() > 0) {
+        ++r.mass_muscles;
+        r.mass_points += m.mass_points.size();
+      }
+    r.core_mass_us = 1e6 * timeEngine(rec, frames, batches) / n;
+    r.core_mass_matrix_mass_us = 1e6 * timeEngine(ref, frames, batches) / n;
+  }
   return r;
 }
 
@@ -108,6 +146,23 @@ std::string formatIdSpeed(const IdSpeedResult& r) {
     std::snprintf(buf, sizeof buf, "  per frame (fastest batch): core %.2f us, Simbody -\n", r.core_us_per_frame);
   s += buf;
   if (!r.simbody_note.empty()) s += "  note: " + r.simbody_note + "\n";
+  std::snprintf(buf, sizeof buf,
+                "  core routes: recursive %.2f us, mass-matrix %.2f us; bare Newton-Euler on the same tree %.2f us "
+                "(trial path / bare %.2f)\n",
+                r.core_us_per_frame, r.core_mass_matrix_us, r.bare_recursive_us,
+                r.bare_recursive_us > 0 ? r.core_us_per_frame / r.bare_recursive_us : 0.0);
+  s += buf;
+  if (r.core_mass_us > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "  with muscle mass (%d muscles, %d points, %.3f kg): core recursive %.2f us, mass-matrix %.2f us",
+                  r.mass_muscles, r.mass_points, r.muscle_mass_kg, r.core_mass_us, r.core_mass_matrix_mass_us);
+    s += buf;
+    if (r.simbody_us_per_frame > 0) {
+      std::snprintf(buf, sizeof buf, "; recursive / Simbody massless %.3f", r.core_mass_us / r.simbody_us_per_frame);
+      s += buf;
+    }
+    s += "\n";
+  }
   std::snprintf(buf, sizeof buf,
                 "  whole `redmax id` run (read, process, solve with core, write): %.3f s = %.3f s setup + %.2f ms "
                 "for %d frames (%.0f frames/s after setup)\n",

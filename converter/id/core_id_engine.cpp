@@ -82,10 +82,16 @@ void CoreIdEngine::calcGeneralizedForces(double t, const VecX& q, const VecX& v,
   }
 
   // external loads at the current poses (an input of this evaluation), then tau = M qddot - f
-  // [D Eq. 4.18]
-  calcBodyPoses(m, q, ws.E_wi);
-  resolveLoads(loads, ws.E_wi, ws.dyn.loads);
-  tau = system_.inverseDynamics(ws.state, ws.qddot, ws.dyn);
+  // [D Eq. 4.18]: recursively (the forward pass gives the poses) or through M
+  if (route_ == Route::Recursive) {
+    system_.beginInverseDynamics(ws.state, ws.qddot, ws.dyn);
+    resolveLoads(loads, ws.dyn.rid.E_wi, ws.dyn.loads);
+    system_.finishInverseDynamics(ws.state, ws.qddot, ws.dyn, tau);
+  } else {
+    calcBodyPoses(m, q, ws.E_wi);
+    resolveLoads(loads, ws.E_wi, ws.dyn.loads);
+    tau = system_.inverseDynamics(ws.state, ws.qddot, ws.dyn);
+  }
 
   // back to OpenSim's u: tau_u = T^-T tau_qdot
   for (size_t k = 0; k < marked_.size(); ++k) {

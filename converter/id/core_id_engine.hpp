@@ -38,7 +38,7 @@ struct CoreIdWorkspace {
   // inputs of the frame in the core's convention (equal to (v, vdot) without marked joints)
   State state;               // t, q, qdot                                      (nr)
   VecX qddot;                //                                                 (nr)
-  // position stage: poses for the loads, speed maps of the marked joints
+  // position stage: poses for the loads (MassMatrix route), speed maps of the marked joints
   std::vector<Mat4> E_wi;    // body poses                                      (nb)
   std::vector<MatJ> T;       // u = T qdot per marked joint (mapping tau back)  (marked)
   // the System's evaluation; dyn.loads holds the frame's resolved external loads
@@ -58,6 +58,13 @@ class CoreIdEngine final : public IdEngine {
   /// of variables applies unchanged. Constraints and force elements are not solved (OpenSim's ID).
   explicit CoreIdEngine(const MusculoskeletalModel& model, IdEngineOptions options = {});
   std::string name() const override { return "core"; }
+  /// How tau is computed: Recursive (default; System::beginInverseDynamics / finishInverseDynamics:
+  /// Newton-Euler, the GRFs and the muscles' mass points as body wrenches, docs/performance.md §6)
+  /// or MassMatrix (System::inverseDynamics, tau = M qddot - f [D Eq. 4.18]: the reference, equal
+  /// to round-off, tests/validation/id_routes_test.cpp).
+  enum class Route { Recursive, MassMatrix };
+  void setRoute(Route route) { route_ = route; }
+  Route route() const { return route_; }
   /// one frame with the engine's own workspace (lastState(), lastQddot())
   void calcGeneralizedForces(double t, const VecX& q, const VecX& v, const VecX& vdot,
                              const std::vector<IdLoadSample>& loads, VecX& tau) override;
@@ -85,6 +92,7 @@ class CoreIdEngine final : public IdEngine {
   IdEngineOptions options_;
   std::vector<int> marked_;  // marked joint slots
   double muscle_mass_ = 0.0;
+  Route route_ = Route::Recursive;
   CoreIdWorkspace ws_;       // for the IdEngine interface (one caller at a time)
 };
 

@@ -67,6 +67,13 @@ struct TermContext {
   }
 };
 
+/// How a term takes part in recursive inverse dynamics (System::inverseDynamicsRecursive).
+enum class TermIdRoute {
+  MassMatrix,             ///< through addMass and addForce: the System adds M_t qddot - f_t
+  Wrenches,               ///< addInverseDynamics from the body motion alone (no J_mr)
+  WrenchesWithKinematics  ///< addInverseDynamics, which also reads ctx.sk (Stage::Velocity)
+};
+
 class ForceTerm {
  public:
   virtual ~ForceTerm() = default;
@@ -107,6 +114,15 @@ class ForceTerm {
     Mdot_v.noalias() += ((Mp - Mm) * s.qdot) / (2.0 * e);
   }
   virtual double kineticEnergy(const Model&, const State&, const TermContext&) const { return 0.0; }
+
+  // recursive inverse dynamics; default: the System forms this term's M_t qddot - f_t
+  virtual TermIdRoute idRoute() const { return TermIdRoute::MassMatrix; }
+  /// this term's share of M qddot - f at (s, qddot) [D Eq. 4.18] (idRoute() other than
+  /// MassMatrix): wrenches the bodies must supply for it added to wrench[b] (body coordinates;
+  /// the skeleton's backward pass maps them through J_mr^T) and generalized forces that act on no
+  /// body added to tau (nr). `motion`: poses, twists and their rates at (s, qddot).
+  virtual void addInverseDynamics(const Model&, const State&, const VecX& qddot, const TermContext&,
+                                  const BodyMotion& motion, std::vector<Vec6>& wrench, VecX& tau) const {}
 
   // auxiliary first-order states (State::z) and controls; defaults: none
   /// number of states this term owns in State::z

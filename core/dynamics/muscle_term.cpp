@@ -10,7 +10,10 @@ MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTe
     : muscles_(std::move(muscles)), options_(options), nr_(model.nr()) {
   for (const Muscle& m : muscles_) {
     validateMuscle(model, m);
-    if (m.mass_points.size() > 0) massive_.push_back(m);
+    if (m.mass_points.size() > 0) {
+      massive_.push_back(m);
+      wraps_.push_back(pathType(m.path) == PathType::III);
+    }
   }
 }
 
@@ -100,6 +103,47 @@ void MuscleTerm::addMassDotTimesVelocity(const Model& model, const State& s, con
       sc.fc.noalias() += J.transpose() * m_Jdv;
     }
     scatterAddColumns(sc.fc, mk, Mdot_v);
+  }
+}
+
+TermIdRoute MuscleTerm::idRoute() const {
+  if (!options_.quadratic_velocity) return TermIdRoute::WrenchesWithKinematics;
+  for (char w : wraps_)
+    if (w) return TermIdRoute::WrenchesWithKinematics;
+  return TermIdRoute::Wrenches;
+}
+
+void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const VecX& qddot, const TermContext& ctx,
+                                    const BodyMotion& motion, std::vector<Vec6>& wrench, VecX& tau) const {
+  if (massive_.empty()) return;
+  if (model.nr() != nr_)
+    throw std::logic_error("MuscleTerm: built for a model with " + std::to_string(nr_) +
+                           " coordinates, used with one with " + std::to_string(model.nr()));
+  auto* slot = dynamic_cast<MuscleTermScratch*>(ctx.scratch);
+  MuscleTermScratch local;
+  MuscleTermScratch& sc = slot ? *slot : local;
+  if (sc.ws.muscles.size() != massive_.size()) sc.ws = MuscleWorkspace(model, massive_);
+  sc.id.resize(massive_.size());
+  sc.evaluation = 0;  // the muscles' kinematics below are partial: no reuse by addMass & co.
+  for (size_t m = 0; m < massive_.size(); ++m) {
+    const Muscle& mu = massive_[m];
+    MuscleKinematics& mk = sc.ws.muscles[m];
+    if (!wraps_[m] && options_.quadratic_velocity) {
+      addMuscleInverseDynamics(model, s, qddot, motion, model.gravity(), mu, mk, sc.id[m], wrench, tau);
+      continue;
+    }
+    // compact J_ar: sum_a J_ar^T m_a (J_ar qddot + Jdot_ar qdot - g) in the muscle's columns
+    calcMuscleKinematics(model, s, ctx.sk, mu, mk, true);
+    gatherColumns(s.qdot, mk, sc.qdot_c);
+    gatherColumns(qddot, mk, sc.qddot_c);
+    sc.fc.setZero(sc.qdot_c.size());
+    const MassPoints& mp = mu.mass_points;
+    for (int a = 0; a < mp.size(); ++a) {
+      Vec3 acc = mk.J_ar.middleRows<3>(3 * a) * sc.qddot_c - model.gravity();
+      if (options_.quadratic_velocity) acc.noalias() += mk.Jdot_ar.middleRows<3>(3 * a) * sc.qdot_c;
+      sc.fc.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * (mp.mass[a] * acc);
+    }
+    scatterAddColumns(sc.fc, mk, tau);
   }
 }
 

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/dynamics/force_term.hpp"
+#include "core/muscles/muscle_inverse_dynamics.hpp"
 #include "core/muscles/muscle_kinematics.hpp"
 
 namespace redmax {
@@ -40,6 +41,9 @@ struct MuscleTermScratch final : TermScratch {
   MatX scaled_J;                    // sqrt(m_a)-scaled J_ar (addMass)                     (3N x k)
   MatX Mc;                          // its J^T W J                                         (k x k)
   VecX qdot_c, fc;                  // qdot and force in the muscle's columns              (k)
+  // recursive inverse dynamics (addInverseDynamics)
+  std::vector<MuscleIdScratch> id;  // path-wise pass of each Type I/II muscle            (n_massive)
+  VecX qddot_c;                     // qddot in a Type III muscle's columns                (k)
 };
 
 class MuscleTerm final : public ForceTerm {
@@ -57,6 +61,12 @@ class MuscleTerm final : public ForceTerm {
   void addMassDotTimesVelocity(const Model& model, const State& s, const TermContext& ctx,
                                VecX& Mdot_v) const override;
   double kineticEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
+  /// Wrenches (Types I and II: addMuscleInverseDynamics, path-wise, no J_ar); with a Type III
+  /// muscle, or without the quadratic velocity vector, WrenchesWithKinematics: those muscles form
+  /// their compact J_ar, Jdot_ar and add J_ar^T m_a (J_ar qddot (+ Jdot_ar qdot) - g) (no M).
+  TermIdRoute idRoute() const override;
+  void addInverseDynamics(const Model& model, const State& s, const VecX& qddot, const TermContext& ctx,
+                          const BodyMotion& motion, std::vector<Vec6>& wrench, VecX& tau) const override;
   double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
 
   const std::vector<Muscle>& muscles() const { return muscles_; }
@@ -75,6 +85,7 @@ class MuscleTerm final : public ForceTerm {
 
   std::vector<Muscle> muscles_;
   std::vector<Muscle> massive_;        // the muscles with at least one mass point
+  std::vector<char> wraps_;            // per massive muscle: Type III (no path-wise ID)
   MuscleTermOptions options_;
   int nr_ = 0;
 };

@@ -77,55 +77,89 @@ void addJointStiffnessDamping(const Model& model, MatX& K_r, MatX& D_r) {
   }
 }
 
-VecX inverseDynamicsRecursive(const Model& model, const State& state, const VecX& qddot) {
-  // forward pass: body twists and accelerations from joint kinematics; backward pass: wrenches.
-  // Body acceleration (body coordinates): phidot_i = Ad_ip phidot_p + ad(phi_i)... derived from
-  // phi_i = Ad_ip phi_p + psi_i with dAd_ip/dt = -ad(psi_i) Ad_ip:
+RecursiveIdWorkspace::RecursiveIdWorkspace(const Model& model) {
+  const int nb = model.nb();
+  jk.resize(nb);
+  S_i.resize(nb);
+  Ad_ij.resize(nb);
+  for (int i = 0; i < nb; ++i) {
+    const int nq = model.joints()[i].nq;
+    jk[i].resize(nq);
+    S_i[i].setZero(6, nq);
+    Ad_ij[i] = AdInv(model.joints()[i].E_mi);  // E_im = E_mi^-1
+  }
+  Ad_ip.assign(nb, Mat6::Identity());
+  E_wi.assign(nb, Mat4::Identity());
+  phi.assign(nb, Vec6::Zero());
+  phidot.assign(nb, Vec6::Zero());
+  w.assign(nb, Vec6::Zero());
+}
+
+void recursiveIdForward(const Model& model, const State& state, const VecX& qddot, RecursiveIdWorkspace& ws) {
+  // body acceleration (body coordinates), from phi_i = Ad_ip phi_p + psi_i with
+  // dAd_ip/dt = -ad(psi_i) Ad_ip:
   //   phidot_i = Ad_ip phidot_p - ad(psi_i) Ad_ip phi_p + Ad_ij (S qddot + Sdot qdot)
   const int nb = model.nb();
-  std::vector<Vec6> phi(nb), phidot(nb), w(nb);
-  std::vector<Mat6> Ad_ip(nb);
-  std::vector<Mat4> E_wi(nb);
-  std::vector<Mat6X> S_i(nb);
-  JointKinematics jk;
   for (int i = 0; i < nb; ++i) {
     const JointSlot& s = model.joints()[i];
+    JointKinematics& jk = ws.jk[i];
     s.joint.calc(state.q.segment(s.q_index, s.nq), state.qdot.segment(s.q_index, s.nq), jk);
     const Mat4 E_pi = s.E_pf * jk.Q * s.E_mi;
-    const Mat6 Ad_ij = AdInv(s.E_mi);
-    Ad_ip[i] = AdInv(E_pi);
-    S_i[i] = Ad_ij * jk.S;
+    const Mat6& Ad_ij = ws.Ad_ij[i];
+    ws.Ad_ip[i] = AdInv(E_pi);
+    ws.S_i[i].noalias() = Ad_ij * jk.S;
     const auto qd = state.qdot.segment(s.q_index, s.nq);
     const auto qdd = qddot.segment(s.q_index, s.nq);
-    const Vec6 psi = S_i[i] * qd;
-    Vec6 acc = S_i[i] * qdd + Ad_ij * (jk.Sdot * qd);
+    const Vec6 psi = ws.S_i[i] * qd;
+    Vec6 acc = ws.S_i[i] * qdd;
+    acc.noalias() += Ad_ij * (jk.Sdot * qd);
     if (s.parent >= 0) {
       const int p = s.parent;
-      E_wi[i] = E_wi[p] * E_pi;
-      const Vec6 phi_pi = Ad_ip[i] * phi[p];
-      phi[i] = phi_pi + psi;
-      phidot[i] = Ad_ip[i] * phidot[p] - ad(psi) * phi_pi + acc;
+      ws.E_wi[i].noalias() = ws.E_wi[p] * E_pi;
+      const Vec6 phi_pi = ws.Ad_ip[i] * ws.phi[p];
+      ws.phi[i] = phi_pi + psi;
+      ws.phidot[i].noalias() = ws.Ad_ip[i] * ws.phidot[p];
+      ws.phidot[i].noalias() -= ad(psi) * phi_pi;
+      ws.phidot[i] += acc;
     } else {
-      E_wi[i] = E_pi;
-      phi[i] = psi;
-      phidot[i] = acc;
+      ws.E_wi[i] = E_pi;
+      ws.phi[i] = psi;
+      ws.phidot[i] = acc;
     }
     // net wrench the body needs minus what gravity and Coriolis give [D Eq. 3.21]
     const Body& b = model.bodies()[i];
-    const Vec3 g_i = E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity());
-    w[i] = b.M * phidot[i] - ad(phi[i]).transpose() * (b.M * phi[i]) - Gamma(b.com).transpose() * g_i;
+    const Vec3 g_i = ws.E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity());
+    const Vec6 Mphi = b.M * ws.phi[i];
+    ws.w[i].noalias() = b.M * ws.phidot[i];
+    ws.w[i].noalias() -= ad(ws.phi[i]).transpose() * Mphi;
+    ws.w[i].noalias() -= Gamma(b.com).transpose() * g_i;
   }
-  VecX tau(model.nr());
-  for (int i = nb - 1; i >= 0; --i) {
+}
+
+void recursiveIdBackward(const Model& model, const State& state, RecursiveIdWorkspace& ws, VecX& tau) {
+  tau.resize(model.nr());
+  for (int i = model.nb() - 1; i >= 0; --i) {
     const JointSlot& s = model.joints()[i];
-    if (s.nq > 0) tau.segment(s.q_index, s.nq) = S_i[i].transpose() * w[i];
+    if (s.nq > 0) tau.segment(s.q_index, s.nq).noalias() = ws.S_i[i].transpose() * ws.w[i];
     // transmit to the parent: wrenches map with Ad^T
-    if (s.parent >= 0) w[s.parent] += Ad_ip[i].transpose() * w[i];
+    if (s.parent >= 0) ws.w[s.parent].noalias() += ws.Ad_ip[i].transpose() * ws.w[i];
   }
   for (int k = 0; k < model.nr(); ++k) {
     const Coordinate& c = model.coordinates()[k];
     tau[k] -= -c.stiffness * (state.q[k] - c.rest_value) - c.damping * state.qdot[k];
   }
+}
+
+void inverseDynamicsRecursive(const Model& model, const State& state, const VecX& qddot,
+                              RecursiveIdWorkspace& ws, VecX& tau) {
+  recursiveIdForward(model, state, qddot, ws);
+  recursiveIdBackward(model, state, ws, tau);
+}
+
+VecX inverseDynamicsRecursive(const Model& model, const State& state, const VecX& qddot) {
+  RecursiveIdWorkspace ws(model);
+  VecX tau;
+  inverseDynamicsRecursive(model, state, qddot, ws, tau);
   return tau;
 }
 

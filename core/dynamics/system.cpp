@@ -9,7 +9,7 @@
 
 namespace redmax {
 
-DynamicsWorkspace::DynamicsWorkspace(const Model& model) : sk(model) {
+DynamicsWorkspace::DynamicsWorkspace(const Model& model) : sk(model), rid(model) {
   const int n = model.nr();
   M.setZero(n, n);
   f.setZero(n);
@@ -421,6 +421,72 @@ VecX System::forwardDynamics(const State& s, DynamicsWorkspace& ws) const {
 VecX System::inverseDynamics(const State& s, const VecX& qddot, DynamicsWorkspace& ws) const {
   calcMassAndForce(s, ws);
   return ws.M * qddot - ws.f;
+}
+
+void System::inverseDynamicsRecursive(const State& s, const VecX& qddot, DynamicsWorkspace& ws, VecX& tau) const {
+  if (map_ || n_extra_ > 0) {
+    tau = inverseDynamics(s, qddot, ws);
+    return;
+  }
+  beginInverseDynamics(s, qddot, ws);
+  finishInverseDynamics(s, qddot, ws, tau);
+}
+
+void System::beginInverseDynamics(const State& s, const VecX& qddot, DynamicsWorkspace& ws) const {
+  if (map_ || n_extra_ > 0)
+    throw ModelError("System::beginInverseDynamics: not with a coordinate map or extra coordinates");
+  if (nz_ > 0 && s.z.size() != nz_)
+    throw ModelError("System::beginInverseDynamics: state has " + std::to_string(s.z.size()) +
+                     " auxiliary states, the system has " + std::to_string(nz_));
+  recursiveIdForward(model_, s, qddot, ws.rid);
+}
+
+void System::finishInverseDynamics(const State& s, const VecX& qddot, DynamicsWorkspace& ws, VecX& tau) const {
+  bind(ws);
+  RecursiveIdWorkspace& r = ws.rid;
+  // external loads: wrenches the joints need not supply, Gamma(x_i)^T R^T f_w [D Eq. 3.14]
+  for (const PointForce& p : ws.loads.point_forces) {
+    if (p.body < 0) continue;
+    const Vec3 f_i = r.E_wi[p.body].topLeftCorner<3, 3>().transpose() * p.force_w;
+    r.w[p.body].head<3>() -= p.point_i.cross(f_i);
+    r.w[p.body].tail<3>() -= f_i;
+  }
+  for (const BodyWrench& b : ws.loads.wrenches) {
+    if (b.body < 0) continue;
+    const Mat3 Rt = r.E_wi[b.body].topLeftCorner<3, 3>().transpose();
+    r.w[b.body].head<3>() -= Rt * b.torque_w;
+    r.w[b.body].tail<3>() -= Rt * b.force_w;
+  }
+  // the terms: J_mr and controls only when one of them needs them
+  bool need_sk = nu_ > 0, mass_matrix = false;
+  for (const auto& t : terms_) {
+    need_sk = need_sk || t->idRoute() != TermIdRoute::Wrenches;
+    mass_matrix = mass_matrix || t->idRoute() == TermIdRoute::MassMatrix;
+  }
+  if (need_sk) {
+    calcSkeletonKinematics(s, ws);
+    calcControls(s, ws);
+  }
+  const int nr = model_.nr();
+  ws.tau_direct.setZero(nr);
+  const BodyMotion motion = r.motion();
+  for (size_t i = 0; i < terms_.size(); ++i)
+    if (terms_[i]->idRoute() != TermIdRoute::MassMatrix)
+      terms_[i]->addInverseDynamics(model_, s, qddot, context(ws, i), motion, r.w, ws.tau_direct);
+  recursiveIdBackward(model_, s, r, tau);
+  tau += ws.tau_direct;
+  if (!mass_matrix) return;
+  // terms without a recursive form: M_t qddot - f_t in the dynamics-stage buffers
+  ws.M.setZero(nr, nr);
+  ws.f.setZero(nr);
+  for (size_t i = 0; i < terms_.size(); ++i) {
+    if (terms_[i]->idRoute() != TermIdRoute::MassMatrix) continue;
+    const TermContext ctx = context(ws, i);
+    terms_[i]->addMass(model_, s, ctx, ws.M);
+    terms_[i]->addForce(model_, s, ctx, ws.f);
+  }
+  tau.noalias() += ws.M * qddot;
+  tau -= ws.f;
 }
 
 VecX System::prescribedForces(const DynamicsWorkspace& ws) const {

@@ -30,6 +30,7 @@
 #include "core/dynamics/controller.hpp"
 #include "core/dynamics/coordinate_map.hpp"
 #include "core/dynamics/force_term.hpp"
+#include "core/dynamics/skeleton_dynamics.hpp"
 #include "core/skeleton/kinematics.hpp"
 
 namespace redmax {
@@ -71,6 +72,10 @@ struct DynamicsWorkspace {
   VecX lambda;     // constraint multipliers           (nc)
   VecX pos_err, vel_err;                            // (nc)
   VecX zdot;       // auxiliary state derivatives (forwardDynamics, calcStateDerivatives) (nz)
+
+  // recursive inverse dynamics (System::inverseDynamicsRecursive): poses, twists, rates, wrenches
+  RecursiveIdWorkspace rid;
+  VecX tau_direct;  // the terms' generalized forces that act on no body              (nr)
 
   // hyper-reduced coordinates only (System with a CoordinateMap); skeleton-side quantities,
   // sized on first use
@@ -194,6 +199,18 @@ class System {
   VecX forwardDynamics(const State& s, DynamicsWorkspace& ws) const;
   /// generalized forces tau with M qddot = f + tau (REDMAX route, unconstrained) [D Eq. 4.18]
   VecX inverseDynamics(const State& s, const VecX& qddot, DynamicsWorkspace& ws) const;
+  /// The same tau by recursive Newton-Euler, without M, J_mr or the terms' Jacobians where the
+  /// terms allow (docs/performance.md §6): the skeleton's forward pass (poses, twists, their rates),
+  /// ws.loads and every term's share as body wrenches (ForceTerm::idRoute, addInverseDynamics;
+  /// terms of route MassMatrix add M_t qddot - f_t), then the backward pass. Equal to
+  /// inverseDynamics to round-off. With a coordinate map or extra coordinates it is
+  /// inverseDynamics.
+  void inverseDynamicsRecursive(const State& s, const VecX& qddot, DynamicsWorkspace& ws, VecX& tau) const;
+  /// inverseDynamicsRecursive in two steps, so that loads that depend on the poses can be set in
+  /// ws.loads in between: begin runs the forward pass (poses in ws.rid.E_wi), finish adds ws.loads
+  /// and the terms and runs the backward pass. Throws ModelError with a map or extra coordinates.
+  void beginInverseDynamics(const State& s, const VecX& qddot, DynamicsWorkspace& ws) const;
+  void finishInverseDynamics(const State& s, const VecX& qddot, DynamicsWorkspace& ws, VecX& tau) const;
   /// generalized forces (ndof) of the prescribed constraints' rows, -G_p^T lambda_p, after
   /// forwardDynamics: the actuation that realises the prescribed motion [D Eq. 4.109]
   VecX prescribedForces(const DynamicsWorkspace& ws) const;

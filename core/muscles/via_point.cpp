@@ -22,18 +22,22 @@ Eigen::Matrix<double, 3, 8> calcJdot_az(double beta, double betadot, const Vec3&
   return J;
 }
 
-void calcEulerianCoordinates(MuscleKinematics& mk, const std::string& muscle_name) {
-  const int P = static_cast<int>(mk.x_w.size());
-  const int n = P - 2;
-  const int k = static_cast<int>(mk.J_xr.cols());  // compact columns
-  if (n < 1) throw std::logic_error("calcEulerianCoordinates: needs at least one internal path point");
-  for (int i = 0; i < P - 1; ++i) {
+void checkEulerianSegments(const MuscleKinematics& mk, const std::string& muscle_name) {
+  for (int i = 0; i + 1 < static_cast<int>(mk.x_w.size()); ++i) {
     if (mk.l[i] > 1e-12 * (1.0 + mk.length)) continue;
     throw MuscleError("muscle '" + muscle_name + "': path segment " + std::to_string(i) +
                       " (between active points " + std::to_string(mk.active[i]) + " and " +
                       std::to_string(mk.active[i + 1]) +
                       ") has zero length here; mass points need distinct consecutive path points");
   }
+}
+
+void calcEulerianCoordinates(MuscleKinematics& mk, const std::string& muscle_name) {
+  const int P = static_cast<int>(mk.x_w.size());
+  const int n = P - 2;
+  const int k = static_cast<int>(mk.J_xr.cols());  // compact columns
+  if (n < 1) throw std::logic_error("calcEulerianCoordinates: needs at least one internal path point");
+  checkEulerianSegments(mk, muscle_name);
 
   // equal strain: s_i = arc length to i / length
   mk.s.resize(P);

@@ -32,6 +32,10 @@ Eigen::Matrix<double, 3, 8> calcJ_az(double beta, const Vec3& F);
 /// its time derivative from betadot [D Eq. 5.31] and Fdot (header)
 Eigen::Matrix<double, 3, 8> calcJdot_az(double beta, double betadot, const Vec3& F, const Vec3& Fdot);
 
+/// Throws MuscleError (naming `muscle_name` and the segment) when a segment of the active path
+/// (mk.l after calcPathPoints) has zero length: the Eulerian coordinates need l_i > 0.
+void checkEulerianSegments(const MuscleKinematics& mk, const std::string& muscle_name);
+
 /// Eulerian coordinates s, J_sx, J_sr (and with mk.velocity: sdot, Jdot_sx, Jdot_sr) of the active
 /// path, after calcPathPoints. Needs P >= 3 and every segment longer than zero (throws MuscleError
 /// naming `muscle_name` and the segment otherwise).

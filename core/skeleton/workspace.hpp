@@ -28,4 +28,13 @@ struct SkeletonWorkspace {
   Stage stage = Stage::None;
 };
 
+/// Body motion up to the acceleration level, as recursive inverse dynamics computes it (body
+/// coordinates): what a ForceTerm needs to give its share of inverse dynamics as body wrenches
+/// without J_mr (core/dynamics/skeleton_dynamics.hpp, RecursiveIdWorkspace).
+struct BodyMotion {
+  const std::vector<Mat4>& E_wi;    // poses in world                                 (nb)
+  const std::vector<Vec6>& phi;     // twists                                         (nb)
+  const std::vector<Vec6>& phidot;  // d/dt phi = J_mr qddot + Jdot_mr qdot           (nb)
+};
+
 }  // namespace redmax
