@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -170,7 +171,9 @@ TEST_F(ForwardCli, ForceSetPointActuatorEqualsTheSameExternalLoad) {
   double worst = 0.0;
   for (int r = 0; r < a.numRows(); ++r)
     for (int j = 0; j < 4; ++j) worst = std::max(worst, std::abs(a.data(r, j) - b.data(r, j)));
-  EXPECT_LT(worst, 1e-6);  // the same right-hand side: measured 0 (bitwise)
+  std::printf("external load vs PointActuator: worst state difference %.3g\n", worst);
+  // measured 0 in the written states (%.8e): allow a few units of their last digit
+  EXPECT_LT(worst, 5e-8);
   // and the force does something: the run without it differs
   ASSERT_EQ(runRedmax(dir_, "forward --quiet --setup " + setup("", "push.xml", "c.xml") + " --out-dir " + (dir_ / "c").string()).code, 0);
   const Storage n = readStorage((dir_ / "c" / "pend_states.sto").string());

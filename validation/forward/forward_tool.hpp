@@ -2,11 +2,14 @@
 // OpenSim's ForwardTool in the REDMAX core: the library behind `redmax forward` and
 // `redmax simulate --controls` (docs/forward.md).
 //
-//   setup (converter/forward_setup.hpp) -> model_file read and built as for `simulate`
-//     (loadSimulationModel: constraints, muscle mass) -> --muscle-class override -> System:
-//     the skeleton (+ MuscleTerm with mass) + MuscleForceTerm (muscles with a model) +
-//     CoordinateActuatorTerm; controllers from the ControllerSet (ControlSetController,
-//     PrescribedController) and the tool's own controls_file, as PrescribedControls
+//   setup (converter/forward_setup.hpp) -> model_file read, force_set_files appended
+//     (replace_force_set: the model's forces dropped), built as for `simulate`
+//     (makeSimulationModel: constraints, muscle mass) -> --muscle-class override -> System:
+//     the skeleton (+ MuscleTerm with mass) + MuscleForceTerm (muscles with a model) + the
+//     ForceSet's actuators and passive forces (converter/build/force_terms.hpp) + the
+//     external_loads_file as a SampledLoadsTerm; controllers from the ControllerSet
+//     (ControlSetController, PrescribedController) and the tool's own controls_file, as
+//     PrescribedControls
 //   -> initial state: defaults, then states_file's closest earlier row to initial_time (no
 //     interpolation; OpenSim 3 names r_elbow_flex, r_elbow_flex_u, BIClong.activation accepted
 //     beside OpenSim 4's), then the muscles' equilibrium if the setup asks
