@@ -69,9 +69,6 @@ int runGaitStudy(const GaitStudyFlags& f, const CLI::App& app) {
   }
   if (!f.quiet) {
     for (const auto& w : res.warnings) std::cerr << "warning: " << w << "\n";
-    for (const auto& r : res.runs)
-      std::printf("gait-study: %s: muscle mass %.6g kg, %zu frames (%d failed), %.2f s\n", r.label.c_str(),
-                  r.muscle_mass, r.so.frames.size(), r.so.failed, r.wall_s);
     std::printf("report: %s/report.md, summary.json%s\n", f.report.c_str(),
                 files.plots_skipped ? (" (plots skipped: " + files.plots_note + ")").c_str() : "");
   }

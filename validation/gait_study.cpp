@@ -118,7 +118,9 @@ GaitStudyResult runGaitStudy(const GaitStudyOptions& opt, const std::string& set
       m.source = osim::MuscleMassOptions::Source::Transfer;
       m.transfer_body = opt.transfer_body;
       m.transfer_fraction = f;
-      values.push_back({"transfer " + number(f), m});
+      std::ostringstream label;
+      label << "transfer " << f;
+      values.push_back({label.str(), m});
     }
   }
   for (const Value& v : values) {
