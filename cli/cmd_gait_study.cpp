@@ -1,6 +1,6 @@
 // `redmax gait-study`: a trial's static optimization at zero muscle mass, physiological muscle mass
 // and over a transfer sweep, per muscle the change of peak force, activation and force-time
-// integral, as a report folder (docs/analyze.md §7). validation/gait_study.hpp does the work.
+// integral, as a report folder (docs/analyze.md, "Gait study"). validation/gait_study.hpp does the work.
 // Exit codes: 0 every run converged at every frame, 1 a frame failed (named in the report) or the
 // report could not be written, 2 bad input or usage.
 #include <cstdio>
