@@ -1,6 +1,6 @@
 // `redmax gait-study`: a trial's static optimization at zero muscle mass, physiological muscle mass
 // and over a transfer sweep, per muscle the change of peak force, activation and force-time
-// integral, as a report folder (docs/analyze.md §7). validation/gait_study.hpp does the work.
+// integral, as a report folder (docs/analyze.md, "Gait study"). validation/gait_study.hpp does the work.
 // Exit codes: 0 every run converged at every frame, 1 a frame failed (named in the report) or the
 // report could not be written, 2 bad input or usage.
 #include <cstdio>
@@ -69,9 +69,6 @@ int runGaitStudy(const GaitStudyFlags& f, const CLI::App& app) {
   }
   if (!f.quiet) {
     for (const auto& w : res.warnings) std::cerr << "warning: " << w << "\n";
-    for (const auto& r : res.runs)
-      std::printf("gait-study: %s: muscle mass %.6g kg, %zu frames (%d failed), %.2f s\n", r.label.c_str(),
-                  r.muscle_mass, r.so.frames.size(), r.so.failed, r.wall_s);
     std::printf("report: %s/report.md, summary.json%s\n", f.report.c_str(),
                 files.plots_skipped ? (" (plots skipped: " + files.plots_note + ")").c_str() : "");
   }

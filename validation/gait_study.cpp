@@ -118,7 +118,9 @@ GaitStudyResult runGaitStudy(const GaitStudyOptions& opt, const std::string& set
       m.source = osim::MuscleMassOptions::Source::Transfer;
       m.transfer_body = opt.transfer_body;
       m.transfer_fraction = f;
-      values.push_back({"transfer " + number(f), m});
+      std::ostringstream label;
+      label << "transfer " << f;
+      values.push_back({label.str(), m});
     }
   }
   for (const Value& v : values) {
@@ -248,11 +250,9 @@ void addGaitStudy(const GaitStudyResult& res, const GaitStudyOptions& opt, Repor
   report.addTable("muscles", mt, "Per muscle: peak |force|, peak activation and force-time integral of each run, "
                                  "and their change from the zero-mass run (%).");
 
-  // which muscles change most: by the force-time integral's change, relative to the largest
-  // zero-mass integral so that near-silent muscles do not dominate
+  // which muscles change most: by the force-time integral's change in N s (a relative change
+  // would rank near-silent muscles first)
   const size_t last = nr - 1;
-  double scale = 0.0;
-  for (const auto& m : res.muscles) scale = std::max(scale, std::abs(m.force_integral[0]));
   std::vector<size_t> order(res.muscles.size());
   std::iota(order.begin(), order.end(), 0);
   auto change = [&](size_t i, size_t r) { return res.muscles[i].force_integral[r] - res.muscles[i].force_integral[0]; };
@@ -286,7 +286,6 @@ void addGaitStudy(const GaitStudyResult& res, const GaitStudyOptions& opt, Repor
   JsonValue most = JsonValue::array();
   for (size_t k = 0; k < std::min<size_t>(10, order.size()); ++k) most.push(res.muscles[order[k]].name);
   sec["changes_most"] = most;
-  (void)scale;
 
   // plots: force over time of the six that change most (zero, reference, last run), and the
   // integral's change against the transfer fraction

@@ -1,6 +1,6 @@
 #pragma once
-// What muscle inertia does to a gait study's static optimization (`redmax gait-study`, docs/analyze.md
-// §7): one trial (model, coordinates, external loads, as for inverse dynamics), OpenSim's
+// What muscle inertia does to a gait study's static optimization (`redmax gait-study`, docs/analyze.md,
+// "Gait study"): one trial (model, coordinates, external loads, as for inverse dynamics), OpenSim's
 // StaticOptimization run by the AnalyzeTool at zero muscle mass, at physiological muscle mass and
 // over a transfer sweep (a fraction of one body's mass moved into the muscles that span it), and
 // per muscle the change of peak force, peak activation and force-time integral from the zero-mass run.

@@ -130,7 +130,7 @@ class AnalyzeTool {
   bool runsStaticOptimization() const { return setup_.static_optimization.present; }
   bool runsMuscleAnalyses() const { return setup_.muscle_analysis.present || setup_.actuation.present; }
 
-  /// MuscleAnalysis and Actuation (docs/analyze.md §4-5): the muscles at each recorded row after
+  /// MuscleAnalysis and Actuation (docs/analyze.md, "MuscleAnalysis", "Actuation"): the muscles at each recorded row after
   /// equilibrium (with solve_for_equilibrium_for_auxiliary_states).
   MuscleAnalysisRun runMuscleAnalyses() const;
   /// `<name>_<MuscleAnalysis>_<quantity>.sto` and `<name>_<Actuation>_force/speed/power.sto`,

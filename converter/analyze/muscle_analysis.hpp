@@ -1,5 +1,5 @@
 #pragma once
-// OpenSim 4's MuscleAnalysis and Actuation analyses of the AnalyzeTool (docs/analyze.md §4-5).
+// OpenSim 4's MuscleAnalysis and Actuation analyses of the AnalyzeTool (docs/analyze.md, "MuscleAnalysis", "Actuation").
 //
 // Per recorded frame (AnalyzeTool::run): the skeleton's q and u from the coordinates or states
 // file; each muscle's states from the states file where it has them, otherwise the model's

@@ -1,5 +1,5 @@
 #pragma once
-// An AnalyzeTool states_file (docs/analyze.md §3): a states table as OpenSim writes it, with
+// An AnalyzeTool states_file (docs/analyze.md, "States file"): a states table as OpenSim writes it, with
 // OpenSim 4 state names (/jointset/J/C/value, /jointset/J/C/speed, /forceset/M/activation,
 // /forceset/M/fiber_length, ...) or OpenSim 3's (C, C_u, M.activation, M.fiber_length). Each row is
 // one state: AnalyzeTool::run sets q, u and the muscles' states from it, without filtering (the
