@@ -24,6 +24,14 @@
 
 namespace redmax {
 
+/// Where one muscle's own states (its model's, in order) and its control sit in a System's
+/// State::z and controls; -1: none. Fibre-following placement (core/muscles/fibre_placement.hpp)
+/// reads them; without them it takes the fibre's equilibrium.
+struct MuscleStateIndex {
+  int z = -1;
+  int u = -1;
+};
+
 struct MuscleTermOptions {
   /// keep -J_ar^T M_a Jdot_ar qdot in f; false drops it (the dissertation's energy experiment,
   /// Sec. 6.2.4). The bones' own quadratic velocity vector is not affected.
@@ -47,6 +55,10 @@ class MuscleTerm final : public ForceTerm {
   /// Validates every muscle against `model` (validateMuscle; throws ModelError). Muscles without
   /// mass points are kept (muscles()) but add nothing.
   MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options = {});
+  /// the same, fibre-following muscles reading their states at `states` (one per muscle of
+  /// `muscles`, or empty); a state index beyond State::z reads none (equilibrium)
+  MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options,
+             std::vector<MuscleStateIndex> states);
 
   std::string name() const override { return "muscle_mass"; }
   /// a MuscleTermScratch sized for the muscles with mass (null when there are none)
@@ -75,12 +87,20 @@ class MuscleTerm final : public ForceTerm {
 
   std::vector<Muscle> muscles_;
   std::vector<Muscle> massive_;        // the muscles with at least one mass point
+  std::vector<MuscleStateIndex> massive_states_;  // their states (fibre-following placement)
   MuscleTermOptions options_;
   int nr_ = 0;
 };
 
 class System;
 struct DynamicsWorkspace;
+
+/// Fibre-following placement in forward dynamics: the MuscleTerm of `sys` (if any) is replaced by
+/// one whose fibre-following muscles read the states and control of the same-named muscle of the
+/// System's MuscleForceTerm (and follow that term's model, e.g. after a muscle-class override). A
+/// muscle without such a model, or whose model's states do not allow it, falls back to the
+/// uniform placement: one line each in the returned notes. No-op without both terms.
+std::vector<std::string> bindMuscleStates(System& sys);
 
 /// takeWrapFallbackCounts of every MuscleTerm of `sys` over its slots in `ws`: what a caller that
 /// reports fallbacks calls for each workspace it evaluated in, after a run or after each span (the

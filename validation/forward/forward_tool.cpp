@@ -11,6 +11,7 @@
 #include "core/dynamics/controller.hpp"
 #include "core/dynamics/coordinate_actuator_term.hpp"
 #include "core/dynamics/muscle_force_term.hpp"
+#include "core/dynamics/muscle_term.hpp"
 #include "core/muscles/hill/muscle_model.hpp"
 
 namespace redmax::validation {
@@ -131,6 +132,10 @@ void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings) {
     }
   }
   if (!acts.empty()) sys->addTerm(std::make_shared<CoordinateActuatorTerm>(model.skeleton(), std::move(acts)));
+  // fibre-following mass points read their muscle's states (core/dynamics/muscle_term.hpp)
+  for (std::string& note : bindMuscleStates(*sys)) warnings.push_back(std::move(note));
+  for (const auto& t : sys->terms())
+    if (auto mt = std::dynamic_pointer_cast<const MuscleTerm>(t)) m.muscle_term = mt;
   m.system = sys;
 }
 
