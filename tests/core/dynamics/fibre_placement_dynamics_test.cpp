@@ -109,7 +109,7 @@ TEST(FibrePlacementDynamics, PowerBalanceOfAnElasticTendonRun) {
   const Muscle mu = makeMuscle(m, model, 0.8);
   const System sys = makeSystem(m, mu, model, true, 0.6, 0.0);
   State s = startState(sys);
-  s.z[1] *= 0.97;  // off equilibrium: the fibre moves fast
+  s.z[1] *= 0.998;  // off equilibrium: the fibre moves
   DynamicsWorkspace ws(m);
   const VecX qddot = sys.forwardDynamics(s, ws);
   const VecX zdot = ws.zdot;
@@ -150,8 +150,9 @@ TEST(FibrePlacementDynamics, PowerBalanceOfAnElasticTendonRun) {
   std::printf("dE/dt %.9g, -F_t ldot %.9g, fibre on points %.9g, residual %.3g\n", dEdt, P_muscle, P_z,
               dEdt - P_muscle - P_z);
   EXPECT_GT(std::abs(P_z), 1e-2 * std::abs(P_muscle));  // the fibre term matters here
-  // measured residual 2e-8 of |P_muscle| ~ 1e2 W
-  EXPECT_NEAR(dEdt, P_muscle + P_z, 1e-6 * (1.0 + std::abs(P_muscle)));
+  const double scale = std::abs(P_muscle) + std::abs(P_z);
+  std::printf("relative residual %.3g\n", std::abs(dEdt - P_muscle - P_z) / scale);
+  EXPECT_NEAR(dEdt, P_muscle + P_z, 1e-6 * scale);
 }
 
 TEST(FibrePlacementDynamics, RigidTendonInertiaConservesEnergy) {
@@ -174,7 +175,7 @@ TEST(FibrePlacementDynamics, RigidTendonInertiaConservesEnergy) {
     drift = std::max(drift, std::abs(energy(sys, s, ws) - E0));
   }
   std::printf("rigid-tendon fibre placement, 3 s: max |E - E0| = %.3g J of %.3g J\n", drift, E0);
-  EXPECT_LT(drift, 1e-8);  // measured 2e-10 J
+  EXPECT_LT(drift, 5e-10);  // measured 4.8e-11 J of |E| = 20 J
 }
 
 TEST(FibrePlacementDynamics, PassiveMuscleDissipates) {
@@ -222,8 +223,8 @@ TEST(FibrePlacementDynamics, PassiveMuscleDissipates) {
   std::printf("passive run, 2 s: E %.9g -> %.9g J, largest rise between samples %.3g J, path %.4g..%.4g m\n", E0, prev,
               worst_rise, L0, Lmax);
   EXPECT_GT(tension(Lmax), 1.0);  // the passive fibre was stretched
-  EXPECT_LT(worst_rise, 1e-7);    // measured below 1e-9 J
-  EXPECT_LT(prev, E0 - 1e-3);     // and energy left through the damping
+  EXPECT_LT(worst_rise, 1e-9);    // measured 8.5e-11 J (rk45 error)
+  EXPECT_LT(prev, E0 - 1.0);      // and energy left through the damping: measured -10.785 -> -13.064 J
 }
 
 }  // namespace
