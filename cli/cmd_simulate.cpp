@@ -92,6 +92,11 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
     parseWrapFlags(f.mm.wrap, mo.muscle_mass);
     mo.muscle_mass.mass_points = static_cast<int>(f.mm.mass_points);
     if (f.mm.region == "whole") mo.muscle_mass.region = MassPointOptions::Region::WholePath;
+    if (f.mm.placement != "uniform") {
+      if (mo.muscle_mass.region == MassPointOptions::Region::WholePath)
+        throw UsageError{"--mass-placement fibre spreads the points over the fibre; it excludes --mass-region whole"};
+      mo.muscle_mass.placement = osim::MuscleMassOptions::Placement::Fibre;
+    }
   } else {
     mo.muscle_mass = parseMuscleMassFlags(f.mm);
   }

@@ -71,6 +71,15 @@ void addMuscleMassFlags(CLI::App& app, MuscleMassFlags& f) {
                      ->type_name("fibre|whole")
                      ->check(oneOf({"fibre", "fiber", "whole"}))
                      ->group(g);
+  f.placement_opt = app.add_option("--mass-placement", f.placement,
+                                   "uniform (default): points at fixed fractions of the whole path, equal\n"
+                                   "strain in fibre and tendon, as the dissertation; fibre: points follow the\n"
+                                   "fibre, the tendon keeping its own length (rigid: slack length; elastic:\n"
+                                   "from the fibre-length state, or equilibrium without states). Muscles\n"
+                                   "without a modelled class, wrapping or with a tendon-force state stay uniform")
+                         ->type_name("uniform|fibre")
+                         ->check(oneOf({"uniform", "fibre", "fiber"}))
+                         ->group(g);
   f.tension_opt = app.add_option("--specific-tension", f.specific_tension,
                                  "Pa; default 600000 (60 N/cm^2, Rajagopal et al. 2016)")
                       ->type_name("PA")
@@ -140,7 +149,8 @@ osim::MuscleMassOptions parseMuscleMassFlags(const MuscleMassFlags& f, bool frac
   }
   const std::vector<std::pair<const CLI::Option*, const char*>> needs_source = {
       {f.muscles_opt, "--muscles"},          {f.mass_points_opt, "--mass-points"},
-      {f.region_opt, "--mass-region"},       {f.tension_opt, "--specific-tension"},
+      {f.region_opt, "--mass-region"},       {f.placement_opt, "--mass-placement"},
+      {f.tension_opt, "--specific-tension"},
       {f.density_opt, "--muscle-density"},   {f.body_opt, "--transfer-body"},
       {f.fraction_opt, "--transfer-fraction"}, {f.wrap.model_opt, "--wrap"},
       {f.wrap.width_opt, "--wrap-width"},    {f.wrap.network_opt, "--wrap-network"}};
@@ -170,6 +180,10 @@ osim::MuscleMassOptions parseMuscleMassFlags(const MuscleMassFlags& f, bool frac
   }
   o.mass_points = static_cast<int>(f.mass_points);
   o.region = f.region == "whole" ? MassPointOptions::Region::WholePath : MassPointOptions::Region::Fibre;
+  o.placement = f.placement == "uniform" ? osim::MuscleMassOptions::Placement::Uniform
+                                         : osim::MuscleMassOptions::Placement::Fibre;
+  if (o.placement == osim::MuscleMassOptions::Placement::Fibre && o.region == MassPointOptions::Region::WholePath)
+    throw UsageError{"--mass-placement fibre spreads the points over the fibre; it excludes --mass-region whole"};
   o.specific_tension = f.specific_tension;
   o.density = f.density;
 

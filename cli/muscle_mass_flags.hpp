@@ -3,6 +3,7 @@
 // that builds a model with muscle mass (`redmax id`, `simulate`, `validate`, ...):
 //   --muscle-mass none|physiological|transfer   (default none)
 //   --muscles all|REGEX|top:K   --mass-points N   --mass-region fibre|whole
+//   --mass-placement uniform|fibre
 //   --specific-tension PA       --muscle-density KG_M3
 //   --transfer-body BODY        --transfer-fraction F
 //   --wrap smooth|exact|neural|lumped  --wrap-width W  --wrap-network FILE
@@ -44,6 +45,7 @@ struct MuscleMassFlags {
   std::string muscles = "all";
   long mass_points = 20;
   std::string region = "fibre";
+  std::string placement = "uniform";
   double specific_tension = osim::MuscleMassOptions{}.specific_tension;
   double density = osim::MuscleMassOptions{}.density;
   std::string transfer_body;
@@ -53,6 +55,7 @@ struct MuscleMassFlags {
   CLI::Option* muscles_opt = nullptr;
   CLI::Option* mass_points_opt = nullptr;
   CLI::Option* region_opt = nullptr;
+  CLI::Option* placement_opt = nullptr;
   CLI::Option* tension_opt = nullptr;
   CLI::Option* density_opt = nullptr;
   CLI::Option* body_opt = nullptr;
@@ -67,7 +70,7 @@ void addMuscleMassFlags(CLI::App& app, MuscleMassFlags& f);
 
 /// The options from the flags (defaults for those not given). Throws UsageError for a value out of
 /// range (F outside [0, 1), a bad REGEX or top:K), for transfer without --transfer-body, and for
-/// --muscles, --mass-points, --mass-region, --specific-tension, --muscle-density, --transfer-*
+/// --muscles, --mass-points, --mass-region, --mass-placement, --specific-tension, --muscle-density, --transfer-*
 /// given without a source that uses them (a flag that would do nothing is a mistake).
 /// `fraction_from_sweep`: --transfer-fraction is not needed (`validate --mass-sweep` gives them).
 osim::MuscleMassOptions parseMuscleMassFlags(const MuscleMassFlags& f, bool fraction_from_sweep = false);

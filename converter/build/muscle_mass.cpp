@@ -74,6 +74,8 @@ void checkOptions(const ModelDescription& d, const MuscleMassOptions& o) {
   if (!(o.density > 0.0) || !std::isfinite(o.density))
     throw std::invalid_argument("--muscle-density must be a finite value > 0 (kg/m^3), got " +
                                 fmt(o.density));
+  if (o.placement == MuscleMassOptions::Placement::Fibre && o.region == MassPointOptions::Region::WholePath)
+    throw std::invalid_argument("--mass-placement fibre spreads the points over the fibre; it excludes --mass-region whole");
   if (o.source == MuscleMassOptions::Source::Transfer) {
     if (!(o.transfer_fraction >= 0.0) || !(o.transfer_fraction < 1.0))
       throw std::invalid_argument("--transfer-fraction must be in [0, 1), got " +
@@ -365,10 +367,16 @@ MuscleMassModel addMuscleMass(const ModelDescription& d, BuildResult base,
   }
 
   const MassPointOptions mpo{options.mass_points, options.region};
+  // the points' placement: fibre-following where asked and possible (alpha at the default pose)
+  auto place = [&](int k, Muscle& mu) {
+    const auto& mm = base.model.muscleModels();
+    return placeMassPoints(model, options, k < static_cast<int>(mm.size()) ? mm[k] : nullptr, mu);
+  };
   auto withPoints = [&](int k, double m) {
     Muscle mu = muscles[k];
     const PathForceDesc& pf = d.muscles[base.muscle_source[k]];
     mu.mass_points = makeMassPoints(m, pf.optimal_fiber_length, pf.tendon_slack_length, mpo);
+    place(k, mu);
     return mu;
   };
 
@@ -529,8 +537,10 @@ MuscleMassModel addMuscleMass(const ModelDescription& d, BuildResult base,
   muscles = addMusclePointMasses(muscles, plain, mpo);
   for (int k = 0; k < nm; ++k) {
     Muscle& mu = muscles[k];
-    if (plain[k] == mass[k] || !(mass[k] > 0.0)) continue;
-    mu.mass_points = makeMassPoints(mass[k], mu.optimal_fiber_length, mu.tendon_slack_length, mpo);
+    if (!(mass[k] > 0.0)) continue;
+    if (plain[k] != mass[k])
+      mu.mass_points = makeMassPoints(mass[k], mu.optimal_fiber_length, mu.tendon_slack_length, mpo);
+    out.plan.muscles[k].uniform_why = place(k, mu);
   }
   // finalize validates every muscle against the edited skeleton (ModelError)
   finish();
@@ -559,6 +569,29 @@ WrapMassCount countWrapMass(const MuscleMassPlan& plan) {
   return c;
 }
 
+MuscleMassOptions::Placement parseMassPlacement(const std::string& text) {
+  if (text == "uniform") return MuscleMassOptions::Placement::Uniform;
+  if (text == "fibre") return MuscleMassOptions::Placement::Fibre;
+  throw std::invalid_argument("--mass-placement must be uniform or fibre, got '" + text + "'");
+}
+
+const char* toString(MuscleMassOptions::Placement placement) {
+  return placement == MuscleMassOptions::Placement::Fibre ? "fibre" : "uniform";
+}
+
+std::string placeMassPoints(const Model& model, const MuscleMassOptions& options,
+                            const std::shared_ptr<const hill::MuscleModel>& mm, Muscle& mu) {
+  mu.fibre = FibreFollowing{};
+  if (options.placement != MuscleMassOptions::Placement::Fibre || mu.mass_points.size() == 0) return "";
+  const std::string why = fibrePlacementUnsupportedReason(mu, mm.get());
+  if (!why.empty()) return why;
+  const VecX q = model.defaultQ();
+  std::vector<Mat4> E_wi(model.nb());
+  calcBodyPoses(model, q, E_wi);
+  setFibrePlacement(model, q, E_wi, mm, mu);
+  return "";
+}
+
 const char* toString(WrapModel model) {
   switch (model) {
     case WrapModel::Smooth: return "smooth";
@@ -577,7 +610,8 @@ std::string describeMuscleMass(const MuscleMassPlan& plan) {
     return os.str();
   }
   os << ", muscles " << o.muscles << ", " << o.mass_points << " points each in the "
-     << (o.region == MassPointOptions::Region::Fibre ? "fibre" : "whole path") << ", density "
+     << (o.region == MassPointOptions::Region::Fibre ? "fibre" : "whole path")
+     << (o.placement == MuscleMassOptions::Placement::Fibre ? " (fibre-following placement)" : "") << ", density "
      << fmt(o.density) << " kg/m^3, specific tension " << fmt(o.specific_tension) << " Pa";
   if (o.source == MuscleMassOptions::Source::Transfer)
     os << ", " << fmt(100.0 * o.transfer_fraction) << "% of " << o.transfer_body;
@@ -609,7 +643,9 @@ std::string describeMuscleMass(const MuscleMassPlan& plan) {
   if (with > 0) {
     os << "  muscles with mass (kg, points):\n";
     for (const auto& e : plan.muscles)
-      if (e.mass > 0.0) os << "    " << e.name << ": " << fmt(e.mass) << " kg, " << e.points << " points\n";
+      if (e.mass > 0.0)
+        os << "    " << e.name << ": " << fmt(e.mass) << " kg, " << e.points << " points"
+           << (e.uniform_why.empty() ? std::string() : ", uniform placement (" + e.uniform_why + ")") << "\n";
   }
   if (with < static_cast<int>(plan.muscles.size())) {
     os << "  lumped (no mass):\n";

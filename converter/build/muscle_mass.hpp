@@ -47,6 +47,12 @@ struct MuscleMassOptions {
   std::string muscles = "all";
   int mass_points = 20;                       ///< per muscle, >= 1
   MassPointOptions::Region region = MassPointOptions::Region::Fibre;
+  /// where the points sit as the muscle moves: Uniform, at fixed arc fractions of the whole path
+  /// (equal strain over fibre and tendon, [D]); Fibre, spread over the fibre with the tendon at
+  /// its own length (core/muscles/fibre_placement.hpp; Type I/II muscles with a Hill model whose
+  /// state is a fibre length or none, the others stay uniform and the plan says why)
+  enum class Placement { Uniform, Fibre };
+  Placement placement = Placement::Uniform;
   double specific_tension = kDefaultSpecificTension;  ///< Pa, > 0
   double density = kDefaultMuscleDensity;             ///< kg/m^3, > 0
   std::string transfer_body;                  ///< Transfer only: a body name of the model
@@ -59,6 +65,16 @@ struct MuscleMassOptions {
   /// shape check, so the model decides which surfaces are supported); used only with wrap_mass
   WrapMassOptions wrap;
 };
+
+/// "uniform" | "fibre"; throws std::invalid_argument otherwise
+MuscleMassOptions::Placement parseMassPlacement(const std::string& text);
+const char* toString(MuscleMassOptions::Placement placement);
+
+/// Fibre-following placement of `mu`'s mass points with its force model `mm` when `options` ask
+/// for it (setFibrePlacement at `model`'s default pose). Returns "" when the points follow the
+/// fibre or uniform placement was asked for, else why they stay uniform.
+std::string placeMassPoints(const Model& model, const MuscleMassOptions& options,
+                            const std::shared_ptr<const hill::MuscleModel>& mm, Muscle& mu);
 
 /// "none" | "physiological" | "transfer"; throws std::invalid_argument otherwise
 MuscleMassOptions::Source parseMuscleMassSource(const std::string& text);
@@ -74,6 +90,8 @@ struct MuscleMassEntry {
   int points = 0;           ///< mass points (0 = lumped)
   std::string lumped_why;   ///< "" when it carries mass, else e.g. "not selected", "Type III path"
   bool wraps = false;       ///< its path has wrap objects (Type III)
+  /// with Placement::Fibre and mass: "" when its points follow the fibre, else why they are uniform
+  std::string uniform_why;
 };
 
 /// a body whose mass changed; inertia about its own centre of mass, body axes

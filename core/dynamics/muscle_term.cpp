@@ -1,19 +1,29 @@
 #include "core/dynamics/muscle_term.hpp"
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/dynamics/muscle_force_term.hpp"
 #include "core/dynamics/system.hpp"
 
 namespace redmax {
 
 MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options)
+    : MuscleTerm(model, std::move(muscles), options, {}) {}
+
+MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options,
+                       std::vector<MuscleStateIndex> states)
     : muscles_(std::move(muscles)), options_(options), nr_(model.nr()) {
-  for (const Muscle& m : muscles_) {
+  if (!states.empty() && states.size() != muscles_.size())
+    throw ModelError("MuscleTerm: " + std::to_string(states.size()) + " state indices for " +
+                     std::to_string(muscles_.size()) + " muscles");
+  for (size_t k = 0; k < muscles_.size(); ++k) {
+    const Muscle& m = muscles_[k];
     validateMuscle(model, m);
-    if (m.mass_points.size() > 0) {
-      massive_.push_back(m);
-      wraps_.push_back(pathType(m.path) == PathType::III);
-    }
+    if (m.mass_points.size() == 0) continue;
+    massive_.push_back(m);
+    massive_states_.push_back(states.empty() ? MuscleStateIndex{} : states[k]);
+    compact_id_.push_back(pathType(m.path) == PathType::III || m.fibre.enabled());
   }
 }
 
@@ -28,6 +38,21 @@ double MuscleTerm::totalMass() const {
   return m;
 }
 
+void MuscleTerm::kinematicsOf(size_t m, const Model& model, const State& s, const TermContext& ctx,
+                              MuscleKinematics& mk) const {
+  const Muscle& mu = massive_[m];
+  if (!mu.fibre.enabled()) {
+    calcMuscleKinematics(model, s, ctx.sk, mu, mk, true);
+    return;
+  }
+  // fibre-following placement: the muscle's states in s.z, else its equilibrium
+  const MuscleStateIndex& si = massive_states_[m];
+  FibreStates fs;
+  if (si.z >= 0 && si.z + mu.fibre.model->numStates() <= s.z.size()) fs.z = s.z.data() + si.z;
+  if (si.u >= 0 && ctx.controls && si.u < ctx.controls->size()) fs.excitation = (*ctx.controls)[si.u];
+  calcMuscleKinematics(model, s, ctx.sk, mu, mk, true, fs);
+}
+
 MuscleTermScratch& MuscleTerm::evaluate(const Model& model, const State& s, const TermContext& ctx,
                                         MuscleTermScratch& local) const {
   if (model.nr() != nr_)
@@ -39,7 +64,7 @@ MuscleTermScratch& MuscleTerm::evaluate(const Model& model, const State& s, cons
   if (slot && ctx.evaluation != 0 && sc.evaluation == ctx.evaluation) return sc;
   sc.evaluation = 0;  // stays 0 if the evaluation throws
   if (sc.ws.muscles.size() != massive_.size()) sc.ws = MuscleWorkspace(model, massive_);
-  calcMuscleKinematics(model, s, ctx.sk, massive_, sc.ws, true);
+  for (size_t m = 0; m < massive_.size(); ++m) kinematicsOf(m, model, s, ctx, sc.ws.muscles[m]);
   sc.evaluation = slot ? ctx.evaluation : 0;
   return sc;
 }
@@ -74,9 +99,12 @@ void MuscleTerm::addForce(const Model& model, const State& s, const TermContext&
     const MuscleKinematics& mk = sc.ws.muscles[m];
     gatherColumns(s.qdot, mk, sc.qdot_c);
     sc.fc.setZero(sc.qdot_c.size());
+    // fibre-following points: the fibre's own motion adds the bias acceleration a_z
+    const bool fibre = mk.a_z.size() == 3 * mp.size() && massive_[m].fibre.enabled();
     for (int a = 0; a < mp.size(); ++a) {
       Vec3 fa = mp.mass[a] * model.gravity();
       if (options_.quadratic_velocity) fa.noalias() -= mp.mass[a] * (mk.Jdot_ar.middleRows<3>(3 * a) * sc.qdot_c);
+      if (fibre) fa.noalias() -= mp.mass[a] * mk.a_z.segment<3>(3 * a);
       sc.fc.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * fa;
     }
     scatterAddColumns(sc.fc, mk, f);
@@ -108,7 +136,7 @@ void MuscleTerm::addMassDotTimesVelocity(const Model& model, const State& s, con
 
 TermIdRoute MuscleTerm::idRoute() const {
   if (!options_.quadratic_velocity) return TermIdRoute::WrenchesWithKinematics;
-  for (char w : wraps_)
+  for (char w : compact_id_)
     if (w) return TermIdRoute::WrenchesWithKinematics;
   return TermIdRoute::Wrenches;
 }
@@ -128,12 +156,13 @@ void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const Ve
   for (size_t m = 0; m < massive_.size(); ++m) {
     const Muscle& mu = massive_[m];
     MuscleKinematics& mk = sc.ws.muscles[m];
-    if (!wraps_[m] && options_.quadratic_velocity) {
+    if (!compact_id_[m] && options_.quadratic_velocity) {
       addMuscleInverseDynamics(model, s, qddot, motion, model.gravity(), mu, mk, sc.id[m], wrench, tau);
       continue;
     }
-    // compact J_ar: sum_a J_ar^T m_a (J_ar qddot + Jdot_ar qdot - g) in the muscle's columns
-    calcMuscleKinematics(model, s, ctx.sk, mu, mk, true);
+    // compact J_ar: sum_a J_ar^T m_a (J_ar qddot + Jdot_ar qdot (+ a_z) - g) in the muscle's columns
+    kinematicsOf(m, model, s, ctx, mk);
+    const bool fibre = mk.a_z.size() == 3 * mu.mass_points.size() && mu.fibre.enabled();
     gatherColumns(s.qdot, mk, sc.qdot_c);
     gatherColumns(qddot, mk, sc.qddot_c);
     sc.fc.setZero(sc.qdot_c.size());
@@ -141,6 +170,7 @@ void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const Ve
     for (int a = 0; a < mp.size(); ++a) {
       Vec3 acc = mk.J_ar.middleRows<3>(3 * a) * sc.qddot_c - model.gravity();
       if (options_.quadratic_velocity) acc.noalias() += mk.Jdot_ar.middleRows<3>(3 * a) * sc.qdot_c;
+      if (fibre) acc.noalias() += mk.a_z.segment<3>(3 * a);  // as addForce: the fibre's own motion
       sc.fc.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * (mp.mass[a] * acc);
     }
     scatterAddColumns(sc.fc, mk, tau);
@@ -175,6 +205,44 @@ void MuscleTerm::takeWrapFallbackCounts(TermScratch* scratch, WrapFallbackMonito
     monitor.add(massive_[k], c);
     c = {};
   }
+}
+
+std::vector<std::string> bindMuscleStates(System& sys) {
+  std::vector<std::string> notes;
+  int im = -1, iff = -1;
+  for (size_t i = 0; i < sys.terms().size(); ++i) {
+    if (dynamic_cast<const MuscleTerm*>(sys.terms()[i].get())) im = static_cast<int>(i);
+    if (dynamic_cast<const MuscleForceTerm*>(sys.terms()[i].get())) iff = static_cast<int>(i);
+  }
+  if (im < 0 || iff < 0) return notes;
+  const auto& term = static_cast<const MuscleTerm&>(*sys.terms()[im]);
+  const auto& force = static_cast<const MuscleForceTerm&>(*sys.terms()[iff]);
+  std::vector<Muscle> muscles = term.muscles();
+  std::vector<MuscleStateIndex> states(muscles.size());
+  bool any = false;
+  for (size_t k = 0; k < muscles.size(); ++k) {
+    Muscle& mu = muscles[k];
+    if (!mu.fibre.enabled()) continue;
+    const auto& act = force.actuated();
+    const auto it = std::find_if(act.begin(), act.end(), [&](const auto& a) { return a.muscle.name == mu.name; });
+    const std::string why = it == act.end() ? std::string("it exerts no force (no muscle model)")
+                                            : fibrePlacementUnsupportedReason(mu, it->model.get());
+    if (!why.empty()) {
+      // uniform at the arc fractions the points had at the default pose
+      mu.fibre = FibreFollowing{};
+      notes.push_back("muscle '" + mu.name + "': mass placement uniform (" + why + ")");
+      continue;
+    }
+    mu.fibre.model = it->model;
+    mu.fibre.fiber_state = fiberStateIndex(*it->model);
+    const size_t a = static_cast<size_t>(it - act.begin());
+    states[k].z = sys.stateOffset(iff) + it->z_offset;
+    states[k].u = sys.controlOffset(iff) + static_cast<int>(a);
+    any = true;
+  }
+  if (!any && notes.empty()) return notes;
+  sys.replaceTerm(im, std::make_shared<MuscleTerm>(sys.model(), std::move(muscles), term.options(), std::move(states)));
+  return notes;
 }
 
 void takeWrapFallbackCounts(const System& sys, DynamicsWorkspace& ws, WrapFallbackMonitor& monitor) {

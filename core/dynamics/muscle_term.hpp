@@ -25,6 +25,14 @@
 
 namespace redmax {
 
+/// Where one muscle's own states (its model's, in order) and its control sit in a System's
+/// State::z and controls; -1: none. Fibre-following placement (core/muscles/fibre_placement.hpp)
+/// reads them; without them it takes the fibre's equilibrium.
+struct MuscleStateIndex {
+  int z = -1;
+  int u = -1;
+};
+
 struct MuscleTermOptions {
   /// keep -J_ar^T M_a Jdot_ar qdot in f; false drops it (the dissertation's energy experiment,
   /// Sec. 6.2.4). The bones' own quadratic velocity vector is not affected.
@@ -51,6 +59,10 @@ class MuscleTerm final : public ForceTerm {
   /// Validates every muscle against `model` (validateMuscle; throws ModelError). Muscles without
   /// mass points are kept (muscles()) but add nothing.
   MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options = {});
+  /// the same, fibre-following muscles reading their states at `states` (one per muscle of
+  /// `muscles`, or empty); a state index beyond State::z reads none (equilibrium)
+  MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options,
+             std::vector<MuscleStateIndex> states);
 
   std::string name() const override { return "muscle_mass"; }
   /// a MuscleTermScratch sized for the muscles with mass (null when there are none)
@@ -82,16 +94,29 @@ class MuscleTerm final : public ForceTerm {
   // already holds this evaluation, or (direct calls without a slot) `local`, evaluated now
   MuscleTermScratch& evaluate(const Model& model, const State& s, const TermContext& ctx,
                               MuscleTermScratch& local) const;
+  /// massive_[m]'s kinematics at s: fibre-following muscles read their states (or equilibrium)
+  void kinematicsOf(size_t m, const Model& model, const State& s, const TermContext& ctx,
+                    MuscleKinematics& mk) const;
 
   std::vector<Muscle> muscles_;
   std::vector<Muscle> massive_;        // the muscles with at least one mass point
-  std::vector<char> wraps_;            // per massive muscle: Type III (no path-wise ID)
+  std::vector<MuscleStateIndex> massive_states_;  // their states (fibre-following placement)
+  // per massive muscle: no path-wise ID (Type III, or fibre-following points, whose placement
+  // moves with the fibre: the compact J_ar route with a_z)
+  std::vector<char> compact_id_;
   MuscleTermOptions options_;
   int nr_ = 0;
 };
 
 class System;
 struct DynamicsWorkspace;
+
+/// Fibre-following placement in forward dynamics: the MuscleTerm of `sys` (if any) is replaced by
+/// one whose fibre-following muscles read the states and control of the same-named muscle of the
+/// System's MuscleForceTerm (and follow that term's model, e.g. after a muscle-class override). A
+/// muscle without such a model, or whose model's states do not allow it, falls back to the
+/// uniform placement: one line each in the returned notes. No-op without both terms.
+std::vector<std::string> bindMuscleStates(System& sys);
 
 /// takeWrapFallbackCounts of every MuscleTerm of `sys` over its slots in `ws`: what a caller that
 /// reports fallbacks calls for each workspace it evaluated in, after a run or after each span (the

@@ -52,6 +52,15 @@ void System::addTerm(std::shared_ptr<const ForceTerm> term) {
   id_.renew();
 }
 
+void System::replaceTerm(size_t i, std::shared_ptr<const ForceTerm> term) {
+  if (!term || i >= terms_.size()) throw ModelError("System::replaceTerm: no term " + std::to_string(i) + " or a null term");
+  if (term->numStates() != terms_[i]->numStates() || term->numControls() != terms_[i]->numControls())
+    throw ModelError("System::replaceTerm: '" + term->name() + "' has other numbers of states or controls than '" +
+                     terms_[i]->name() + "'");
+  terms_[i] = std::move(term);
+  id_.renew();
+}
+
 std::vector<std::string> System::stateNames() const {
   std::vector<std::string> names;
   for (const auto& t : terms_)

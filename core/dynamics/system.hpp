@@ -126,6 +126,8 @@ class System {
 
   /// add a term; its states and controls (if any) follow those of the terms before it
   void addTerm(std::shared_ptr<const ForceTerm> term);
+  /// replace term i by one with the same numbers of states and controls (ModelError otherwise)
+  void replaceTerm(size_t i, std::shared_ptr<const ForceTerm> term);
   void addConstraint(std::shared_ptr<const Constraint> c);
   const std::vector<std::shared_ptr<const ForceTerm>>& terms() const { return terms_; }
   const std::vector<std::shared_ptr<const Constraint>>& constraints() const { return constraints_; }

@@ -68,6 +68,15 @@ void validateMuscle(const Model& model, const Muscle& muscle) {
       throw ModelError(who + "has wrap objects (Type III path) and mass points, but " + why +
                        "; keep its mass lumped in the bodies (no mass points)");
   }
+  if (muscle.fibre.enabled()) {
+    if (pathType(muscle.path) == PathType::III)
+      throw ModelError(who + "fibre-following mass placement is not available on wrapping (Type III) paths");
+    if (static_cast<int>(muscle.fibre.c.size()) != mp.size())
+      throw ModelError(who + "fibre-following placement has " + std::to_string(muscle.fibre.c.size()) +
+                       " fibre fractions for " + std::to_string(mp.size()) + " mass points");
+    for (double c : muscle.fibre.c)
+      if (!(c > 0.0 && c < 1.0)) throw ModelError(who + "fibre fraction " + std::to_string(c) + " is not in (0, 1)");
+  }
   for (int k = 0; k < mp.size(); ++k) {
     if (!(mp.alpha[k] >= 0.0 && mp.alpha[k] <= 1.0))
       throw ModelError(who + "mass point " + std::to_string(k) + ": alpha not in [0, 1]");

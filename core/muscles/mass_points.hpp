@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "core/muscles/hill/muscle_model.hpp"
 #include "core/muscles/path.hpp"
 
 namespace redmax {
@@ -72,6 +73,16 @@ struct WrapMassOptions {
   // fallbacks are counted in the workspace (MuscleKinematics::wrap_counts), not here
 };
 
+/// Fibre-following placement of a muscle's mass points (core/muscles/fibre_placement.hpp):
+/// with a model the points spread over the fibre's share of the path, the tendon taking its own
+/// length; without one they sit at the fixed arc fractions mass_points.alpha ([D], "uniform").
+struct FibreFollowing {
+  std::shared_ptr<const hill::MuscleModel> model;  ///< null: uniform placement
+  std::vector<double> c;                           ///< each point's fraction of the fibre, (0, 1) (N)
+  int fiber_state = -1;                            ///< fiber_length among the model's states; -1: rigid tendon
+  bool enabled() const { return model != nullptr; }
+};
+
 /// A musculotendon: its path and, when it carries inertia, its mass points. A muscle with no mass
 /// points is lumped (massless), as OpenSim sees it. Type III paths carry mass points only in the
 /// shape core/muscles/wrap_muscle.hpp supports (origin, one wrap surface, insertion).
@@ -82,10 +93,12 @@ struct Muscle {
   double tendon_slack_length = 0.0;   // m
   MassPoints mass_points;             // empty = massless
   WrapMassOptions wrap;               // Type III with mass points only
+  FibreFollowing fibre;               // Type I/II with mass points only; default uniform
 };
 
 /// validatePath plus: Type III paths with mass points must have the supported shape
-/// (wrapMassPointsUnsupportedReason in core/muscles/wrap_muscle.hpp), alpha and masses checked.
+/// (wrapMassPointsUnsupportedReason in core/muscles/wrap_muscle.hpp), alpha and masses checked;
+/// fibre-following placement only on Type I/II paths, one fraction c in (0, 1) per point.
 /// Throws ModelError naming the muscle.
 void validateMuscle(const Model& model, const Muscle& muscle);
 

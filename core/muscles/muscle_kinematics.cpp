@@ -6,7 +6,19 @@ namespace redmax {
 
 void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
                           const Muscle& muscle, MuscleKinematics& mk, bool velocity) {
+  calcMuscleKinematics(model, state, sk, muscle, mk, velocity, FibreStates{});
+}
+
+void calcMuscleKinematics(const Model& model, const State& state, const SkeletonWorkspace& sk,
+                          const Muscle& muscle, MuscleKinematics& mk, bool velocity, const FibreStates& fs) {
   const MassPoints& mp = muscle.mass_points;
+  if (muscle.fibre.enabled() && mp.size() > 0) {
+    // fibre-following placement (Type I/II only, validateMuscle)
+    calcPathPoints(model, state, sk, muscle.path, mk, velocity);
+    const TendonKinematics tk = calcTendonKinematics(muscle, mk.length, velocity ? mk.lengthening_speed : 0.0, fs, velocity);
+    calcFibreMassPoints(muscle.fibre.c, tk, mk, muscle.name);
+    return;
+  }
   const bool wrapping = mp.size() > 0 && pathType(muscle.path) == PathType::III;
   // Type III with mass: the wrap surface's body joins the columns (core/muscles/wrap_muscle.hpp)
   if (wrapping) initWrapMuscleColumns(model, muscle, mk);
@@ -40,9 +52,13 @@ void calcMuscleKinematics(const Model& model, const State& state, const Skeleton
 
 double muscleKineticEnergy(const MassPoints& mp, const MuscleKinematics& mk, const VecX& qdot) {
   const VecX qdot_c = gatherColumns(qdot, mk);  // J_ar has the compact columns
+  const bool fibre = mk.v_z.size() == 3 * mp.size() && mp.size() > 0;
   double T = 0.0;
-  for (int a = 0; a < mp.size(); ++a)
-    T += 0.5 * mp.mass[a] * (mk.J_ar.middleRows<3>(3 * a) * qdot_c).squaredNorm();
+  for (int a = 0; a < mp.size(); ++a) {
+    Vec3 v = mk.J_ar.middleRows<3>(3 * a) * qdot_c;
+    if (fibre) v += mk.v_z.segment<3>(3 * a);
+    T += 0.5 * mp.mass[a] * v.squaredNorm();
+  }
   return T;
 }
 

@@ -60,6 +60,13 @@ struct MuscleKinematics {
   std::vector<double> beta;         // fraction within that segment [D Eq. 5.29]             (N)
   MatX J_ar;                        // J_am J_mr = J_az J_zm J_mr [D Eq. 5.4, 5.15]         (3N x k)
   MatX Jdot_ar;                     // Jdot_am J_mr + J_am Jdot_mr [D Eq. 5.5]              (3N x k)
+  // fibre-following placement only (core/muscles/fibre_placement.hpp); empty otherwise. Then
+  // J_ar is dx_a/dq at fixed muscle states, Jdot_ar its total time derivative, and
+  // xdot_a = J_ar qdot + v_z, xddot_a = J_ar qddot + Jdot_ar qdot + a_z
+  VecX J_aT;                        // dx_a / d(tendon length) at fixed q                     (3N)
+  VecX v_z;                         // point velocities from the muscle states' rates          (3N)
+  VecX a_z;                         // their time derivative                                   (3N)
+  MatX seg_lq, seg_lqdot;           // scratch: dl_i/dq and its time derivative, per segment (P-1 x k)
 
   bool velocity = false;            // true when the velocity-stage fields are valid
 

@@ -15,6 +15,10 @@ bool isMoving(const PathPoint& pt) { return pt.kind == PathPointKind::Moving && 
 
 std::string simbodyWrapShapeUnsupportedReason(const Muscle& mu) {
   if (mu.mass_points.size() == 0) return "";
+  // the Simbody side moves points at fixed arc fractions only (core/muscles/fibre_placement.hpp)
+  if (mu.fibre.enabled())
+    return "muscle '" + mu.name + "': fibre-following mass placement is computed by the core only (--engine core, "
+           "or --mass-placement uniform)";
   const std::string why = generalPathMapUnsupportedReason(mu);
   return why.empty() ? "" : "muscle '" + mu.name + "': the Simbody side cannot carry these mass points: " + why;
 }

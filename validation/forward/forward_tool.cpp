@@ -14,6 +14,7 @@
 #include "core/dynamics/sampled_loads.hpp"
 #include "core/dynamics/controller.hpp"
 #include "core/dynamics/muscle_force_term.hpp"
+#include "core/dynamics/muscle_term.hpp"
 #include "core/muscles/hill/muscle_model.hpp"
 
 namespace redmax::validation {
@@ -129,6 +130,10 @@ void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bo
   for (const osim::ForceDesc& f : m.description.forces)
     if (include(f) && !f.modelled)
       warnings.push_back(f.class_name + " '" + f.name + "' is not modelled in forward simulation; ignored");
+  // fibre-following mass points read their muscle's states (core/dynamics/muscle_term.hpp)
+  for (std::string& note : bindMuscleStates(*sys)) warnings.push_back(std::move(note));
+  for (const auto& t : sys->terms())
+    if (auto mt = std::dynamic_pointer_cast<const MuscleTerm>(t)) m.muscle_term = mt;
   m.system = sys;
 }
 

@@ -149,6 +149,7 @@ SimulationModel makeSimulationModel(const osim::ModelDescription& d, const Simul
 
   // explicit masses: added to the muscles, no body gives any
   std::vector<double> masses(built.size(), 0.0);
+  std::vector<std::string> placement_notes(built.size());
   if (explicit_mass) {
     if (options.muscle_mass.mass_points < 1)
       throw std::invalid_argument("--mass-points must be at least 1");
@@ -181,6 +182,14 @@ SimulationModel makeSimulationModel(const osim::ModelDescription& d, const Simul
       mu.mass_points = makeMassPoints(masses[k], mu.optimal_fiber_length, mu.tendon_slack_length, mp);
       validateMuscle(m.build.model, mu);
     }
+    // fibre-following placement where asked (a muscle that cannot stays uniform, said below)
+    for (size_t k = 0; k < built.size(); ++k) {
+      if (!(masses[k] > 0.0)) continue;
+      const auto& mms = m.build.model.muscleModels();
+      const std::string why = osim::placeMassPoints(m.build.model.skeleton(), options.muscle_mass,
+                                                    k < mms.size() ? mms[k] : nullptr, edit.muscle(static_cast<int>(k)));
+      if (!why.empty()) placement_notes[k] = ", uniform placement (" + why + ")";
+    }
   }
   m.build.model = edit.finalize();
   const std::vector<Muscle>& muscles = m.build.model.muscles();
@@ -193,7 +202,7 @@ SimulationModel makeSimulationModel(const osim::ModelDescription& d, const Simul
          << (pathType(muscles[k].path) == PathType::III
                  ? std::string(", wrapping, wrap model ") + osim::toString(muscles[k].wrap.model)
                  : std::string())
-         << "\n";
+         << (muscles[k].fibre.enabled() ? ", fibre-following" : "") << placement_notes[k] << "\n";
       m.added_mass += masses[k];
     }
     m.mass_summary = os.str();

@@ -20,6 +20,9 @@ std::string simbodyEngineUnsupportedReason(const SimulationModel& m, const Simul
            std::to_string(m.system->numConstraintRows()) +
            " rows: locked, coupled or prescribed coordinates, welds); use --engine core";
   if (m.impulses) return "--engine simbody does not apply --impulse loads; use --engine core";
+  for (const Muscle& mu : m.build.model.muscles())
+    if (mu.fibre.enabled() && mu.mass_points.size() > 0)
+      return "--engine simbody moves mass points at fixed arc fractions only; --mass-placement fibre needs --engine core";
   // particles always carry their full inertia: there is no quadratic velocity term to drop
   if (!quadratic_velocity) return "--no-qvv has no Simbody counterpart (particles carry their full inertia)";
   return "";
