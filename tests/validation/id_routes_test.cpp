@@ -88,6 +88,19 @@ TEST_P(IdRoutes, RecursiveEqualsMassMatrixWithAndWithoutMuscleMass) {
 
 INSTANTIATE_TEST_SUITE_P(Sets, IdRoutes, ::testing::Values("E", "F"));
 
+// fibre-following points (placement from each muscle's equilibrium per frame) take the compact
+// J_ar route with the fibre's bias acceleration a_z, as MuscleTerm::addForce does
+TEST(IdRoutesFibrePlacement, RecursiveEqualsMassMatrixOnSetF) {
+  IdToolSettings s = gaitSet("F");
+  if (!fs::exists(s.setup_file)) GTEST_SKIP() << "shared OpenSim data not found: " << s.setup_file;
+  s.muscle_mass.source = Source::Physiological;
+  s.muscle_mass.placement = MuscleMassOptions::Placement::Fibre;
+  const RouteDiff d = compareRoutes(s);
+  EXPECT_GT(d.muscle_mass, 1.0);
+  EXPECT_LE(d.worst, 1e-13);
+  report("set F, physiological mass, fibre-following placement", d);
+}
+
 TEST(IdRoutesRunningLeg, RecursiveEqualsMassMatrixWithWrappingMuscles) {
   IdToolSettings s;
   s.model_file = source("osim_models/running_leg.osim");
