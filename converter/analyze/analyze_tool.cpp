@@ -310,10 +310,6 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   }
   I.geometry = std::move(built.model);
   const Model& skel = I.id->model();
-  auto coreCoordinate = [&](const std::string& name) {
-    const int ci = d.findCoordinate(name);
-    return ci >= 0 ? built.coordinate_index[ci] : -1;
-  };
   for (int k = 0; k < skel.nr(); ++k) I.coordinate_desc.push_back(d.findCoordinate(skel.coordinates()[k].name));
   I.muscle_source = built.muscle_source;
   I.coordinate_index = built.coordinate_index;
@@ -327,7 +323,6 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   // the force set in OpenSim's order (the model's in file order, then force_set_files), those
   // with appliesForce false removed
   std::vector<Actuator>& acts = I.actuators;
-  const bool physiology = so.use_muscle_physiology;
   if (!so.use_model_force_set) {
     // CoordinateActuator::CreateForceSetOfCoordinateActuatorsForModel(s, model, 1, false)
     for (int k = 0; k < skel.nr(); ++k) {
