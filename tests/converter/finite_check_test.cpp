@@ -1,6 +1,8 @@
 // buildCoreModel refuses numbers the reader takes as OpenSim's parser does ("nan", "inf") but no
 // model can use, and non-positive sizes of wrap objects a path uses: each is an error at the
 // element's line of the file, and the unmodified file builds.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -28,7 +30,11 @@ class FiniteCheck : public ::testing::Test {
   void SetUp() override {
     src_ = slurp(std::string(REDMAX_SOURCE_DIR) + "/osim_models/double_pendulum_wrap.osim");
     ASSERT_FALSE(src_.empty());
-    dir_ = fs::temp_directory_path() / ("redmax_finite_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+    // ctest runs each test in its own process at the same time; the pid and the test name keep
+    // their scratch folders apart (gtest's random seed is time-based and can coincide)
+    dir_ = fs::temp_directory_path() /
+           ("redmax_finite_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
