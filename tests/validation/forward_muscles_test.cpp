@@ -3,8 +3,8 @@
 //     fibre to 80 m (fal underflows, fpe infinite) and the run stopped at t = 0.184 s with a NaN
 //     rate; rk45 now retries such a step from its start with a smaller step. The run completes
 //     and agrees with cvode's;
-//   - the wrist (25 Schutte1993Muscle_Deprecated with their SimmSpline curves) stays finite;
-//   - a run that needs cvode: rk45 takes thousands of steps where cvode takes tens (docs/forward.md §5).
+//   - the wrist (25 Schutte1993Muscle_Deprecated with their SimmSpline curves) stays finite.
+// A run that needs cvode (a stiff tendon) is in forward_hard_cases_test.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>

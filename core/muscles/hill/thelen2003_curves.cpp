@@ -111,6 +111,10 @@ void thelenB(double afl, double F, double Af, double Flen, bool concentric, doub
 
 double Thelen2003Curves::dlceN(double a, double fal, double F) const {
   const double afl = a * fal, asy_e = afl * Flen, k = 0.25 + 0.75 * a;
+  // fal underflows to 0 far outside the curve (a trial stage's state): both tangent lines are
+  // 0/0 there (OpenSim's NaN); their limit as a fal -> 0 is -k at F = 0 and infinitely fast
+  // otherwise (no damping holds the fibre), a non-finite rate the integrators refuse by name
+  if (!(afl > 0.0)) return F > 0.0 ? HUGE_VAL : F < 0.0 ? -HUGE_VAL : -k;
   double b, db;
   if (F > 0.0 && F < asy_e * fv_linear_extrap_threshold) {
     thelenB(afl, F, Af, Flen, F <= afl, b, db);
@@ -221,6 +225,9 @@ double Thelen2003DeprecatedCurves::fiberVelocity(double a, double fal, double Fv
   if (Fv < .95 * Fa * Flen) return ecc(Fv);
   // beyond 0.95 Fa Flen: the secant over [0.95, 0.95 + eps] Fa Flen
   const double F0 = .95 * Fa * Flen, F1 = (.95 + eps) * Fa * Flen;
+  // fal underflows to 0 far outside the curve (|lceN - 1| > 18 sqrt(KshapeActive), a trial stage's
+  // state): the secant is 0/0 (OpenSim's NaN); its limit as Fa -> 0 is the damper alone
+  if (!(F1 > F0)) return Fv / damping;
   const double fv0 = ecc(F0), fv1 = ecc(F1);
   return fv0 + (fv1 - fv0) / (F1 - F0) * (Fv - F0);
 }

@@ -5,6 +5,10 @@
 //     active force), one below it is read as at it;
 //   - pennation near 90 degrees: F_T / cos(phi) grows without bound; the Deprecated models switch
 //     to their stiff-tendon branch at 90 degrees;
+//   - fibre lengths far outside the curves (as a long explicit trial stage gives them: arm26's
+//     TRIlong reached -5.5 m in one rk45 stage): the Gaussian fal underflows to 0, so the
+//     Deprecated force-velocity secant over [0.95, 0.95 + 1e-6] a fal Flen was 0/0 = NaN and
+//     stopped a whole forward run; rates must stay finite at every finite state;
 //   - very stiff tendons: the elastic tendon's equilibrium must approach the rigid tendon's as the
 //     tendon stiffens (a model whose stiff limit is wrong would show it here first).
 #include <gtest/gtest.h>
@@ -49,6 +53,29 @@ TEST(HillHardCases, ActivationNearZeroKeepsRatesFiniteAndTheFibreGivesWay) {
             EXPECT_GT(zd[1], 0.0) << cls << " a " << a << " lN " << lN;
           }
         }
+  }
+}
+
+TEST(HillHardCases, FibreFarOutsideItsCurvesKeepsRatesFinite) {
+  // the stage of arm26's F = 0.3 fibre-placement run (docs/forward.md §5): TRIlong at activation
+  // 0.0100, fibre -5.465 m, path 0.292 m; then a sweep of absurd fibre lengths and paths.
+  // Millard's curves have floors and linear ends: finite everywhere
+  for (const std::string cls : {"Thelen2003Muscle", "Thelen2003Muscle_Deprecated", "Millard2012EquilibriumMuscle"}) {
+    const auto m = makeMuscleModel(cls, test::triLong());
+    for (double a : {0.0100137732, 0.5})
+      for (double lf : {-5.46489121, -0.1, 1e-9, 3.0, 12.0})
+        for (double L : {0.292, 0.5, 5.0})
+          for (double speed : {0.0, -3.0}) {
+            double z[2] = {a, lf}, zd[2];
+            MuscleOutput out;
+            m->calc(z, {L, speed, 0.05}, out, zd);
+            // Thelen2003Muscle has no damping: where fal underflows its fibre rate's limit is
+            // infinite (a named non-finite rate for the integrator), never NaN
+            const bool ok = cls == "Thelen2003Muscle" ? !std::isnan(zd[0]) && !std::isnan(zd[1])
+                                                      : std::isfinite(zd[0]) && std::isfinite(zd[1]);
+            EXPECT_TRUE(ok) << cls << " a " << a << " l_f " << lf << " L " << L << ": rates " << zd[0] << ", "
+                            << zd[1];
+          }
   }
 }
 
