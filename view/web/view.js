@@ -56,7 +56,7 @@
 
   // bodies: meshes, else the inertia ellipsoid; the joint frame (M) in each
   const boneMaterial = new THREE.MeshLambertMaterial({ color: 0xd8cfc0 });
-  const ellipsoidMaterial = new THREE.MeshLambertMaterial({ color: 0xd8cfc0, transparent: true, opacity: 0.6 });
+  const ellipsoidMaterial = new THREE.MeshLambertMaterial({ color: 0xd8cfc0, transparent: true, opacity: 0.35, depthWrite: false });
   const bodies = V.bodies.map((b) => {
     const g = new THREE.Group();
     scene.add(g);
@@ -149,7 +149,7 @@
       mu.markers.geometry.setDrawRange(0, m);
       const x = F.mass_points[k];
       for (let i = 0; i < mu.data.mass_points; i++) {
-        const r = 0.015 * size * Math.cbrt(mu.data.point_masses[i] / heaviest);
+        const r = 0.008 * size * Math.cbrt(mu.data.point_masses[i] / heaviest);
         scratch.compose(at.fromArray(x, 3 * i), unitQ, scale.set(r, r, r));
         mu.mass.setMatrixAt(i, scratch);
       }
@@ -196,7 +196,7 @@
 
   // camera: orbit about the centre of the first frame, looking along -z (OpenSim's sagittal view)
   const camera = new THREE.PerspectiveCamera(35, 1, size / 1000, size * 100);
-  const orbit = { az: 0.35, el: 0.2, dist: 1.8 * size };
+  const orbit = { az: 0.35, el: 0.2, dist: 1.3 * size };
   function render() {
     camera.position.set(centre.x + orbit.dist * Math.cos(orbit.el) * Math.sin(orbit.az),
                         centre.y + orbit.dist * Math.sin(orbit.el),
