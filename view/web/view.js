@@ -45,10 +45,14 @@
 
   const setPose = (obj, p) => { obj.position.set(p[0], p[1], p[2]); obj.quaternion.set(p[3], p[4], p[5], p[6]); };
 
-  // the size of the scene over the motion: body origins and path points of every frame
-  const box = new THREE.Box3(), point = new THREE.Vector3();
+  // the size of the scene over the motion: body origins, centres of mass and path points
+  const box = new THREE.Box3(), point = new THREE.Vector3(), origin = new THREE.Vector3(), turn = new THREE.Quaternion();
   V.frames.forEach((F) => {
-    for (let b = 0; b < V.bodies.length; b++) box.expandByPoint(point.fromArray(F.bodies, 7 * b));
+    V.bodies.forEach((b, i) => {
+      box.expandByPoint(point.fromArray(F.bodies, 7 * i));
+      turn.fromArray(F.bodies, 7 * i + 3);
+      box.expandByPoint(point.fromArray(b.ellipsoid_pose).applyQuaternion(turn).add(origin.fromArray(F.bodies, 7 * i)));
+    });
     F.paths.forEach((p) => { for (let i = 0; i < p.x.length; i += 3) box.expandByPoint(point.fromArray(p.x, i)); });
   });
   const size = Math.max(box.getSize(new THREE.Vector3()).length(), 0.1);
@@ -224,7 +228,7 @@
   renderer.domElement.addEventListener("wheel", (e) => { e.preventDefault(); orbit.dist *= e.deltaY > 0 ? 1.1 : 1 / 1.1; render(); });
   window.addEventListener("resize", resize);
 
-  // time: the frame nearest to t; #t=SECONDS in the URL picks it
+  // time: the frame nearest to t; #t=SECONDS in the URL picks it (#t=0.2&muscle=NAME)
   function frameAt(t) {
     let best = 0;
     V.times.forEach((x, i) => { if (Math.abs(x - t) < Math.abs(V.times[best] - t)) best = i; });
@@ -234,7 +238,13 @@
     const m = /t=([-+0-9.eE]+)/.exec(location.hash);
     return m ? frameAt(parseFloat(m[1])) : 0;
   }
-  window.addEventListener("hashchange", () => show(fromHash()));
+  // #muscle=NAME selects a muscle (its readout), as a click on its name does
+  function selectFromHash() {
+    const m = /muscle=([^&]+)/.exec(location.hash);
+    const k = m ? V.muscles.findIndex((x) => x.name === decodeURIComponent(m[1])) : -1;
+    if (k >= 0) select(k);
+  }
+  window.addEventListener("hashchange", () => { selectFromHash(); show(fromHash()); });
   $("slider").max = V.times.length - 1;
   $("slider").addEventListener("input", (e) => show(parseInt(e.target.value, 10)));
   let playing = null;
@@ -252,6 +262,7 @@
   });
 
   resize();
+  selectFromHash();
   show(fromHash());
   status.ready = true;
   status.load_ms = Math.round(performance.now() - started);
