@@ -2,7 +2,6 @@
 // browser opened from disk (docs/view.md). The work is view/view.hpp; this file parses the flags,
 // finds the page's files and prints the summary.
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -12,10 +11,6 @@
 #include "cli/muscle_mass_flags.hpp"
 #include "converter/osim_reader.hpp"
 #include "view/view.hpp"
-
-#ifndef REDMAX_SOURCE_DIR
-#define REDMAX_SOURCE_DIR ""
-#endif
 
 namespace redmax::cli {
 namespace {
@@ -29,18 +24,6 @@ struct ViewFlags {
   bool quiet = false;
 };
 
-// $REDMAX_VIEW_ASSETS, then build/view/ beside this executable's build tree (CMake copies the
-// files there), then view/web/ of the source tree it was built from
-std::vector<std::string> assetFolders() {
-  std::vector<std::string> folders;
-  if (const char* env = std::getenv("REDMAX_VIEW_ASSETS"); env && *env) folders.push_back(env);
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) folders.push_back((exe.parent_path().parent_path() / "view").string());
-  if (*REDMAX_SOURCE_DIR) folders.push_back((fs::path(REDMAX_SOURCE_DIR) / "view" / "web").string());
-  return folders;
-}
-
 int runView(const ViewFlags& f, const CLI::App& app) {
   if (f.models.size() != 1)
     throw UsageError{f.models.empty() ? "view needs a MODEL.osim" : "view takes one MODEL.osim"};
@@ -49,7 +32,7 @@ int runView(const ViewFlags& f, const CLI::App& app) {
   in.mass = parseMuscleMassFlags(f.mass);
   view::ViewAssets assets;
   try {
-    assets = view::findViewAssets(assetFolders());
+    assets = view::findViewAssets(viewAssetFolders());
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;

@@ -241,3 +241,14 @@ def test_meshes_beside_the_model_are_drawn(chromium, redmax_exe, tmp_path):
     assert st["errors"] == [] and st["meshes"] == 1 and st["ellipsoids"] == 1
     # no motion: one frame at the default pose, said on the page
     assert len(data["frames"]) == 1 and any("default pose" in m for m in st["messages"])
+
+
+def test_validate_report_links_the_trial_view(redmax_exe, tmp_path):
+    report = tmp_path / "report"
+    r = run(redmax_exe, "validate", "--model", LEG, "--coordinates", SWING, "--no-simbody", "--no-plots", "--quiet",
+            "--muscle-mass", "physiological", "--view", "--report", report)
+    assert r.returncode == 0, r.stderr
+    assert "[view/index.html](view/index.html)" in (report / "report.md").read_text()
+    data = view_data(report / "view")
+    assert len(data["frames"]) == 81 and data["muscle_mass"] == "physiological"
+    assert sum(m["mass_points"] for m in data["muscles"]) == 80
