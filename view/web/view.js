@@ -45,18 +45,24 @@
 
   const setPose = (obj, p) => { obj.position.set(p[0], p[1], p[2]); obj.quaternion.set(p[3], p[4], p[5], p[6]); };
 
-  // the size of the scene over the motion: body origins, centres of mass and path points
-  const box = new THREE.Box3(), point = new THREE.Vector3(), origin = new THREE.Vector3(), turn = new THREE.Quaternion();
-  V.frames.forEach((F) => {
+  // the size of the model (the largest extent of one frame: body origins, centres of mass, path
+  // points) and its centre relative to the first body, which the camera follows (a walking model
+  // stays in view)
+  let size = 0.1;
+  const centreOffset = new THREE.Vector3(), point = new THREE.Vector3(), origin = new THREE.Vector3(),
+        turn = new THREE.Quaternion();
+  V.frames.forEach((F, f) => {
+    const box = new THREE.Box3();
     V.bodies.forEach((b, i) => {
       box.expandByPoint(point.fromArray(F.bodies, 7 * i));
       turn.fromArray(F.bodies, 7 * i + 3);
       box.expandByPoint(point.fromArray(b.ellipsoid_pose).applyQuaternion(turn).add(origin.fromArray(F.bodies, 7 * i)));
     });
     F.paths.forEach((p) => { for (let i = 0; i < p.x.length; i += 3) box.expandByPoint(point.fromArray(p.x, i)); });
+    size = Math.max(size, box.getSize(point).length());
+    if (f === 0) centreOffset.copy(box.getCenter(point)).sub(origin.fromArray(F.bodies, 0));
   });
-  const size = Math.max(box.getSize(new THREE.Vector3()).length(), 0.1);
-  const centre = box.getCenter(new THREE.Vector3());
+  const centre = new THREE.Vector3();
 
   // bodies: meshes, else the inertia ellipsoid; the joint frame (M) in each
   const boneMaterial = new THREE.MeshLambertMaterial({ color: 0xd8cfc0 });
@@ -198,10 +204,11 @@
     $("muscles").appendChild(label);
   });
 
-  // camera: orbit about the centre of the first frame, looking along -z (OpenSim's sagittal view)
+  // camera: orbit about the model's centre, looking along -z (OpenSim's sagittal view) when az = 0
   const camera = new THREE.PerspectiveCamera(35, 1, size / 1000, size * 100);
-  const orbit = { az: 0.35, el: 0.2, dist: 1.3 * size };
+  const orbit = { az: 0.35, el: 0.2, dist: 1.8 * size };
   function render() {
+    centre.fromArray(V.frames[frame].bodies, 0).add(centreOffset);
     camera.position.set(centre.x + orbit.dist * Math.cos(orbit.el) * Math.sin(orbit.az),
                         centre.y + orbit.dist * Math.sin(orbit.el),
                         centre.z + orbit.dist * Math.cos(orbit.el) * Math.cos(orbit.az));
