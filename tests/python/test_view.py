@@ -252,3 +252,25 @@ def test_validate_report_links_the_trial_view(redmax_exe, tmp_path):
     data = view_data(report / "view")
     assert len(data["frames"]) == 81 and data["muscle_mass"] == "physiological"
     assert sum(m["mass_points"] for m in data["muscles"]) == 80
+
+
+def test_opensim3_display_geometry_is_found(redmax_exe, tmp_path):
+    # arm26 as OpenSim 3 wrote it (<DisplayGeometry><geometry_file>): the humerus's .vtp in
+    # Geometry/ is drawn, the bones without a file are named
+    from conftest import shared
+    arm = shared("opensim-models@a26e12c", "Tutorials", "Computed_Muscle_Control", "OutputReference", "arm26.osim")
+    shutil.copy(arm, tmp_path / "arm26.osim")
+    (tmp_path / "Geometry").mkdir()
+    (tmp_path / "Geometry" / "arm_r_humerus.vtp").write_text(
+        '<VTKFile type="PolyData"><PolyData><Piece NumberOfPoints="3" NumberOfPolys="1"><Points>'
+        '<DataArray type="Float32" NumberOfComponents="3" format="ascii">0 0 0 0.01 0 0 0 -0.3 0</DataArray>'
+        '</Points><Polys><DataArray type="Int32" Name="connectivity" format="ascii">0 1 2</DataArray>'
+        '<DataArray type="Int32" Name="offsets" format="ascii">3</DataArray></Polys></Piece></PolyData></VTKFile>')
+    out = tmp_path / "v"
+    r = run(redmax_exe, "view", tmp_path / "arm26.osim", "--quiet", "--out", out)
+    assert r.returncode == 0, r.stderr
+    data = view_data(out)
+    meshes = {b["name"]: [m["file"] for m in b["meshes"]] for b in data["bodies"]}
+    assert meshes["r_humerus"] == ["arm_r_humerus.vtp"] and meshes["r_ulna_radius_hand"] == []
+    missing = [m for m in data["messages"] if "mesh files not found" in m]
+    assert len(missing) == 1 and missing[0].startswith("29 of 30 "), data["messages"]
