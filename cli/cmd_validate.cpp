@@ -64,7 +64,7 @@ CommandRegistration reg(
            "                 [--forces-to-exclude LIST] [--exact]\n"
            "                 [--reference OPENSIM_ID.sto]... [--published ID.sto]...\n"
            "                 [--tolerance REL] [--max-tolerance REL] [--engine-tolerance REL]\n"
-           "                 [--interpolation linear|cubic] [--no-simbody] [--no-plots] [--gnuplot PATH]\n"
+           "                 [--interpolation linear|cubic] [--no-simbody] [--no-plots] [--gnuplot PATH] [--view]\n"
            "                 [MUSCLE-MASS OPTIONS] [--mass-sweep V1,V2,... [--sweep-columns LIST]]\n"
            "                 [--quiet] --report DIR\n"
            "Processes the inputs once, as `redmax id` does (see `redmax id --help` for the input flags),\n"

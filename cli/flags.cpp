@@ -3,8 +3,13 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <sstream>
+
+#ifndef REDMAX_SOURCE_DIR
+#define REDMAX_SOURCE_DIR ""
+#endif
 
 namespace redmax::cli {
 namespace {
@@ -160,6 +165,17 @@ std::string joinChoices(const std::vector<std::string>& names) {
     s += names[i];
   }
   return s;
+}
+
+std::vector<std::string> viewAssetFolders() {
+  namespace fs = std::filesystem;
+  std::vector<std::string> folders;
+  if (const char* env = std::getenv("REDMAX_VIEW_ASSETS"); env && *env) folders.push_back(env);
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) folders.push_back((exe.parent_path().parent_path() / "view").string());
+  if (*REDMAX_SOURCE_DIR) folders.push_back((fs::path(REDMAX_SOURCE_DIR) / "view" / "web").string());
+  return folders;
 }
 
 }  // namespace redmax::cli

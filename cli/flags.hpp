@@ -36,6 +36,11 @@ CLI::Validator oneOf(const std::vector<std::string>& names);
 /// true when `flag` ("--name") was given on the command line
 bool given(const CLI::App& app, const std::string& flag);
 
+/// Where `redmax view` and `validate --view` look for the page's files (view/view.hpp
+/// findViewAssets), in order: $REDMAX_VIEW_ASSETS, build/view/ beside this executable's build tree
+/// (CMake copies them there), then view/web/ of the source tree it was built from.
+std::vector<std::string> viewAssetFolders();
+
 /// A parsed command's flags by name, for commands whose defaults depend on a mode flag
 /// (`train-wrap --study` trains smaller networks by default than plain training). Values were
 /// checked by the flags' validators during the parse.

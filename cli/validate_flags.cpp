@@ -66,6 +66,10 @@ void addValidateFlags(CLI::App& app, ValidateFlags& f) {
       ->group("Muscle mass");
   app.add_option("--report", f.report, "the report folder (required)")->type_name("DIR");
   app.add_flag("--no-plots", f.no_plots, "no gnuplot plots");
+  app.add_flag("--view", f.view,
+               "also write the trial's `redmax view` into DIR/view (the model along the\n"
+               "coordinates file with the run's muscle mass, a sweep's largest value), linked\n"
+               "from report.md (docs/view.md)");
   app.add_option("--gnuplot", f.gnuplot, "the gnuplot executable (default: found on PATH)")->type_name("PATH");
   app.add_flag("--quiet", f.quiet, "no progress, summary or warnings");
 }
@@ -102,6 +106,13 @@ validation::IdValidationOptions parseValidateFlags(const ValidateFlags& f, const
   if (given(app, "--interpolation")) opt.interpolation = validation::parseInterpolation(f.interpolation);
   opt.gnuplot = f.no_plots ? "none" : f.gnuplot;
   opt.progress = !f.quiet;
+  if (f.view) {
+    try {
+      opt.view = view::findViewAssets(viewAssetFolders());
+    } catch (const std::runtime_error& e) {
+      throw UsageError{std::string("--view: ") + e.what()};
+    }
+  }
   return opt;
 }
 

@@ -16,7 +16,7 @@ struct ValidateFlags {
   double tolerance = validation::IdValidationOptions{}.reference_rms_rel;
   double max_tolerance = 0.0;
   double engine_tolerance = validation::IdValidationOptions{}.engine_rel;
-  bool quiet = false, no_simbody = false, no_plots = false;
+  bool quiet = false, no_simbody = false, no_plots = false, view = false;
 };
 
 /// Declares the ID input flags (cli/id_flags.hpp), the comparisons, the mass sweep, --report,

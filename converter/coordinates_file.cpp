@@ -1,5 +1,7 @@
 #include "converter/coordinates_file.hpp"
 
+#include "converter/error.hpp"
+
 namespace redmax::osim {
 namespace {
 
@@ -81,6 +83,33 @@ CoordinateColumns matchCoordinateColumns(const Storage& table, const std::vector
       if (path && !exact) m.unused_path_labels.push_back(label);
     }
   return m;
+}
+
+CoordinateRows coordinateRows(const Storage& table, const std::vector<CoordinateDesc>& coordinates,
+                              const std::vector<int>& coordinate_index, int nr, const std::string& table_file) {
+  CoordinateRows out;
+  VecX q0 = VecX::Zero(nr);
+  const CoordinateColumns columns = matchCoordinateColumns(table, coordinates);
+  std::vector<std::pair<int, int>> column_of;  // (core coordinate, data column)
+  std::vector<double> scale;
+  for (size_t ci = 0; ci < coordinates.size(); ++ci) {
+    const int k = coordinate_index[ci];
+    if (k < 0) continue;
+    q0[k] = coordinates[ci].default_value;
+    if (columns.value_column[ci] < 0) {
+      ++out.missing;
+      continue;
+    }
+    column_of.emplace_back(k, columns.value_column[ci]);
+    scale.push_back(columns.scale[ci]);
+  }
+  if (column_of.empty()) throw ConvertError(table_file, 0, "no column names a coordinate of the model");
+  for (int row = 0; row < table.numRows(); ++row) {
+    VecX q = q0;
+    for (size_t j = 0; j < column_of.size(); ++j) q[column_of[j].first] = table.data(row, column_of[j].second) * scale[j];
+    out.q.push_back(std::move(q));
+  }
+  return out;
 }
 
 }  // namespace redmax::osim

@@ -57,4 +57,16 @@ struct CoordinateColumns {
 CoordinateColumns matchCoordinateColumns(const Storage& table, const std::vector<CoordinateDesc>& coordinates,
                                          CoordinateLabels rule = CoordinateLabels::NameOrPath);
 
+/// The coordinate vectors (core q order, SI) of every row of `table`: each coordinate's default
+/// value, overwritten by its column where the table has one (NameOrPath labels, degrees converted).
+/// `coordinate_index` maps description coordinates to core ones (BuildResult::coordinate_index; -1
+/// = none), `nr` is the core's size. Throws ConvertError(table_file, 0, ...) when no column names a
+/// coordinate.
+struct CoordinateRows {
+  std::vector<VecX> q;  ///< one per row
+  int missing = 0;      ///< coordinates of the model without a column (held at their defaults)
+};
+CoordinateRows coordinateRows(const Storage& table, const std::vector<CoordinateDesc>& coordinates,
+                              const std::vector<int>& coordinate_index, int nr, const std::string& table_file);
+
 }  // namespace redmax::osim

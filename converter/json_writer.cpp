@@ -149,6 +149,31 @@ JsonWriter& JsonWriter::numbers(const double* x, int n) {
   return endArray();
 }
 
+JsonWriter& JsonWriter::compactNumbers(const double* x, int n, int digits) {
+  beforeValue();
+  out_ += "[";
+  char buf[40];
+  for (int i = 0; i < n; ++i) {
+    if (std::isfinite(x[i]))
+      std::snprintf(buf, sizeof buf, "%s%.*g", i ? "," : "", digits, x[i]);
+    else
+      std::snprintf(buf, sizeof buf, "%snull", i ? "," : "");
+    out_ += buf;
+  }
+  out_ += "]";
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::compactIntegers(const int* x, int n) {
+  beforeValue();
+  out_ += "[";
+  for (int i = 0; i < n; ++i) out_ += (i ? "," : "") + std::to_string(x[i]);
+  out_ += "]";
+  if (stack_.empty()) done_ = true;
+  return *this;
+}
+
 const std::string& JsonWriter::str() const {
   if (!stack_.empty()) throw std::logic_error("JsonWriter: unclosed containers");
   return out_;

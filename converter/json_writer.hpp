@@ -24,6 +24,10 @@ class JsonWriter {
   JsonWriter& value(bool b);
   JsonWriter& null();
   JsonWriter& numbers(const double* x, int n);  ///< an array of numbers
+  /// an array of numbers on one line, each with `digits` significant digits (large data arrays)
+  JsonWriter& compactNumbers(const double* x, int n, int digits);
+  /// an array of integers on one line
+  JsonWriter& compactIntegers(const int* x, int n);
   /// the document; throws std::logic_error if containers are still open
   const std::string& str() const;
 

@@ -1,5 +1,6 @@
 #include "validation/id_validation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,8 @@
 #include <stdexcept>
 
 #include "converter/id/core_id_engine.hpp"
+#include "converter/osim_reader.hpp"
+#include "converter/storage.hpp"
 #include "plugin/simbody/id_engine.hpp"
 #include "plugin/simbody/simbody_options.hpp"
 #include "validation/report/progress.hpp"
@@ -135,6 +138,43 @@ void addInertialEffect(InertialEffect& ie, const osim::Storage& mass, const osim
        << fmt("%.3g", m.max_rel) << " | " << fmt("%.3g", m.rms_rel) << " |\n";
   if (!ie.description.empty()) md << "\n```\n" << ie.description << "```\n";
   report.addMarkdown("Inertial effect", md.str());
+}
+
+}  // namespace
+
+namespace {
+
+// the trial's `redmax view` in report_dir/view (docs/view.md), with the muscle mass of the run
+// (a sweep's largest value), linked from report.md
+void addTrialView(const IdValidationOptions& opt, const osim::IdToolConfig& config, Report& report) {
+  view::ViewInput in;
+  in.mass = opt.muscle_mass;
+  std::string mass_note = "no muscle mass";
+  if (!opt.mass_sweep.empty()) {
+    const double largest = *std::max_element(opt.mass_sweep.begin(), opt.mass_sweep.end());
+    if (in.mass.source == osim::MuscleMassOptions::Source::Transfer)
+      in.mass.transfer_fraction = largest;
+    else
+      in.mass.density *= largest;
+    mass_note = "the sweep's largest value, " + fmt("%g", largest);
+  } else if (in.mass.source != osim::MuscleMassOptions::Source::None) {
+    mass_note = std::string("muscle mass ") + osim::toString(in.mass.source);
+  }
+  const std::string dir = (std::filesystem::path(opt.report_dir) / "view").string();
+  view::ViewSummary vs;
+  try {
+    in.description = osim::readOsimModel(config.model_file);
+    in.motion_file = config.coordinates_file;
+    in.motion = osim::readStorage(config.coordinates_file);
+    vs = view::writeView(in, opt.view, dir);
+  } catch (const std::runtime_error& e) {
+    throw ReportError(dir, e.what());
+  }
+  std::ostringstream md;
+  md << "[view/index.html](view/index.html): the model along the whole coordinates file (" << vs.frames
+     << " frames), muscle paths and " << vs.mass_points << " mass points (" << mass_note
+     << ") in a browser opened from disk; `view/index.html#t=SECONDS` opens at a time (docs/view.md).\n";
+  report.addMarkdown("View", md.str());
 }
 
 }  // namespace
@@ -434,6 +474,8 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
     for (const auto& s : r.warnings) w << "- " << s << "\n";
     report.addMarkdown("Warnings", w.str());
   }
+
+  if (!opt.view.index_html.empty()) addTrialView(opt, config, report);
 
   r.files = report.write();
   r.passed = report.passed();

@@ -34,6 +34,7 @@
 #include "validation/compare/metrics.hpp"
 #include "validation/mass_sweep.hpp"
 #include "validation/report/report.hpp"
+#include "view/view.hpp"
 
 namespace redmax::validation {
 
@@ -66,6 +67,10 @@ struct IdValidationOptions {
   std::vector<double> mass_sweep;
   /// columns the sweep's figures show (empty: chooseMainColumns)
   std::vector<std::string> sweep_columns;
+  /// the page files of `redmax view` (view/view.hpp); given (index_html not empty), the trial's
+  /// view (model, coordinates file, muscle mass; a sweep's largest value) is written into
+  /// report_dir/view and linked from report.md
+  view::ViewAssets view;
 };
 
 /// The core with muscle mass against the zero-mass core: per-column differences (a = with mass,

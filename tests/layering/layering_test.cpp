@@ -5,7 +5,8 @@
 //   core/dynamics <- core/model (the musculoskeletal aggregate, beside core/integrators)
 //   converter/, plugin/ -> core/ (plugin may also read the converter's description)
 //   tools/ -> core/ (offline work the engine never runs: wrap-network training, wrap benchmarks)
-//   validation/ -> core, converter, plugin;  cli/ -> anything
+//   view/ -> core, converter (`redmax view`, docs/view.md)
+//   validation/ -> core, converter, plugin, view;  cli/ -> anything
 // External libraries: tinyxml2 only in converter/; Simbody only in plugin/, validation/ and
 // tests; SUNDIALS only in core/integrators/*.cpp (never a header).
 #include <gtest/gtest.h>
@@ -54,7 +55,7 @@ std::string layerOf(const std::string& inc) {
   static const std::vector<std::string> layers = {
       "core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles",
       "core/dynamics",
-      "core/integrators", "core/model", "converter", "plugin", "tools", "validation", "cli"};
+      "core/integrators", "core/model", "converter", "plugin", "tools", "view", "validation", "cli"};
   for (const auto& l : layers)
     if (inc.rfind(l + "/", 0) == 0) return l;
   return "";
@@ -89,14 +90,17 @@ std::map<std::string, std::set<std::string>> layerRules() {
   };
   std::set<std::string> core_all = rules.at("core/integrators");
   core_all.insert("core/model");
-  std::set<std::string> converter = core_all, plugin = core_all, tools = core_all, validation = core_all;
+  std::set<std::string> converter = core_all, plugin = core_all, tools = core_all, validation = core_all,
+                        view = core_all;
   converter.insert("converter");
+  view.insert({"converter", "view"});
   plugin.insert({"converter", "plugin"});
   tools.insert("tools");
-  validation.insert({"converter", "plugin", "validation"});
+  validation.insert({"converter", "plugin", "view", "validation"});
   rules["converter"] = converter;
   rules["plugin"] = plugin;
   rules["tools"] = tools;
+  rules["view"] = view;
   rules["validation"] = validation;
   return rules;
 }
@@ -158,6 +162,8 @@ TEST(Layering, DetectsAViolation) {
   EXPECT_FALSE(mayInclude("validation", "tools/wrap_training/train.hpp"));
   EXPECT_FALSE(mayInclude("tools", "validation/report/csv.hpp"));
   EXPECT_TRUE(mayInclude("tools", "core/muscles/wrap/network.hpp"));
+  EXPECT_FALSE(mayInclude("view", "validation/report/csv.hpp"));  // the view sits below validation
+  EXPECT_TRUE(mayInclude("validation", "view/view.hpp"));
   EXPECT_TRUE(mayInclude("core/spatial", "Eigen/Core"));
   // the Hill models sit below everything: not even spatial algebra
   EXPECT_EQ(layerOf("core/muscles/hill/muscle_model.hpp"), "core/muscles/hill");

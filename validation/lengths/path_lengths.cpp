@@ -82,22 +82,9 @@ PathLengthResult calcPathLengths(const osim::ModelDescription& d, const osim::Bu
 
   // coordinates: default values, overwritten by the file's columns (converter/coordinates_file.hpp)
   const Model& model = build.model;
-  VecX q0 = VecX::Zero(model.nr());
-  const osim::CoordinateColumns columns = osim::matchCoordinateColumns(coords, d.coordinates);
-  std::vector<std::pair<int, int>> column_of;  // (core coordinate, data column)
-  std::vector<double> scale;
-  for (size_t ci = 0; ci < d.coordinates.size(); ++ci) {
-    const int k = build.coordinate_index[ci];
-    if (k < 0) continue;
-    q0[k] = d.coordinates[ci].default_value;
-    if (columns.value_column[ci] < 0) {
-      ++res.missing_coordinates;
-      continue;
-    }
-    column_of.emplace_back(k, columns.value_column[ci]);
-    scale.push_back(columns.scale[ci]);
-  }
-  if (column_of.empty()) throw osim::ConvertError(coords_file, 0, "no column names a coordinate of the model");
+  const osim::CoordinateRows rows =
+      osim::coordinateRows(coords, d.coordinates, build.coordinate_index, model.nr(), coords_file);
+  res.missing_coordinates = rows.missing;
 
   // the paths without their wraps when asked (None: straight segments only)
   std::vector<MusclePath> paths;
@@ -151,9 +138,7 @@ PathLengthResult calcPathLengths(const osim::ModelDescription& d, const osim::Bu
   std::vector<int> active;
   std::vector<Vec3> x_w;
   for (int row = 0; row < coords.numRows(); ++row) {
-    VecX q = q0;
-    for (size_t j = 0; j < column_of.size(); ++j)
-      q[column_of[j].first] = coords.data(row, column_of[j].second) * scale[j];
+    const VecX& q = rows.q[row];
     calcBodyPoses(model, q, E_wi);
     for (size_t j = 0; j < wl_cols.size(); ++j) {
       // one wrapped-path evaluation per path, at its first column
