@@ -298,26 +298,12 @@ NetworkWrapEval calcWrapModelPoints(const WrapMassOptions& options, const WrapSu
   out.x_alphadot.assign(with_alpha ? n : 0, Vec3::Zero());
   switch (options.model) {
     case WrapModel::Smooth: {
+      // one shared construction for all the points (the fraction is a seventh input when it
+      // moves or its derivative is asked for: its rate enters Jdot)
       SmoothWrapOptions so;
       so.width = options.width;
-      for (int a = 0; a < n; ++a) {
-        if (with_alpha || moving_alpha) {
-          // the fraction is a seventh input: its rate enters Jdot
-          const SmoothWrapSegmentPoint sp = calcSmoothWrapSegmentPoint(surface, p1, p2, alphas[a], v1, v2, alphadot(a), so);
-          out.x[a] = sp.x;
-          out.J[a] = sp.J.leftCols<6>();
-          out.Jdot[a] = sp.Jdot.leftCols<6>();
-          if (with_alpha) {
-            out.x_alpha[a] = sp.J.col(6);
-            out.x_alphadot[a] = sp.Jdot.col(6);
-          }
-        } else {
-          const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(surface, p1, p2, alphas[a], v1, v2, so);
-          out.x[a] = sp.x;
-          out.J[a] = sp.J;
-          out.Jdot[a] = sp.Jdot;
-        }
-      }
+      calcSmoothWrapPoints(surface, p1, p2, v1, v2, alphas, velocity ? alphadots : std::vector<double>{}, so, out,
+                           with_alpha ? &out.x_alpha : nullptr, with_alpha ? &out.x_alphadot : nullptr);
       return {};
     }
     case WrapModel::Neural:  // the network, or the smooth model outside its training box (wrap/network_model.hpp)
@@ -567,6 +553,8 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
   std::vector<int> idx;
   std::vector<double> betas, betadots;
   WrapModelPoints wp;
+  MatX JwA(3, k), inner(3, k);
+  Eigen::RowVectorXd J_b(k), Jdot_b(k);
   for (int i = 0; i < nseg; ++i) {
     const int w = seg_wrap[i];
     if (w < 0) continue;
@@ -598,29 +586,42 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
       const Vec3 Rw = R * wp.x[j];
       mk.x_a[a] = Rw + m.p;
       const Mat3 Jw1 = wp.J[j].leftCols<3>(), Jw2 = wp.J[j].rightCols<3>();
-      MatX JwA = Jw1 * e.A1 + Jw2 * e.A2;  // dw/dq in the surface frame
-      Eigen::RowVectorXd J_b;
+      // products one by one into buffers sized once: no allocation per point
+      JwA.noalias() = Jw1 * e.A1;  // dw/dq in the surface frame
+      JwA.noalias() += Jw2 * e.A2;
       if (moving_beta) {
         // beta (ds) = alpha - s_i
         J_b = -((1.0 - beta) * mk.J_sr.row(i) + beta * mk.J_sr.row(i + 1)) / ds;
         JwA.noalias() += wp.x_alpha[j] * J_b;
       }
-      mk.J_ar.middleRows(3 * a, 3).noalias() = R * JwA - skew(Rw) * m.J_om + m.J_p;
+      auto J_a = mk.J_ar.middleRows(3 * a, 3);
+      J_a.noalias() = R * JwA;
+      J_a.noalias() -= skew(Rw) * m.J_om;
+      J_a += m.J_p;
       if (!vel) continue;
       Vec3 wdot = Jw1 * e.p1dot + Jw2 * e.p2dot;
       const Mat3 Jw1dot = wp.Jdot[j].leftCols<3>(), Jw2dot = wp.Jdot[j].rightCols<3>();
-      MatX inner = Jw1dot * e.A1 + Jw2dot * e.A2 + Jw1 * e.A1dot + Jw2 * e.A2dot;
+      inner.noalias() = Jw1dot * e.A1;
+      inner.noalias() += Jw2dot * e.A2;
+      inner.noalias() += Jw1 * e.A1dot;
+      inner.noalias() += Jw2 * e.A2dot;
       if (moving_beta) {
         const double bd = betadots[j];
         const double dsdot = mk.sdot[i + 1] - mk.sdot[i];
-        const Eigen::RowVectorXd Jdot_b = -((1.0 - beta) * mk.Jdot_sr.row(i) + beta * mk.Jdot_sr.row(i + 1) + dsdot * J_b +
-                                 bd * (mk.J_sr.row(i + 1) - mk.J_sr.row(i))) / ds;
+        Jdot_b = -((1.0 - beta) * mk.Jdot_sr.row(i) + beta * mk.Jdot_sr.row(i + 1) + dsdot * J_b +
+                   bd * (mk.J_sr.row(i + 1) - mk.J_sr.row(i))) / ds;
         wdot += wp.x_alpha[j] * bd;
-        inner.noalias() += wp.x_alphadot[j] * J_b + wp.x_alpha[j] * Jdot_b;
+        inner.noalias() += wp.x_alphadot[j] * J_b;
+        inner.noalias() += wp.x_alpha[j] * Jdot_b;
       }
       const Vec3 Rwdot = m.omega.cross(Rw) + R * wdot;
-      mk.Jdot_ar.middleRows(3 * a, 3).noalias() =
-          skew(m.omega) * R * JwA + R * inner - skew(Rwdot) * m.J_om - skew(Rw) * m.Jdot_om + m.Jdot_p;
+      const Mat3 WR = skew(m.omega) * R;
+      auto Jdot_a = mk.Jdot_ar.middleRows(3 * a, 3);
+      Jdot_a.noalias() = WR * JwA;
+      Jdot_a.noalias() += R * inner;
+      Jdot_a.noalias() -= skew(Rwdot) * m.J_om;
+      Jdot_a.noalias() -= skew(Rw) * m.Jdot_om;
+      Jdot_a += m.Jdot_p;
     }
   }
 }
