@@ -20,21 +20,13 @@
 #include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/system.hpp"
 #include "validation/scenes/humanoid.hpp"
+#include "validation/bench/cpu_reporter.hpp"
 
 namespace {
 
 using namespace redmax;
 
-class CpuReporter : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& r : runs)
-      if (r.run_type == Run::RT_Iteration && !r.error_occurred)
-        us[r.benchmark_name()] = r.GetAdjustedCPUTime() / benchmark::GetTimeUnitMultiplier(r.time_unit) * 1e6;
-    ConsoleReporter::ReportRuns(runs);
-  }
-  std::map<std::string, double> us;
-};
+using bench::CpuReporter;
 
 // n links; `points` mass points spread over min(10, n - 2) Type II muscles of 1 kg (0: no muscle)
 struct Scene {

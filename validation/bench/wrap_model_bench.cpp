@@ -19,22 +19,14 @@
 #include "core/skeleton/kinematics.hpp"
 #include "validation/scenes/scenes.hpp"
 #include "validation/scenes/wrap_pendulums.hpp"
+#include "validation/bench/cpu_reporter.hpp"
 
 namespace {
 
 using namespace redmax;
 constexpr int kPoints = 20;
 
-class CpuReporter : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& r : runs)
-      if (r.run_type == Run::RT_Iteration && !r.error_occurred)
-        us[r.benchmark_name()] = r.GetAdjustedCPUTime() / benchmark::GetTimeUnitMultiplier(r.time_unit) * 1e6;
-    ConsoleReporter::ReportRuns(runs);
-  }
-  std::map<std::string, double> us;
-};
+using bench::CpuReporter;
 
 // the pendulum's muscle in three shapes: 0 straight, 1 via point at the cylinder, 2 wrapping
 Muscle pendulumMuscle(int shape) {
