@@ -115,10 +115,12 @@ int main(int argc, char** argv) {
   const double eol = at("model/type2_via_eol") / kPoints;
   for (const char* s : shapes) {
     const double t = at(std::string("model/") + s) / kPoints;
+    if (t == 0.0) continue;  // filtered out
     std::printf("  model/%-16s %8.3f us/point  (%.2fx Type II EOL)\n", s, t, eol > 0 ? t / eol : 0.0);
   }
   for (auto& [name, sc] : surfaces) {
     const double a = at("surface/" + name + "/nested_per_point") / kPoints, b = at("surface/" + name + "/shared_jet") / kPoints;
+    if (a == 0.0 && b == 0.0) continue;  // filtered out
     std::printf("  surface/%-10s nested per point %8.3f us, shared jet %7.3f us (%.1fx faster); shared = %.2fx Type II EOL\n",
                 name.c_str(), a, b, b > 0 ? a / b : 0.0, eol > 0 ? b / eol : 0.0);
   }
