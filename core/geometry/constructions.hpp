@@ -4,7 +4,7 @@
 // plane through the apex; the sphere's wrapping plane, tangent points and arc; the torus's search
 // for the centre-circle point nearest the line and its local cylinder frame. The exact library
 // (cylinder.cpp, sphere.cpp, torus.cpp) runs them on double; the smooth wrap model
-// (core/muscles/wrap/smooth.cpp) on nested duals for exact J and Jdot. Discrete choices (which
+// (core/muscles/wrap/smooth.cpp) on Jet numbers for exact J and Jdot. Discrete choices (which
 // candidate, which side, whether a point slides) are decided on values, so T only carries
 // derivatives through the continuous parts. All in the surface frame; see wrap_surface.hpp for the
 // OpenSim behaviours reproduced.

@@ -298,26 +298,12 @@ NetworkWrapEval calcWrapModelPoints(const WrapMassOptions& options, const WrapSu
   out.x_alphadot.assign(with_alpha ? n : 0, Vec3::Zero());
   switch (options.model) {
     case WrapModel::Smooth: {
+      // one shared construction for all the points (the fraction is a seventh input when it
+      // moves or its derivative is asked for: its rate enters Jdot)
       SmoothWrapOptions so;
       so.width = options.width;
-      for (int a = 0; a < n; ++a) {
-        if (with_alpha || moving_alpha) {
-          // the fraction is a seventh input: its rate enters Jdot
-          const SmoothWrapSegmentPoint sp = calcSmoothWrapSegmentPoint(surface, p1, p2, alphas[a], v1, v2, alphadot(a), so);
-          out.x[a] = sp.x;
-          out.J[a] = sp.J.leftCols<6>();
-          out.Jdot[a] = sp.Jdot.leftCols<6>();
-          if (with_alpha) {
-            out.x_alpha[a] = sp.J.col(6);
-            out.x_alphadot[a] = sp.Jdot.col(6);
-          }
-        } else {
-          const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(surface, p1, p2, alphas[a], v1, v2, so);
-          out.x[a] = sp.x;
-          out.J[a] = sp.J;
-          out.Jdot[a] = sp.Jdot;
-        }
-      }
+      calcSmoothWrapPoints(surface, p1, p2, v1, v2, alphas, velocity ? alphadots : std::vector<double>{}, so, out,
+                           with_alpha ? &out.x_alpha : nullptr, with_alpha ? &out.x_alphadot : nullptr);
       return {};
     }
     case WrapModel::Neural:  // the network, or the smooth model outside its training box (wrap/network_model.hpp)
@@ -567,6 +553,7 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
   std::vector<int> idx;
   std::vector<double> betas, betadots;
   WrapModelPoints wp;
+  MatX stackJ, stackD, cJ, cD;  // sized per segment, reused by its points
   for (int i = 0; i < nseg; ++i) {
     const int w = seg_wrap[i];
     if (w < 0) continue;
@@ -592,35 +579,56 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
     }
     const Mat3& R = m.R;
     const double ds = mk.s[i + 1] - mk.s[i];
+    const double dsdot = vel ? mk.sdot[i + 1] - mk.sdot[i] : 0.0;
+    // the segment's rows stacked once, so that each point's J_ar and Jdot_ar are one product of a
+    // 3 x r coefficient matrix with them (the header's formulas, terms regrouped):
+    //   J_ar    = [R Jw, -[Rw], I, R w_a c_i, R w_a c_i1] [A; J_om; J_p; J_s,i; J_s,i+1]
+    //   Jdot_ar = [[omega] R Jw + R Jwdot, R Jw, -[Rwdot], -[Rw], I, (beta rows)]
+    //             [A; Adot; J_om; Jdot_om; Jdot_p; J_s,i; J_s,i+1; Jdot_s,i; Jdot_s,i+1]
+    // with A = [A_1; A_2] and J_beta = c_i J_s,i + c_i1 J_s,i+1 (c_i = -(1 - beta) / ds, c_i1 = -beta / ds)
+    const int nb = moving_beta ? 2 : 0;
+    stackJ.resize(12 + nb, k);
+    stackJ.topRows(12) << e.A1, e.A2, m.J_om, m.J_p;
+    if (moving_beta) stackJ.bottomRows(2) << mk.J_sr.row(i), mk.J_sr.row(i + 1);
+    if (vel) {
+      stackD.resize(21 + 2 * nb, k);
+      stackD.topRows(21) << e.A1, e.A2, e.A1dot, e.A2dot, m.J_om, m.Jdot_om, m.Jdot_p;
+      if (moving_beta) stackD.bottomRows(4) << mk.J_sr.row(i), mk.J_sr.row(i + 1), mk.Jdot_sr.row(i), mk.Jdot_sr.row(i + 1);
+    }
+    const Mat3 WR = skew(m.omega) * R;
     for (size_t j = 0; j < idx.size(); ++j) {
       const int a = idx[j];
       const double beta = betas[j];
       const Vec3 Rw = R * wp.x[j];
       mk.x_a[a] = Rw + m.p;
-      const Mat3 Jw1 = wp.J[j].leftCols<3>(), Jw2 = wp.J[j].rightCols<3>();
-      MatX JwA = Jw1 * e.A1 + Jw2 * e.A2;  // dw/dq in the surface frame
-      Eigen::RowVectorXd J_b;
+      const Eigen::Matrix<double, 3, 6> RJw = R * wp.J[j];
+      cJ.resize(3, 12 + nb);
+      cJ.leftCols(12) << RJw, -skew(Rw), Mat3::Identity();
+      const double ci = -(1.0 - beta) / ds, ci1 = -beta / ds;
+      Vec3 Rwa = Vec3::Zero();
       if (moving_beta) {
-        // beta (ds) = alpha - s_i
-        J_b = -((1.0 - beta) * mk.J_sr.row(i) + beta * mk.J_sr.row(i + 1)) / ds;
-        JwA.noalias() += wp.x_alpha[j] * J_b;
+        Rwa = R * wp.x_alpha[j];
+        cJ.col(12) = ci * Rwa;
+        cJ.col(13) = ci1 * Rwa;
       }
-      mk.J_ar.middleRows(3 * a, 3).noalias() = R * JwA - skew(Rw) * m.J_om + m.J_p;
+      mk.J_ar.middleRows(3 * a, 3).noalias() = cJ * stackJ;
       if (!vel) continue;
-      Vec3 wdot = Jw1 * e.p1dot + Jw2 * e.p2dot;
-      const Mat3 Jw1dot = wp.Jdot[j].leftCols<3>(), Jw2dot = wp.Jdot[j].rightCols<3>();
-      MatX inner = Jw1dot * e.A1 + Jw2dot * e.A2 + Jw1 * e.A1dot + Jw2 * e.A2dot;
-      if (moving_beta) {
-        const double bd = betadots[j];
-        const double dsdot = mk.sdot[i + 1] - mk.sdot[i];
-        const Eigen::RowVectorXd Jdot_b = -((1.0 - beta) * mk.Jdot_sr.row(i) + beta * mk.Jdot_sr.row(i + 1) + dsdot * J_b +
-                                 bd * (mk.J_sr.row(i + 1) - mk.J_sr.row(i))) / ds;
-        wdot += wp.x_alpha[j] * bd;
-        inner.noalias() += wp.x_alphadot[j] * J_b + wp.x_alpha[j] * Jdot_b;
-      }
+      Vec3 wdot = wp.J[j].leftCols<3>() * e.p1dot + wp.J[j].rightCols<3>() * e.p2dot;
+      const double bd = moving_beta ? betadots[j] : 0.0;
+      if (moving_beta) wdot += wp.x_alpha[j] * bd;
       const Vec3 Rwdot = m.omega.cross(Rw) + R * wdot;
-      mk.Jdot_ar.middleRows(3 * a, 3).noalias() =
-          skew(m.omega) * R * JwA + R * inner - skew(Rwdot) * m.J_om - skew(Rw) * m.Jdot_om + m.Jdot_p;
+      cD.resize(3, 21 + 2 * nb);
+      cD.leftCols(21) << WR * wp.J[j] + R * wp.Jdot[j], RJw, -skew(Rwdot), -skew(Rw), Mat3::Identity();
+      if (moving_beta) {
+        // (WR w_a + R w_adot) J_beta + R w_a Jdot_beta, with Jdot_beta = c_i Jdot_s,i + c_i1 Jdot_s,i+1
+        //   - (dsdot J_beta + bd (J_s,i+1 - J_s,i)) / ds
+        const Vec3 cw = WR * wp.x_alpha[j] + R * wp.x_alphadot[j];
+        cD.col(21) = ci * cw - (dsdot * ci - bd) / ds * Rwa;
+        cD.col(22) = ci1 * cw - (dsdot * ci1 + bd) / ds * Rwa;
+        cD.col(23) = ci * Rwa;
+        cD.col(24) = ci1 * Rwa;
+      }
+      mk.Jdot_ar.middleRows(3 * a, 3).noalias() = cD * stackD;
     }
   }
 }

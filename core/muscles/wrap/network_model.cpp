@@ -182,25 +182,10 @@ NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface,
 
   out.used_network = false;
   const Vec3 v1 = with_jdot ? p1dot : Vec3::Zero(), v2 = with_jdot ? p2dot : Vec3::Zero();
-  bool moving_alpha = false;
-  for (int k = 0; k < n; ++k) moving_alpha = moving_alpha || alphadot(k) != 0.0;
-  for (int k = 0; k < n; ++k) {
-    if (x_alpha || x_alphadot || moving_alpha) {
-      // the fraction as a seventh input of the smooth model
-      const SmoothWrapSegmentPoint sp =
-          calcSmoothWrapSegmentPoint(surface, p1, p2, alphas[k], v1, v2, alphadot(k), options.fallback);
-      out.x[k] = sp.x;
-      out.J[k] = sp.J.leftCols<6>();
-      out.Jdot[k] = sp.Jdot.leftCols<6>();
-      if (x_alpha) (*x_alpha)[k] = sp.J.col(6);
-      if (x_alphadot) (*x_alphadot)[k] = sp.Jdot.col(6);
-    } else {
-      const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(surface, p1, p2, alphas[k], v1, v2, options.fallback);
-      out.x[k] = sp.x;
-      out.J[k] = sp.J;
-      out.Jdot[k] = sp.Jdot;
-    }
-  }
+  // the smooth model on the same points, sharing its construction (wrap/smooth.hpp)
+  calcSmoothWrapPoints(surface, p1, p2, v1, v2, alphas, with_jdot ? alphadots : std::vector<double>{},
+                       options.fallback, out, x_alpha, x_alphadot);
+  out.used_network = false;
   return ev;
 }
 

@@ -22,29 +22,41 @@ constexpr double kQuadrantBlend = 0.25;
 // alpha may be a constant or carry derivatives of its own (the same scalar type as the points)
 template <class T> using Alpha = std::type_identity_t<T>;
 
-// point at fraction alpha of p1 -> r1 -> arc -> r2 -> p2; the arc turns r1 about the unit axis k
-// through the origin by angle phi (with rise h along k): the library's calcWrappedPathPoint;
-// total_out (if given) receives the geometric length |p1 r1| + arc + |r2 p2|
+// the path p1 -> r1 -> arc -> r2 -> p2, the arc turning r1 about the unit axis k through the
+// origin by angle phi (with rise h along k): the library's calcWrappedPathPoint, with its
+// alpha-independent lengths kept so that a muscle's mass points share them
 template <class T>
-V3<T> pathPoint(const V3<T>& p1, const V3<T>& p2, const V3<T>& r1, const V3<T>& r2, const V3<T>& k, const T& phi,
-                const T& h, const Alpha<T>& alpha, T* total_out = nullptr) {
-  const T l1 = norm(r1 - p1);
+struct ArcPath {
+  V3<T> p1{}, p2{}, r1{}, r2{}, k{};
+  T phi{}, h{}, l1{}, la{}, l2{}, total{};  // total: the geometric length |p1 r1| + arc + |r2 p2|
+};
+
+template <class T>
+ArcPath<T> makeArcPath(const V3<T>& p1, const V3<T>& p2, const V3<T>& r1, const V3<T>& r2, const V3<T>& k,
+                       const T& phi, const T& h) {
+  ArcPath<T> a{p1, p2, r1, r2, k, phi, h};
+  a.l1 = norm(r1 - p1);
   const V3<T> r1_perp = r1 - dot(r1, k) * k;
   const T rho_phi = norm(r1_perp) * phi;
-  const T la = dsqrt(rho_phi * rho_phi + h * h);
-  const T l2 = norm(p2 - r2);
-  const T total = l1 + la + l2;
-  if (total_out) *total_out = total;
-  T s = alpha * total;
-  if (value(s) <= value(l1)) return p1 + (s / l1) * (r1 - p1);
-  s = s - l1;
-  if (value(s) <= value(la)) {
-    const T f = s / la;
-    return rotate(k, f * phi, r1) + (f * h) * k;
+  a.la = dsqrt(rho_phi * rho_phi + h * h);
+  a.l2 = norm(p2 - r2);
+  a.total = a.l1 + a.la + a.l2;
+  return a;
+}
+
+// point at fraction alpha of the path
+template <class T>
+V3<T> arcPathPoint(const ArcPath<T>& a, const Alpha<T>& alpha) {
+  T s = alpha * a.total;
+  if (value(s) <= value(a.l1)) return a.p1 + (s / a.l1) * (a.r1 - a.p1);
+  s = s - a.l1;
+  if (value(s) <= value(a.la)) {
+    const T f = s / a.la;
+    return rotate(a.k, f * a.phi, a.r1) + (f * a.h) * a.k;
   }
-  s = s - la;
-  const T f = s / l2;
-  return value(f) < 1.0 ? r2 + f * (p2 - r2) : p2;
+  s = s - a.la;
+  const T f = s / a.l2;
+  return value(f) < 1.0 ? a.r2 + f * (a.p2 - a.r2) : a.p2;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -89,8 +101,7 @@ T penetration(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2) {
 // false when the library would not wrap for a reason other than penetration (both tangent points
 // beyond the cylinder's ends).
 template <class T>
-bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, const Alpha<T>& alpha, V3<T>& x,
-                   T* total_out = nullptr) {
+bool cylinderSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, ArcPath<T>& path) {
   V3<T> r1, r2;
   bool long_wrap = false;
   if (!cylinderTangentPoints(surf.radius, surf.length, surf.quadrant_axis, surf.quadrant_sign, p1, p2, r1, r2,
@@ -98,14 +109,13 @@ bool cylinderPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, co
     return false;
   // helix about the axis
   const T theta = cylinderHelixAngle(r1, r2, long_wrap);
-  x = pathPoint(p1, p2, r1, r2, zAxis<T>(), theta, r2[2] - r1[2], alpha, total_out);
+  path = makeArcPath(p1, p2, r1, r2, zAxis<T>(), theta, r2[2] - r1[2]);
   return true;
 }
 
 // the exact library's unconstrained sphere over any scalar (constructions.hpp, as core/geometry/sphere.cpp)
 template <class T>
-bool spherePoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, const Alpha<T>& alpha, V3<T>& x,
-                 T* total_out = nullptr) {
+bool sphereSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, ArcPath<T>& path) {
   const double R = surf.radius;
   const V3<T> n = sphereWrapPlaneNormal(p1, p2);
   V3<T> r1a, r1b, r2a, r2b;
@@ -118,7 +128,7 @@ bool spherePoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, cons
   T angle;
   V3<T> ax;
   sphereArc(r1, r2, n, angle, ax);
-  x = pathPoint(p1, p2, r1, r2, ax, angle, T(0.0), alpha, total_out);
+  path = makeArcPath(p1, p2, r1, r2, ax, angle, T(0.0));
   return true;
 }
 
@@ -407,14 +417,10 @@ bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, E
   return true;
 }
 
+// the point at fraction alpha of p1 -> r1 -> arc -> r2 -> p2 (scaled back)
 template <class T>
-bool ellipsoidPoint(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, const Alpha<T>& alpha, V3<T>& x,
-                    T* total_out = nullptr) {
-  EllipsoidWrap<T> ew;
-  if (!ellipsoidSetup(surf, P1, P2, ew)) return false;
+V3<T> ellipsoidPoint(const EllipsoidWrap<T>& ew, const Alpha<T>& alpha) {
   const EllipsoidArc<T>& arc = ew.arc;
-  // the point at fraction alpha of p1 -> r1 -> arc -> r2 -> p2 (scaled back)
-  if (total_out) *total_out = ew.total / ew.factor;
   const T s = alpha * ew.total;
   V3<T> xs;
   if (value(s) <= value(ew.d1)) {
@@ -450,8 +456,7 @@ bool ellipsoidPoint(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, c
     const T f = (s - ew.d1 - ew.la) / ew.d2;
     xs = value(f) < 1.0 ? ew.r2 + f * (ew.p2 - ew.r2) : ew.p2;
   }
-  x = (1.0 / ew.factor) * xs;
-  return true;
+  return (1.0 / ew.factor) * xs;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -504,14 +509,31 @@ bool torusFrame(const WrapSurface& s, const V3<T>& p1, const V3<T>& p2, TorusFra
   return makeTorusFrame(radius, p + u * dir, p1, p2, f);
 }
 
-// the blended point over any scalar; length_out (if given) receives the blended segment length
-// L = L_straight + w (L_wrapped - L_straight), the exact wrapped length outside the band
+// everything of the blended path that does not depend on alpha (a muscle's mass points share
+// it): the straight ends, the blend weight, the wrapped geometry; for a torus, in its local
+// cylinder's frame
 template <class T>
-V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, const Alpha<T>& alpha, double width, T* d_out,
-                  T* w_out, T* length_out = nullptr) {
-  const V3<T> straight = p1 + alpha * (p2 - p1);
-  const T l_straight = norm(p2 - p1);
-  if (length_out) *length_out = l_straight;
+struct SmoothSetup {
+  enum class Mode { Straight, Wrapped, Blend } mode = Mode::Straight;
+  V3<T> p1{}, p2{};       // the straight path's ends (the local cylinder's frame for a torus)
+  T l_straight{}, w{}, d{};
+  bool ellipsoid = false;  // geometry: the ellipsoid's, else the arc path
+  ArcPath<T> arc{};
+  EllipsoidWrap<T> ew{};
+  bool torus = false;      // points go back through `frame`
+  TorusFrame<T> frame{};
+  T wrappedLength() const { return ellipsoid ? ew.total / ew.factor : arc.total; }
+  V3<T> wrappedPoint(const Alpha<T>& alpha) const { return ellipsoid ? ellipsoidPoint(ew, alpha) : arcPathPoint(arc, alpha); }
+};
+
+// the blend's setup over any scalar (the blended point: smoothPoint below)
+template <class T>
+void smoothSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double width, SmoothSetup<T>& st) {
+  st.torus = false;
+  st.p1 = p1;
+  st.p2 = p2;
+  st.l_straight = norm(p2 - p1);
+  st.mode = SmoothSetup<T>::Mode::Straight;
   if (surf.type == WrapType::Torus) {
     // the smooth quadrant cylinder in the anchor's frame (lengths and blends are frame-free);
     // where the library does not wrap at all (no anchor, an end inside the local cylinder) the
@@ -522,13 +544,18 @@ V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, con
     const double ri = cyl.radius;
     const Vec3 q1 = values(f.q1), q2 = values(f.q2);
     if (!ok || std::hypot(q1[0], q1[1]) < ri || std::hypot(q2[0], q2[1]) < ri) {
-      if (d_out) *d_out = T(-1.0);
-      if (w_out) *w_out = T(0.0);
-      return straight;
+      st.d = T(-1.0);
+      st.w = T(0.0);
+      return;
     }
-    return f.toTorus(smoothPoint(cyl, f.q1, f.q2, alpha, width, d_out, w_out, length_out));
+    smoothSetup(cyl, f.q1, f.q2, width, st);
+    st.torus = true;
+    st.frame = f;
+    return;
   }
-  T d = penetration(surf, p1, p2);
+  const T d = penetration(surf, p1, p2);
+  st.d = d;
+  st.w = T(0.0);
   T u_scale = T(1.0);
   if (surf.type == WrapType::Cylinder && surf.quadrant_sign != 0) {
     // the library's quadrant logic: with an end on the active side it wraps when the segment
@@ -550,13 +577,10 @@ V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, con
     const T foot = sign * near_axis;
     const double kR = kQuadrantBlend * surf.radius;
     if (forced || (value(d) > 0.0 && !(value(foot) > 0.0))) {
-      if (d_out) *d_out = d;
-      if (w_out) *w_out = T(1.0);
-      V3<T> wrapped;
-      T l_wrapped = l_straight;
-      const bool ok = cylinderPoint(surf, p1, p2, alpha, wrapped, &l_wrapped);
-      if (ok && length_out) *length_out = l_wrapped;
-      return ok ? wrapped : straight;
+      st.w = T(1.0);
+      st.ellipsoid = false;
+      if (cylinderSetup(surf, p1, p2, st.arc)) st.mode = SmoothSetup<T>::Mode::Wrapped;
+      return;
     }
     // as the nearest point nears the quadrant plane the band narrows to nothing (u = d kR /
     // (width foot)), so the weight reaches 1 before the forced wrap takes over on the other side:
@@ -564,29 +588,53 @@ V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, con
     // switches between no wrap and a forced wrap
     if (value(foot) > 0.0 && value(foot) < kR) u_scale = kR / foot;
   }
-  if (d_out) *d_out = d;
-  if (w_out) *w_out = T(0.0);
   // below u = 1e-6 the blend weight is < 1e-17 and the wrapped branch is not evaluated: its
   // derivatives grow like d^(-1/2) at the contact (the arc angle ~ sqrt(d)), and inf * 0 would
   // poison the dual parts
   const T u = u_scale * (d / width);
-  if (!(value(u) > 1e-6)) return straight;
-  V3<T> wrapped;
-  T l_wrapped = l_straight;
-  const bool ok = surf.type == WrapType::Cylinder    ? cylinderPoint(surf, p1, p2, alpha, wrapped, &l_wrapped)
-                  : surf.type == WrapType::Ellipsoid ? ellipsoidPoint(surf, p1, p2, alpha, wrapped, &l_wrapped)
-                                                     : spherePoint(surf, p1, p2, alpha, wrapped, &l_wrapped);
-  if (!ok) return straight;  // the library's finite-length cut-off (not smoothed)
+  if (!(value(u) > 1e-6)) return;
+  st.ellipsoid = surf.type == WrapType::Ellipsoid;
+  const bool ok = surf.type == WrapType::Cylinder    ? cylinderSetup(surf, p1, p2, st.arc)
+                  : surf.type == WrapType::Ellipsoid ? ellipsoidSetup(surf, p1, p2, st.ew)
+                                                     : sphereSetup(surf, p1, p2, st.arc);
+  if (!ok) return;  // the library's finite-length cut-off (not smoothed)
   if (value(u) >= 1.0) {
-    if (w_out) *w_out = T(1.0);
-    if (length_out) *length_out = l_wrapped;
-    return wrapped;
+    st.w = T(1.0);
+    st.mode = SmoothSetup<T>::Mode::Wrapped;
+    return;
   }
   // quintic smoothstep: C2 at both ends of the band (see the header)
-  const T w = u * u * u * (10.0 + u * (-15.0 + 6.0 * u));
-  if (w_out) *w_out = w;
-  if (length_out) *length_out = l_straight + w * (l_wrapped - l_straight);
-  return straight + w * (wrapped - straight);
+  st.w = u * u * u * (10.0 + u * (-15.0 + 6.0 * u));
+  st.mode = SmoothSetup<T>::Mode::Blend;
+}
+
+// the blended point at fraction alpha from a setup; length_out (if given) receives the blended
+// segment length L = L_straight + w (L_wrapped - L_straight), the exact wrapped length outside the band
+template <class T>
+V3<T> smoothEval(const SmoothSetup<T>& st, const Alpha<T>& alpha, T* length_out = nullptr) {
+  using Mode = typename SmoothSetup<T>::Mode;
+  V3<T> x = st.p1 + alpha * (st.p2 - st.p1);
+  if (length_out) *length_out = st.l_straight;
+  if (st.mode == Mode::Wrapped) {
+    x = st.wrappedPoint(alpha);
+    if (length_out) *length_out = st.wrappedLength();
+  } else if (st.mode == Mode::Blend) {
+    x = x + st.w * (st.wrappedPoint(alpha) - x);
+    if (length_out) *length_out = st.l_straight + st.w * (st.wrappedLength() - st.l_straight);
+  }
+  return st.torus ? st.frame.toTorus(x) : x;
+}
+
+// the blended point over any scalar, one evaluation per point (the setup not shared: the
+// reference route, nested duals per input direction)
+template <class T>
+V3<T> smoothPoint(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, const Alpha<T>& alpha, double width, T* d_out,
+                  T* w_out, T* length_out = nullptr) {
+  SmoothSetup<T> st;
+  smoothSetup(surf, p1, p2, width, st);
+  if (d_out) *d_out = st.d;
+  if (w_out) *w_out = st.w;
+  return smoothEval(st, alpha, length_out);
 }
 
 void checkInputs(const WrapSurface& surf, const Vec3& p1, const Vec3& p2) {
@@ -643,6 +691,131 @@ Vec3 calcSmoothWrapPoint(const WrapSurface& surface, const Vec3& p1, const Vec3&
   return values(smoothPoint<double>(surface, constant<double>(p1), constant<double>(p2), alpha,
                                     widthOf(surface, options), nullptr, nullptr));
 }
+
+namespace {
+
+// the inputs (p1, p2) as jets: value, velocity, a unit partial per coordinate
+template <int N>
+void seedEnds(const Vec3& p1, const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot, V3<Jet<N>>& q1, V3<Jet<N>>& q2) {
+  for (int k = 0; k < 3; ++k) {
+    q1[k] = Jet<N>(p1[k]);
+    q1[k].t = p1dot[k];
+    q1[k].g[k] = 1.0;
+    q2[k] = Jet<N>(p2[k]);
+    q2[k].t = p2dot[k];
+    q2[k].g[k + 3] = 1.0;
+  }
+}
+
+// the shared route: one setup over jets for the muscle's points on this surface, then each point
+// (N = 7: alpha is the seventh input, moving at its rate)
+template <int N>
+void smoothPointsJet(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
+                     const std::vector<double>& alphas, const std::vector<double>& alphadots, double width,
+                     WrapMassPoints& out, std::vector<Vec3>* x_alpha, std::vector<Vec3>* x_alphadot) {
+  using J = Jet<N>;
+  V3<J> q1, q2;
+  seedEnds(p1, p2, p1dot, p2dot, q1, q2);
+  SmoothSetup<J> st;
+  smoothSetup(surface, q1, q2, width, st);
+  const size_t n = alphas.size();
+  out.x.resize(n);
+  out.J.resize(n);
+  out.Jdot.resize(n);
+  if (x_alpha) x_alpha->resize(n);
+  if (x_alphadot) x_alphadot->resize(n);
+  for (size_t a = 0; a < n; ++a) {
+    J al(std::clamp(alphas[a], 0.0, 1.0));
+    if constexpr (N == 7) {
+      al.t = alphadots.empty() ? 0.0 : alphadots[a];
+      al.g[6] = 1.0;
+    }
+    const V3<J> x = smoothEval(st, al);
+    for (int k = 0; k < 3; ++k) {
+      out.x[a][k] = x[k].v;
+      for (int i = 0; i < 6; ++i) {
+        out.J[a](k, i) = x[k].g[i];
+        out.Jdot[a](k, i) = x[k].gt[i];
+      }
+      if constexpr (N == 7) {
+        if (x_alpha) (*x_alpha)[a][k] = x[k].g[6];
+        if (x_alphadot) (*x_alphadot)[a][k] = x[k].gt[6];
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void calcSmoothWrapPoints(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
+                          const Vec3& p2dot, const std::vector<double>& alphas, const std::vector<double>& alphadots,
+                          const SmoothWrapOptions& options, WrapMassPoints& out, std::vector<Vec3>* x_alpha,
+                          std::vector<Vec3>* x_alphadot) {
+  checkInputs(surface, p1, p2);
+  if (!alphadots.empty() && alphadots.size() != alphas.size())
+    throw std::invalid_argument("smooth wrap: alphadots must be empty or one per alpha");
+  out.used_network = false;
+  const double width = widthOf(surface, options);
+  bool moving_alpha = false;
+  for (double ad : alphadots) moving_alpha = moving_alpha || ad != 0.0;
+  if (moving_alpha || x_alpha || x_alphadot)
+    smoothPointsJet<7>(surface, p1, p2, p1dot, p2dot, alphas, alphadots, width, out, x_alpha, x_alphadot);
+  else
+    smoothPointsJet<6>(surface, p1, p2, p1dot, p2dot, alphas, {}, width, out, nullptr, nullptr);
+}
+
+SmoothWrapPoint calcSmoothWrapPointDerivatives(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                                               double alpha, const Vec3& p1dot, const Vec3& p2dot,
+                                               const SmoothWrapOptions& options) {
+  checkInputs(surface, p1, p2);
+  using J = Jet<6>;
+  V3<J> q1, q2;
+  seedEnds(p1, p2, p1dot, p2dot, q1, q2);
+  SmoothSetup<J> st;
+  smoothSetup(surface, q1, q2, widthOf(surface, options), st);
+  const V3<J> x = smoothEval(st, J(std::clamp(alpha, 0.0, 1.0)));
+  SmoothWrapPoint out;
+  for (int k = 0; k < 3; ++k) {
+    out.x[k] = x[k].v;
+    for (int i = 0; i < 6; ++i) out.J(k, i) = x[k].g[i], out.Jdot(k, i) = x[k].gt[i];
+  }
+  out.penetration = st.d.v;
+  out.weight = st.w.v;
+  return out;
+}
+
+SmoothWrapSegmentPoint calcSmoothWrapSegmentPoint(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                                                  double alpha, const Vec3& p1dot, const Vec3& p2dot,
+                                                  double alphadot, const SmoothWrapOptions& options) {
+  WrapMassPoints mp;
+  std::vector<Vec3> xa, xad;
+  calcSmoothWrapPoints(surface, p1, p2, p1dot, p2dot, {alpha}, {alphadot}, options, mp, &xa, &xad);
+  SmoothWrapSegmentPoint out;
+  out.x = mp.x[0];
+  out.J << mp.J[0], xa[0];
+  out.Jdot << mp.Jdot[0], xad[0];
+  return out;
+}
+
+SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
+                                      const Vec3& p2dot, const SmoothWrapOptions& options) {
+  checkInputs(surface, p1, p2);
+  using J = Jet<6>;
+  V3<J> q1, q2;
+  seedEnds(p1, p2, p1dot, p2dot, q1, q2);
+  SmoothSetup<J> st;
+  smoothSetup(surface, q1, q2, widthOf(surface, options), st);
+  J L;
+  smoothEval(st, J(0.0), &L);
+  SmoothWrapLength out;
+  out.length = L.v;
+  for (int i = 0; i < 6; ++i) out.J(0, i) = L.g[i], out.Jdot(0, i) = L.gt[i];
+  return out;
+}
+
+// the route before issue 18 (nested duals, one pass per input direction, per point): the tests'
+// reference for the shared route above
+namespace smooth_reference {
 
 SmoothWrapPoint calcSmoothWrapPointDerivatives(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
                                                double alpha, const Vec3& p1dot, const Vec3& p2dot,
@@ -722,5 +895,7 @@ SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1
   }
   return out;
 }
+
+}  // namespace smooth_reference
 
 }  // namespace redmax

@@ -16,9 +16,11 @@
 // inside the band, which is O(width)).
 // Wrapped path: the exact library's own construction for cylinders, spheres and tori (the function
 // templates of core/geometry/constructions.hpp, which the library runs on double) evaluated on
-// nested dual numbers (core/geometry/dual.hpp), so J = dx/d(p1, p2) and Jdot = dJ/dt along (p1dot,
-// p2dot) are exact to round-off (forward-over-forward differentiation, 6 passes: one per input
-// direction, each also carrying the velocity direction); ellipsoids below.
+// Jet numbers (core/geometry/dual.hpp: value, velocity derivative, all 6 or 7 input partials and
+// their velocity derivatives in one pass), so J = dx/d(p1, p2) and Jdot = dJ/dt along (p1dot,
+// p2dot) are exact to round-off; ellipsoids below. The alpha-independent construction is built
+// once per segment and shared by its mass points (calcSmoothWrapPoints). The earlier route
+// (nested duals, one pass per input direction, per point) stays as smooth_reference.
 //
 // Supported: Cylinder (also with a quadrant), Sphere and Ellipsoid without a quadrant, and Torus,
 // single wrap (OpenSim's algorithms as the exact library reproduces them).
@@ -61,10 +63,7 @@
 // in the chord direction (mu in [0.7073, 0.9]) and its fade near the chord's ends, a fan sample
 // switching between roots of the closest-point equation (interior points), and the library's
 // "same direction seen from the centre" cut-off.
-// Cost: ellipsoids and tori keep their alpha-independent construction (anchor and frame; plane,
-// tangent points and arc-length table) per thread for the last 8 end-point pairs, keyed by the
-// points with all their dual parts, so a muscle's mass points share it; results never depend on
-// the cache. Measured by `redmax train-wrap --compare` (docs/wrapping.md, smooth model).
+// Cost: measured in docs/performance.md §7 (validation/bench/wrap_model_bench.cpp).
 // Penetration of an ellipsoid: 1 - the line's distance from the centre in coordinates divided by
 // the semi-axes, times the smallest semi-axis (> 0 exactly when the library wraps).
 // Not supported (smoothWrapUnsupportedReason() says why): spheres and ellipsoids with a quadrant.
@@ -142,5 +141,32 @@ struct WrapMassPoints {
   std::vector<Eigen::Matrix<double, 3, 6>> J, Jdot;
   bool used_network = false;  ///< false: the inputs left the network's training box (or no network)
 };
+
+/// A muscle's mass points on one wrapped segment p1 -> p2 (frame s) at fractions `alphas` (each
+/// clamped to [0, 1]) moving at `alphadots` (empty: all zero): x, J = dx/d(p1, p2) and Jdot along
+/// (p1dot, p2dot, alphadots), and (when given) x_alpha = dx/dalpha and its time derivative
+/// x_alphadot. The alpha-independent construction (penetration, blend weight, tangent points, arc;
+/// ellipsoid plane and arc-length table; torus anchor) is built once for all points, over Jet
+/// numbers (core/geometry/dual.hpp) that carry every input direction in one pass. Equal to the
+/// per-point nested-dual route (smooth_reference) to round-off (tests/core/muscles/
+/// wrap_smooth_shared_test.cpp). Throws as calcSmoothWrapPoint.
+void calcSmoothWrapPoints(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
+                          const Vec3& p2dot, const std::vector<double>& alphas, const std::vector<double>& alphadots,
+                          const SmoothWrapOptions& options, WrapMassPoints& out, std::vector<Vec3>* x_alpha = nullptr,
+                          std::vector<Vec3>* x_alphadot = nullptr);
+
+/// The smooth model's derivatives as computed before issue 18: nested dual numbers, one pass per
+/// input direction, the whole construction per point. Kept as the reference the tests compare
+/// the shared route with (same signatures and meaning as the functions above).
+namespace smooth_reference {
+SmoothWrapPoint calcSmoothWrapPointDerivatives(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                                               double alpha, const Vec3& p1dot, const Vec3& p2dot,
+                                               const SmoothWrapOptions& options = {});
+SmoothWrapSegmentPoint calcSmoothWrapSegmentPoint(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
+                                                  double alpha, const Vec3& p1dot, const Vec3& p2dot,
+                                                  double alphadot, const SmoothWrapOptions& options = {});
+SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
+                                      const Vec3& p2dot, const SmoothWrapOptions& options = {});
+}  // namespace smooth_reference
 
 }  // namespace redmax
