@@ -54,7 +54,7 @@ std::string layerOf(const std::string& inc) {
   static const std::vector<std::string> layers = {
       "core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles",
       "core/dynamics",
-      "core/integrators", "core/model", "converter", "plugin", "tools", "validation", "cli"};
+      "core/integrators", "core/adjoint", "core/model", "converter", "plugin", "tools", "validation", "cli"};
   for (const auto& l : layers)
     if (inc.rfind(l + "/", 0) == 0) return l;
   return "";
@@ -86,9 +86,12 @@ std::map<std::string, std::set<std::string>> layerRules() {
       {"core/model",
        {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles", "core/dynamics",
         "core/model"}},
+      {"core/adjoint",
+       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles", "core/dynamics",
+        "core/integrators", "core/adjoint"}},
   };
   std::set<std::string> core_all = rules.at("core/integrators");
-  core_all.insert("core/model");
+  core_all.insert({"core/model", "core/adjoint"});
   std::set<std::string> converter = core_all, plugin = core_all, tools = core_all, validation = core_all;
   converter.insert("converter");
   plugin.insert({"converter", "plugin"});
