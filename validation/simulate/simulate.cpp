@@ -14,8 +14,6 @@
 
 namespace redmax::validation {
 
-namespace {
-
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> out;
   std::string cur;
@@ -49,6 +47,8 @@ bool parseVec3(const std::string& text, Vec3& v) {
     if (!parseNumber(parts[k], v[k])) return false;
   return true;
 }
+
+namespace {
 
 bool isAdaptive(const std::string& name) { return name == "rk45" || name == "cvode"; }
 
