@@ -279,18 +279,32 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   return res;
 }
 
-VecX finiteDifferenceGradient(const Problem& pr, const Objective& obj, const VecX& p, double rel_step) {
+VecX finiteDifferenceGradient(const Problem& pr, const Objective& obj, const VecX& p) {
   VecX g(p.size());
+  auto J = [&](const VecX& x) { return evaluate(pr, obj, x, false).objective; };
+  // fourth-order central differences at relative steps 1e-3 .. 1e-6: a large step loses to the
+  // run's nonlinearity (truncation), a small one to its round-off (eps |J| / e); the pair of
+  // neighbouring steps whose estimates agree best gives the finer of the two
+  const double rel[4] = {1e-3, 1e-4, 1e-5, 1e-6};
   for (Eigen::Index i = 0; i < p.size(); ++i) {
-    double e = rel_step * std::max(1.0, std::abs(p[i]));
-    if (i >= p.size() - pr.num_system_params) {
-      // a system parameter (a mass) must stay admissible: never step below zero
-      if (p[i] > 0.0) e = std::min(e, 0.5 * p[i]);
+    double d[4];
+    for (int j = 0; j < 4; ++j) {
+      double e = rel[j] * std::max(1.0, std::abs(p[i]));
+      // a system parameter (a mass) must stay admissible: never step to zero or below
+      if (i >= p.size() - pr.num_system_params && p[i] > 0.0) e = std::min(e, 0.25 * p[i]);
+      VecX x = p;
+      double f[4];
+      const double at[4] = {-2.0, -1.0, 1.0, 2.0};
+      for (int k = 0; k < 4; ++k) {
+        x[i] = p[i] + at[k] * e;
+        f[k] = J(x);
+      }
+      d[j] = (f[0] - 8.0 * f[1] + 8.0 * f[2] - f[3]) / (12.0 * e);
     }
-    VecX pp = p, pm = p;
-    pp[i] += e;
-    pm[i] -= e;
-    g[i] = (evaluate(pr, obj, pp, false).objective - evaluate(pr, obj, pm, false).objective) / (2.0 * e);
+    int best = 0;
+    for (int j = 1; j < 3; ++j)
+      if (std::abs(d[j] - d[j + 1]) < std::abs(d[best] - d[best + 1])) best = j;
+    g[i] = d[best + 1];
   }
   return g;
 }

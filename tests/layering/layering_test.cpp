@@ -3,6 +3,7 @@
 //   core/spatial <- core/geometry <- core/muscles   (surface geometry: wrap surfaces, dual numbers)
 //   core/muscles/hill (Hill-type muscle models: the standard library only) <- core/muscles
 //   core/dynamics <- core/model (the musculoskeletal aggregate, beside core/integrators)
+//   core/integrators <- core/adjoint (the discrete adjoint of the fixed-step integrators)
 //   converter/, plugin/ -> core/ (plugin may also read the converter's description)
 //   tools/ -> core/ (offline work the engine never runs: wrap-network training, wrap benchmarks)
 //   validation/ -> core, converter, plugin;  cli/ -> anything

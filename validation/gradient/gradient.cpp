@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "converter/osim_reader.hpp"
+#include "validation/simulate/spec_parse.hpp"
 
 namespace redmax::validation {
 namespace {

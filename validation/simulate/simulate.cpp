@@ -10,6 +10,7 @@
 
 #include "converter/coordinates_file.hpp"
 #include "converter/osim_reader.hpp"
+#include "validation/simulate/spec_parse.hpp"
 #include "core/dynamics/body_loads.hpp"
 
 namespace redmax::validation {

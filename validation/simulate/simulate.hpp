@@ -49,12 +49,6 @@ struct ImpulseSpec {
 ImpulseSpec parseImpulse(const std::string& text);
 
 /// How the model is set up for simulation.
-/// SPEC helpers of the flag parsers (--impulse here, `redmax gradient`'s SPECs): split at every
-/// `sep` (empty items kept), a strict finite number (the whole text), three numbers "x,y,z"
-std::vector<std::string> split(const std::string& s, char sep);
-bool parseNumber(const std::string& text, double& v);
-bool parseVec3(const std::string& text, Vec3& v);
-
 struct SimulationModelOptions {
   /// --muscle-mass options (none: the model as OpenSim sees it)
   osim::MuscleMassOptions muscle_mass;
