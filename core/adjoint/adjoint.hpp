@@ -14,7 +14,8 @@
 // every path type, K and D of bdf1, the KKT rows of constraints, the z update) is in it; the
 // generalized-force columns dPhi_k/du are central differences of the step along each driven
 // coordinate (one pair per coordinate, shared by all of its time pieces); system parameters
-// (muscle masses) are central differences of the step between two systems built at p -+ delta.
+// (muscle masses) are fourth-order central differences of the step between systems built at
+// s -+ delta and s -+ 2 delta.
 // The objective's derivatives are analytic. The forward run is the integrator's own step; no
 // chart switch (System::reparameterize) is applied between steps.
 #include <functional>
@@ -55,7 +56,8 @@ struct Problem {
   /// none); the system must have no controls and no coordinate map (checked)
   SystemFactory make_system;
   int num_system_params = 0;
-  VecX system_param_delta;           ///< step of the central difference per system parameter
+  VecX system_param_delta;           ///< step of the central differences per system parameter
+                                     ///< (the systems at s - 2 delta must be valid)
   int numParameters() const {
     return static_cast<int>(forces.size() + initial_q.size() + initial_qdot.size()) + num_system_params;
   }

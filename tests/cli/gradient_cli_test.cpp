@@ -64,7 +64,7 @@ TEST_F(GradientCli, BadSpecsExitTwo) {
   EXPECT_NE(r.err.find("needs a positive mass for it in --muscle-mass-kg via_muscle=KG"), std::string::npos) << r.err;
   r = run("--duration 0.1 --objective speed");
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err, "error: gradient needs --params\n");
+  EXPECT_EQ(r.err, "error: gradient needs --params\n(see `redmax gradient --help`)\n");
 }
 
 }  // namespace

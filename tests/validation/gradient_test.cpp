@@ -38,8 +38,12 @@ TEST_P(MuscleGradient, AdjointMatchesCentralDifferences) {
   p[4] = 0.5 * u(rng);
   const adjoint::Result r = adjoint::evaluate(g.problem, g.objective, p, true);
   const VecX fd = adjoint::finiteDifferenceGradient(g.problem, g.objective, p);
-  // measured: below 1e-8 relative for every case
-  EXPECT_LE(adjoint::worstRelativeError(r.gradient, fd), 1e-6)
+  // measured: 1.0e-10 (Type I), 5.0e-10 (Type II), euler and bdf1 alike (these models have no
+  // joint springs, so bdf1's step is euler's); Type III 7.4e-7 (euler, bdf1) and 1.8e-7 (sdirk2),
+  // every component off by about the same relative amount (the run crosses the wrap's contact
+  // changes; whether the adjoint or the reference carries it is not resolved)
+  const bool wraps = std::string(c.muscle) == "wrap_muscle";
+  EXPECT_LE(adjoint::worstRelativeError(r.gradient, fd), wraps ? 1e-6 : 5e-9)
       << "adjoint " << r.gradient.transpose() << "\ndifferences " << fd.transpose();
   EXPECT_NE(r.gradient[5], 0.0);  // the muscle's mass moves the hand
 }
@@ -71,9 +75,9 @@ TEST(GradientSpec, BadSpecsNameTheItem) {
   };
   EXPECT_EQ(message("torques:elbow", "speed"), "--params 'torques:elbow': no coordinate named 'elbow'");
   EXPECT_EQ(message("torque:q1", "speed"), "--params 'torque:q1': unknown kind 'torque' (torques, q0, qdot0 or masses)");
-  EXPECT_EQ(message("torques:q1@0", "speed"), "--params 'q1@0': the piece count after '@' must be a whole number >= 1");
+  EXPECT_EQ(message("torques:q1@0", "speed"), "--params 'torques:q1@0': the piece count after '@' must be a whole number >= 1");
   EXPECT_EQ(message("masses:straight_muscle", "speed"),
-            "--params 'straight_muscle': needs a positive mass for it in --muscle-mass-kg straight_muscle=KG");
+            "--params 'masses:straight_muscle': needs a positive mass for it in --muscle-mass-kg straight_muscle=KG");
   EXPECT_EQ(message("torques:q1", "point:hand@0,0,0=1,2,3"), "--objective 'point:hand@0,0,0=1,2,3': no body named 'hand'");
   EXPECT_EQ(message("torques:q1", "point:link2@0,0=1,2,3"),
             "--objective 'point:link2@0,0=1,2,3': the point must be three numbers x,y,z (m, body frame)");

@@ -21,11 +21,12 @@ int coordinateIndex(const SimulationModel& m, const std::string& flag, const std
 }
 
 // NAME[=V]: the name and, when given, the value
-std::string nameAndValue(const std::string& flag, const std::string& item, double& v, bool& has_value) {
-  const auto eq = item.find('=');
+std::string nameAndValue(const std::string& flag, const std::string& text, const std::string& item, double& v,
+                         bool& has_value) {
+  const auto eq = text.find('=');
   has_value = eq != std::string::npos;
-  if (has_value && !parseNumber(item.substr(eq + 1), v)) throw bad(flag, item, "the value after '=' must be a number");
-  const std::string name = item.substr(0, eq);
+  if (has_value && !parseNumber(text.substr(eq + 1), v)) throw bad(flag, item, "the value after '=' must be a number");
+  const std::string name = text.substr(0, eq);
   if (name.empty()) throw bad(flag, item, "no name");
   return name;
 }
@@ -68,11 +69,13 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
     const std::string kind = group.substr(0, colon);
     const std::string list = group.substr(colon + 1);
     if (list.empty()) throw bad(pflag, group, "no items");
-    for (const std::string& item : split(list, ',')) {
+    for (const std::string& item_text : split(list, ',')) {
+      // messages name the item with its kind, e.g. 'torques:elbow'
+      const std::string item = kind + ":" + item_text;
       double v = 0.0;
       bool has_value = false;
       if (kind == "torques") {
-        std::string name = nameAndValue(pflag, item, v, has_value);
+        std::string name = nameAndValue(pflag, item_text, item, v, has_value);
         int pieces = 1;
         const auto at = name.find('@');
         if (at != std::string::npos) {
@@ -91,7 +94,7 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
                             v});
         }
       } else if (kind == "q0" || kind == "qdot0") {
-        const std::string name = nameAndValue(pflag, item, v, has_value);
+        const std::string name = nameAndValue(pflag, item_text, item, v, has_value);
         const int c = coordinateIndex(g.model, pflag, item, name);
         if (kind == "q0") {
           pr.initial_q.push_back(c);
@@ -101,11 +104,11 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
           v0.push_back({"qdot0 " + name, has_value ? v : pr.initial.qdot[c]});
         }
       } else if (kind == "masses") {
-        if (item.find('=') != std::string::npos)
+        if (item_text.find('=') != std::string::npos)
           throw bad(pflag, item, "a muscle's mass comes from --muscle-mass-kg NAME=KG, not from the SPEC");
-        if (explicitMass(options, item) <= 0.0)
-          throw bad(pflag, item, "needs a positive mass for it in --muscle-mass-kg " + item + "=KG");
-        masses.push_back(item);
+        if (explicitMass(options, item_text) <= 0.0)
+          throw bad(pflag, item, "needs a positive mass for it in --muscle-mass-kg " + item_text + "=KG");
+        masses.push_back(item_text);
       } else {
         throw bad(pflag, group, "unknown kind '" + kind + "' (torques, q0, qdot0 or masses)");
       }
@@ -127,7 +130,8 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
   // the system, rebuilt for other muscle masses (the explicit masses of the named muscles replaced)
   pr.num_system_params = static_cast<int>(masses.size());
   pr.system_param_delta.resize(pr.num_system_params);
-  for (int j = 0; j < pr.num_system_params; ++j) pr.system_param_delta[j] = 1e-6 * std::max(1.0, g.p0[np - pr.num_system_params + j]);
+  // a mass steps by 1e-3 of itself (fourth-order differences of the step, core/adjoint)
+  for (int j = 0; j < pr.num_system_params; ++j) pr.system_param_delta[j] = 1e-3 * g.p0[np - pr.num_system_params + j];
   const std::shared_ptr<const System> base = g.model.system;
   pr.make_system = [description, options, masses, base](const VecX& sp) -> std::shared_ptr<const System> {
     if (sp.size() == 0) return base;
