@@ -26,29 +26,6 @@ namespace redmax::cli {
 namespace {
 
 
-// --muscle-mass-kg NAME=KG,NAME=KG
-std::vector<std::pair<std::string, double>> parseMassList(const std::string& text) {
-  std::vector<std::pair<std::string, double>> out;
-  for (const std::string& item : splitList(text, ",")) {
-    const auto eq = item.find('=');
-    double kg = 0.0;
-    bool ok = eq != std::string::npos && eq > 0;
-    if (ok) {
-      try {
-        size_t used = 0;
-        kg = std::stod(item.substr(eq + 1), &used);
-        ok = used == item.size() - eq - 1 && std::isfinite(kg) && kg >= 0.0;
-      } catch (const std::exception&) {
-        ok = false;
-      }
-    }
-    if (!ok) throw UsageError{"--muscle-mass-kg expects NAME=KG[,NAME=KG...] with KG >= 0, got '" + item + "'"};
-    out.push_back({item.substr(0, eq), kg});
-  }
-  if (out.empty()) throw UsageError{"--muscle-mass-kg expects NAME=KG[,NAME=KG...]"};
-  return out;
-}
-
 const std::vector<std::string> kIntegrators = {"euler", "symplectic", "bdf1", "sdirk2", "rk45", "cvode"};
 
 struct SimulateFlags {
@@ -74,32 +51,9 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
 
   validation::SimulateOptions& so = f.so;
   IntegratorOptions& io = so.integrator_options;
-  // --wrap and friends (muscle_mass_flags.hpp) choose how wrapping muscles with mass move; with no
-  // mass at all they would do nothing
-  if (f.mm.wrap.any() && !given(app, "--muscle-mass-kg") && f.mm.source == "none")
-    throw UsageError{f.mm.wrap.firstGiven() +
-                     " needs muscle mass (--muscle-mass physiological|transfer or --muscle-mass-kg)"};
-
   validation::SimulationModelOptions mo;
   mo.quadratic_velocity = !f.no_qvv;
-  if (given(app, "--muscle-mass-kg")) {
-    // explicit masses take the point count and region from --mass-points / --mass-region; the
-    // flags that choose or size a mass source do not apply
-    if (f.mm.source != "none") throw UsageError{"--muscle-mass-kg excludes --muscle-mass " + f.mm.source};
-    for (const char* n : {"--muscles", "--specific-tension", "--muscle-density", "--transfer-body", "--transfer-fraction"})
-      if (given(app, n)) throw UsageError{std::string(n) + " needs --muscle-mass physiological or transfer"};
-    mo.explicit_masses = parseMassList(f.muscle_mass_kg);
-    parseWrapFlags(f.mm.wrap, mo.muscle_mass);
-    mo.muscle_mass.mass_points = static_cast<int>(f.mm.mass_points);
-    if (f.mm.region == "whole") mo.muscle_mass.region = MassPointOptions::Region::WholePath;
-    if (f.mm.placement != "uniform") {
-      if (mo.muscle_mass.region == MassPointOptions::Region::WholePath)
-        throw UsageError{"--mass-placement fibre spreads the points over the fibre; it excludes --mass-region whole"};
-      mo.muscle_mass.placement = osim::MuscleMassOptions::Placement::Fibre;
-    }
-  } else {
-    mo.muscle_mass = parseMuscleMassFlags(f.mm);
-  }
+  applyMuscleMassOptions(app, f.mm, f.muscle_mass_kg, mo);
   if (given(app, "--impulse"))
     for (const std::string& item : splitList(f.impulse, ";")) mo.impulses.push_back(validation::parseImpulse(item));
   const bool quiet = f.quiet;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/muscles/wrap/network_model.hpp"
+#include "validation/simulate/simulate.hpp"
 
 namespace redmax::cli {
 
@@ -205,6 +206,61 @@ const char* muscleMassFooter() {
   return "Muscle mass is taken from the bodies it was lumped into, so the model's total mass never changes;\n"
          "the run prints every affected body's mass before and after and every muscle's mass and point\n"
          "count on stderr (not with --quiet).\n";
+}
+
+namespace {
+
+// --muscle-mass-kg NAME=KG,NAME=KG
+std::vector<std::pair<std::string, double>> parseMassList(const std::string& text) {
+  std::vector<std::pair<std::string, double>> out;
+  for (const std::string& item : splitList(text, ",")) {
+    const auto eq = item.find('=');
+    double kg = 0.0;
+    bool ok = eq != std::string::npos && eq > 0;
+    if (ok) {
+      try {
+        size_t used = 0;
+        kg = std::stod(item.substr(eq + 1), &used);
+        ok = used == item.size() - eq - 1 && std::isfinite(kg) && kg >= 0.0;
+      } catch (const std::exception&) {
+        ok = false;
+      }
+    }
+    if (!ok) throw UsageError{"--muscle-mass-kg expects NAME=KG[,NAME=KG...] with KG >= 0, got '" + item + "'"};
+    out.push_back({item.substr(0, eq), kg});
+  }
+  if (out.empty()) throw UsageError{"--muscle-mass-kg expects NAME=KG[,NAME=KG...]"};
+  return out;
+}
+
+}  // namespace
+
+void applyMuscleMassOptions(const CLI::App& app, const MuscleMassFlags& mm, const std::string& muscle_mass_kg,
+                            validation::SimulationModelOptions& mo) {
+  // --wrap and friends (muscle_mass_flags.hpp) choose how wrapping muscles with mass move; with no
+  // mass at all they would do nothing
+  if (mm.wrap.any() && !given(app, "--muscle-mass-kg") && mm.source == "none")
+    throw UsageError{mm.wrap.firstGiven() +
+                     " needs muscle mass (--muscle-mass physiological|transfer or --muscle-mass-kg)"};
+
+  if (given(app, "--muscle-mass-kg")) {
+    // explicit masses take the point count and region from --mass-points / --mass-region; the
+    // flags that choose or size a mass source do not apply
+    if (mm.source != "none") throw UsageError{"--muscle-mass-kg excludes --muscle-mass " + mm.source};
+    for (const char* n : {"--muscles", "--specific-tension", "--muscle-density", "--transfer-body", "--transfer-fraction"})
+      if (given(app, n)) throw UsageError{std::string(n) + " needs --muscle-mass physiological or transfer"};
+    mo.explicit_masses = parseMassList(muscle_mass_kg);
+    parseWrapFlags(mm.wrap, mo.muscle_mass);
+    mo.muscle_mass.mass_points = static_cast<int>(mm.mass_points);
+    if (mm.region == "whole") mo.muscle_mass.region = MassPointOptions::Region::WholePath;
+    if (mm.placement != "uniform") {
+      if (mo.muscle_mass.region == MassPointOptions::Region::WholePath)
+        throw UsageError{"--mass-placement fibre spreads the points over the fibre; it excludes --mass-region whole"};
+      mo.muscle_mass.placement = osim::MuscleMassOptions::Placement::Fibre;
+    }
+  } else {
+    mo.muscle_mass = parseMuscleMassFlags(mm);
+  }
 }
 
 }  // namespace redmax::cli

@@ -19,6 +19,10 @@
 #include "converter/build/muscle_mass.hpp"
 #include "core/muscles/wrap/network_model.hpp"
 
+namespace redmax::validation {
+struct SimulationModelOptions;
+}
+
 namespace redmax::cli {
 
 /// --wrap, --wrap-width, --wrap-network: values as given, and whether each was given.
@@ -88,5 +92,12 @@ std::shared_ptr<WrapFallbackMonitor> makeWrapFallbackMonitor(const WrapFlags& f)
 
 /// What the run prints about muscle mass, for the footer of a command's --help.
 const char* muscleMassFooter();
+
+/// The muscle mass of a model that simulate-like commands build: MUSCLE-MASS OPTIONS, or
+/// `--muscle-mass-kg NAME=KG,...` (muscle_mass_kg; the command declares that flag) with its point
+/// count, region, placement and wrap flags, into mo.muscle_mass and mo.explicit_masses. Throws
+/// UsageError for flags that do not combine.
+void applyMuscleMassOptions(const CLI::App& app, const MuscleMassFlags& mm, const std::string& muscle_mass_kg,
+                            validation::SimulationModelOptions& mo);
 
 }  // namespace redmax::cli

@@ -3,6 +3,7 @@
 //   core/spatial <- core/geometry <- core/muscles   (surface geometry: wrap surfaces, dual numbers)
 //   core/muscles/hill (Hill-type muscle models: the standard library only) <- core/muscles
 //   core/dynamics <- core/model (the musculoskeletal aggregate, beside core/integrators)
+//   core/integrators <- core/adjoint (the discrete adjoint of the fixed-step integrators)
 //   converter/, plugin/ -> core/ (plugin may also read the converter's description)
 //   tools/ -> core/ (offline work the engine never runs: wrap-network training, wrap benchmarks)
 //   view/ -> core, converter (`redmax view`, docs/view.md)
@@ -55,7 +56,7 @@ std::string layerOf(const std::string& inc) {
   static const std::vector<std::string> layers = {
       "core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles",
       "core/dynamics",
-      "core/integrators", "core/model", "converter", "plugin", "tools", "view", "validation", "cli"};
+      "core/integrators", "core/adjoint", "core/model", "converter", "plugin", "tools", "view", "validation", "cli"};
   for (const auto& l : layers)
     if (inc.rfind(l + "/", 0) == 0) return l;
   return "";
@@ -87,9 +88,12 @@ std::map<std::string, std::set<std::string>> layerRules() {
       {"core/model",
        {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles", "core/dynamics",
         "core/model"}},
+      {"core/adjoint",
+       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles", "core/dynamics",
+        "core/integrators", "core/adjoint"}},
   };
   std::set<std::string> core_all = rules.at("core/integrators");
-  core_all.insert("core/model");
+  core_all.insert({"core/model", "core/adjoint"});
   std::set<std::string> converter = core_all, plugin = core_all, tools = core_all, validation = core_all,
                         view = core_all;
   converter.insert("converter");

@@ -10,11 +10,10 @@
 
 #include "converter/coordinates_file.hpp"
 #include "converter/osim_reader.hpp"
+#include "validation/simulate/spec_parse.hpp"
 #include "core/dynamics/body_loads.hpp"
 
 namespace redmax::validation {
-
-namespace {
 
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> out;
@@ -49,6 +48,8 @@ bool parseVec3(const std::string& text, Vec3& v) {
     if (!parseNumber(parts[k], v[k])) return false;
   return true;
 }
+
+namespace {
 
 bool isAdaptive(const std::string& name) { return name == "rk45" || name == "cvode"; }
 

@@ -1,0 +1,320 @@
+#include "core/adjoint/adjoint.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "core/dynamics/coordinate_actuator_term.hpp"
+#include "core/integrators/integrator.hpp"
+#include "core/skeleton/kinematics.hpp"
+
+namespace redmax::adjoint {
+namespace {
+
+// relative step of the central differences of one step: about cbrt(machine epsilon), where the
+// truncation error (h^2) and the round-off (eps / h) of a central difference meet
+constexpr double kStepFdRel = 6e-6;
+
+// the system of a run: the problem's system plus one CoordinateActuatorTerm (optimal force 1)
+// whose controls are the generalized forces of the driven coordinates
+struct RunSystem {
+  std::shared_ptr<System> sys;
+  std::vector<int> driven;           // distinct driven coordinates, in control order
+  std::vector<int> control_of;       // per force parameter: its control index
+};
+
+RunSystem makeRunSystem(const Problem& pr, const VecX& system_params) {
+  if (!pr.make_system) throw AdjointError("adjoint: the problem has no system");
+  const std::shared_ptr<const System> base = pr.make_system(system_params);
+  if (!base) throw AdjointError("adjoint: the system factory returned no system");
+  if (base->numControls() > 0 || !base->controllers().empty())
+    throw AdjointError("adjoint: the system has actuators with controls; only generalized-force parameters drive it");
+  if (base->coordinateMap()) throw AdjointError("adjoint: hyper-reduced coordinates (a coordinate map) are not supported");
+  RunSystem rs;
+  rs.sys = std::make_shared<System>(*base);
+  const int nr = base->model().nr();
+  std::map<int, int> index;
+  std::vector<CoordinateActuatorTerm::Actuator> acts;
+  for (const ForceParameter& fp : pr.forces) {
+    if (fp.coordinate < 0 || fp.coordinate >= nr)
+      throw AdjointError("adjoint: force parameter on coordinate " + std::to_string(fp.coordinate) +
+                         " outside the model's " + std::to_string(nr));
+    if (fp.pieces < 1 || fp.piece < 0 || fp.piece >= fp.pieces)
+      throw AdjointError("adjoint: force parameter piece " + std::to_string(fp.piece) + " of " +
+                         std::to_string(fp.pieces));
+    auto [it, fresh] = index.emplace(fp.coordinate, static_cast<int>(rs.driven.size()));
+    if (fresh) {
+      rs.driven.push_back(fp.coordinate);
+      acts.push_back({"u_" + std::to_string(fp.coordinate), fp.coordinate, 1.0});
+    }
+    rs.control_of.push_back(it->second);
+  }
+  if (!acts.empty()) rs.sys->addTerm(std::make_shared<CoordinateActuatorTerm>(base->model(), std::move(acts)));
+  return rs;
+}
+
+int numSteps(const Problem& pr) {
+  if (!(pr.dt > 0.0) || !(pr.duration > 0.0)) throw AdjointError("adjoint: dt and duration must be positive");
+  const double ratio = pr.duration / pr.dt;
+  if (!(ratio < 1e8)) throw AdjointError("adjoint: duration / dt too large");
+  return static_cast<int>(std::max(1L, static_cast<long>(std::ceil(ratio - 1e-9))));  // as advance()
+}
+
+// the controls (one per driven coordinate) during step k of n
+VecX controlsAt(const Problem& pr, const RunSystem& rs, const VecX& p, int k, int n) {
+  VecX u = VecX::Zero(static_cast<Eigen::Index>(rs.driven.size()));
+  for (size_t j = 0; j < pr.forces.size(); ++j) {
+    const ForceParameter& fp = pr.forces[j];
+    if (static_cast<long>(k) * fp.pieces / n == fp.piece) u[rs.control_of[j]] += p[static_cast<Eigen::Index>(j)];
+  }
+  return u;
+}
+
+// one fixed step as FixedStepIntegrator::advance takes it, on packed y = (q, qdot, z)
+class Stepper {
+ public:
+  Stepper(const Problem& pr, const System& sys) : sys_(sys), ws_(sys) {
+    IntegratorOptions opt;
+    opt.dt = pr.dt;
+    opt.newton_tol = pr.newton_tol;
+    if (pr.integrator != "euler" && pr.integrator != "bdf1" && pr.integrator != "sdirk2")
+      throw AdjointError("adjoint: integrator '" + pr.integrator + "' has no adjoint (euler, bdf1, sdirk2)");
+    owner_ = makeIntegrator(pr.integrator, opt);
+    integ_ = dynamic_cast<FixedStepIntegrator*>(owner_.get());
+    n_ = sys.ndof();
+    nz_ = sys.numStates();
+  }
+  int size() const { return 2 * n_ + nz_; }
+  State unpack(const VecX& y, double t) const {
+    State s;
+    s.t = t;
+    s.q = y.head(n_);
+    s.qdot = y.segment(n_, n_);
+    s.z = y.tail(nz_);
+    return s;
+  }
+  static VecX pack(const State& s) {
+    VecX y(s.q.size() + s.qdot.size() + s.z.size());
+    y << s.q, s.qdot, s.z;
+    return y;
+  }
+  VecX step(const VecX& y, double t, double h, const VecX& u) {
+    ++evaluations;
+    State s = unpack(y, t);
+    ws_.controls = u;
+    VecX zdot;
+    // auxiliary states: explicit Euler with the rate at the step's start (integrator.hpp)
+    if (nz_ > 0) {
+      sys_.calcStateDerivatives(s, ws_);
+      zdot = ws_.zdot;
+    }
+    integ_->step(sys_, s, h, ws_);
+    if (nz_ > 0) s.z.noalias() += h * zdot;
+    return pack(s);
+  }
+  long evaluations = 0;
+
+ private:
+  const System& sys_;
+  DynamicsWorkspace ws_;
+  std::unique_ptr<Integrator> owner_;
+  FixedStepIntegrator* integ_ = nullptr;
+  int n_ = 0, nz_ = 0;
+};
+
+double fdStep(double x) { return kStepFdRel * std::max(1.0, std::abs(x)); }
+
+// objective at the final state and its explicit derivatives (dJ/dy_N, dJ/du summed per step)
+double objectiveValue(const System& sys, const Objective& obj, const State& fin, VecX* dJ_dy) {
+  const Model& model = sys.model();
+  const int n = sys.ndof();
+  double J = 0.0;
+  if (dJ_dy) dJ_dy->setZero(2 * n + fin.z.size());
+  if (!obj.points.empty()) {
+    SkeletonWorkspace ws(model);
+    calcKinematics(model, fin, ws);
+    MatX Jp(3, model.nr());
+    for (const Objective::Point& pt : obj.points) {
+      const Vec3 e = pointPosition(ws, pt.body, pt.x_i) - pt.target;
+      J += 0.5 * pt.weight * e.squaredNorm();
+      if (dJ_dy) {
+        // dx/dq = the point's velocity Jacobian, since dq/dt = qdot for every joint (integrator.hpp)
+        Jp.setZero();
+        pointJacobian(model, ws, pt.body, pt.x_i, Jp);
+        dJ_dy->head(model.nr()) += pt.weight * (Jp.transpose() * e);
+      }
+    }
+  }
+  if (obj.speed_weight != 0.0) {
+    J += 0.5 * obj.speed_weight * fin.qdot.squaredNorm();
+    if (dJ_dy) dJ_dy->segment(n, n) += obj.speed_weight * fin.qdot;
+  }
+  return J;
+}
+
+void checkProblem(const Problem& pr, const VecX& p, const System& sys) {
+  if (p.size() != pr.numParameters())
+    throw AdjointError("adjoint: " + std::to_string(p.size()) + " parameter values for " +
+                       std::to_string(pr.numParameters()) + " parameters");
+  const int n = sys.ndof();
+  if (pr.initial.q.size() != n || pr.initial.qdot.size() != n || pr.initial.z.size() != sys.numStates())
+    throw AdjointError("adjoint: the initial state does not fit the system");
+  for (int c : pr.initial_q)
+    if (c < 0 || c >= n) throw AdjointError("adjoint: initial-q parameter outside the coordinates");
+  for (int c : pr.initial_qdot)
+    if (c < 0 || c >= n) throw AdjointError("adjoint: initial-qdot parameter outside the coordinates");
+  if (pr.num_system_params > 0 && pr.system_param_delta.size() != pr.num_system_params)
+    throw AdjointError("adjoint: system_param_delta needs one entry per system parameter");
+}
+
+}  // namespace
+
+Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool with_gradient) {
+  const int nf = static_cast<int>(pr.forces.size());
+  const int nq0 = static_cast<int>(pr.initial_q.size()), nv0 = static_cast<int>(pr.initial_qdot.size());
+  const int ns = pr.num_system_params;
+  const VecX sp = p.size() == pr.numParameters() ? VecX(p.tail(ns)) : VecX();
+  const RunSystem rs = makeRunSystem(pr, sp);
+  const System& sys = *rs.sys;
+  checkProblem(pr, p, sys);
+  const int n = sys.ndof();
+  const int N = numSteps(pr);
+  const double h = pr.duration / N;
+  const double t0 = pr.initial.t;
+  auto timeAt = [&](int k) { return k == N ? t0 + pr.duration : t0 + k * h; };
+
+  // initial state with its parameters
+  State s0 = pr.initial;
+  for (int j = 0; j < nq0; ++j) s0.q[pr.initial_q[j]] = p[nf + j];
+  for (int j = 0; j < nv0; ++j) s0.qdot[pr.initial_qdot[j]] = p[nf + nq0 + j];
+
+  Stepper stepper(pr, sys);
+  const int ny = stepper.size();
+  const std::vector<std::string> z_names = sys.numStates() > 0 ? sys.stateNames() : std::vector<std::string>{};
+  std::vector<VecX> y(N + 1);
+  y[0] = Stepper::pack(s0);
+  checkFinite(s0, h, pr.integrator.c_str(), &z_names);
+  double effort = 0.0;
+  for (int k = 0; k < N; ++k) {
+    const VecX u = controlsAt(pr, rs, p, k, N);
+    effort += h * u.squaredNorm();
+    y[k + 1] = stepper.step(y[k], timeAt(k), h, u);
+    checkFinite(stepper.unpack(y[k + 1], timeAt(k + 1)), h, pr.integrator.c_str(), &z_names);
+  }
+
+  Result res;
+  res.final = stepper.unpack(y[N], timeAt(N));
+  res.steps = N;
+  VecX lambda;
+  res.objective = objectiveValue(sys, obj, res.final, with_gradient ? &lambda : nullptr) + obj.effort_weight * effort;
+  if (!with_gradient) {
+    res.step_evaluations = stepper.evaluations;
+    return res;
+  }
+
+  // systems at s -+ delta and s -+ 2 delta for the system parameters (e.g. muscle masses), with
+  // steppers: their derivative is a fourth-order central difference of the step, so that delta
+  // can be large enough for the round-off (eps |y| / delta) to stay small
+  const double at[4] = {-2.0, -1.0, 1.0, 2.0};
+  std::vector<RunSystem> sys_at;
+  std::vector<std::unique_ptr<Stepper>> step_at;  // 4 per system parameter
+  for (int j = 0; j < ns; ++j)
+    for (double a : at) {
+      VecX x = sp;
+      x[j] += a * pr.system_param_delta[j];
+      sys_at.push_back(makeRunSystem(pr, x));
+      step_at.push_back(std::make_unique<Stepper>(pr, *sys_at.back().sys));
+    }
+
+  // reverse sweep: lambda_k = (dPhi_k/dy)^T lambda_{k+1}, parameter terms from lambda_{k+1}
+  res.gradient = VecX::Zero(pr.numParameters());
+  const int nd = static_cast<int>(rs.driven.size());
+  MatX Jy(ny, ny);
+  VecX Ju(nd);
+  for (int k = N - 1; k >= 0; --k) {
+    const double t = timeAt(k);
+    const VecX u = controlsAt(pr, rs, p, k, N);
+    // generalized-force columns: one central difference per driven coordinate (the step is
+    // linear in them for euler and bdf1, so this is exact up to round-off there)
+    for (int c = 0; c < nd; ++c) {
+      const double e = fdStep(u[c]);
+      VecX up = u, um = u;
+      up[c] += e;
+      um[c] -= e;
+      Ju[c] = lambda.dot(stepper.step(y[k], t, h, up) - stepper.step(y[k], t, h, um)) / (2.0 * e);
+    }
+    for (int j = 0; j < nf; ++j) {
+      const ForceParameter& fp = pr.forces[j];
+      if (static_cast<long>(k) * fp.pieces / N == fp.piece) res.gradient[j] += Ju[rs.control_of[j]];
+    }
+    for (int j = 0; j < ns; ++j) {
+      auto phi = [&](int m) { return step_at[4 * j + m]->step(y[k], t, h, u); };
+      const VecX d = phi(0) - 8.0 * phi(1) + 8.0 * phi(2) - phi(3);
+      res.gradient[nf + nq0 + nv0 + j] += lambda.dot(d) / (12.0 * pr.system_param_delta[j]);
+    }
+    // state Jacobian of the step, column by column
+    for (int i = 0; i < ny; ++i) {
+      const double e = fdStep(y[k][i]);
+      VecX yp = y[k], ym = y[k];
+      yp[i] += e;
+      ym[i] -= e;
+      Jy.col(i) = (stepper.step(yp, t, h, u) - stepper.step(ym, t, h, u)) / (2.0 * e);
+    }
+    lambda = (Jy.transpose() * lambda).eval();
+  }
+  for (int j = 0; j < nq0; ++j) res.gradient[nf + j] += lambda[pr.initial_q[j]];
+  for (int j = 0; j < nv0; ++j) res.gradient[nf + nq0 + j] += lambda[n + pr.initial_qdot[j]];
+  // effort: w sum_k h u_k^2, each step's u the sum of its active force parameters
+  if (obj.effort_weight != 0.0) {
+    for (int k = 0; k < N; ++k) {
+      const VecX u = controlsAt(pr, rs, p, k, N);
+      for (int j = 0; j < nf; ++j) {
+        const ForceParameter& fp = pr.forces[j];
+        if (static_cast<long>(k) * fp.pieces / N == fp.piece)
+          res.gradient[j] += 2.0 * obj.effort_weight * h * u[rs.control_of[j]];
+      }
+    }
+  }
+  res.step_evaluations = stepper.evaluations;
+  for (const auto& s : step_at) res.step_evaluations += s->evaluations;
+  return res;
+}
+
+VecX finiteDifferenceGradient(const Problem& pr, const Objective& obj, const VecX& p) {
+  VecX g(p.size());
+  auto J = [&](const VecX& x) { return evaluate(pr, obj, x, false).objective; };
+  // fourth-order central differences at relative steps 1e-3 .. 1e-6: a large step loses to the
+  // run's nonlinearity (truncation), a small one to its round-off (eps |J| / e); the pair of
+  // neighbouring steps whose estimates agree best gives the finer of the two
+  const double rel[4] = {1e-3, 1e-4, 1e-5, 1e-6};
+  for (Eigen::Index i = 0; i < p.size(); ++i) {
+    double d[4];
+    for (int j = 0; j < 4; ++j) {
+      double e = rel[j] * std::max(1.0, std::abs(p[i]));
+      // a system parameter (a mass) must stay admissible: never step to zero or below
+      if (i >= p.size() - pr.num_system_params && p[i] > 0.0) e = std::min(e, 0.25 * p[i]);
+      VecX x = p;
+      double f[4];
+      const double at[4] = {-2.0, -1.0, 1.0, 2.0};
+      for (int k = 0; k < 4; ++k) {
+        x[i] = p[i] + at[k] * e;
+        f[k] = J(x);
+      }
+      d[j] = (f[0] - 8.0 * f[1] + 8.0 * f[2] - f[3]) / (12.0 * e);
+    }
+    int best = 0;
+    for (int j = 1; j < 3; ++j)
+      if (std::abs(d[j] - d[j + 1]) < std::abs(d[best] - d[best + 1])) best = j;
+    g[i] = d[best + 1];
+  }
+  return g;
+}
+
+double worstRelativeError(const VecX& a, const VecX& b) {
+  const double scale = b.size() > 0 ? b.cwiseAbs().maxCoeff() : 0.0;
+  const double err = a.size() > 0 ? (a - b).cwiseAbs().maxCoeff() : 0.0;
+  if (scale == 0.0) return err == 0.0 ? 0.0 : INFINITY;
+  return err / scale;
+}
+
+}  // namespace redmax::adjoint

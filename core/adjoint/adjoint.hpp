@@ -1,0 +1,111 @@
+#pragma once
+// Differentiable simulation: the discrete adjoint of the core's fixed-step integrators
+// (docs/gradients.md). The dissertation optimizes a reaching task with the adjoint method
+// [D Sec. 6.2.11]; this is that method for the steps of core/integrators.
+//
+// A run is the map y_{k+1} = Phi_k(y_k, p) with y = (q, qdot, z) and N fixed steps of length h
+// (FixedStepIntegrator::step: euler [D Eq. 4.20], bdf1 [D Eq. 4.80-4.82], sdirk2), and an
+// objective J(y_N, p). Reverse accumulation gives dJ/dp for any number of parameters at a cost
+// that does not grow with their number:
+//   lambda_N = dJ/dy_N,   lambda_k = (dPhi_k/dy_k)^T lambda_{k+1},
+//   dJ/dp    = dJ/dp|explicit + sum_k (dPhi_k/dp)^T lambda_{k+1} + (dy_0/dp)^T lambda_0.
+// What is differentiated how (docs/gradients.md §2): dPhi_k/dy_k is the central difference of the
+// whole step, so every term the step evaluates (M, f with springs, dampers, muscle inertia of
+// every path type, K and D of bdf1, the KKT rows of constraints, the z update) is in it; the
+// generalized-force columns dPhi_k/du are central differences of the step along each driven
+// coordinate (one pair per coordinate, shared by all of its time pieces); system parameters
+// (muscle masses) are fourth-order central differences of the step between systems built at
+// s -+ delta and s -+ 2 delta.
+// The objective's derivatives are analytic. The forward run is the integrator's own step; no
+// chart switch (System::reparameterize) is applied between steps.
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/dynamics/system.hpp"
+
+namespace redmax::adjoint {
+
+/// One generalized-force parameter: a constant force (N m or N) on a system coordinate during
+/// time piece `piece` of `pieces` equal pieces of the run (step k of N is in piece k * pieces / N).
+struct ForceParameter {
+  int coordinate = -1;
+  int piece = 0;
+  int pieces = 1;
+};
+
+/// A system that depends on parameters (e.g. muscle masses): built for a value of them.
+using SystemFactory = std::function<std::shared_ptr<const System>(const VecX& system_params)>;
+
+/// What is simulated and which parameters the gradient is taken with respect to. The parameter
+/// vector p is ordered: forces, initial q entries, initial qdot entries, system parameters.
+struct Problem {
+  std::string integrator = "euler";  ///< euler, bdf1 or sdirk2
+  double dt = 1e-3;
+  double duration = 1.0;             ///< cut into ceil(duration / dt) equal steps (as advance())
+  /// sdirk2's Newton tolerance: tighter than a simulation's default (1e-10), since the step
+  /// Jacobians difference converged stages and the iteration's error would show in them
+  double newton_tol = 1e-12;
+  State initial;                     ///< the state the run starts from before p is applied
+  std::vector<ForceParameter> forces;
+  std::vector<int> initial_q;        ///< coordinates whose initial value is a parameter
+  std::vector<int> initial_qdot;     ///< coordinates whose initial speed is a parameter
+  /// builds the system for the system parameters (called with an empty vector when there are
+  /// none); the system must have no controls and no coordinate map (checked)
+  SystemFactory make_system;
+  int num_system_params = 0;
+  VecX system_param_delta;           ///< step of the central differences per system parameter
+                                     ///< (the systems at s - 2 delta must be valid)
+  int numParameters() const {
+    return static_cast<int>(forces.size() + initial_q.size() + initial_qdot.size()) + num_system_params;
+  }
+};
+
+/// J(y_N, p) = sum of weighted terms:
+///   point:  w/2 |x(q_N) - target|^2 for a point fixed in a body (x_i in body coordinates)
+///   speed:  w/2 |qdot_N|^2 (come to rest)
+///   effort: w sum_steps h |u_k|^2 (the integral of the squared generalized forces)
+struct Objective {
+  struct Point {
+    int body = -1;
+    Vec3 x_i = Vec3::Zero();
+    Vec3 target = Vec3::Zero();
+    double weight = 1.0;
+  };
+  std::vector<Point> points;
+  double speed_weight = 0.0;
+  double effort_weight = 0.0;
+};
+
+struct Result {
+  double objective = 0.0;
+  VecX gradient;             ///< dJ/dp (empty unless asked)
+  State final;               ///< y_N
+  long steps = 0;
+  long step_evaluations = 0; ///< calls of the integrator's step, forward and adjoint together
+};
+
+/// Thrown for a problem that cannot be differentiated (bad sizes, unknown integrator, controls).
+class AdjointError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Simulate at parameters p and return the objective, with the adjoint gradient when
+/// `with_gradient`. Throws AdjointError for an invalid problem and SimulationError when the run
+/// diverges or produces NaN.
+Result evaluate(const Problem& problem, const Objective& objective, const VecX& p, bool with_gradient);
+
+/// The gradient by central differences of whole simulations: the reference `redmax gradient
+/// --check` compares with. Per parameter, fourth-order differences (at p_i -+ e, -+ 2e) with
+/// e = r max(1, |p_i|) for r = 1e-3, 1e-4, 1e-5, 1e-6 (a mass steps at most a quarter of itself),
+/// and of the neighbouring pair of estimates that agree best the finer: 16 runs per parameter.
+VecX finiteDifferenceGradient(const Problem& problem, const Objective& objective, const VecX& p);
+
+/// max_i |a_i - b_i| / max_i |b_i|: the worst component error relative to the reference's scale
+/// (0 when both vanish).
+double worstRelativeError(const VecX& a, const VecX& b);
+
+}  // namespace redmax::adjoint

@@ -1,0 +1,70 @@
+// `redmax gradient` end to end (docs/gradients.md §3): --check passes on the Type II double
+// pendulum with muscle mass, a tolerance it cannot meet exits 1, bad SPECs exit 2 with the item
+// named.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "tests/cli/cli_test_util.hpp"
+
+namespace {
+
+using namespace redmax::cli_test;
+namespace fs = std::filesystem;
+
+class GradientCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to cli_tests (build target redmax)";
+    dir_ = fs::temp_directory_path() / ("redmax_gradient_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  CmdResult run(const std::string& args) const { return runRedmax(dir_, "gradient --model " + scene("double_pendulum_via.osim") + " " + args); }
+  fs::path dir_;
+};
+
+const std::string kRun =
+    "--duration 0.1 --dt 0.005 --muscle-mass-kg via_muscle=0.5 --mass-points 6 "
+    "--params 'torques:q1@2=0.5,q2=-1;qdot0:q1=0.3;masses:via_muscle' "
+    "--objective 'point:link2@0,-1,0=0.5,-1.5,0;0.1*speed;0.01*effort'";
+
+TEST_F(GradientCli, CheckAgreesWithCentralDifferences) {
+  for (const char* integrator : {"euler", "bdf1"}) {
+    const CmdResult r = run(kRun + " --integrator " + integrator + " --check");
+    EXPECT_EQ(r.code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("objective "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("torque q1 piece 2/2"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("mass via_muscle"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("-> ok"), std::string::npos) << r.out;
+  }
+}
+
+TEST_F(GradientCli, CheckAboveTheToleranceExitsOne) {
+  // no gradient meets differences of whole runs to 1e-15
+  const CmdResult r = run(kRun + " --check --check-tolerance 1e-15");
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("-> FAILED"), std::string::npos) << r.out;
+}
+
+TEST_F(GradientCli, BadSpecsExitTwo) {
+  CmdResult r = run("--duration 0.1 --params 'torques:elbow' --objective speed");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: --params 'torques:elbow': no coordinate named 'elbow'\n");
+  r = run("--duration 0.1 --params 'torques:q1' --objective 'point:link2@0,0,0'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: --objective 'point:link2@0,0,0': expected point:BODY@x,y,z=X,Y,Z\n");
+  r = run("--duration 0.1 --params 'masses:via_muscle' --objective speed");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("needs a positive mass for it in --muscle-mass-kg via_muscle=KG"), std::string::npos) << r.err;
+  r = run("--duration 0.1 --objective speed");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: gradient needs --params\n(see `redmax gradient --help`)\n");
+}
+
+}  // namespace

@@ -1,0 +1,218 @@
+// The discrete adjoint (core/adjoint/adjoint.hpp, docs/gradients.md): a closed form for a linear
+// spring-mass, and central differences of whole simulations for a double pendulum with springs
+// and dampers and for a constrained four-bar, with every fixed-step integrator that has an adjoint.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/adjoint/adjoint.hpp"
+#include "core/dynamics/constraints/point_constraint.hpp"
+#include "../dynamics/constraint_scenes.hpp"
+#include "validation/scenes/scenes.hpp"
+
+namespace redmax {
+namespace {
+
+using adjoint::ForceParameter;
+using adjoint::Objective;
+using adjoint::Problem;
+
+// a body of mass m on a slider along x with a joint spring k and damper d, no gravity
+Model springMass(double m, double k, double d) {
+  ModelBuilder b("spring_mass");
+  b.setGravity(Vec3::Zero());
+  const int body = b.addBody("block", m, Vec3::Zero(), Mat3::Identity() * 0.01, -1, "slider", Prismatic{});
+  b.coordinate(body, 0).stiffness = k;
+  b.coordinate(body, 0).damping = d;
+  return b.finalize();
+}
+
+Problem problemFor(std::shared_ptr<const System> sys, const std::string& integrator, double duration, double dt) {
+  Problem pr;
+  pr.integrator = integrator;
+  pr.duration = duration;
+  pr.dt = dt;
+  pr.initial = sys->defaultState();
+  pr.make_system = [sys](const VecX&) { return sys; };
+  return pr;
+}
+
+// Closed form of the discrete run: both steps are linear in y = (x, v) and F for a linear
+// spring-mass, y+ = A y + b F, so the sensitivities S = dy/d(F, x0, v0) follow S+ = A S + (b 0 0).
+struct Discrete {
+  double x = 0.0, v = 0.0;
+  Eigen::Matrix<double, 2, 3> S = Eigen::Matrix<double, 2, 3>::Zero();
+};
+Discrete closedForm(const std::string& integrator, double m, double k, double d, double h, int N, double F,
+                    double x0, double v0) {
+  Eigen::Matrix2d A;
+  Eigen::Vector2d b;
+  if (integrator == "euler") {
+    // v+ = v + h (F - k x - d v) / m,  x+ = x + h v+   [D Eq. 4.20]
+    A << 0.0, 0.0, -h * k / m, 1.0 - h * d / m;
+    b << 0.0, h / m;
+  } else {
+    // (m + h d + h^2 k) v+ = m v + h (F - k x)   [D Eq. 4.80]
+    const double c = m + h * d + h * h * k;
+    A << 0.0, 0.0, -h * k / c, m / c;
+    b << 0.0, h / c;
+  }
+  // x+ = x + h v+
+  A.row(0) = Eigen::RowVector2d(1.0, 0.0) + h * A.row(1);
+  b[0] = h * b[1];
+  Discrete r;
+  Eigen::Vector2d y(x0, v0);
+  r.S(0, 1) = 1.0;
+  r.S(1, 2) = 1.0;
+  for (int i = 0; i < N; ++i) {
+    y = A * y + b * F;
+    r.S = (A * r.S).eval();
+    r.S.col(0) += b;
+  }
+  r.x = y[0];
+  r.v = y[1];
+  return r;
+}
+
+class SpringMass : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SpringMass, GradientEqualsTheClosedFormOfTheDiscreteRun) {
+  const double m = 2.0, k = 50.0, d = 0.4, T = 0.5, h = 1e-3;
+  const double F = 3.0, x0 = -0.05, v0 = 0.2;
+  const auto sys = std::make_shared<System>(springMass(m, k, d));
+  Problem pr = problemFor(sys, GetParam(), T, h);
+  pr.forces = {{0, 0, 1}};
+  pr.initial_q = {0};
+  pr.initial_qdot = {0};
+  Objective obj;
+  obj.points.push_back({0, Vec3::Zero(), Vec3(0.3, 0.0, 0.0), 1.0});
+  obj.speed_weight = 0.5;
+  obj.effort_weight = 0.01;
+  VecX p(3);
+  p << F, x0, v0;
+  const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
+  const Discrete c = closedForm(GetParam(), m, k, d, h, 500, F, x0, v0);
+  EXPECT_NEAR(r.final.q[0], c.x, 1e-13);
+  const double J = 0.5 * (c.x - 0.3) * (c.x - 0.3) + 0.25 * c.v * c.v + 0.01 * T * F * F;
+  EXPECT_NEAR(r.objective, J, 1e-13);
+  Eigen::RowVector3d g = (c.x - 0.3) * c.S.row(0) + 0.5 * c.v * c.S.row(1);
+  g[0] += 2.0 * 0.01 * T * F;
+  // measured: 1.9e-10 (euler), 1.2e-10 (bdf1) relative; the step Jacobians are central differences
+  EXPECT_LE(adjoint::worstRelativeError(r.gradient, g.transpose()), 1e-9)
+      << "adjoint " << r.gradient.transpose() << "\nclosed form " << g;
+}
+
+TEST_P(SpringMass, TendsToTheContinuousClosedForm) {
+  // undamped: x(T) = F/k (1 - cos wT) + x0 cos wT + v0/w sin wT, so dx(T)/dF = (1 - cos wT)/k;
+  // the discrete run's derivative differs by O(h)
+  const double m = 2.0, k = 50.0, T = 0.5, w = std::sqrt(k / m);
+  for (double h : {1e-3, 1e-4}) {
+    const auto sys = std::make_shared<System>(springMass(m, k, 0.0));
+    Problem pr = problemFor(sys, GetParam(), T, h);
+    pr.forces = {{0, 0, 1}};
+    Objective obj;
+    obj.points.push_back({0, Vec3::Zero(), Vec3(-10.0, 0.0, 0.0), 1.0});  // dJ/dF = (x - target) dx/dF
+    VecX p(1);
+    p << 1.0;
+    const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
+    const double dxdF = r.gradient[0] / (r.final.q[0] + 10.0);
+    const double exact = (1.0 - std::cos(w * T)) / k;
+    // measured: euler 8.3e-4 (h = 1e-3), 8.3e-5 (h = 1e-4); bdf1 (more dissipative) 2.78e-3,
+    // 2.78e-4 relative: first order in h
+    const double factor = GetParam() == "euler" ? 1.0 : 3.0;
+    EXPECT_LE(std::abs(dxdF - exact) / exact, factor * h) << "h = " << h;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, SpringMass, ::testing::Values("euler", "bdf1"));
+
+class AgainstCentralDifferences : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(AgainstCentralDifferences, DoublePendulumWithSpringsAndDampers) {
+  ModelBuilder b(scenes::doublePendulum(1.0, 1.0));
+  for (int c = 0; c < 2; ++c) {
+    b.coordinateAt(c).stiffness = 3.0 + c;
+    b.coordinateAt(c).rest_value = 0.2;
+    b.coordinateAt(c).damping = 0.2;
+  }
+  const auto sys = std::make_shared<System>(b.finalize());
+  Problem pr = problemFor(sys, GetParam(), 0.3, 0.01);
+  pr.initial.q << 0.4, -0.3;
+  pr.forces = {{0, 0, 3}, {0, 1, 3}, {0, 2, 3}, {1, 0, 1}};
+  pr.initial_q = {1};
+  pr.initial_qdot = {0};
+  Objective obj;
+  obj.points.push_back({1, Vec3(0, -1, 0), Vec3(1.0, -1.2, 0.1), 1.0});
+  obj.speed_weight = 0.1;
+  obj.effort_weight = 0.01;
+  std::mt19937 rng(19);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    VecX p(6);
+    for (int i = 0; i < 6; ++i) p[i] = u(rng);
+    const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
+    const VecX fd = adjoint::finiteDifferenceGradient(pr, obj, p);
+    // measured: 7.8e-11 .. 3.8e-10 relative (euler, bdf1, sdirk2; the issue asks 1e-6)
+    EXPECT_LE(adjoint::worstRelativeError(r.gradient, fd), 3e-9)
+        << "adjoint " << r.gradient.transpose() << "\ndifferences " << fd.transpose();
+  }
+}
+
+TEST_P(AgainstCentralDifferences, FourBarWithAClosedLoop) {
+  const redmax::testing::FourBar fb;
+  auto sys = std::make_shared<System>(fb.model);
+  sys->addConstraint(std::make_shared<HingePointConstraint>(fb.model, fb.rocker_body, fb.tip_rocker(), -1,
+                                                            fb.pivot_world(), -1, Vec3::UnitZ()));
+  Problem pr = problemFor(sys, GetParam(), 0.2, 0.01);
+  pr.initial.q = fb.closedQ(0.7);
+  pr.initial.qdot = fb.closedQdot(pr.initial.q, 0.5);
+  pr.forces = {{0, 0, 2}, {0, 1, 2}, {2, 0, 1}};
+  Objective obj;
+  obj.points.push_back({fb.coupler_body, Vec3(1.0, 0, 0), Vec3(1.0, 1.5, 0.0), 1.0});
+  obj.speed_weight = 0.05;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  VecX p(3);
+  for (int i = 0; i < 3; ++i) p[i] = u(rng);
+  const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
+  const VecX fd = adjoint::finiteDifferenceGradient(pr, obj, p);
+  // measured: 5.2e-10 (euler, bdf1: no springs, the same step), 8.5e-10 (sdirk2) relative (the
+  // issue asks 1e-6)
+  EXPECT_LE(adjoint::worstRelativeError(r.gradient, fd), 5e-9)
+      << "adjoint " << r.gradient.transpose() << "\ndifferences " << fd.transpose();
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, AgainstCentralDifferences, ::testing::Values("euler", "bdf1", "sdirk2"));
+
+TEST(Adjoint, CostDoesNotGrowWithTheNumberOfForceParameters) {
+  const auto sys = std::make_shared<System>(scenes::doublePendulum(1.0, 1.0));
+  Problem pr = problemFor(sys, "euler", 0.2, 0.01);
+  Objective obj;
+  obj.points.push_back({1, Vec3(0, -1, 0), Vec3(1.0, -1.2, 0.0), 1.0});
+  long evaluations[2] = {0, 0};
+  for (int pieces : {2, 20}) {
+    pr.forces.clear();
+    for (int c = 0; c < 2; ++c)
+      for (int k = 0; k < pieces; ++k) pr.forces.push_back({c, k, pieces});
+    const adjoint::Result r = adjoint::evaluate(pr, obj, VecX::Constant(2 * pieces, 0.5), true);
+    evaluations[pieces == 20] = r.step_evaluations;
+  }
+  // forward N, and per step 2 per driven coordinate and 2 per state entry: 20 (1 + 4 + 8)
+  EXPECT_EQ(evaluations[0], 20 * 13);
+  EXPECT_EQ(evaluations[1], evaluations[0]);
+}
+
+TEST(Adjoint, RefusesWhatItCannotDifferentiate) {
+  const auto sys = std::make_shared<System>(scenes::doublePendulum(1.0, 1.0));
+  Problem pr = problemFor(sys, "rk45", 0.1, 0.01);
+  pr.forces = {{0, 0, 1}};
+  EXPECT_THROW(adjoint::evaluate(pr, Objective{}, VecX::Zero(1), true), adjoint::AdjointError);
+  pr.integrator = "euler";
+  EXPECT_THROW(adjoint::evaluate(pr, Objective{}, VecX::Zero(2), true), adjoint::AdjointError);
+  pr.forces = {{5, 0, 1}};
+  EXPECT_THROW(adjoint::evaluate(pr, Objective{}, VecX::Zero(1), true), adjoint::AdjointError);
+}
+
+}  // namespace
+}  // namespace redmax

@@ -1,0 +1,185 @@
+#include "validation/gradient/gradient.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "converter/osim_reader.hpp"
+#include "validation/simulate/spec_parse.hpp"
+
+namespace redmax::validation {
+namespace {
+
+std::invalid_argument bad(const std::string& flag, const std::string& item, const std::string& why) {
+  return std::invalid_argument(flag + " '" + item + "': " + why);
+}
+
+int coordinateIndex(const SimulationModel& m, const std::string& flag, const std::string& item,
+                    const std::string& name) {
+  const int c = m.system->model().findCoordinate(name);
+  if (c < 0) throw bad(flag, item, "no coordinate named '" + name + "'");
+  return c;
+}
+
+// NAME[=V]: the name and, when given, the value
+std::string nameAndValue(const std::string& flag, const std::string& text, const std::string& item, double& v,
+                         bool& has_value) {
+  const auto eq = text.find('=');
+  has_value = eq != std::string::npos;
+  if (has_value && !parseNumber(text.substr(eq + 1), v)) throw bad(flag, item, "the value after '=' must be a number");
+  const std::string name = text.substr(0, eq);
+  if (name.empty()) throw bad(flag, item, "no name");
+  return name;
+}
+
+double explicitMass(const SimulationModelOptions& o, const std::string& muscle) {
+  for (const auto& [name, kg] : o.explicit_masses)
+    if (name == muscle) return kg;
+  return -1.0;
+}
+
+}  // namespace
+
+GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationModelOptions& options,
+                                const std::string& integrator, double duration, double dt,
+                                const std::string& params_spec, const std::string& objective_spec) {
+  GradientSetup g;
+  const auto description = std::make_shared<const osim::ModelDescription>(osim::readOsimModel(osim_path));
+  g.model = makeSimulationModel(*description, options);
+  adjoint::Problem& pr = g.problem;
+  pr.integrator = integrator;
+  pr.duration = duration;
+  pr.dt = dt;
+  pr.initial = defaultInitialState(g.model);
+  const int nz = g.model.system->numStates();
+  pr.initial.z = VecX::Zero(nz);
+
+  // parameters, collected per kind and then stacked in the problem's order
+  struct Value {
+    std::string name;
+    double v;
+  };
+  std::vector<Value> forces, q0, v0;
+  std::vector<std::string> masses;
+  const std::string pflag = "--params";
+  if (params_spec.empty()) throw std::invalid_argument("--params: no parameters");
+  for (const std::string& group : split(params_spec, ';')) {
+    const auto colon = group.find(':');
+    if (colon == std::string::npos)
+      throw bad(pflag, group, "expected KIND:ITEM,... with KIND torques, q0, qdot0 or masses");
+    const std::string kind = group.substr(0, colon);
+    const std::string list = group.substr(colon + 1);
+    if (list.empty()) throw bad(pflag, group, "no items");
+    for (const std::string& item_text : split(list, ',')) {
+      // messages name the item with its kind, e.g. 'torques:elbow'
+      const std::string item = kind + ":" + item_text;
+      double v = 0.0;
+      bool has_value = false;
+      if (kind == "torques") {
+        std::string name = nameAndValue(pflag, item_text, item, v, has_value);
+        int pieces = 1;
+        const auto at = name.find('@');
+        if (at != std::string::npos) {
+          double k = 0.0;
+          if (!parseNumber(name.substr(at + 1), k) || k < 1.0 || k != static_cast<int>(k) || k > 100000)
+            throw bad(pflag, item, "the piece count after '@' must be a whole number >= 1");
+          pieces = static_cast<int>(k);
+          name = name.substr(0, at);
+        }
+        const int c = coordinateIndex(g.model, pflag, item, name);
+        for (int k = 0; k < pieces; ++k) {
+          pr.forces.push_back({c, k, pieces});
+          forces.push_back({"torque " + name + (pieces > 1 ? " piece " + std::to_string(k + 1) + "/" +
+                                                                 std::to_string(pieces)
+                                                           : std::string()),
+                            v});
+        }
+      } else if (kind == "q0" || kind == "qdot0") {
+        const std::string name = nameAndValue(pflag, item_text, item, v, has_value);
+        const int c = coordinateIndex(g.model, pflag, item, name);
+        if (kind == "q0") {
+          pr.initial_q.push_back(c);
+          q0.push_back({"q0 " + name, has_value ? v : pr.initial.q[c]});
+        } else {
+          pr.initial_qdot.push_back(c);
+          v0.push_back({"qdot0 " + name, has_value ? v : pr.initial.qdot[c]});
+        }
+      } else if (kind == "masses") {
+        if (item_text.find('=') != std::string::npos)
+          throw bad(pflag, item, "a muscle's mass comes from --muscle-mass-kg NAME=KG, not from the SPEC");
+        if (explicitMass(options, item_text) <= 0.0)
+          throw bad(pflag, item, "needs a positive mass for it in --muscle-mass-kg " + item_text + "=KG");
+        masses.push_back(item_text);
+      } else {
+        throw bad(pflag, group, "unknown kind '" + kind + "' (torques, q0, qdot0 or masses)");
+      }
+    }
+  }
+  const int np = static_cast<int>(forces.size() + q0.size() + v0.size() + masses.size());
+  g.p0.resize(np);
+  int i = 0;
+  for (const auto* list : {&forces, &q0, &v0})
+    for (const Value& v : *list) {
+      g.param_names.push_back(v.name);
+      g.p0[i++] = v.v;
+    }
+  for (const std::string& m : masses) {
+    g.param_names.push_back("mass " + m);
+    g.p0[i++] = explicitMass(options, m);
+  }
+
+  // the system, rebuilt for other muscle masses (the explicit masses of the named muscles replaced)
+  pr.num_system_params = static_cast<int>(masses.size());
+  pr.system_param_delta.resize(pr.num_system_params);
+  // a mass steps by 1e-3 of itself (fourth-order differences of the step, core/adjoint)
+  for (int j = 0; j < pr.num_system_params; ++j) pr.system_param_delta[j] = 1e-3 * g.p0[np - pr.num_system_params + j];
+  const std::shared_ptr<const System> base = g.model.system;
+  pr.make_system = [description, options, masses, base](const VecX& sp) -> std::shared_ptr<const System> {
+    if (sp.size() == 0) return base;
+    SimulationModelOptions o = options;
+    for (size_t j = 0; j < masses.size(); ++j)
+      for (auto& [name, kg] : o.explicit_masses)
+        if (name == masses[j]) kg = sp[static_cast<Eigen::Index>(j)];
+    return makeSimulationModel(*description, o).system;
+  };
+
+  // objective
+  const std::string oflag = "--objective";
+  if (objective_spec.empty()) throw std::invalid_argument("--objective: no terms");
+  const Model& model = g.model.system->model();
+  for (const std::string& term_text : split(objective_spec, ';')) {
+    std::string term = term_text;
+    double w = 1.0;
+    const auto star = term.find('*');
+    if (star != std::string::npos) {
+      if (!parseNumber(term.substr(0, star), w) || w < 0.0)
+        throw bad(oflag, term_text, "the weight before '*' must be a number >= 0");
+      term = term.substr(star + 1);
+    }
+    if (term == "speed") {
+      g.objective.speed_weight += w;
+    } else if (term == "effort") {
+      g.objective.effort_weight += w;
+    } else if (term.rfind("point:", 0) == 0) {
+      const std::string body_spec = term.substr(6);
+      const auto at = body_spec.find('@');
+      const auto eq = body_spec.find('=');
+      if (at == std::string::npos || eq == std::string::npos || eq < at)
+        throw bad(oflag, term_text, "expected point:BODY@x,y,z=X,Y,Z");
+      adjoint::Objective::Point pt;
+      const std::string body = body_spec.substr(0, at);
+      pt.body = model.findBody(body);
+      if (pt.body < 0) throw bad(oflag, term_text, "no body named '" + body + "'");
+      if (!parseVec3(body_spec.substr(at + 1, eq - at - 1), pt.x_i))
+        throw bad(oflag, term_text, "the point must be three numbers x,y,z (m, body frame)");
+      if (!parseVec3(body_spec.substr(eq + 1), pt.target))
+        throw bad(oflag, term_text, "the target must be three numbers X,Y,Z (m, ground)");
+      pt.weight = w;
+      g.objective.points.push_back(pt);
+    } else {
+      throw bad(oflag, term_text, "unknown term (point:BODY@x,y,z=X,Y,Z, speed or effort)");
+    }
+  }
+  return g;
+}
+
+}  // namespace redmax::validation

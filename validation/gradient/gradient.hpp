@@ -1,0 +1,38 @@
+#pragma once
+// `redmax gradient`: an OpenSim model, parameter and objective SPECs (docs/gradients.md §3) turned
+// into an adjoint problem (core/adjoint/adjoint.hpp).
+//
+//   --params    groups separated by ';':
+//                 torques:C[@K][=V],...   a constant generalized force on coordinate C (N m or N),
+//                                         in K equal time pieces (default 1), start value V (0)
+//                 q0:C[=V],...            the initial value of C (default: the model's)
+//                 qdot0:C[=V],...         the initial speed of C
+//                 masses:M,...            the mass of muscle M (needs --muscle-mass-kg M=KG)
+//   --objective terms separated by ';', each [W*]TERM with weight W (default 1):
+//                 point:BODY@x,y,z=X,Y,Z  W/2 |p - target|^2 for the point (x,y,z) of BODY (body
+//                                         frame, m) against the ground point (X,Y,Z) at the end
+//                 speed                   W/2 |qdot|^2 at the end
+//                 effort                  W * integral of the squared generalized forces
+#include <string>
+#include <vector>
+
+#include "core/adjoint/adjoint.hpp"
+#include "validation/simulate/simulate.hpp"
+
+namespace redmax::validation {
+
+struct GradientSetup {
+  adjoint::Problem problem;
+  adjoint::Objective objective;
+  VecX p0;                               ///< the parameter values the SPEC gives
+  std::vector<std::string> param_names;  ///< e.g. "torque elbow_flexion piece 2/10", "mass BIClong"
+  SimulationModel model;                 ///< the model at p0's system parameters
+};
+
+/// Throws std::invalid_argument with a message naming the SPEC item for a bad SPEC (unknown
+/// coordinate, body, muscle, malformed number), osim::ConvertError / ModelError for the model.
+GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationModelOptions& options,
+                                const std::string& integrator, double duration, double dt,
+                                const std::string& params_spec, const std::string& objective_spec);
+
+}  // namespace redmax::validation
