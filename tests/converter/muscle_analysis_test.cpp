@@ -212,51 +212,59 @@ TEST(MuscleAnalysis, FibrePowersBalanceTheMusculotendonPower) {
   dir.write("m.osim", armModel());
   dir.write("q.mot", armMotion());
   AnalyzeToolSettings s;
-  s.setup_file = dir.write("setup.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"));
-  const AnalyzeTool tool(s);
-  const MuscleAnalysisRun run = tool.runMuscleAnalyses();
-  ASSERT_EQ(run.frames.size(), 51u);
-  std::vector<const MuscleFrame*> frames;
-  for (const MuscleFrame& f : run.frames) frames.push_back(&f);
-  const auto tables = muscleAnalysisTables(tool.setup().muscle_analysis, run.columns, frames);
   const BuildResult b = buildCoreModel(readOsimModel(dir.file("m.osim")));
   const auto* bi = dynamic_cast<const hill::Millard2012EquilibriumMuscle*>(b.model.muscleModels()[0].get());
   ASSERT_NE(bi, nullptr);
-  for (int c = 0; c < 2; ++c) {
-    const auto fap = column(tables, "FiberActivePower", c), fpp = column(tables, "FiberPassivePower", c);
-    const auto tp = column(tables, "TendonPower", c), map = column(tables, "MuscleActuatorPower", c);
-    double worst = 0.0, peak = 0.0, worst_passive = 0.0, worst_active = 0.0, peak_passive = 0.0;
-    for (size_t r = 0; r < frames.size(); ++r) {
-      const hill::MuscleOutput& o = out(*frames[r], run.columns.muscle_index[static_cast<size_t>(c)]);
-      peak = std::max(peak, std::abs(map[r]));
-      worst = std::max(worst, std::abs(fap[r] + fpp[r] + tp[r] - map[r]));
-      // closed forms of the elastic passive force (independent of the classes' code paths)
-      const double lceN = o.fiber_length / (c == 0 ? 0.14 : 0.1), fmax = c == 0 ? 300.0 : 200.0;
-      const double elastic =
-          c == 0 ? fmax * bi->fiberForceLengthCurve().value(lceN)
-                 : (lceN > 1 ? fmax * (std::exp(4.0 * (lceN - 1) / 0.6) - 1) / (std::exp(4.0) - 1) : 0.0);
-      const double damping = c == 0 ? fmax * 0.1 * o.normalized_fiber_velocity : 0.0;
-      worst_passive = std::max(worst_passive, std::abs(fpp[r] + elastic * o.fiber_velocity));
-      worst_active = std::max(worst_active, std::abs(fap[r] + (o.active_fiber_force + damping) * o.fiber_velocity));
-      peak_passive = std::max(peak_passive, std::abs(fpp[r]));
+  // with equilibrium the tri's fibre is beyond its optimal length (passive power) and the bi's
+  // fibre does not move; without, both fibres move at their default lengths (damping power)
+  double damping_power = 0.0, thelen_passive = 0.0;
+  for (const bool equilibrium : {true, false}) {
+    s.setup_file = dir.write("setup.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>",
+                                                   equilibrium));
+    const AnalyzeTool tool(s);
+    const MuscleAnalysisRun run = tool.runMuscleAnalyses();
+    ASSERT_EQ(run.frames.size(), 51u);
+    std::vector<const MuscleFrame*> frames;
+    for (const MuscleFrame& f : run.frames) frames.push_back(&f);
+    const auto tables = muscleAnalysisTables(tool.setup().muscle_analysis, run.columns, frames);
+    for (int c = 0; c < 2; ++c) {
+      const auto fap = column(tables, "FiberActivePower", c), fpp = column(tables, "FiberPassivePower", c);
+      const auto tp = column(tables, "TendonPower", c), map = column(tables, "MuscleActuatorPower", c);
+      double worst = 0.0, peak = 0.0, worst_passive = 0.0, worst_active = 0.0, peak_passive = 0.0;
+      for (size_t r = 0; r < frames.size(); ++r) {
+        const hill::MuscleOutput& o = out(*frames[r], run.columns.muscle_index[static_cast<size_t>(c)]);
+        peak = std::max(peak, std::abs(map[r]));
+        worst = std::max(worst, std::abs(fap[r] + fpp[r] + tp[r] - map[r]));
+        // closed forms of the elastic passive force: Millard's fibre force-length curve; Thelen's
+        // exponential with OpenSim's defaults KshapePassive 5, FmaxMuscleStrain 0.6
+        const double lceN = o.fiber_length / (c == 0 ? 0.14 : 0.1), fmax = c == 0 ? 300.0 : 200.0;
+        const double elastic =
+            c == 0 ? fmax * bi->fiberForceLengthCurve().value(lceN)
+                   : (lceN > 1 ? fmax * (std::exp(5.0 * (lceN - 1) / 0.6) - 1) / (std::exp(5.0) - 1) : 0.0);
+        const double damping = c == 0 ? fmax * 0.1 * o.normalized_fiber_velocity : 0.0;  // Millard's beta 0.1
+        worst_passive = std::max(worst_passive, std::abs(fpp[r] + elastic * o.fiber_velocity));
+        worst_active = std::max(worst_active, std::abs(fap[r] + (o.active_fiber_force + damping) * o.fiber_velocity));
+        peak_passive = std::max(peak_passive, std::abs(fpp[r]));
+        if (c == 0) damping_power = std::max(damping_power, std::abs(damping * o.fiber_velocity));
+      }
+      if (c == 1) thelen_passive = std::max(thelen_passive, peak_passive);
+      std::printf("[ measured ] %s, equilibrium %d: peak |MuscleActuatorPower| %.3g W, peak |FiberPassivePower| %.3g W, "
+                  "max |FAP + FPP + TP - MAP| %.3g W, passive vs closed form %.3g W, active %.3g W\n",
+                  run.columns.muscles[static_cast<size_t>(c)].c_str(), equilibrium ? 1 : 0, peak, peak_passive, worst,
+                  worst_passive, worst_active);
+      EXPECT_GT(peak, 0.1);  // the muscles do work: the balance is not 0 = 0
+      // exact where the tendon force equals the fibre's along the tendon (equilibrium: measured
+      // 3.3e-16 / 1.8e-16 of the peak); otherwise to the velocity solve's force tolerance
+      // (measured: Millard 1.8e-9, Thelen 1.2e-12 of the peak)
+      EXPECT_LE(worst, (equilibrium ? 2e-15 : 1e-8) * peak);
+      EXPECT_LE(worst_passive, 1e-16 * peak);  // measured 2.8e-18 of the peak (tri), 0 (bi)
+      EXPECT_LE(worst_active, 1e-16 * peak);   // measured 0
     }
-    std::printf("[ measured ] %s: peak |MuscleActuatorPower| %.3g W, peak |FiberPassivePower| %.3g W, max |FAP + FPP + "
-                "TP - MAP| %.3g W, passive vs closed form %.3g W, active %.3g W\n",
-                run.columns.muscles[static_cast<size_t>(c)].c_str(), peak, peak_passive, worst, worst_passive,
-                worst_active);
-    EXPECT_GT(peak, 1.0);  // the muscles do work: the balance is not 0 = 0
-    EXPECT_LE(worst, 1e-9 * peak);
-    EXPECT_LE(worst_passive, 1e-9 * peak);
-    EXPECT_LE(worst_active, 1e-9 * peak);
   }
-  // the Millard fibre's damping moves power from passive to active: with it, the passive power
-  // alone is the elastic one (checked above) and differs from -passive force * v_f
-  double damping_power = 0.0;
-  for (const MuscleFrame* f : frames) {
-    const hill::MuscleOutput& o = out(*f, 0);
-    damping_power = std::max(damping_power, std::abs(fiberPassivePower(o) + o.passive_fiber_force * o.fiber_velocity));
-  }
-  EXPECT_GT(damping_power, 1e-6);
+  std::printf("[ measured ] peak Millard damping power %.3g W, peak Thelen passive power %.3g W\n", damping_power,
+              thelen_passive);
+  EXPECT_GT(damping_power, 1e-3);   // the damping is in the active power, not the passive one
+  EXPECT_GT(thelen_passive, 1e-3);  // the elastic closed form was exercised
 
   // as Thelen2003Muscle_Deprecated: OpenSim's ActivationFiberLengthMuscle_Deprecated leaves the
   // powers, the fibre force and the pennation angular velocity unset (nan in OpenSim's files)
