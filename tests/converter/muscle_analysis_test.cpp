@@ -193,6 +193,13 @@ TEST(MuscleAnalysis, EquilibriumAndPathIdentitiesAndOpenSimsFiles) {
   EXPECT_TRUE(warned);
 }
 
+// every frame of a run, as the tables take them
+std::vector<const MuscleFrame*> framesOf(const MuscleAnalysisRun& run) {
+  std::vector<const MuscleFrame*> f;
+  for (const MuscleFrame& x : run.frames) f.push_back(&x);
+  return f;
+}
+
 // the column of table `name` for muscle column c
 std::vector<double> column(const std::vector<Storage>& tables, const std::string& name, int c) {
   for (const Storage& t : tables)
@@ -224,8 +231,7 @@ TEST(MuscleAnalysis, FibrePowersBalanceTheMusculotendonPower) {
     const AnalyzeTool tool(s);
     const MuscleAnalysisRun run = tool.runMuscleAnalyses();
     ASSERT_EQ(run.frames.size(), 51u);
-    std::vector<const MuscleFrame*> frames;
-    for (const MuscleFrame& f : run.frames) frames.push_back(&f);
+    const std::vector<const MuscleFrame*> frames = framesOf(run);
     const auto tables = muscleAnalysisTables(tool.setup().muscle_analysis, run.columns, frames);
     for (int c = 0; c < 2; ++c) {
       const auto fap = column(tables, "FiberActivePower", c), fpp = column(tables, "FiberPassivePower", c);
@@ -271,8 +277,7 @@ TEST(MuscleAnalysis, FibrePowersBalanceTheMusculotendonPower) {
   s.muscle_class = "Thelen2003Muscle_Deprecated";
   const AnalyzeTool dep(s);
   const MuscleAnalysisRun dr = dep.runMuscleAnalyses();
-  std::vector<const MuscleFrame*> df;
-  for (const MuscleFrame& f : dr.frames) df.push_back(&f);
+  const std::vector<const MuscleFrame*> df = framesOf(dr);
   const auto dt = muscleAnalysisTables(dep.setup().muscle_analysis, dr.columns, df);
   for (const char* q : {"FiberActivePower", "FiberPassivePower", "TendonPower", "MuscleActuatorPower", "FiberForce",
                         "PennationAngularVelocity"})
@@ -332,8 +337,7 @@ TEST(MuscleAnalysis, ControlsFileDrivesActuatorsAndExcitations) {
   ASSERT_EQ(run.actuators.size(), 4u);
   ASSERT_EQ(run.actuators[2].name, "sh_reserve");
   ASSERT_EQ(run.actuators[3].name, "rt");
-  std::vector<const MuscleFrame*> frames;
-  for (const MuscleFrame& f : run.frames) frames.push_back(&f);
+  const std::vector<const MuscleFrame*> frames = framesOf(run);
   const auto act = actuationTables(run.actuators, frames);
   const int rt = 2;  // geometry index of the RigidTendonMuscle
   for (size_t r = 0; r < frames.size(); ++r) {
@@ -421,8 +425,7 @@ TEST(MuscleAnalysis, PointAndTorqueActuatorSpeedsAsOpenSim) {
   ASSERT_EQ(run.actuators.size(), 5u);
   ASSERT_EQ(run.actuators[3].name, "px");
   ASSERT_EQ(run.actuators[4].name, "tq");
-  std::vector<const MuscleFrame*> frames;
-  for (const MuscleFrame& f : run.frames) frames.push_back(&f);
+  const std::vector<const MuscleFrame*> frames = framesOf(run);
   const auto act = actuationTables(run.actuators, frames);
   double worst_p = 0.0, worst_t = 0.0;
   for (size_t r = 0; r < frames.size(); ++r) {
@@ -477,8 +480,7 @@ TEST(MuscleAnalysis, CoupledCoordinatesMomentArmsFollowTheConstraint) {
   const AnalyzeTool tool(s);
   const MuscleAnalysisRun run = tool.runMuscleAnalyses();
   ASSERT_EQ(run.frames.size(), 21u);
-  std::vector<const MuscleFrame*> frames;
-  for (const MuscleFrame& f : run.frames) frames.push_back(&f);
+  const std::vector<const MuscleFrame*> frames = framesOf(run);
   const auto tables = muscleAnalysisTables(tool.setup().muscle_analysis, run.columns, frames);
 
   BuildOptions bo;
