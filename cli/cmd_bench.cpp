@@ -11,6 +11,7 @@
 #include "cli/flags.hpp"
 #include "converter/error.hpp"
 #include "plugin/simbody/speed_comparison.hpp"
+#include "validation/analyze_speed.hpp"
 #include "validation/id_speed.hpp"
 #include "validation/scenes/humanoid.hpp"
 #include "validation/scenes/scenes.hpp"
@@ -35,7 +36,7 @@ Model makeScene(const std::string& name) {
 
 
 struct BenchFlags {
-  std::string scene = "all", json, integrators, spherical = "gimbal", id_setup, id_model;
+  std::string scene = "all", json, integrators, spherical = "gimbal", id_setup, id_model, analyze_setup;
   long repeats = 200, batches = 5;
   double dt = 1e-3;
 };
@@ -52,6 +53,20 @@ int runBench(const BenchFlags& f, const CLI::App& app) {
     o.batches = static_cast<int>(batches);
     try {
       std::cout << validation::formatIdSpeed(validation::timeIdEngines(o));
+    } catch (const osim::ConvertError& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 2;
+    }
+    if (!given(app, "--scene")) return 0;
+  }
+
+  // the AnalyzeTool's analyses on a setup (validation/analyze_speed.hpp)
+  if (given(app, "--analyze-setup")) {
+    validation::AnalyzeSpeedOptions o;
+    o.settings.setup_file = f.analyze_setup;
+    o.batches = static_cast<int>(batches);
+    try {
+      std::cout << validation::formatAnalyzeSpeed(validation::timeAnalyze(o));
     } catch (const osim::ConvertError& e) {
       std::cerr << "error: " << e.what() << "\n";
       return 2;
@@ -139,10 +154,17 @@ CommandRegistration reg(
                       "fallback for it. Scenes run too only if --scene is given")
            ->type_name("ID_SETUP.xml");
        app.add_option("--id-model", f->id_model, "with --id-setup: overrides its model")->type_name("M.osim");
+       app.add_option("--analyze-setup", f->analyze_setup,
+                      "time `redmax analyze` on an AnalyzeTool setup instead: frames per second of its\n"
+                      "StaticOptimization (without and with physiological muscle mass) and of its\n"
+                      "MuscleAnalysis + Actuation, the fastest of --batches passes, the tool's setup\n"
+                      "timed apart. Scenes run too only if --scene is given")
+           ->type_name("ANALYZE_SETUP.xml");
        app.footer(
            "usage: redmax bench [--scene NAME[,NAME...]|all] [--repeats N] [--batches B] [--json OUT]\n"
            "                    [--integrators LIST|none] [--spherical gimbal|ball] [--dt S]\n"
            "       redmax bench --id-setup ID_SETUP.xml [--id-model M.osim] [--batches B] [--scene ...]\n"
+           "       redmax bench --analyze-setup ANALYZE_SETUP.xml [--batches B] [--scene ...]\n"
            "Times, on the same tree and state, each core operation next to Simbody's equivalent:\n"
      "  kinematics        calcKinematics                     vs realize(Velocity)\n"
      "  mass_matrix       calcSkeletonMass                   vs calcM\n"

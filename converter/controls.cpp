@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "converter/build/functions_to_core.hpp"
 #include "converter/detail/xml_util.hpp"
 #include "converter/storage.hpp"
 
@@ -28,18 +29,15 @@ double evalNodes(const std::vector<ControlNodeDesc>& n, bool extrapolate, bool u
     if (!(std::abs(dt) > 0.0)) return a.value;
     return a.value + (b.value - a.value) * (t - a.t) / dt;
   };
-  if (t < n[0].t) {
-    if (!extrapolate || size == 1) return n[0].value;
-    return line(n[0], n[1]);
-  }
-  if (t >= n[size - 1].t) {
-    if (!extrapolate || size == 1) return n[size - 1].value;
-    return line(n[size - 2], n[size - 1]);
-  }
+  // steps never extrapolate (getControlValue: `!_useSteps && getExtrapolate()`)
+  const bool lines = extrapolate && !use_steps && size > 1;
+  if (t < n[0].t) return lines ? line(n[0], n[1]) : n[0].value;
+  if (t >= n[size - 1].t) return lines ? line(n[size - 2], n[size - 1]) : n[size - 1].value;
   // the largest i with n[i].t <= t (OpenSim's searchBinary)
   const auto it = std::upper_bound(n.begin(), n.end(), t, [](double x, const ControlNodeDesc& c) { return x < c.t; });
   const size_t i = static_cast<size_t>(it - n.begin()) - 1;
-  if (use_steps) return n[i + 1].value;
+  // steps: node i+1's value holds on (t_i, t_i+1], so at t_i itself node i's
+  if (use_steps) return t == n[i].t ? n[i].value : n[i + 1].value;
   return line(n[i], n[i + 1]);
 }
 
@@ -162,5 +160,77 @@ ControlSetDesc readControlSet(const std::string& path) {
 }
 
 AxisFunctionPtr makeControlFunction(const ControlLinearDesc& c) { return std::make_shared<ControlFunction>(c); }
+
+namespace {
+bool listsAll(const std::vector<std::string>& list) {
+  return list.empty() || (list.size() == 1 && detail::toLower(list[0]) == "all");
+}
+}  // namespace
+
+ResolvedController resolveControlsFile(const std::string& file, const std::vector<std::string>& names,
+                                       std::vector<std::string>& warnings,
+                                       const std::vector<std::string>& actuator_list) {
+  const ControlSetDesc cs = readControlSet(file);
+  std::set<std::string> allowed;
+  if (!listsAll(actuator_list)) allowed.insert(actuator_list.begin(), actuator_list.end());
+  ResolvedController out;
+  out.name = "ControlSetController " + file;
+  std::set<std::string> used;
+  for (int k = 0; k < static_cast<int>(names.size()); ++k) {
+    if (!allowed.empty() && !allowed.count(names[k])) continue;
+    const ControlLinearDesc* c = cs.findForActuator(names[k]);
+    if (!c) {
+      warnings.push_back(file + ": no control for actuator '" + names[k] + "' (its control stays 0)");
+      continue;
+    }
+    used.insert(c->name);
+    out.entries.push_back({k, makeControlFunction(*c)});
+  }
+  for (const ControlLinearDesc& c : cs.controls)
+    if (!used.count(c.name) && c.is_model_control)
+      warnings.push_back(file + ": control '" + c.name + "' names no actuator of the model; ignored");
+  return out;
+}
+
+std::vector<ResolvedController> resolveSetupControllers(const std::vector<ControllerSetupDesc>& controllers,
+                                                        const std::string& setup_file,
+                                                        const std::vector<std::string>& names,
+                                                        std::vector<std::string>& warnings) {
+  std::vector<ResolvedController> out;
+  for (const ControllerSetupDesc& c : controllers) {
+    if (c.disabled) continue;
+    if (c.type == "ControlSetController") {
+      if (c.controls_file.empty())
+        throw ConvertError(setup_file, c.line, "ControlSetController '" + c.name + "' has no controls_file");
+      out.push_back(resolveControlsFile(c.controls_file, names, warnings, c.actuator_list));
+      continue;
+    }
+    // PrescribedController: a function named after an actuator drives it; otherwise the k-th
+    // function drives the k-th actuator of actuator_list (OpenSim's order)
+    ResolvedController r;
+    r.name = "PrescribedController " + c.name;
+    for (size_t k = 0; k < c.functions.size(); ++k) {
+      const auto& [fname, fdesc] = c.functions[k];
+      std::string actuator;
+      if (std::find(names.begin(), names.end(), fname) != names.end()) actuator = fname;
+      else if (k < c.actuator_list.size() && !listsAll(c.actuator_list)) actuator = c.actuator_list[k];
+      else
+        throw ConvertError(setup_file, fdesc.line ? fdesc.line : c.line,
+                           "PrescribedController '" + c.name + "': function " + std::to_string(k + 1) +
+                               " names no actuator (name it after one, or list the actuators in actuator_list)");
+      const auto it = std::find(names.begin(), names.end(), actuator);
+      if (it == names.end()) {
+        warnings.push_back(setup_file + ": PrescribedController '" + c.name + "': actuator '" + actuator +
+                           "' is not an actuator the model simulates; ignored");
+        continue;
+      }
+      r.entries.push_back({static_cast<int>(it - names.begin()),
+                           makeCoreFunction(fdesc, 1, setup_file, "PrescribedController '" + c.name + "'")});
+    }
+    if (!r.entries.empty()) out.push_back(std::move(r));
+    if (!c.controls_file.empty()) out.push_back(resolveControlsFile(c.controls_file, names, warnings, c.actuator_list));
+  }
+  return out;
+}
 
 }  // namespace redmax::osim

@@ -2,11 +2,12 @@
 // OpenSim controls (docs/forward.md §3): ControlSet XML files (ControlLinear, ControlConstant),
 // controls .sto files, and their evaluation as OpenSim's ControlLinear::getControlValue does:
 //   no nodes                          the control's default (ControlConstant: its value; else 0)
-//   t before the first node           extrapolate: the line through the first two nodes (one node:
-//                                     its value); otherwise the first node's value
+//   t before the first node           extrapolate (and not use_steps): the line through the first
+//                                     two nodes (one node: its value); otherwise the first node's value
 //   t at or after the last node       the same with the last two nodes / the last value
-//   between nodes i, i+1              use_steps: node i+1's value (a node holds the value of the
-//                                     interval that ends at it); otherwise linear interpolation
+//   from node i to node i+1           use_steps: node i+1's value on (t_i, t_i+1], node i's at t_i
+//                                     itself (a node holds the value of the interval that ends at
+//                                     it); otherwise linear interpolation
 // min/max (default_min/max, min_nodes/max_nodes) are read and evaluated alike; OpenSim's
 // ControlSetController does not clamp with them (the muscle clamps its excitation), nor do we.
 // Names: `<actuator>.excitation` and bare actuator names both name the actuator.
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "converter/error.hpp"
+#include "converter/model_description.hpp"
 #include "core/joints/functions.hpp"
 
 namespace redmax::osim {
@@ -58,5 +60,47 @@ ControlSetDesc readControlSet(const std::string& path);
 
 /// the control as a core function of time (one argument)
 AxisFunctionPtr makeControlFunction(const ControlLinearDesc& c);
+
+/// One controller of a tool setup's ControllerSet (ForwardTool, AnalyzeTool).
+struct ControllerSetupDesc {
+  std::string type;                 ///< ControlSetController or PrescribedController
+  std::string name;
+  int line = 0;
+  std::vector<std::string> actuator_list;  ///< empty or ALL: every actuator with a control
+  bool disabled = false;            ///< isDisabled / enabled = false
+  std::string controls_file;        ///< ControlSetController (resolved); PrescribedController's optional file
+  /// PrescribedController: its FunctionSet, each with the name it was given ("" when unnamed)
+  std::vector<std::pair<std::string, FunctionDesc>> functions;
+};
+
+/// A controller resolved against a list of actuator names: control k of the list is driven by
+/// `function` (one argument: time). As OpenSim's ControllerSet, controllers add up.
+struct ResolvedController {
+  struct Entry {
+    int actuator = -1;        ///< index into the names the controller was resolved against
+    AxisFunctionPtr function;
+  };
+  std::string name;           ///< "ControlSetController FILE", "PrescribedController NAME"
+  std::vector<Entry> entries;
+};
+
+/// A controls file (ControlSetController) for the actuators `names` it names (bare actuator name
+/// or <actuator>.excitation), only those of actuator_list unless it is empty or ALL; actuators
+/// without a control and controls that name no actuator go to warnings. Throws ConvertError for
+/// unreadable or malformed files.
+ResolvedController resolveControlsFile(const std::string& file, const std::vector<std::string>& names,
+                                       std::vector<std::string>& warnings,
+                                       const std::vector<std::string>& actuator_list = {});
+
+/// A setup's controllers (disabled ones skipped) against `names`: a ControlSetController's
+/// controls file; a PrescribedController's functions (a function named after an actuator drives
+/// it, otherwise the k-th function the k-th actuator of actuator_list) and its optional controls
+/// file. Throws ConvertError naming setup_file and the controller's line for a controller that
+/// cannot be built (no controls file, an unnamed function beyond actuator_list, a function that
+/// cannot be evaluated); an actuator that is not among `names` is a warning.
+std::vector<ResolvedController> resolveSetupControllers(const std::vector<ControllerSetupDesc>& controllers,
+                                                        const std::string& setup_file,
+                                                        const std::vector<std::string>& names,
+                                                        std::vector<std::string>& warnings);
 
 }  // namespace redmax::osim

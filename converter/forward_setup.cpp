@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "converter/detail/controller_set.hpp"
 #include "converter/detail/osim_functions.hpp"
 #include "converter/detail/xml_util.hpp"
 #include "converter/id_setup.hpp"
@@ -48,6 +49,19 @@ ControllerSetupDesc readController(const XmlDocument& doc, const XMLElement* e, 
 }
 
 }  // namespace
+
+std::vector<ControllerSetupDesc> detail::readControllerSet(const XmlDocument& doc, const XMLElement* tool,
+                                                           const std::string& dir) {
+  std::vector<ControllerSetupDesc> out;
+  if (const XMLElement* cs = firstChild(tool, "ControllerSet")) {
+    const XMLElement* objects = firstChild(cs, "objects");
+    for (const XMLElement* c : childElements(objects ? objects : cs)) {
+      if (std::string(c->Name()) == "groups") continue;
+      out.push_back(readController(doc, c, dir));
+    }
+  }
+  return out;
+}
 
 ForwardSetup readForwardSetup(const std::string& path) {
   XmlDocument doc(path);
@@ -95,13 +109,7 @@ ForwardSetup readForwardSetup(const std::string& path) {
   s.maximum_integrator_step_size = positive("maximum_integrator_step_size", 1.0);
   s.minimum_integrator_step_size = positive("minimum_integrator_step_size", 1e-8);
   s.integrator_error_tolerance = positive("integrator_error_tolerance", 1e-5);
-  if (const XMLElement* cs = firstChild(el, "ControllerSet")) {
-    const XMLElement* objects = firstChild(cs, "objects");
-    for (const XMLElement* c : childElements(objects ? objects : cs)) {
-      if (std::string(c->Name()) == "groups") continue;
-      s.controllers.push_back(readController(doc, c, s.directory));
-    }
-  }
+  s.controllers = readControllerSet(doc, el, s.directory);
   s.controls_file = file("controls_file");
   s.external_loads_file = file("external_loads_file");
   s.states_file = file("states_file");

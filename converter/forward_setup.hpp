@@ -4,22 +4,11 @@
 #include <string>
 #include <vector>
 
+#include "converter/controls.hpp"
 #include "converter/error.hpp"
 #include "converter/model_description.hpp"
 
 namespace redmax::osim {
-
-/// One controller of the setup's ControllerSet.
-struct ControllerSetupDesc {
-  std::string type;                 ///< ControlSetController or PrescribedController
-  std::string name;
-  int line = 0;
-  std::vector<std::string> actuator_list;  ///< empty or ALL: every actuator with a control
-  bool disabled = false;            ///< isDisabled / enabled = false
-  std::string controls_file;        ///< ControlSetController (resolved); PrescribedController's optional file
-  /// PrescribedController: its FunctionSet, each with the name it was given ("" when unnamed)
-  std::vector<std::pair<std::string, FunctionDesc>> functions;
-};
 
 struct ForwardSetup {
   std::string name;                 ///< the tool's name: DIR/<name>_states.sto

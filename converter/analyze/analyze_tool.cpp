@@ -18,6 +18,7 @@
 #include "converter/build/build_core_model.hpp"
 #include "converter/build/force_terms.hpp"
 #include "converter/osim_reader.hpp"
+#include "converter/detail/controller_set.hpp"
 #include "converter/detail/xml_util.hpp"
 #include "converter/id/core_id_engine.hpp"
 #include "converter/id/inverse_dynamics_tool.hpp"
@@ -49,6 +50,15 @@ const std::set<std::string>& openSimAnalysisClasses() {
 
 bool isCoordinateActuator(const std::string& cls) {
   return cls == "CoordinateActuator" || cls == "ActivationCoordinateActuator";
+}
+
+// the actuator named `name` of a PointActuatorTerm / TorqueActuatorTerm (null: none)
+template <class Term>
+const typename Term::Actuator* findByName(const std::shared_ptr<const Term>& term, const std::string& name) {
+  if (!term) return nullptr;
+  for (const auto& a : term->actuators())
+    if (a.name == name) return &a;
+  return nullptr;
 }
 
 }  // namespace
@@ -86,6 +96,9 @@ AnalyzeSetup readAnalyzeSetup(const std::string& path) {
     s.output_precision = parseInt(doc, p);
   if (s.output_precision < 1 || s.output_precision > 30)
     doc.fail(firstChild(el, "output_precision"), "output_precision must be in [1, 30]");
+
+  s.controllers = readControllerSet(doc, el, s.directory);
+  s.controls_file = file("controls_file");
 
   const XMLElement* set = firstChild(el, "AnalysisSet");
   for (const XMLElement* a : childElements(set ? firstChild(set, "objects") : nullptr)) {
@@ -199,6 +212,21 @@ struct AnalyzeTool::Impl {
   std::vector<int> coordinate_index;            ///< per description coordinate: its core index (-1: none)
   MuscleAnalysisColumns ma_columns;             ///< MuscleAnalysis's muscles and coordinates
   std::vector<ActuationColumn> act_columns;     ///< Actuation's actuators
+  // controls (AbstractTool's ControllerSet): per actuator of the force set, by name
+  std::vector<std::string> control_names;
+  std::vector<ResolvedController> controllers;
+  std::vector<int> muscle_control;              ///< per geometry muscle: its control, or -1
+  std::unique_ptr<BuildResult> constrained;     ///< the model's constraints for MuscleAnalysis's moment arms
+
+  // the controls at time t (ControllerSet: every controller adds from zero)
+  VecX controlsAt(double t) const {
+    VecX u = VecX::Zero(static_cast<Eigen::Index>(control_names.size()));
+    VecJ x(1);
+    x[0] = t;
+    for (const ResolvedController& c : controllers)
+      for (const auto& e : c.entries) u[e.actuator] += e.function->value(x);
+    return u;
+  }
 };
 
 AnalyzeTool::~AnalyzeTool() = default;
@@ -318,6 +346,9 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   for (size_t m = 0; m < I.mk.size(); ++m) initMuscleKinematics(skel, I.geometry.muscles()[m], I.mk[m]);
   I.force_term = std::make_unique<MuscleForceTerm>(skel, I.geometry.muscles(), I.geometry.muscleModels());
   if (runsMuscleAnalyses()) prepareMuscleAnalyses();
+  if (so.present && (!setup_.controllers.empty() || !setup_.controls_file.empty()))
+    warnings_.push_back(so.name + ": the setup's controllers are not used: static optimization overrides the "
+                                  "actuators' controls (as OpenSim's StaticOptimizationTarget does)");
   if (!so.present) return;
 
   // the force set in OpenSim's order (the model's in file order, then force_set_files), those
@@ -634,6 +665,32 @@ void AnalyzeTool::prepareMuscleAnalyses() {
   // replace_force_set takes the model's forces away, muscles included (AbstractTool::updateModelForces)
   const bool model_forces = !setup_.replace_force_set;
 
+  // the controls: one per actuator of the force set, by name (the model's, then force_set_files)
+  std::map<std::string, int> control_of;
+  auto addControl = [&](const std::string& name) {
+    if (control_of.count(name)) return control_of[name];
+    I.control_names.push_back(name);
+    return control_of[name] = static_cast<int>(I.control_names.size()) - 1;
+  };
+  I.muscle_control.assign(I.geometry.muscles().size(), -1);
+  ModelDescription files = d;
+  files.forces.clear();
+  for (const std::string& file : setup_.force_set_files) appendForceSetFile(files, file);
+  if (model_forces) {
+    for (size_t k = 0; k < d.muscles.size(); ++k) {
+      const PathForceDesc& pf = d.muscles[k];
+      if (pf.applies_force && (pf.is_muscle || pf.class_name.find("Actuator") != std::string::npos) && geometry_of[k] >= 0)
+        I.muscle_control[static_cast<size_t>(geometry_of[k])] = addControl(pf.name);
+    }
+    for (const ForceDesc& f : d.forces)
+      if (f.applies_force && f.class_name.find("Actuator") != std::string::npos) addControl(f.name);
+  }
+  for (const ForceDesc& f : files.forces)
+    if (f.applies_force && f.class_name.find("Actuator") != std::string::npos) addControl(f.name);
+  I.controllers = resolveSetupControllers(setup_.controllers, setup_.source_file, I.control_names, warnings_);
+  if (!setup_.controls_file.empty())
+    I.controllers.push_back(resolveControlsFile(setup_.controls_file, I.control_names, warnings_));
+
   if (const MuscleAnalysisSettings& ma = setup_.muscle_analysis; ma.present) {
     MuscleAnalysisColumns& c = I.ma_columns;
     std::vector<int> muscles;  // the force set's Muscles, file order
@@ -655,7 +712,9 @@ void AnalyzeTool::prepareMuscleAnalyses() {
     }
     for (int m : c.muscle_index) {
       c.muscles.push_back(I.geometry.muscles()[static_cast<size_t>(m)].name);
-      if (!I.geometry.muscleModels()[static_cast<size_t>(m)]) no_model.push_back(c.muscles.back());
+      const auto& model = I.geometry.muscleModels()[static_cast<size_t>(m)];
+      c.classes.push_back(model ? model->className() : std::string());
+      if (!model) no_model.push_back(c.muscles.back());
     }
     if (!absent.empty())
       warnings_.push_back(ma.name + ": muscle_list names no muscle of the force set: " + joinNames(absent) +
@@ -686,9 +745,27 @@ void AnalyzeTool::prepareMuscleAnalyses() {
           warnings_.push_back(ma.name + ": moment_arm_coordinate_list: coordinate(s) " + joinNames(unknown) +
                               " not part of the model (dropped, as OpenSim drops them)");
       }
-      if (!d.constraints.empty())
-        warnings_.push_back(ma.name + ": moment arms are -dl/dq per coordinate; the model's constraints "
-                                      "(OpenSim's MomentArmSolver accounts for them) are not");
+      if (!d.constraints.empty()) {
+        // OpenSim's MomentArmSolver moves the coordinates the constraints couple (coupler,
+        // weld, point constraints; locked and prescribed coordinates are not constraints here)
+        BuildOptions cb;
+        cb.simbody_compat = true;
+        cb.couplers = CouplerHandling::Constraint;
+        cb.locked_coordinates = false;
+        cb.prescribed_coordinates = false;
+        cb.muscles = false;
+        I.constrained = std::make_unique<BuildResult>(buildCoreModel(d, cb));
+        const Model& cs = I.constrained->model.skeleton();
+        bool same = cs.nr() == I.id->model().nr();
+        for (int k = 0; same && k < cs.nr(); ++k)
+          same = cs.coordinates()[k].name == I.id->model().coordinates()[k].name;
+        if (!same || I.constrained->model.constraints().empty()) {
+          if (!same)
+            warnings_.push_back(ma.name + ": moment arms are -dl/dq per coordinate: the constrained model's "
+                                          "coordinates differ from the tool's");
+          I.constrained.reset();
+        }
+      }
     }
   }
 
@@ -700,12 +777,25 @@ void AnalyzeTool::prepareMuscleAnalyses() {
       if (!f.applies_force || f.class_name.find("Actuator") == std::string::npos) return std::nullopt;
       ActuationColumn a;
       a.name = f.name;
+      a.control = control_of.count(f.name) ? control_of[f.name] : -1;
+      a.optimal_force = f.optimal_force;
       if (isCoordinateActuator(f.class_name)) {
         const int ci = d.findCoordinate(f.coordinate);
         a.coordinate = ci >= 0 ? I.coordinate_index[static_cast<size_t>(ci)] : -1;
         if (a.coordinate < 0 && !f.source_file.empty())
           throw ConvertError(f.source_file, f.line, f.class_name + " '" + f.name +
                                                         "': the model has no coordinate '" + f.coordinate + "'");
+      } else if (const auto* pa = findByName(I.forces.point_actuators, f.name);
+                 pa && f.class_name == "PointActuator") {
+        a.rigid = ActuationColumn::Rigid::Point;
+        a.body_a = pa->body;
+        a.vector = pa->point;  // as written: OpenSim's calcSpeed reads it as a body station
+      } else if (const auto* ta = findByName(I.forces.torque_actuators, f.name);
+                 ta && f.class_name == "TorqueActuator") {
+        a.rigid = ActuationColumn::Rigid::Torque;
+        a.body_a = ta->body_a;
+        a.body_b = ta->body_b;
+        a.vector = ta->axis;
       } else {
         unmodelled.push_back(f.name + " (" + f.class_name + ")");
       }
@@ -719,6 +809,8 @@ void AnalyzeTool::prepareMuscleAnalyses() {
         a.name = pf.name;
         a.path = geometry_of[k];
         a.muscle = pf.is_muscle;
+        a.control = control_of.count(pf.name) ? control_of[pf.name] : -1;
+        a.optimal_force = pf.optimal_force;
         model_acts.emplace_back(pf.line, a);
       }
       for (const ForceDesc& f : d.forces)
@@ -728,14 +820,11 @@ void AnalyzeTool::prepareMuscleAnalyses() {
     }
     for (auto& [line, a] : model_acts) I.act_columns.push_back(a);
     // force_set_files, read by the same reader the force set of static optimization uses
-    ModelDescription files = d;
-    files.forces.clear();
-    for (const std::string& file : setup_.force_set_files) appendForceSetFile(files, file);
     for (const ForceDesc& f : files.forces)
       if (auto a = actuationColumn(f)) I.act_columns.push_back(*a);
     if (!unmodelled.empty())
-      warnings_.push_back(setup_.actuation.name + ": force 0 (no controller) but speed and power nan for " +
-                          joinNames(unmodelled) + ": redmax does not model these actuators");
+      warnings_.push_back(setup_.actuation.name + ": speed and power nan for " + joinNames(unmodelled) +
+                          ": redmax does not model these actuators' speeds");
     if (I.act_columns.empty())
       warnings_.push_back(setup_.actuation.name + ": the force set has no actuators (OpenSim cancels the analysis)");
   }
@@ -753,6 +842,7 @@ MuscleAnalysisRun AnalyzeTool::runMuscleAnalyses() const {
   const int ma_step = setup_.muscle_analysis.step_interval, act_step = setup_.actuation.step_interval;
   VecX q, v, vdot;
   std::vector<IdLoadSample> loads;
+  SkeletonWorkspace sk(I.id->model());
   for (int i = w.first_row; i <= w.last_row; ++i) {
     // Analysis::proceed: begin (first row), end (last row) and every step_interval-th step
     const bool ends = i == w.first_row || i == w.last_row;
@@ -768,7 +858,25 @@ MuscleAnalysisRun AnalyzeTool::runMuscleAnalyses() const {
     }
     in.q = q;
     in.u = v;
+    in.controls = I.controlsAt(in.time);
+    if (!I.controllers.empty()) {
+      // the muscles' excitations from the controllers (controls start at 0, as OpenSim's)
+      in.excitation = VecX::Zero(static_cast<Eigen::Index>(I.muscle_control.size()));
+      for (size_t m = 0; m < I.muscle_control.size(); ++m)
+        if (I.muscle_control[m] >= 0) in.excitation[static_cast<Eigen::Index>(m)] = in.controls[I.muscle_control[m]];
+    }
     run.frames.push_back(eval.evaluate(in, setup_.solve_for_equilibrium_for_auxiliary_states));
+    if (ma && I.constrained)
+      run.frames.back().coupling = constraintCoupling(I.constrained->model.skeleton(), I.constrained->model.constraints(),
+                                                      q, I.ma_columns.coordinate_index);
+    if (act) {
+      State st;
+      st.t = in.time;
+      st.q = q;
+      st.qdot = v;
+      calcKinematics(I.id->model(), st, sk);
+      run.frames.back().actuator_speed = actuatorSpeeds(I.act_columns, sk);
+    }
     run.muscle_analysis.push_back(ma);
     run.actuation.push_back(act);
     for (const std::string& f : run.frames.back().failures) {

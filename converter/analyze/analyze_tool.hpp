@@ -23,6 +23,7 @@
 
 #include "converter/analyze/muscle_analysis.hpp"
 #include "converter/build/muscle_mass.hpp"
+#include "converter/controls.hpp"
 #include "converter/error.hpp"
 #include "converter/storage.hpp"
 #include "core/spatial/types.hpp"
@@ -60,6 +61,10 @@ struct AnalyzeSetup {
   double lowpass_cutoff_frequency_for_coordinates = -1.0;
   bool solve_for_equilibrium_for_auxiliary_states = false;
   int output_precision = 8;
+  /// the setup's ControllerSet (ControlSetController, PrescribedController) and the tool's own
+  /// (OpenSim 3) controls_file, resolved; the controls drive MuscleAnalysis and Actuation
+  std::vector<ControllerSetupDesc> controllers;
+  std::string controls_file;
   std::vector<AnalysisEntry> analyses;
   StaticOptimizationSettings static_optimization;
   MuscleAnalysisSettings muscle_analysis;

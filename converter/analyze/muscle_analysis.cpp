@@ -6,6 +6,8 @@
 #include <limits>
 #include <memory>
 
+#include <Eigen/QR>
+
 #include "core/dynamics/muscle_force_term.hpp"
 #include "core/muscles/path_kinematics.hpp"
 #include "core/skeleton/kinematics.hpp"
@@ -35,6 +37,41 @@ double tendonVelocity(const hill::MuscleOutput& o, double path_speed) {
   return path_speed - o.fiber_velocity * c + o.fiber_length * s * pennationAngularVelocity(o);
 }
 
+MatX constraintCoupling(const Model& skeleton, const std::vector<std::shared_ptr<const Constraint>>& constraints,
+                        const VecX& q, const std::vector<int>& coordinates) {
+  const int nr = skeleton.nr();
+  MatX C = MatX::Identity(nr, nr);
+  int rows = 0;
+  for (const auto& c : constraints) rows += c->rows();
+  if (rows == 0) return C;
+  State st;
+  st.q = q;
+  st.qdot = VecX::Zero(nr);
+  SkeletonWorkspace sk(skeleton);
+  calcKinematics(skeleton, st, sk);
+  MatX G(rows, nr);
+  VecX rhs(rows);
+  int r = 0;
+  for (const auto& c : constraints) {
+    c->calcAcceleration(skeleton, st, sk, G.middleRows(r, c->rows()), rhs.segment(r, c->rows()));
+    r += c->rows();
+  }
+  // projection onto the null space of G: e - G^+ G e (G^+ also for redundant rows)
+  const MatX Gp = Eigen::CompleteOrthogonalDecomposition<MatX>(G).pseudoInverse();
+  for (int k : coordinates) {
+    VecX u = VecX::Unit(nr, k) - Gp * G.col(k);
+    C.col(k) = u / u[k];  // OpenSim divides by the coordinate's own speed after the projection
+  }
+  return C;
+}
+
+double fiberActivePower(const hill::MuscleOutput& o) {
+  const double damping = o.passive_fiber_force - o.passive_fiber_elastic_force;
+  return -(o.active_fiber_force + damping) * o.fiber_velocity;
+}
+
+double fiberPassivePower(const hill::MuscleOutput& o) { return -o.passive_fiber_elastic_force * o.fiber_velocity; }
+
 struct MuscleFrameEvaluator::Impl {
   std::unique_ptr<MuscleForceTerm> term;  // muscles with a force model, as forward applies them
   std::vector<int> actuated;              // per muscle: its index in term, or -1
@@ -58,6 +95,7 @@ MuscleFrame MuscleFrameEvaluator::evaluate(const MuscleFrameInput& in, bool equi
   f.time = in.time;
   f.q = in.q;
   f.u = in.u;
+  f.controls = in.controls;
   f.length.resize(nm);
   f.speed.resize(nm);
   f.dl_dq = MatX::Zero(nm, nr);
@@ -104,12 +142,14 @@ MuscleFrame MuscleFrameEvaluator::evaluate(const MuscleFrameInput& in, bool equi
     if (static_cast<int>(in.z_given.size()) > m)
       for (size_t j = 0; j < z.size() && j < in.z_given[static_cast<size_t>(m)].size(); ++j)
         if (!std::isnan(in.z_given[static_cast<size_t>(m)][j])) z[j] = in.z_given[static_cast<size_t>(m)][j];
-    // the control: OpenSim's AnalyzeTool runs no controller here, so a muscle without an
-    // activation state sees control 0; with one, the excitation only moves zdot
+    // the control: the setup's controllers when it has any; without, a muscle without an
+    // activation state sees control 0 and one with it its activation (the excitation then only
+    // moves zdot, which no output reads)
     double excitation = 0.0;
     const auto& names = model.stateNames();
     for (size_t j = 0; j < names.size(); ++j)
       if (names[j] == "activation") excitation = z[j];
+    if (in.excitation.size() == nm) excitation = in.excitation[m];  // the setup's controllers
     const hill::MusculotendonInput mi{f.length[m], f.speed[m], excitation};
     if (equilibrate) {
       try {
@@ -149,6 +189,13 @@ std::string actuationDescription() {
 
 namespace {
 
+// MuscleAnalysis's moment arm of muscle m about core coordinate q (MomentArmSolver)
+double momentArm(const MuscleFrame& f, size_t m, int q) {
+  const auto row = f.dl_dq.row(static_cast<Eigen::Index>(m));
+  if (f.coupling.size() == 0) return -row[q];
+  return -row.dot(f.coupling.col(q));
+}
+
 template <class F>
 Storage table(const std::string& name, const std::vector<std::string>& labels,
               const std::vector<const MuscleFrame*>& frames, F value) {
@@ -173,17 +220,24 @@ std::vector<Storage> muscleAnalysisTables(const MuscleAnalysisSettings& settings
   const auto& L = cols.muscles;
   auto m = [&](size_t c) { return static_cast<size_t>(cols.muscle_index[c]); };
   auto o = [&](const MuscleFrame& f, size_t c) -> const hill::MuscleOutput& { return f.out[m(c)]; };
+  // OpenSim's reporting gaps (docs/analyze.md): the deprecated classes fill only part of
+  // MuscleDynamicsInfo and FiberVelocityInfo, RigidTendonMuscle no pennation angular velocity
+  auto cls = [&](size_t c) -> const std::string& { return cols.classes[c]; };
+  auto deprecated = [&](size_t c) {
+    const std::string& k = cls(c);
+    return k.size() > 11 && k.compare(k.size() - 11, 11, "_Deprecated") == 0;
+  };
+  auto rigid = [&](size_t c) { return cls(c) == "RigidTendonMuscle"; };
   if (settings.compute_moments) {
     for (size_t k = 0; k < cols.coordinates.size(); ++k) {
       const int q = cols.coordinate_index[k];
-      out.push_back(table("MomentArm_" + cols.coordinates[k], L, frames, [&](const MuscleFrame& f, size_t c) {
-        return -f.dl_dq(static_cast<Eigen::Index>(m(c)), q);
-      }));
+      out.push_back(table("MomentArm_" + cols.coordinates[k], L, frames,
+                          [&](const MuscleFrame& f, size_t c) { return momentArm(f, m(c), q); }));
     }
     for (size_t k = 0; k < cols.coordinates.size(); ++k) {
       const int q = cols.coordinate_index[k];
       out.push_back(table("Moment_" + cols.coordinates[k], L, frames, [&](const MuscleFrame& f, size_t c) {
-        return -f.dl_dq(static_cast<Eigen::Index>(m(c)), q) * o(f, c).tendon_force;
+        return momentArm(f, m(c), q) * o(f, c).tendon_force;
       }));
     }
   }
@@ -197,10 +251,12 @@ std::vector<Storage> muscleAnalysisTables(const MuscleAnalysisSettings& settings
   out.push_back(table("NormFiberVelocity", L, frames,
                       [&](const MuscleFrame& f, size_t c) { return o(f, c).normalized_fiber_velocity; }));
   out.push_back(table("PennationAngularVelocity", L, frames,
-                      [&](const MuscleFrame& f, size_t c) { return pennationAngularVelocity(o(f, c)); }));
+                      [&](const MuscleFrame& f, size_t c) {
+                        return deprecated(c) || rigid(c) ? kNaN : pennationAngularVelocity(o(f, c));
+                      }));
   out.push_back(table("TendonForce", L, frames, [&](const MuscleFrame& f, size_t c) { return o(f, c).tendon_force; }));
   out.push_back(table("FiberForce", L, frames, [&](const MuscleFrame& f, size_t c) {
-    return o(f, c).active_fiber_force + o(f, c).passive_fiber_force;
+    return deprecated(c) ? kNaN : o(f, c).active_fiber_force + o(f, c).passive_fiber_force;
   }));
   out.push_back(table("ActiveFiberForce", L, frames, [&](const MuscleFrame& f, size_t c) { return o(f, c).active_fiber_force; }));
   out.push_back(table("PassiveFiberForce", L, frames, [&](const MuscleFrame& f, size_t c) { return o(f, c).passive_fiber_force; }));
@@ -210,13 +266,41 @@ std::vector<Storage> muscleAnalysisTables(const MuscleAnalysisSettings& settings
   out.push_back(table("PassiveFiberForceAlongTendon", L, frames, [&](const MuscleFrame& f, size_t c) {
     return o(f, c).passive_fiber_force * std::cos(o(f, c).pennation_angle);
   }));
+  out.push_back(table("FiberActivePower", L, frames, [&](const MuscleFrame& f, size_t c) { return fiberActivePower(o(f, c)); }));
+  out.push_back(table("FiberPassivePower", L, frames, [&](const MuscleFrame& f, size_t c) { return fiberPassivePower(o(f, c)); }));
   out.push_back(table("TendonPower", L, frames, [&](const MuscleFrame& f, size_t c) {
+    if (deprecated(c)) return kNaN;
+    if (rigid(c)) return 0.0;
     return -o(f, c).tendon_force * tendonVelocity(o(f, c), f.speed[static_cast<Eigen::Index>(m(c))]);
   }));
   out.push_back(table("MuscleActuatorPower", L, frames, [&](const MuscleFrame& f, size_t c) {
-    return -o(f, c).tendon_force * f.speed[static_cast<Eigen::Index>(m(c))];
+    return deprecated(c) ? kNaN : -o(f, c).tendon_force * f.speed[static_cast<Eigen::Index>(m(c))];
   }));
   return out;
+}
+
+VecX actuatorSpeeds(const std::vector<ActuationColumn>& columns, const SkeletonWorkspace& sk) {
+  VecX v = VecX::Constant(static_cast<Eigen::Index>(columns.size()), kNaN);
+  // a body's angular velocity and a station's velocity in ground (twists are in body coordinates)
+  auto omega = [&](int b) -> Vec3 {
+    if (b < 0) return Vec3::Zero();
+    return sk.E_wi[static_cast<size_t>(b)].topLeftCorner<3, 3>() * sk.phi[static_cast<size_t>(b)].head<3>();
+  };
+  for (size_t c = 0; c < columns.size(); ++c) {
+    const ActuationColumn& a = columns[c];
+    if (a.rigid == ActuationColumn::Rigid::Point) {
+      if (a.body_a < 0) {
+        v[static_cast<Eigen::Index>(c)] = 0.0;
+        continue;
+      }
+      const Vec6& phi = sk.phi[static_cast<size_t>(a.body_a)];
+      const Vec3 vel_i = phi.tail<3>() + phi.head<3>().cross(a.vector);
+      v[static_cast<Eigen::Index>(c)] = vel_i.norm();  // |R v| = |v|
+    } else if (a.rigid == ActuationColumn::Rigid::Torque) {
+      v[static_cast<Eigen::Index>(c)] = (omega(a.body_a) - omega(a.body_b)).dot(a.vector);
+    }
+  }
+  return v;
 }
 
 std::vector<Storage> actuationTables(const std::vector<ActuationColumn>& columns,
@@ -225,18 +309,21 @@ std::vector<Storage> actuationTables(const std::vector<ActuationColumn>& columns
   for (const auto& c : columns) labels.push_back(c.name);
   auto force = [&](const MuscleFrame& f, size_t c) {
     const ActuationColumn& a = columns[c];
-    return a.muscle ? f.out[static_cast<size_t>(a.path)].tendon_force : 0.0;  // control 0 without a controller
+    if (a.muscle) return f.out[static_cast<size_t>(a.path)].tendon_force;
+    return a.control >= 0 && a.control < f.controls.size() ? f.controls[a.control] * a.optimal_force : 0.0;
   };
   auto speed = [&](const MuscleFrame& f, size_t c) {
     const ActuationColumn& a = columns[c];
     if (a.path >= 0) return f.speed[a.path];
     if (a.coordinate >= 0) return f.u[a.coordinate];
+    if (a.rigid != ActuationColumn::Rigid::None && static_cast<Eigen::Index>(c) < f.actuator_speed.size())
+      return f.actuator_speed[static_cast<Eigen::Index>(c)];
     return kNaN;
   };
   std::vector<Storage> out;
   out.push_back(table("ActuatorForces", labels, frames, force));
   out.push_back(table("ActuatorSpeeds", labels, frames, speed));
-  // PathActuator::getPower = -F ldot; Actuator::getPower = F qdot (0 at control 0, whatever the speed)
+  // PathActuator::getPower = -F ldot; ScalarActuator::getPower = F speed (0 at control 0, whatever the speed)
   out.push_back(table("ActuatorPowers", labels, frames, [&](const MuscleFrame& f, size_t c) {
     const double F = force(f, c);
     if (F == 0.0) return 0.0;

@@ -63,7 +63,8 @@ TEST(Controls, ControlLinearInterpolatesExtrapolatesAndSteps) {
   const ControlLinearDesc* b = cs.findForActuator("B");
   ASSERT_NE(b, nullptr);
   EXPECT_DOUBLE_EQ(b->value(0.5), 2.0);  // steps: the next node's value
-  EXPECT_DOUBLE_EQ(b->value(1.0), 3.0);
+  EXPECT_DOUBLE_EQ(b->value(1.0), 2.0);  // (t_i, t_i+1]: at a node its own value (OpenSim)
+  EXPECT_DOUBLE_EQ(b->value(1.0 + 1e-12), 3.0);
   EXPECT_DOUBLE_EQ(b->value(-5.0), 1.0);  // no extrapolation: end values
   EXPECT_DOUBLE_EQ(b->value(5.0), 3.0);
   EXPECT_EQ(cs.findForActuator("P"), nullptr);  // not a model control
@@ -75,6 +76,23 @@ TEST(Controls, ControlLinearInterpolatesExtrapolatesAndSteps) {
   x[0] = 1.5;
   makeControlFunction(*a)->evaluate(x, 0, v);
   EXPECT_DOUBLE_EQ(v.value, 0.25);
+}
+
+// use_steps never extrapolates, even with extrapolate true (ControlLinear::getControlValue)
+TEST(Controls, StepsDoNotExtrapolate) {
+  test::TempDir dir;
+  const ControlSetDesc cs = readControlSet(dir.write("s.xml", R"(<ControlSet name="s"><objects>
+<ControlLinear name="S"><extrapolate> true </extrapolate><use_steps> true </use_steps><x_nodes>
+<ControlLinearNode><t> 0 </t><value> 1 </value></ControlLinearNode>
+<ControlLinearNode><t> 1 </t><value> 2 </value></ControlLinearNode>
+</x_nodes></ControlLinear></objects></ControlSet>
+)"));
+  const ControlLinearDesc* s = cs.findForActuator("S");
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(s->value(-1.0), 1.0);
+  EXPECT_EQ(s->value(0.0), 1.0);
+  EXPECT_EQ(s->value(0.5), 2.0);
+  EXPECT_EQ(s->value(3.0), 2.0);
 }
 
 TEST(Controls, StorageColumnsBecomeLinearControls) {

@@ -28,7 +28,7 @@ namespace fs = std::filesystem;
 
 // two links on pins about z: a biarticular pennated Millard muscle over a via point and a
 // Thelen2003Muscle across the elbow, and a CoordinateActuator on the shoulder
-std::string armModel() {
+std::string armModel(const std::string& extra_forces = "") {
   auto frame = [](const std::string& name, const std::string& parent, const std::string& t) {
     return "<PhysicalOffsetFrame name=\"" + name + "\"><socket_parent>" + parent + "</socket_parent><translation>" + t +
            "</translation><orientation>0 0 0</orientation></PhysicalOffsetFrame>\n";
@@ -64,7 +64,7 @@ std::string armModel() {
       "<pennation_angle>0.2</pennation_angle><default_activation>0.2</default_activation>"
       "<default_fiber_length>0.09</default_fiber_length></Thelen2003Muscle>\n"
       "<CoordinateActuator name=\"sh_reserve\"><coordinate>shoulder_q</coordinate><optimal_force>10</optimal_force>"
-      "</CoordinateActuator>\n"
+      "</CoordinateActuator>\n" + extra_forces +
       "</objects></ForceSet>\n";
   return test::modernOsim(bodies, joints, forces);
 }
@@ -147,8 +147,8 @@ TEST(MuscleAnalysis, EquilibriumAndPathIdentitiesAndOpenSimsFiles) {
     EXPECT_NEAR(out(f, 1).activation, 0.2, 1e-15);
   }
   const auto files = tool.writeMuscleAnalyses(run);
-  // MomentArm / Moment per coordinate, 16 quantities, then Actuation's three
-  ASSERT_EQ(files.size(), 4u + 16u + 3u);
+  // MomentArm / Moment per coordinate, 18 quantities, then Actuation's three
+  ASSERT_EQ(files.size(), 4u + 18u + 3u);
   EXPECT_EQ(fs::path(files[0]).filename(), "arm_MuscleAnalysis_MomentArm_shoulder_q.sto");
   EXPECT_EQ(fs::path(files[3]).filename(), "arm_MuscleAnalysis_Moment_elbow_q.sto");
   for (const char* q : {"FiberLength", "TendonLength", "NormalizedFiberLength", "PennationAngle", "ActiveFiberForce",
@@ -191,6 +191,329 @@ TEST(MuscleAnalysis, EquilibriumAndPathIdentitiesAndOpenSimsFiles) {
   bool warned = false;
   for (const auto& w : step.warnings()) warned = warned || w.find("nothere") != std::string::npos;
   EXPECT_TRUE(warned);
+}
+
+// every frame of a run, as the tables take them
+std::vector<const MuscleFrame*> framesOf(const MuscleAnalysisRun& run) {
+  std::vector<const MuscleFrame*> f;
+  for (const MuscleFrame& x : run.frames) f.push_back(&x);
+  return f;
+}
+
+// the column of table `name` for muscle column c
+std::vector<double> column(const std::vector<Storage>& tables, const std::string& name, int c) {
+  for (const Storage& t : tables)
+    if (t.name == name) return std::vector<double>(t.data.col(c).data(), t.data.col(c).data() + t.data.rows());
+  ADD_FAILURE() << "no table " << name;
+  return {};
+}
+
+// FiberActivePower and FiberPassivePower (OpenSim's MuscleDynamicsInfo): the power balance
+// OpenSim's testMuscles checks, d/dt(tendon PE + fibre PE - fibre work - boundary work) = 0, i.e.
+// FiberActivePower + FiberPassivePower + TendonPower = MuscleActuatorPower, at every frame of a
+// moving arm (Millard with fibre damping 0.1, Thelen); the passive power against the classes'
+// closed-form elastic curves (Thelen's exponential, Millard's fibre force-length curve) and the
+// Millard damping force beta F_max v_N counted in the active power
+TEST(MuscleAnalysis, FibrePowersBalanceTheMusculotendonPower) {
+  test::TempDir dir;
+  dir.write("m.osim", armModel());
+  dir.write("q.mot", armMotion());
+  AnalyzeToolSettings s;
+  const BuildResult b = buildCoreModel(readOsimModel(dir.file("m.osim")));
+  const auto* bi = dynamic_cast<const hill::Millard2012EquilibriumMuscle*>(b.model.muscleModels()[0].get());
+  ASSERT_NE(bi, nullptr);
+  // with equilibrium the tri's fibre is beyond its optimal length (passive power) and the bi's
+  // fibre does not move; without, both fibres move at their default lengths (damping power)
+  double damping_power = 0.0, thelen_passive = 0.0;
+  for (const bool equilibrium : {true, false}) {
+    s.setup_file = dir.write("setup.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>",
+                                                   equilibrium));
+    const AnalyzeTool tool(s);
+    const MuscleAnalysisRun run = tool.runMuscleAnalyses();
+    ASSERT_EQ(run.frames.size(), 51u);
+    const std::vector<const MuscleFrame*> frames = framesOf(run);
+    const auto tables = muscleAnalysisTables(tool.setup().muscle_analysis, run.columns, frames);
+    for (int c = 0; c < 2; ++c) {
+      const auto fap = column(tables, "FiberActivePower", c), fpp = column(tables, "FiberPassivePower", c);
+      const auto tp = column(tables, "TendonPower", c), map = column(tables, "MuscleActuatorPower", c);
+      double worst = 0.0, peak = 0.0, worst_passive = 0.0, worst_active = 0.0, peak_passive = 0.0;
+      for (size_t r = 0; r < frames.size(); ++r) {
+        const hill::MuscleOutput& o = out(*frames[r], run.columns.muscle_index[static_cast<size_t>(c)]);
+        peak = std::max(peak, std::abs(map[r]));
+        worst = std::max(worst, std::abs(fap[r] + fpp[r] + tp[r] - map[r]));
+        // closed forms of the elastic passive force: Millard's fibre force-length curve; Thelen's
+        // exponential with OpenSim's defaults KshapePassive 5, FmaxMuscleStrain 0.6
+        const double lceN = o.fiber_length / (c == 0 ? 0.14 : 0.1), fmax = c == 0 ? 300.0 : 200.0;
+        const double elastic =
+            c == 0 ? fmax * bi->fiberForceLengthCurve().value(lceN)
+                   : (lceN > 1 ? fmax * (std::exp(5.0 * (lceN - 1) / 0.6) - 1) / (std::exp(5.0) - 1) : 0.0);
+        const double damping = c == 0 ? fmax * 0.1 * o.normalized_fiber_velocity : 0.0;  // Millard's beta 0.1
+        worst_passive = std::max(worst_passive, std::abs(fpp[r] + elastic * o.fiber_velocity));
+        worst_active = std::max(worst_active, std::abs(fap[r] + (o.active_fiber_force + damping) * o.fiber_velocity));
+        peak_passive = std::max(peak_passive, std::abs(fpp[r]));
+        if (c == 0) damping_power = std::max(damping_power, std::abs(damping * o.fiber_velocity));
+      }
+      if (c == 1) thelen_passive = std::max(thelen_passive, peak_passive);
+      std::printf("[ measured ] %s, equilibrium %d: peak |MuscleActuatorPower| %.3g W, peak |FiberPassivePower| %.3g W, "
+                  "max |FAP + FPP + TP - MAP| %.3g W, passive vs closed form %.3g W, active %.3g W\n",
+                  run.columns.muscles[static_cast<size_t>(c)].c_str(), equilibrium ? 1 : 0, peak, peak_passive, worst,
+                  worst_passive, worst_active);
+      EXPECT_GT(peak, 0.1);  // the muscles do work: the balance is not 0 = 0
+      // exact where the tendon force equals the fibre's along the tendon (equilibrium: measured
+      // 3.3e-16 / 1.8e-16 of the peak); otherwise to the velocity solve's force tolerance
+      // (measured: Millard 1.8e-9, Thelen 1.2e-12 of the peak)
+      EXPECT_LE(worst, (equilibrium ? 2e-15 : 1e-8) * peak);
+      EXPECT_LE(worst_passive, 1e-16 * peak);  // measured 2.8e-18 of the peak (tri), 0 (bi)
+      EXPECT_LE(worst_active, 1e-16 * peak);   // measured 0
+    }
+  }
+  std::printf("[ measured ] peak Millard damping power %.3g W, peak Thelen passive power %.3g W\n", damping_power,
+              thelen_passive);
+  EXPECT_GT(damping_power, 1e-3);   // the damping is in the active power, not the passive one
+  EXPECT_GT(thelen_passive, 1e-3);  // the elastic closed form was exercised
+
+  // as Thelen2003Muscle_Deprecated: OpenSim's ActivationFiberLengthMuscle_Deprecated leaves the
+  // powers, the fibre force and the pennation angular velocity unset (nan in OpenSim's files)
+  s.muscle_class = "Thelen2003Muscle_Deprecated";
+  const AnalyzeTool dep(s);
+  const MuscleAnalysisRun dr = dep.runMuscleAnalyses();
+  const std::vector<const MuscleFrame*> df = framesOf(dr);
+  const auto dt = muscleAnalysisTables(dep.setup().muscle_analysis, dr.columns, df);
+  for (const char* q : {"FiberActivePower", "FiberPassivePower", "TendonPower", "MuscleActuatorPower", "FiberForce",
+                        "PennationAngularVelocity"})
+    EXPECT_TRUE(std::isnan(column(dt, q, 1)[5])) << q;
+  for (const char* q : {"FiberLength", "TendonForce", "ActiveFiberForce", "PassiveFiberForce", "FiberVelocity"})
+    EXPECT_TRUE(std::isfinite(column(dt, q, 1)[5])) << q;
+}
+
+// a RigidTendonMuscle across the elbow: no activation state, its activation is its control
+const char* kRigid =
+    "<RigidTendonMuscle name=\"rt\"><GeometryPath name=\"path\"><PathPointSet><objects>\n"
+    "<PathPoint name=\"o\"><socket_parent_frame>/bodyset/upper</socket_parent_frame><location>0.02 -0.1 0</location></PathPoint>\n"
+    "<PathPoint name=\"i\"><socket_parent_frame>/bodyset/lower</socket_parent_frame><location>0.02 -0.04 0</location></PathPoint>\n"
+    "</objects></PathPointSet></GeometryPath><max_isometric_force>150</max_isometric_force>"
+    "<optimal_fiber_length>0.12</optimal_fiber_length><tendon_slack_length>0.1</tendon_slack_length>"
+    "</RigidTendonMuscle>\n";
+
+// controls of the AnalyzeTool (AbstractTool's ControllerSet, the tool's own controls_file):
+// ControlLinear interpolated (linear, and use_steps: the node that ends the interval), applied as
+// the actuators' controls: the CoordinateActuator's Actuation force is control * optimal force,
+// the RigidTendonMuscle's activation is its control; a muscle with an activation state keeps it
+TEST(MuscleAnalysis, ControlsFileDrivesActuatorsAndExcitations) {
+  test::TempDir dir;
+  dir.write("m.osim", armModel(kRigid));
+  dir.write("q.mot", armMotion());
+  dir.write("c.xml", R"(<?xml version="1.0" encoding="UTF-8"?>
+<OpenSimDocument Version="40000">
+<ControlSet name="c"><objects>
+  <ControlLinear name="sh_reserve.excitation">
+    <x_nodes>
+      <ControlLinearNode><t> 0 </t><value> 0.5 </value></ControlLinearNode>
+      <ControlLinearNode><t> 1 </t><value> 1.5 </value></ControlLinearNode>
+    </x_nodes>
+  </ControlLinear>
+  <ControlLinear name="rt.excitation">
+    <use_steps> true </use_steps>
+    <x_nodes>
+      <ControlLinearNode><t> 0 </t><value> 0.1 </value></ControlLinearNode>
+      <ControlLinearNode><t> 0.51 </t><value> 0.7 </value></ControlLinearNode>
+      <ControlLinearNode><t> 1 </t><value> 0.4 </value></ControlLinearNode>
+    </x_nodes>
+  </ControlLinear>
+  <ControlLinear name="tri.excitation">
+    <x_nodes><ControlLinearNode><t> 0 </t><value> 0.9 </value></ControlLinearNode></x_nodes>
+  </ControlLinear>
+</objects></ControlSet>
+</OpenSimDocument>
+)");
+  const std::string controller =
+      "<ControllerSet name=\"Controllers\"><objects><ControlSetController name=\"c\"><controls_file>c.xml"
+      "</controls_file></ControlSetController></objects></ControllerSet>";
+  AnalyzeToolSettings s;
+  s.setup_file = dir.write("setup.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>" + controller));
+  const AnalyzeTool tool(s);
+  const MuscleAnalysisRun run = tool.runMuscleAnalyses();
+  ASSERT_EQ(run.frames.size(), 51u);
+  ASSERT_EQ(run.actuators.size(), 4u);
+  ASSERT_EQ(run.actuators[2].name, "sh_reserve");
+  ASSERT_EQ(run.actuators[3].name, "rt");
+  const std::vector<const MuscleFrame*> frames = framesOf(run);
+  const auto act = actuationTables(run.actuators, frames);
+  const int rt = 2;  // geometry index of the RigidTendonMuscle
+  for (size_t r = 0; r < frames.size(); ++r) {
+    const MuscleFrame& f = *frames[r];
+    const double t = f.time;
+    EXPECT_NEAR(act[0].data(static_cast<Eigen::Index>(r), 2), 10.0 * (0.5 + t), 1e-12) << t;  // optimal force 10
+    EXPECT_NEAR(act[2].data(static_cast<Eigen::Index>(r), 2), 10.0 * (0.5 + t) * f.u[0], 1e-12) << t;
+    // use_steps: a node holds the value of the interval that ends at it
+    const double step = t <= 0.0 ? 0.1 : (t <= 0.51 ? 0.7 : 0.4);
+    EXPECT_EQ(out(f, rt).activation, step) << t;
+    EXPECT_EQ(out(f, 1).activation, 0.2) << t;  // tri: its activation state, not the control
+    // RigidTendonMuscle's powers (OpenSim's calcMuscleDynamicsInfo): -F v with v = ldot, tendon 0
+    EXPECT_NEAR(fiberActivePower(out(f, rt)), -out(f, rt).active_fiber_force * f.speed[rt], 1e-12);
+    EXPECT_GT(out(f, rt).active_fiber_force, 0.0);
+  }
+  EXPECT_EQ(column(muscleAnalysisTables(tool.setup().muscle_analysis, run.columns, frames), "TendonPower", 2)[7], 0.0);
+
+  // the same controls as an OpenSim 3 tool-level controls_file in .sto form: linear between rows
+  std::ostringstream sto;
+  sto << "controls\nversion=1\nnRows=3\nnColumns=3\ninDegrees=no\nendheader\ntime\tsh_reserve\trt.excitation\n"
+      << "0\t0.5\t0.1\n0.5\t1.5\t0.7\n1\t0.5\t0.4\n";
+  dir.write("c.sto", sto.str());
+  s.setup_file = dir.write("sto.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"
+                                                                    "<controls_file>c.sto</controls_file>"));
+  const AnalyzeTool st(s);
+  bool warned_tri = false;
+  for (const auto& w : st.warnings()) warned_tri = warned_tri || w.find("no control for actuator 'tri'") != std::string::npos;
+  EXPECT_TRUE(warned_tri);
+  const MuscleAnalysisRun sr = st.runMuscleAnalyses();
+  for (const MuscleFrame& f : sr.frames) {
+    const double t = f.time;
+    const double u = t <= 0.5 ? 0.5 + 2 * t : 1.5 - 2 * (t - 0.5);
+    const double a = t <= 0.5 ? 0.1 + 1.2 * t : 0.7 - 0.6 * (t - 0.5);
+    EXPECT_NEAR(f.controls[sr.actuators[2].control], u, 1e-12) << t;  // sh_reserve
+    EXPECT_NEAR(out(f, rt).activation, a, 1e-12) << t;
+  }
+
+  // malformed input: error at the file and line, nothing run
+  dir.write("bad.xml", "<?xml version=\"1.0\"?>\n<ControlSet name=\"c\"><objects>\n<ControlLinear name=\"rt\">\n"
+                       "<x_nodes><ControlLinearNode><t> 0 </t><value> x </value></ControlLinearNode></x_nodes>\n"
+                       "</ControlLinear></objects></ControlSet>\n");
+  s.setup_file = dir.write("bad_setup.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"
+                                                                          "<controls_file>bad.xml</controls_file>"));
+  try {
+    AnalyzeTool bad(s);
+    ADD_FAILURE() << "a malformed controls file was accepted";
+  } catch (const ConvertError& e) {
+    EXPECT_EQ(e.file(), dir.file("bad.xml"));
+    EXPECT_EQ(e.line(), 4) << e.what();
+  }
+  // a ControlSetController without a controls file: an error at its line of the setup
+  s.setup_file = dir.write("nofile.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>\n"
+                                                                       "<ControllerSet><objects>\n<ControlSetController "
+                                                                       "name=\"c\"/></objects></ControllerSet>"));
+  try {
+    AnalyzeTool bad(s);
+    ADD_FAILURE() << "a ControlSetController without controls_file was accepted";
+  } catch (const ConvertError& e) {
+    EXPECT_EQ(e.file(), s.setup_file);
+    EXPECT_GT(e.line(), 0);
+    EXPECT_NE(std::string(e.what()).find("has no controls_file"), std::string::npos) << e.what();
+  }
+}
+
+// Actuation speeds of a PointActuator and a TorqueActuator as OpenSim's calcSpeed gives them:
+// |v| of the station on the lower arm (closed form of the two-link chain: the station's velocity
+// is the sum of the two joints' rotations about z) and the relative angular velocity of the two
+// links about the global z axis (the elbow's speed); power = force * speed (ScalarActuator)
+TEST(MuscleAnalysis, PointAndTorqueActuatorSpeedsAsOpenSim) {
+  test::TempDir dir;
+  dir.write("m.osim", armModel(
+                          "<PointActuator name=\"px\"><body>lower</body><point>0.05 -0.2 0</point><direction>1 0 0"
+                          "</direction><optimal_force>20</optimal_force></PointActuator>\n"
+                          "<TorqueActuator name=\"tq\"><bodyA>/bodyset/lower</bodyA><bodyB>/bodyset/upper</bodyB>"
+                          "<axis>0 0 2</axis><optimal_force>5</optimal_force></TorqueActuator>\n"));
+  dir.write("q.mot", armMotion());
+  dir.write("c.sto", "controls\nversion=1\nnRows=2\nnColumns=3\ninDegrees=no\nendheader\ntime\tpx\ttq\n"
+                     "0\t1\t-1\n1\t1\t-1\n");
+  AnalyzeToolSettings s;
+  s.setup_file = dir.write("setup.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"
+                                                                      "<controls_file>c.sto</controls_file>"));
+  const AnalyzeTool tool(s);
+  for (const auto& w : tool.warnings()) EXPECT_EQ(w.find("speed and power nan"), std::string::npos) << w;
+  const MuscleAnalysisRun run = tool.runMuscleAnalyses();
+  ASSERT_EQ(run.actuators.size(), 5u);
+  ASSERT_EQ(run.actuators[3].name, "px");
+  ASSERT_EQ(run.actuators[4].name, "tq");
+  const std::vector<const MuscleFrame*> frames = framesOf(run);
+  const auto act = actuationTables(run.actuators, frames);
+  double worst_p = 0.0, worst_t = 0.0;
+  for (size_t r = 0; r < frames.size(); ++r) {
+    const MuscleFrame& f = *frames[r];
+    // planar chain about z: elbow at R(q1) (0, -0.3), the station at R(q1 + q2) (0.05, -0.2) from it
+    const double q1 = f.q[0], q2 = f.q[1], w1 = f.u[0], w2 = f.u[1];
+    auto perp = [](double a, double x, double y) {  // d/da of R(a) (x, y)
+      return Eigen::Vector2d(-std::sin(a) * x - std::cos(a) * y, std::cos(a) * x - std::sin(a) * y);
+    };
+    const Eigen::Vector2d v = w1 * perp(q1, 0.0, -0.3) + (w1 + w2) * perp(q1 + q2, 0.05, -0.2);
+    const Eigen::Index i = static_cast<Eigen::Index>(r);
+    worst_p = std::max(worst_p, std::abs(act[1].data(i, 3) - v.norm()));
+    worst_t = std::max(worst_t, std::abs(act[1].data(i, 4) - w2));  // (omega_lower - omega_upper) . z
+    EXPECT_EQ(act[0].data(i, 3), 20.0);
+    EXPECT_EQ(act[0].data(i, 4), -5.0);
+    EXPECT_NEAR(act[2].data(i, 3), 20.0 * act[1].data(i, 3), 1e-12);
+    EXPECT_NEAR(act[2].data(i, 4), -5.0 * act[1].data(i, 4), 1e-12);
+  }
+  std::printf("[ measured ] PointActuator speed vs closed form %.3g m/s, TorqueActuator %.3g rad/s\n", worst_p,
+              worst_t);
+  EXPECT_LE(worst_p, 1e-14);
+  EXPECT_LE(worst_t, 1e-14);
+}
+
+// MuscleAnalysis's moment arms with a coupler (elbow_q = 0.5 shoulder_q + 0.1), as OpenSim's
+// MomentArmSolver computes them: the coupled coordinate moves along, so the moment arm about
+// either coordinate is minus the derivative of the path length along the constraint; against
+// central differences of the length along the coupler
+TEST(MuscleAnalysis, CoupledCoordinatesMomentArmsFollowTheConstraint) {
+  test::TempDir dir;
+  std::string model = armModel();
+  const size_t at = model.find("</Model>");
+  ASSERT_NE(at, std::string::npos);
+  model.insert(at,
+               "<ConstraintSet><objects>\n<CoordinateCouplerConstraint name=\"cc\">\n"
+               "<coupled_coordinates_function><LinearFunction><coefficients>0.5 0.1</coefficients>"
+               "</LinearFunction></coupled_coordinates_function>\n"
+               "<independent_coordinate_names>shoulder_q</independent_coordinate_names>\n"
+               "<dependent_coordinate_name>elbow_q</dependent_coordinate_name>\n"
+               "</CoordinateCouplerConstraint>\n</objects></ConstraintSet>\n");
+  dir.write("m.osim", model);
+  std::ostringstream os;
+  os.precision(17);
+  os << "Coordinates\nversion=1\nnRows=21\nnColumns=3\ninDegrees=no\nendheader\ntime\tshoulder_q\telbow_q\n";
+  for (int k = 0; k <= 20; ++k) {
+    const double t = 0.05 * k;
+    os << t << "\t" << qShoulder(t) << "\t" << 0.5 * qShoulder(t) + 0.1 << "\n";
+  }
+  dir.write("q.mot", os.str());
+  AnalyzeToolSettings s;
+  s.setup_file = dir.write("setup.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"));
+  const AnalyzeTool tool(s);
+  const MuscleAnalysisRun run = tool.runMuscleAnalyses();
+  ASSERT_EQ(run.frames.size(), 21u);
+  const std::vector<const MuscleFrame*> frames = framesOf(run);
+  const auto tables = muscleAnalysisTables(tool.setup().muscle_analysis, run.columns, frames);
+
+  BuildOptions bo;
+  bo.simbody_compat = true;
+  bo.constraints = false;
+  const BuildResult b = buildCoreModel(readOsimModel(dir.file("m.osim")), bo);
+  const MuscleFrameEvaluator eval(b.model.skeleton(), b.model);
+  auto length = [&](double qs, double qe, int m) {
+    MuscleFrameInput in;
+    in.q = VecX(2);
+    in.q << qs, qe;
+    in.u = VecX::Zero(2);
+    return eval.evaluate(in, false).length[m];
+  };
+  double worst = 0.0, coupling_effect = 0.0;
+  const double h = 1e-5;
+  for (int c = 0; c < 2; ++c) {
+    const auto ms = column(tables, "MomentArm_shoulder_q", c), me = column(tables, "MomentArm_elbow_q", c);
+    for (size_t r = 0; r < frames.size(); r += 4) {
+      const MuscleFrame& f = *frames[r];
+      const double qs = f.q[0], qe = f.q[1];
+      // along the coupler: d(shoulder) = 1, d(elbow) = 0.5; per unit elbow: 2 and 1
+      const double cs = -(length(qs + h, qe + 0.5 * h, c) - length(qs - h, qe - 0.5 * h, c)) / (2 * h);
+      const double ce = -(length(qs + 2 * h, qe + h, c) - length(qs - 2 * h, qe - h, c)) / (2 * h);
+      worst = std::max({worst, std::abs(ms[r] - cs), std::abs(me[r] - ce)});
+      coupling_effect = std::max(coupling_effect, std::abs(ms[r] + f.dl_dq(c, 0)));
+    }
+  }
+  std::printf("[ measured ] coupled moment arms vs central differences along the coupler %.3g m; "
+              "coupling changes the shoulder moment arm by up to %.3g m\n",
+              worst, coupling_effect);
+  EXPECT_LE(worst, 1e-9);
+  EXPECT_GT(coupling_effect, 1e-3);  // the tri spans the elbow only: its shoulder moment arm comes from the coupler
 }
 
 // moment arms: -dl/dq of the evaluator against central differences of the path length it reports

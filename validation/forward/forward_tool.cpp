@@ -22,15 +22,6 @@ namespace redmax::validation {
 namespace {
 namespace fs = std::filesystem;
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-bool listsAll(const std::vector<std::string>& list) {
-  return list.empty() || (list.size() == 1 && lower(list[0]) == "all");
-}
-
 // the muscle model of every muscle of the model (null: none)
 std::vector<std::shared_ptr<const hill::MuscleModel>> muscleModelsOf(const MusculoskeletalModel& model) {
   std::vector<std::shared_ptr<const hill::MuscleModel>> models = model.muscleModels();
@@ -40,64 +31,24 @@ std::vector<std::shared_ptr<const hill::MuscleModel>> muscleModelsOf(const Muscu
 
 }  // namespace
 
+namespace {
+void addResolved(System& sys, const osim::ResolvedController& r) {
+  if (r.entries.empty()) return;
+  std::vector<PrescribedControls::Entry> entries;
+  for (const auto& e : r.entries) entries.push_back({e.actuator, e.function});
+  sys.addController(std::make_shared<PrescribedControls>(r.name, entries));
+}
+}  // namespace
+
 void addControlsFile(System& sys, const std::string& file, std::vector<std::string>& warnings,
                      const std::vector<std::string>& actuator_list) {
-  const osim::ControlSetDesc cs = osim::readControlSet(file);
-  const std::vector<std::string> names = sys.controlNames();
-  std::set<std::string> allowed;
-  if (!listsAll(actuator_list)) allowed.insert(actuator_list.begin(), actuator_list.end());
-  std::vector<PrescribedControls::Entry> entries;
-  std::set<std::string> used;
-  for (int k = 0; k < static_cast<int>(names.size()); ++k) {
-    if (!allowed.empty() && !allowed.count(names[k])) continue;
-    const osim::ControlLinearDesc* c = cs.findForActuator(names[k]);
-    if (!c) {
-      warnings.push_back(file + ": no control for actuator '" + names[k] + "' (its control stays 0)");
-      continue;
-    }
-    used.insert(c->name);
-    entries.push_back({k, osim::makeControlFunction(*c)});
-  }
-  for (const osim::ControlLinearDesc& c : cs.controls)
-    if (!used.count(c.name) && c.is_model_control)
-      warnings.push_back(file + ": control '" + c.name + "' names no actuator of the model; ignored");
-  if (!entries.empty()) sys.addController(std::make_shared<PrescribedControls>("ControlSetController " + file, entries));
+  addResolved(sys, osim::resolveControlsFile(file, sys.controlNames(), warnings, actuator_list));
 }
 
 void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vector<std::string>& warnings) {
-  const std::vector<std::string> names = sys.controlNames();
-  for (const osim::ControllerSetupDesc& c : setup.controllers) {
-    if (c.disabled) continue;
-    if (c.type == "ControlSetController") {
-      if (c.controls_file.empty())
-        throw osim::ConvertError(setup.source_file, c.line, "ControlSetController '" + c.name + "' has no controls_file");
-      addControlsFile(sys, c.controls_file, warnings, c.actuator_list);
-      continue;
-    }
-    // PrescribedController: a function named after an actuator drives it; otherwise the k-th
-    // function drives the k-th actuator of actuator_list (OpenSim's order)
-    std::vector<PrescribedControls::Entry> entries;
-    for (size_t k = 0; k < c.functions.size(); ++k) {
-      const auto& [fname, fdesc] = c.functions[k];
-      std::string actuator;
-      if (std::find(names.begin(), names.end(), fname) != names.end()) actuator = fname;
-      else if (k < c.actuator_list.size() && !listsAll(c.actuator_list)) actuator = c.actuator_list[k];
-      else
-        throw osim::ConvertError(setup.source_file, fdesc.line ? fdesc.line : c.line,
-                                 "PrescribedController '" + c.name + "': function " + std::to_string(k + 1) +
-                                     " names no actuator (name it after one, or list the actuators in actuator_list)");
-      const auto it = std::find(names.begin(), names.end(), actuator);
-      if (it == names.end()) {
-        warnings.push_back(setup.source_file + ": PrescribedController '" + c.name + "': actuator '" + actuator +
-                           "' is not an actuator the model simulates; ignored");
-        continue;
-      }
-      entries.push_back({static_cast<int>(it - names.begin()),
-                         osim::makeCoreFunction(fdesc, 1, setup.source_file, "PrescribedController '" + c.name + "'")});
-    }
-    if (!entries.empty()) sys.addController(std::make_shared<PrescribedControls>("PrescribedController " + c.name, entries));
-    if (!c.controls_file.empty()) addControlsFile(sys, c.controls_file, warnings, c.actuator_list);
-  }
+  for (const osim::ResolvedController& r :
+       osim::resolveSetupControllers(setup.controllers, setup.source_file, sys.controlNames(), warnings))
+    addResolved(sys, r);
 }
 
 void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces) {

@@ -185,6 +185,7 @@ void DeGrooteFregly2016Muscle::calc(const double* z, const MusculotendonInput& i
   out.tendon_force = e.tendon_force;
   out.active_fiber_force = e.active;
   out.passive_fiber_force = e.passive;
+  out.passive_fiber_elastic_force = m_.max_isometric_force * e.fpe;  // the rest is damping
   if (i_act_ >= 0) {
     // first-order activation with the time constant switched smoothly by tanh [De Groote 2016, Eq. 2]
     const double u = in.excitation, tf = 0.5 + 1.5 * a;

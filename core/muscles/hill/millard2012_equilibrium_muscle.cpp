@@ -282,10 +282,10 @@ void Millard2012EquilibriumMuscle::calc(const double* z, const MusculotendonInpu
   }
 
   // dynamics stage
-  double aFm = 0, pFm = 0, fmAT = 0;
+  double aFm = 0, pFm = 0, fmAT = 0, p1 = 0;
   if (!clamped) {
     aFm = fiso * (a * fal * fv);
-    const double p1 = fiso * fpe;
+    p1 = fiso * fpe;
     double p2 = fiso * beta_ * dlceN;
     double fm = aFm + (p1 + p2);
     // a rigid tendon cannot push: the damping takes what would make the fibre force negative
@@ -308,6 +308,7 @@ void Millard2012EquilibriumMuscle::calc(const double* z, const MusculotendonInpu
   out.tendon_force = tendon_force;
   out.active_fiber_force = aFm;
   out.passive_fiber_force = pFm;
+  out.passive_fiber_elastic_force = p1;  // p2 (damping) is in pFm only
   if (i_act_ >= 0) zdot[i_act_] = act_.derivative(z[i_act_], in.excitation);
   if (i_len_ >= 0) zdot[i_len_] = dlce;
 }

@@ -8,6 +8,7 @@
 // The states of one muscle are named as OpenSim 4 names them under the muscle
 // (/forceset/<muscle>/<stateName>), in the order stateNames() gives; a System stores them in
 // State::z (docs/muscle_dynamics.md).
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -41,6 +42,10 @@ struct MuscleOutput {
   double tendon_length = 0.0;
   double active_fiber_force = 0.0;   ///< along the fibre
   double passive_fiber_force = 0.0;  ///< along the fibre (elastic + damping)
+  /// the conservative (elastic) part of passive_fiber_force; the rest is damping, which OpenSim
+  /// counts in the fibre's active power (MuscleDynamicsInfo::fiberActivePower). nan where the
+  /// class leaves OpenSim's powers undefined (the *_Deprecated classes).
+  double passive_fiber_elastic_force = std::numeric_limits<double>::quiet_NaN();
   double normalized_fiber_length = 0.0;
   double normalized_fiber_velocity = 0.0;  ///< fiber_velocity / (max_contraction_velocity * l_opt)
 };

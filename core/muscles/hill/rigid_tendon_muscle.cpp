@@ -92,6 +92,7 @@ void RigidTendonMuscle::calc(const double*, const MusculotendonInput& in, Muscle
   out.normalized_fiber_velocity = k.vN;
   out.active_fiber_force = F_max * a * fal * fv;
   out.passive_fiber_force = F_max * fpe;
+  out.passive_fiber_elastic_force = out.passive_fiber_force;
   out.tendon_force = (out.active_fiber_force + out.passive_fiber_force) * k.cos_phi;
 }
 

@@ -146,6 +146,7 @@ void Thelen2003Muscle::calc(const double* z, const MusculotendonInput& in, Muscl
   // calcMuscleDynamicsInfo: no active force while the fibre state is clamped
   out.active_fiber_force = clamped ? 0.0 : a * fal * fv * F_max;
   out.passive_fiber_force = fpe * F_max;
+  out.passive_fiber_elastic_force = out.passive_fiber_force;  // no damping
 
   zdot[0] = act_.derivative(z[0], in.excitation);
   zdot[1] = dlce;
