@@ -1,5 +1,7 @@
 #include "validation/simulate/simulate.hpp"
 
+#include "core/dynamics/contact_force_terms.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +13,7 @@
 #include "converter/coordinates_file.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/body_loads.hpp"
+#include "core/dynamics/contact_force_terms.hpp"
 
 namespace redmax::validation {
 
@@ -416,11 +419,50 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
   SimulationResult res = makeStatesResult(m);
   DynamicsWorkspace ws(sys.model());
   StateRecorder recorder(res);
+  // the contact terms, watched at every row (docs/contact.md)
+  std::vector<const ContactForceTerm*> contact_terms;
+  for (const auto& t : sys.terms())
+    if (auto c = dynamic_cast<const ContactForceTerm*>(t.get())) contact_terms.push_back(c);
+  SkeletonWorkspace contact_sk(sys.model());
+  std::vector<ContactReport> reports;
+
+  // false (failed set) when a contact went deeper than its sphere's radius
+  auto watch_contacts = [&](const State& s_r) -> bool {
+    if (contact_terms.empty()) return true;
+    calcKinematics(sys.model(), s_r, contact_sk);
+    reports.clear();
+    for (const ContactForceTerm* c : contact_terms) c->contacts(contact_sk, reports);
+    ContactStats& cs = res.contacts;
+    cs.contacts = static_cast<int>(reports.size());
+    cs.active_final = 0;
+    for (const ContactReport& r : reports) {
+      if (!r.active) continue;
+      ++cs.active_final;
+      if (r.penetration > cs.max_penetration) {
+        cs.max_penetration = r.penetration;
+        cs.deepest = r.name;
+        cs.deepest_time = s_r.t;
+      }
+      if (r.radius > 0.0 && r.penetration > r.radius) {
+        std::ostringstream os;
+        os << "contact '" << r.name << "' penetrates " << r.penetration << " m, deeper than the sphere's radius "
+           << r.radius << " m, at t = " << s_r.t << ": the step is too large for the contact's stiffness"
+           << (adaptive ? " (lower --max-step or the tolerances)" : " (use a smaller --dt, or rk45)");
+        res.failed = true;
+        res.failure = os.str();
+        res.failure_time = s_r.t;
+        return false;
+      }
+    }
+    cs.active_max = std::max(cs.active_max, cs.active_final);
+    return true;
+  };
 
   auto record = [&](const State& s) -> bool {
     const double K = sys.kineticEnergy(s, ws), V = sys.potentialEnergy(s, ws);
     const State s_r = sys.expandState(s);
     if (!recorder.add(s.t, s_r.q, s_r.qdot, K, V, "", s.z)) return false;
+    if (!watch_contacts(s_r)) return false;
     if (options.check) {
       const std::string why = options.check(s, K, V);
       if (!why.empty()) {
