@@ -144,6 +144,8 @@ void HuntCrossleyForceTerm::evaluate(const SkeletonWorkspace& sk, std::vector<Co
     rep.name = F.name + ": " + s1.name + " - " + s2.name;
     rep.penetration = depth;
     rep.radius = rmin;
+    rep.body1 = s1.body;
+    rep.body2 = s2.body;
     if (!(depth > 0.0)) {
       if (out) out->push_back(rep);
       continue;
@@ -158,6 +160,8 @@ void HuntCrossleyForceTerm::evaluate(const SkeletonWorkspace& sk, std::vector<Co
     const double fH = (4.0 / 3.0) * k * depth * std::sqrt(R * k * depth);
     if (V) *V += 0.4 * fH * depth;
     rep.point_w = x;
+    rep.normal_w = n;
+    rep.stiffness = 1.5 * fH / depth;
     // relative velocity of the material points at x (1 relative to 2): v_n > 0 while approaching
     const Vec3 st1 = stationAt(sk, s1.body, x), st2 = stationAt(sk, s2.body, x);
     const Vec3 v = velocityAt(sk, s1.body, st1) - velocityAt(sk, s2.body, st2);
@@ -261,6 +265,11 @@ void SmoothSphereHalfSpaceForceTerm::evaluate(const SkeletonWorkspace& sk, std::
       rep.active = x > 0.0;
       rep.point_w = point;
       rep.force_w = -force;
+      // surface 1 is the half-space: the normal from it into the sphere is -n
+      rep.normal_w = -n;
+      rep.body1 = c.half_space.body;
+      rep.body2 = c.sphere.body;
+      rep.stiffness = 1.5 * fh / std::max(std::abs(x), std::sqrt(cf) + 1e-12);
       out->push_back(rep);
     }
   }

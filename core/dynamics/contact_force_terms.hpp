@@ -35,6 +35,11 @@ struct ContactReport {
   bool active = false;       ///< penetration > 0
   Vec3 point_w = Vec3::Zero();   ///< where the force acts (world)
   Vec3 force_w = Vec3::Zero();   ///< on surface 2 (world frame, N); surface 1 receives -force_w
+  Vec3 normal_w = Vec3::UnitY(); ///< from surface 1 into surface 2 (world)
+  int body1 = -1, body2 = -1;    ///< the surfaces' bodies (-1: ground)
+  /// d f_n / d penetration of the elastic part at this depth (N/m): with the effective mass along
+  /// the normal it gives the contact's frequency, which a fixed step must resolve
+  double stiffness = 0.0;
 };
 
 /// What a run reports of its contacts at one state.

@@ -1,7 +1,5 @@
 #include "validation/simulate/simulate.hpp"
 
-#include "core/dynamics/contact_force_terms.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,6 +12,7 @@
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/body_loads.hpp"
 #include "core/dynamics/contact_force_terms.hpp"
+#include "core/dynamics/skeleton_dynamics.hpp"
 
 namespace redmax::validation {
 
@@ -425,6 +424,25 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
     if (auto c = dynamic_cast<const ContactForceTerm*>(t.get())) contact_terms.push_back(c);
   SkeletonWorkspace contact_sk(sys.model());
   std::vector<ContactReport> reports;
+  MatX contact_M;
+  MatX contact_J(3, sys.model().nr());
+  // the effective mass of a contact along its normal, 1 / (w^T M^-1 w) with w = (J_2 - J_1)^T n
+  // (the skeleton's mass matrix: mass points only add mass, so the frequency is not underestimated)
+  auto effective_mass = [&](const ContactReport& r) {
+    const Model& model = sys.model();
+    VecX w = VecX::Zero(model.nr());
+    for (const auto& [body, sign] : {std::pair{r.body2, 1.0}, std::pair{r.body1, -1.0}}) {
+      if (body < 0) continue;
+      const Mat4& E = contact_sk.E_wi[body];
+      const Vec3 x_i = E.topLeftCorner<3, 3>().transpose() * (r.point_w - E.topRightCorner<3, 1>());
+      pointJacobian(model, contact_sk, body, x_i, contact_J);
+      w += sign * contact_J.transpose() * r.normal_w;
+    }
+    if (contact_M.rows() != model.nr()) contact_M.resize(model.nr(), model.nr());
+    calcSkeletonMass(model, contact_sk, contact_M);
+    const double inv = w.dot(contact_M.ldlt().solve(w));
+    return inv > 0.0 ? 1.0 / inv : 0.0;
+  };
 
   // false (failed set) when a contact went deeper than its sphere's radius
   auto watch_contacts = [&](const State& s_r) -> bool {
@@ -442,6 +460,23 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
         cs.max_penetration = r.penetration;
         cs.deepest = r.name;
         cs.deepest_time = s_r.t;
+      }
+      // a fixed step beyond the stability limit of the contact's oscillation (omega h > 2 for
+      // an explicit spring) throws the body off at growing speed: refused with the limit
+      if (!adaptive && r.stiffness > 0.0) {
+        const double m_eff = effective_mass(r);
+        const double omega = m_eff > 0.0 ? std::sqrt(r.stiffness / m_eff) : 0.0;
+        if (omega * dt > 2.0) {
+          std::ostringstream os;
+          os << "contact '" << r.name << "' at t = " << s_r.t << ": the step h = " << dt
+             << " s is too large for the contact's stiffness (" << r.stiffness << " N/m at penetration "
+             << r.penetration << " m, effective mass " << m_eff << " kg: omega = " << omega
+             << " rad/s needs h < 2 / omega = " << 2.0 / omega << " s; use a smaller --dt, or rk45)";
+          res.failed = true;
+          res.failure = os.str();
+          res.failure_time = s_r.t;
+          return false;
+        }
       }
       if (r.radius > 0.0 && r.penetration > r.radius) {
         std::ostringstream os;
