@@ -461,17 +461,18 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
         cs.deepest = r.name;
         cs.deepest_time = s_r.t;
       }
-      // a fixed step beyond the stability limit of the contact's oscillation (omega h > 2 for
-      // an explicit spring) throws the body off at growing speed: refused with the limit
+      // a fixed step too long for the contact's oscillation throws the body off: the explicit
+      // stability limit is omega h = 2, but impacts gain energy well before it (docs/contact.md
+      // §3: omega h = 1.25 quadrupled a ball's energy in 2 s), so h < 1 / omega is asked
       if (!adaptive && r.stiffness > 0.0) {
         const double m_eff = effective_mass(r);
         const double omega = m_eff > 0.0 ? std::sqrt(r.stiffness / m_eff) : 0.0;
-        if (omega * dt > 2.0) {
+        if (omega * dt > 1.0) {
           std::ostringstream os;
           os << "contact '" << r.name << "' at t = " << s_r.t << ": the step h = " << dt
              << " s is too large for the contact's stiffness (" << r.stiffness << " N/m at penetration "
              << r.penetration << " m, effective mass " << m_eff << " kg: omega = " << omega
-             << " rad/s needs h < 2 / omega = " << 2.0 / omega << " s; use a smaller --dt, or rk45)";
+             << " rad/s needs h < 1 / omega = " << 1.0 / omega << " s; use a smaller --dt, or rk45)";
           res.failed = true;
           res.failure = os.str();
           res.failure_time = s_r.t;
