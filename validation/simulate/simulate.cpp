@@ -463,7 +463,7 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
       }
       // a fixed step too long for the contact's oscillation throws the body off: the explicit
       // stability limit is omega h = 2, but impacts gain energy well before it (docs/contact.md
-      // §3: omega h = 1.25 quadrupled a ball's energy in 2 s), so h < 1 / omega is asked
+      // §3: omega h = 1.24 quadrupled a ball's energy in 2 s), so h < 1 / omega is asked
       if (!adaptive && r.stiffness > 0.0) {
         const double m_eff = effective_mass(r);
         const double omega = m_eff > 0.0 ? std::sqrt(r.stiffness / m_eff) : 0.0;
