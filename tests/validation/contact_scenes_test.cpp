@@ -31,7 +31,7 @@ TEST(ContactScenes, WalkerAtRestCarriesItsWeightOnTheFootSpheres) {
   ASSERT_FALSE(r.failed) << r.failure;
   EXPECT_EQ(r.contacts.contacts, 4);
   EXPECT_EQ(r.contacts.active_final, 4);
-  // the largest penetration, about 1 cm (the Hertz depth under a quarter of the weight)
+  // the largest penetration (measured 11.5 mm in the first settling; 9.2 mm at rest)
   EXPECT_GT(r.contacts.max_penetration, 0.005);
   EXPECT_LT(r.contacts.max_penetration, 0.03);
   // sum of the vertical forces the spheres receive at the end
@@ -53,9 +53,9 @@ TEST(ContactScenes, WalkerAtRestCarriesItsWeightOnTheFootSpheres) {
   EXPECT_NEAR(mass, 31.0, 1e-12);
   std::printf("walker: sum F_y %.9g N, weight %.9g N, relative %.2g; sum F_x %.2g N; max penetration %.4g m\n", fy,
               weight, std::abs(fy - weight) / weight, fx, r.contacts.max_penetration);
-  // at rest the ground carries the weight
-  EXPECT_NEAR(fy, weight, 1e-4 * weight) << fy;
-  EXPECT_LT(std::abs(fx), 1e-3 * weight) << fx;
+  // at rest the ground carries the weight: measured 5.6e-16 relative, sum F_x -9.9e-8 N
+  EXPECT_NEAR(fy, weight, 1e-14 * weight) << fy;
+  EXPECT_LT(std::abs(fx), 1e-6) << fx;
   EXPECT_LT(r.final_state.qdot.norm(), 1e-3);
 }
 
