@@ -31,8 +31,10 @@ int runForward(const ForwardFlags& f, const CLI::App& app) {
     std::cerr << "error: " << f.setup << ": " << e.what() << "\n";
     return 2;
   }
-  if (!f.quiet)
+  if (!f.quiet) {
     for (const std::string& w : tool->warnings()) std::cerr << "warning: " << w << "\n";
+    for (const std::string& w : tool->notApplied()) std::cerr << "warning: not applied: " << w << "\n";
+  }
   validation::ForwardResult r;
   try {
     r = tool->run();
@@ -67,7 +69,7 @@ CommandRegistration reg(
        app.footer(
            "usage: redmax forward --setup FORWARD_SETUP.xml [--out-dir DIR] [--muscle-class CLASS]\n"
            "                      [--integrator NAME] [--report-interval S] [--tolerance T]\n"
-           "                      [MUSCLE-MASS OPTIONS]\n"
+           "                      [--strict] [MUSCLE-MASS OPTIONS]\n"
            "States are written under OpenSim 4 names: /jointset/J/C/value, /jointset/J/C/speed,\n"
            "/forceset/M/activation, /forceset/M/fiber_length.\n"
            "Exit codes: 0 success, 1 the run failed (nothing written), 2 bad input or usage.");

@@ -32,7 +32,7 @@ struct SimulateFlags {
   std::string model, out, initial, muscle_mass_kg, impulse, engine = "core", controls;
   validation::SimulateOptions so;
   double initial_time = 0.0;
-  bool no_qvv = false, progress = false, quiet = false, full_precision = false;
+  bool no_qvv = false, progress = false, quiet = false, full_precision = false, strict = false;
   MuscleMassFlags mm;
   std::string simbody_method, simbody_norm = "rms";
 };
@@ -64,13 +64,16 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   // model and initial state: every problem here is the user's input (exit 2)
   validation::SimulationModel model;
   State initial;
-  std::vector<std::string> control_warnings;
+  std::vector<std::string> control_warnings, not_applied;
   try {
     model = validation::loadSimulationModel(model_path, mo);
     if (given(app, "--controls")) {
       // the muscles and actuators as forces, driven by the file (validation/forward/forward_tool.hpp)
-      validation::addActuatorTerms(model, control_warnings);
+      validation::addActuatorTerms(model, control_warnings, true, &not_applied);
       validation::addControlsFile(*model.system, f.controls, control_warnings);
+    } else {
+      // the passive forces and contacts; the Simbody engine takes none of them (docs/contact.md)
+      validation::addPassiveTerms(model, control_warnings, not_applied, engine == "core");
     }
     if (given(app, "--initial")) {
       const osim::Storage table = osim::readStorage(f.initial);
@@ -96,8 +99,14 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
     return 2;
   }
   for (const auto& w : model.build.warnings) std::cerr << "warning: " << w << "\n";
-  if (!quiet)
+  if (f.strict && !not_applied.empty()) {
+    std::cerr << "error: " << model_path << ": " << validation::strictRefusal(not_applied) << "\n";
+    return 2;
+  }
+  if (!quiet) {
     for (const auto& w : control_warnings) std::cerr << "warning: " << w << "\n";
+    for (const auto& w : not_applied) std::cerr << "warning: not applied: " << w << "\n";
+  }
   if (!quiet) {
     const Model& core = model.system->model();
     std::printf("simulate: %s, %d coordinates, %d constraint rows, %zu muscles (%.4g kg in mass points)\n",
@@ -182,6 +191,11 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
                 so.duration, (simbody_flags.method.empty() ? so.integrator : simbody_flags.method).c_str(), engine.c_str(), res.stats.steps, res.stats.rhs_evals,
                 res.stats.failed_steps, res.wall_s, cpu_s, res.energy_initial, res.energy_final, res.energy_drift_rel, res.energy_drift_abs,
                 out_path.c_str());
+    // contacts, sampled at the output rows (docs/contact.md)
+    if (res.contacts.contacts > 0)
+      std::printf("contacts: %d pairs, %d active at the end (at most %d at once), largest penetration %.4g m (%s at t = %g)\n",
+                  res.contacts.contacts, res.contacts.active_final, res.contacts.active_max, res.contacts.max_penetration,
+                  res.contacts.deepest.empty() ? "none" : res.contacts.deepest.c_str(), res.contacts.deepest_time);
   }
   // --wrap neural: how often the smooth model stood in for the network (muscle_mass_flags.hpp)
   if (monitor && !quiet) {
@@ -277,6 +291,9 @@ CommandRegistration reg(
            ->check(oneOf({"rms", "inf"}));
        app.add_flag("--progress", f->progress, "progress on stderr (otherwise shown once a run takes over 2 s)");
        app.add_flag("--quiet", f->quiet, "no summary and no progress");
+       app.add_flag("--strict", f->strict,
+                    "refuse to run (exit 2) when a force or contact geometry of the model would not\n"
+                    "be applied (each is named; without --strict each is a warning)");
        app.add_flag("--full-precision", f->full_precision,
                     "write %.16e instead of %16.8lf (restarts from the file are then exact)");
        addMuscleMassFlags(app, f->mm);
@@ -288,9 +305,12 @@ CommandRegistration reg(
            "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
            "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
            "                       [--engine core|simbody [--simbody-method M] [--simbody-norm rms|inf]]\n"
-           "                       [--progress] [--quiet] [--full-precision]\n"
+           "                       [--progress] [--quiet] [--strict] [--full-precision]\n"
            "Integrates the model under gravity from its default pose (each coordinate's default_value and\n"
-           "default_speed_value) with its constraints (locked, coupled and prescribed coordinates, welds).\n"
+           "default_speed_value) with its constraints (locked, coupled and prescribed coordinates, welds),\n"
+           "its passive forces (CoordinateLimitForce, springs, BushingForce) and contacts (HuntCrossleyForce,\n"
+           "SmoothSphereHalfSpaceForce over ContactSphere / ContactHalfSpace; docs/contact.md). Muscles and\n"
+           "actuators pull only with --controls. Every force or geometry not applied is named in a warning.\n"
            "Output: time, /jointset/<joint>/<coord>/value and .../speed for every coordinate (radians, SI),\n"
            "kinetic_energy, potential_energy, total_energy (J; gravity potential relative to the origin).\n"
            "A NaN or divergence stops the run: exit 1, the time, coordinate and step are named, and nothing\n"

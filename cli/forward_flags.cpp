@@ -25,6 +25,9 @@ void addForwardFlags(CLI::App& app, ForwardFlags& f) {
       ->type_name("T")
       ->check(positive());
   app.add_flag("--quiet", f.quiet, "no summary and no warnings");
+  app.add_flag("--strict", f.strict,
+               "refuse to run (exit 2) when a force or contact geometry of the model would not\n"
+               "be applied (each is named)");
   addMuscleMassFlags(app, f.mm);
 }
 
@@ -38,6 +41,7 @@ validation::ForwardToolSettings parseForwardFlags(const ForwardFlags& f, const C
   s.integrator = f.integrator;
   s.report_interval = f.report_interval;
   if (given(app, "--tolerance")) s.tolerance = f.tolerance;
+  s.strict = f.strict;
   return s;
 }
 

@@ -12,12 +12,12 @@ namespace redmax::cli {
 struct ForwardFlags {
   std::string setup, out_dir, muscle_class, integrator = "rk45";
   double report_interval = 0.01, tolerance = 0.0;
-  bool quiet = false;
+  bool quiet = false, strict = false;
   MuscleMassFlags mm;
 };
 
 /// Declares --setup, --out-dir, --muscle-class, --integrator, --report-interval, --tolerance,
-/// --quiet and the MUSCLE-MASS OPTIONS on `app`.
+/// --quiet, --strict and the MUSCLE-MASS OPTIONS on `app`.
 void addForwardFlags(CLI::App& app, ForwardFlags& f);
 
 /// The tool's settings from the parsed flags. Throws UsageError without --setup and for bad

@@ -77,5 +77,8 @@ int ModelDescription::findCoordinate(const std::string& n) const {
 int ModelDescription::findWrapObject(const std::string& n) const {
   return findByName(wrap_objects, n);
 }
+int ModelDescription::findContactGeometry(const std::string& n) const {
+  return findByName(contact_geometry, n);
+}
 
 }  // namespace redmax::osim

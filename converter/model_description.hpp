@@ -246,6 +246,28 @@ struct PathForceDesc {
   int line = 0;
 };
 
+/// one ContactGeometrySet member (docs/contact.md §1): ContactSphere and ContactHalfSpace are
+/// modelled; others (ContactMesh, ...) are kept with modelled = false and listed as unsupported
+struct ContactGeometryDesc {
+  std::string name;
+  std::string class_name;  ///< ContactSphere, ContactHalfSpace, ContactMesh, ...
+  std::string frame;       ///< path of the frame it is attached to
+  std::string body;        ///< base body of that frame (ground_name for ground)
+  /// pose of the geometry in its base body: frame offset * (location, body-fixed XYZ orientation)
+  Mat4 X_body = Mat4::Identity();
+  double radius = 0.0;     ///< ContactSphere
+  bool modelled = false;
+  int line = 0;
+};
+
+/// HuntCrossleyForce::ContactParameters: the material of every geometry it names
+struct ContactParametersDesc {
+  std::vector<std::string> geometry;  ///< ContactGeometrySet names
+  double stiffness = 0.0, dissipation = 0.0;
+  double static_friction = 0.0, dynamic_friction = 0.0, viscous_friction = 0.0;
+  int line = 0;
+};
+
 /// any other ForceSet member: read and listed
 struct ForceDesc {
   std::string name;
@@ -278,6 +300,13 @@ struct ForceDesc {
   /// frame1, frame2 as poses in body1, body2
   Vec6 bushing_stiffness = Vec6::Zero(), bushing_damping = Vec6::Zero();
   Mat4 X_body1 = Mat4::Identity(), X_body2 = Mat4::Identity();
+  /// HuntCrossleyForce: its contact_parameters and transition_velocity (default 0.01 m/s)
+  std::vector<ContactParametersDesc> contact_parameters;
+  double transition_velocity = 0.01;
+  /// SmoothSphereHalfSpaceForce: the sphere and half_space sockets (ContactGeometrySet names),
+  /// its material in contact_parameters[0] and OpenSim's smoothing constants
+  std::string sphere, half_space;
+  double constant_contact_force = 1e-5, hertz_smoothing = 300.0, hunt_crossley_smoothing = 50.0;
   /// the force_set_files file it came from; "" for the model's own ForceSet
   std::string source_file;
   int line = 0;
@@ -339,6 +368,7 @@ struct ModelDescription {
   std::vector<CoordinateDesc> coordinates; ///< multibody-tree (q) order, §3.1
   std::vector<ConstraintDesc> constraints; ///< file order, then tree-building loop closures
   std::vector<WrapObjectDesc> wrap_objects;
+  std::vector<ContactGeometryDesc> contact_geometry;  ///< ContactGeometrySet order
   std::vector<PathForceDesc> muscles;      ///< every force with a path (muscles first-class)
   std::vector<ForceDesc> forces;           ///< all other forces
   std::vector<ForceGroupDesc> force_groups;
@@ -352,6 +382,7 @@ struct ModelDescription {
   int findJoint(const std::string& name) const;
   int findCoordinate(const std::string& name) const;
   int findWrapObject(const std::string& name) const;
+  int findContactGeometry(const std::string& name) const;
   int numDofs() const { return static_cast<int>(coordinates.size()); }
 };
 

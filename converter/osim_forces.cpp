@@ -103,7 +103,18 @@ int quadrantAxis(const std::string& q, int& sign) {
 const std::set<std::string>& modelledForceClasses() {
   static const std::set<std::string> s = {"CoordinateActuator",   "PointActuator",          "TorqueActuator",
                                           "CoordinateLimitForce", "SpringGeneralizedForce", "PointToPointSpring",
-                                          "BushingForce"};
+                                          "BushingForce",         "HuntCrossleyForce",      "SmoothSphereHalfSpaceForce"};
+  return s;
+}
+
+// contact forces redmax does not model, and why (docs/contact.md §4)
+const std::map<std::string, std::string>& unmodelledContactForces() {
+  static const std::map<std::string, std::string> s = {
+      {"ElasticFoundationForce",
+       "triangle-mesh contact (a spring per mesh face of a ContactMesh) is not modelled: meshes are not read"},
+      {"ExponentialContactForce", "Simbody's ExponentialSpringForce is not modelled"},
+      {"MeyerFregly2016Force", "the Moco contact model is not modelled; use SmoothSphereHalfSpaceForce"},
+      {"EspositoMiller2018Force", "the Moco contact model is not modelled; use SmoothSphereHalfSpaceForce"}};
   return s;
 }
 
@@ -207,6 +218,9 @@ void OsimReader::readForceSet(const XMLElement* set, const std::string& source) 
     }
     if (modelledForceClasses().count(cls)) {
       readModelledForce(e, f);
+    } else if (auto it = unmodelledContactForces().find(cls); applies && it != unmodelledContactForces().end()) {
+      const std::string where = source.empty() ? std::string() : source + ":" + std::to_string(lineOf(e)) + ": ";
+      addUnsupported(e, where + "force '" + name + "' (" + cls + ") is listed but its force is not modelled: " + it->second);
     } else if (applies && !actuatorClasses().count(cls)) {
       // a force_set_files entry names its file and line (the list's lines are the model's)
       const std::string where = source.empty() ? std::string() : source + ":" + std::to_string(lineOf(e)) + ": ";
@@ -308,6 +322,8 @@ void OsimReader::readModelledForce(const XMLElement* e, ForceDesc& f) {
     f.point2 = childVec3(doc(), e, "point2", Vec3::Zero());
     f.stiffness = nonNegative("stiffness", 1.0);
     f.rest_length = nonNegative("rest_length", 0.0);
+  } else if (cls == "HuntCrossleyForce" || cls == "SmoothSphereHalfSpaceForce") {
+    readContactForce(e, f);
   } else if (cls == "BushingForce") {
     readBushing(e, f);
   }
@@ -467,6 +483,122 @@ void OsimReader::readMuscleParameters(const XMLElement* e, PathForceDesc& m) {
     const int line = it != m.parameter_lines.end() ? it->second : m.line;
     throw ConvertError(doc().path(), line, m.class_name + " " + err.what());
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// contact geometry and contact forces (docs/contact.md)
+
+void OsimReader::readContactGeometry() {
+  const XMLElement* set = modelChild("ContactGeometrySet");
+  if (!set) return;
+  const std::string set_path = "/" + (attribute(set, "name").empty() ? std::string("contactgeometryset") : attribute(set, "name"));
+  std::set<std::string> names;
+  for (const XMLElement* e : childElements(firstChild(set, "objects"))) {
+    ContactGeometryDesc g;
+    g.class_name = e->Name();
+    g.name = componentName(e, names);
+    g.line = lineOf(e);
+    const std::string what = g.class_name + " '" + g.name + "'";
+    // the frame: socket_frame (4.0), else the 3.x body_name
+    const XMLElement* where = nullptr;
+    const std::string socket = frameReference(e, "frame", "body_name", &where);
+    if (socket.empty()) fail(e, what + " names no frame or body");
+    const FrameNode& fr = frameForSocket(set_path + "/" + g.name, socket, where ? where : e, what + " frame");
+    g.frame = fr.path;
+    g.body = fr.base_body;
+    // ContactGeometry::getTransform: location, body-fixed x-y-z orientation, in the frame
+    g.X_body = fr.X_base * makePose(childVec3(doc(), e, "location", Vec3::Zero()),
+                                    childVec3(doc(), e, "orientation", Vec3::Zero()));
+    if (g.class_name == "ContactSphere") {
+      g.radius = childDouble(doc(), e, "radius", 0.0);
+      if (!(g.radius > 0.0) || !std::isfinite(g.radius))
+        fail(firstChild(e, "radius") ? firstChild(e, "radius") : e, what + ": radius must be positive and finite");
+      g.modelled = true;
+    } else if (g.class_name == "ContactHalfSpace") {
+      g.modelled = true;
+    } else if (g.class_name == "ContactMesh") {
+      addUnsupported(e, what + " in ContactGeometrySet: mesh contact is not modelled (meshes are not read; "
+                               "Simbody's HuntCrossleyForce ignores mesh contacts too)");
+    } else {
+      addUnsupported(e, what + " in ContactGeometrySet: this contact geometry is not modelled");
+    }
+    d_.contact_geometry.push_back(g);
+  }
+}
+
+// HuntCrossleyForce (its ContactParametersSet) and SmoothSphereHalfSpaceForce (sockets sphere,
+// half_space and one material), with OpenSim's defaults
+void OsimReader::readContactForce(const XMLElement* e, ForceDesc& f) {
+  const std::string what = f.class_name + " '" + f.name + "'";
+  auto nonNegative = [&](const XMLElement* p, const char* tag, double fallback) {
+    const double v = childDouble(doc(), p, tag, fallback);
+    if (!(v >= 0.0) || !std::isfinite(v))
+      fail(firstChild(p, tag) ? firstChild(p, tag) : p, what + ": " + tag + " must be finite and >= 0");
+    return v;
+  };
+  auto positive = [&](const XMLElement* p, const char* tag, double fallback) {
+    const double v = childDouble(doc(), p, tag, fallback);
+    if (!(v > 0.0) || !std::isfinite(v))
+      fail(firstChild(p, tag) ? firstChild(p, tag) : p, what + ": " + tag + " must be positive and finite");
+    return v;
+  };
+  auto endsWith = [](const std::string& s, const std::string& tail) {
+    return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  f.transition_velocity = positive(e, "transition_velocity", 0.01);
+  if (f.class_name == "HuntCrossleyForce") {
+    // <HuntCrossleyForce::ContactParametersSet name="contact_parameters"><objects>
+    //   <HuntCrossleyForce::ContactParameters> ...
+    for (const XMLElement* set : childElements(e)) {
+      if (!endsWith(set->Name(), "ContactParametersSet")) continue;
+      for (const XMLElement* p : childElements(firstChild(set, "objects"))) {
+        if (!endsWith(p->Name(), "ContactParameters")) fail(p, what + ": <" + std::string(p->Name()) + "> is not ContactParameters");
+        ContactParametersDesc cp;
+        cp.line = lineOf(p);
+        cp.geometry = splitWords(childText(p, "geometry"));
+        for (const std::string& g : cp.geometry)
+          if (d_.findContactGeometry(g) < 0)
+            fail(firstChild(p, "geometry"), what + ": '" + g + "' is not in the model's ContactGeometrySet");
+        // a zero stiffness makes Simbody's s1 = 0/0: refused here instead of a NaN there
+        cp.stiffness = positive(p, "stiffness", 0.0);
+        cp.dissipation = nonNegative(p, "dissipation", 0.0);
+        cp.static_friction = nonNegative(p, "static_friction", 0.0);
+        cp.dynamic_friction = nonNegative(p, "dynamic_friction", 0.0);
+        cp.viscous_friction = nonNegative(p, "viscous_friction", 0.0);
+        f.contact_parameters.push_back(cp);
+      }
+    }
+    if (f.contact_parameters.empty()) warn(e, what + " has no contact parameters: it applies no force");
+    return;
+  }
+  // SmoothSphereHalfSpaceForce
+  auto geometry = [&](const char* socket, const char* cls) {
+    const XMLElement* w = nullptr;
+    std::string v = socketValue(e, socket, &w);
+    const auto slash = v.rfind('/');
+    const std::string name = slash == std::string::npos ? v : v.substr(slash + 1);
+    const int gi = d_.findContactGeometry(name);
+    if (name.empty() || gi < 0)
+      fail(w ? w : e, what + ": socket " + socket + " '" + v + "' is not in the model's ContactGeometrySet");
+    if (d_.contact_geometry[static_cast<size_t>(gi)].class_name != cls)
+      fail(w ? w : e, what + ": socket " + socket + " '" + v + "' is a " +
+                          d_.contact_geometry[static_cast<size_t>(gi)].class_name + ", not a " + cls);
+    return name;
+  };
+  f.sphere = geometry("sphere", "ContactSphere");
+  f.half_space = geometry("half_space", "ContactHalfSpace");
+  ContactParametersDesc cp;
+  cp.line = f.line;
+  cp.geometry = {f.sphere, f.half_space};
+  cp.stiffness = nonNegative(e, "stiffness", 1.0);
+  cp.dissipation = nonNegative(e, "dissipation", 0.0);
+  cp.static_friction = nonNegative(e, "static_friction", 0.0);
+  cp.dynamic_friction = nonNegative(e, "dynamic_friction", 0.0);
+  cp.viscous_friction = nonNegative(e, "viscous_friction", 0.0);
+  f.contact_parameters = {cp};
+  f.constant_contact_force = nonNegative(e, "constant_contact_force", 1e-5);
+  f.hertz_smoothing = nonNegative(e, "hertz_smoothing", 300.0);
+  f.hunt_crossley_smoothing = nonNegative(e, "hunt_crossley_smoothing", 50.0);
 }
 
 // BushingForce (a TwoFrameLinker): frame1, frame2 are sockets, usually to offset frames the force

@@ -245,6 +245,7 @@ ModelDescription OsimReader::read() {
   buildJoints();
   readConstraints();
   readWrapObjects();
+  readContactGeometry();
   readForces();
   readMarkers();
   noteIgnoredSets();
@@ -992,7 +993,6 @@ void OsimReader::noteIgnoredSets() {
     const char* why;
   };
   const SetInfo sets[] = {
-      {"ContactGeometrySet", "contact geometry is not modelled"},
       {"ProbeSet", "probes are not evaluated"},
       {"ControllerSet", "controllers are not run (excitations are zero)"},
   };

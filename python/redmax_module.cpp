@@ -440,7 +440,9 @@ py::dict forward(std::vector<std::string> flags) {
   }
   py::dict out;
   out["name"] = tool->setup().name;
-  out["warnings"] = tool->warnings();
+  std::vector<std::string> warnings = tool->warnings();
+  for (const std::string& w : tool->notApplied()) warnings.push_back("not applied: " + w);
+  out["warnings"] = warnings;
   out["steps"] = r.stats.steps;
   out["rhs_evals"] = r.stats.rhs_evals;
   out["failed_steps"] = r.stats.failed_steps;

@@ -18,6 +18,8 @@ std::vector<std::shared_ptr<const ForceTerm>> ForceTermSet::passiveTerms() const
   if (generalized_springs) out.push_back(generalized_springs);
   if (point_springs) out.push_back(point_springs);
   if (bushings) out.push_back(bushings);
+  if (hunt_crossley) out.push_back(hunt_crossley);
+  if (smooth_contacts) out.push_back(smooth_contacts);
   return out;
 }
 
@@ -65,6 +67,27 @@ ForceTermSet buildForceTerms(const ModelDescription& d, const BuildResult& b, st
   std::vector<SpringGeneralizedForceTerm::Spring> gs;
   std::vector<PointToPointSpringTerm::Spring> ps;
   std::vector<BushingForceTerm::Bushing> bu;
+  std::vector<HuntCrossleyForceTerm::Force> hc;
+  std::vector<SmoothSphereHalfSpaceForceTerm::Contact> sc;
+  // a ContactGeometrySet member as a core surface; false (with a warning) when it cannot be one
+  auto surface = [&](const ForceDesc& f, const std::string& name, ContactSurface& out) {
+    const int gi = d.findContactGeometry(name);
+    if (gi < 0) return false;  // the reader refused unknown names
+    const ContactGeometryDesc& g = d.contact_geometry[static_cast<size_t>(gi)];
+    if (!g.modelled) {
+      warnings.push_back(where(f) + ": contact geometry '" + name + "' (" + g.class_name +
+                         ") is not modelled; its contacts are ignored");
+      return false;
+    }
+    const int bb = body(f, g.body);
+    if (bb < -1) return false;
+    out.name = g.name;
+    out.shape = g.class_name == "ContactSphere" ? ContactShape::Sphere : ContactShape::HalfSpace;
+    out.body = bb;
+    out.X_body = g.X_body;
+    out.radius = g.radius;
+    return true;
+  };
   for (size_t i = 0; i < d.forces.size(); ++i) {
     const ForceDesc& f = d.forces[i];
     if (!f.modelled || !(include ? include(f) : f.applies_force)) continue;
@@ -101,6 +124,40 @@ ForceTermSet buildForceTerms(const ModelDescription& d, const BuildResult& b, st
       const int b1 = body(f, f.body1), b2 = body(f, f.body2);
       if (b1 < -1 || b2 < -1) continue;
       bu.push_back({f.name, b1, b2, f.X_body1, f.X_body2, f.bushing_stiffness, f.bushing_damping});
+    } else if (cls == "HuntCrossleyForce") {
+      // every geometry of every ContactParameters joins one contact set with that material
+      HuntCrossleyForceTerm::Force F;
+      F.name = f.name;
+      F.transition_velocity = f.transition_velocity;
+      for (const ContactParametersDesc& cp : f.contact_parameters)
+        for (const std::string& g : cp.geometry) {
+          ContactSurface cs;
+          if (!surface(f, g, cs)) continue;
+          F.surfaces.push_back(cs);
+          F.materials.push_back({cp.stiffness, cp.dissipation, cp.static_friction, cp.dynamic_friction,
+                                 cp.viscous_friction});
+        }
+      hc.push_back(std::move(F));
+    } else if (cls == "SmoothSphereHalfSpaceForce") {
+      SmoothSphereHalfSpaceForceTerm::Contact c;
+      if (f.contact_parameters.empty() || !surface(f, f.sphere, c.sphere) || !surface(f, f.half_space, c.half_space))
+        continue;
+      if (c.sphere.body == c.half_space.body) {
+        warnings.push_back(where(f) + ": the sphere and the half-space are on one body; it applies no force");
+        continue;
+      }
+      const ContactParametersDesc& cp = f.contact_parameters.front();
+      c.name = f.name;
+      c.stiffness = cp.stiffness;
+      c.dissipation = cp.dissipation;
+      c.static_friction = cp.static_friction;
+      c.dynamic_friction = cp.dynamic_friction;
+      c.viscous_friction = cp.viscous_friction;
+      c.transition_velocity = f.transition_velocity;
+      c.constant_contact_force = f.constant_contact_force;
+      c.hertz_smoothing = f.hertz_smoothing;
+      c.hunt_crossley_smoothing = f.hunt_crossley_smoothing;
+      sc.push_back(std::move(c));
     }
   }
   if (!ca.empty()) set.coordinate_actuators = std::make_shared<CoordinateActuatorTerm>(skel, std::move(ca));
@@ -110,6 +167,8 @@ ForceTermSet buildForceTerms(const ModelDescription& d, const BuildResult& b, st
   if (!gs.empty()) set.generalized_springs = std::make_shared<SpringGeneralizedForceTerm>(skel, std::move(gs));
   if (!ps.empty()) set.point_springs = std::make_shared<PointToPointSpringTerm>(skel, std::move(ps));
   if (!bu.empty()) set.bushings = std::make_shared<BushingForceTerm>(skel, std::move(bu));
+  if (!hc.empty()) set.hunt_crossley = std::make_shared<HuntCrossleyForceTerm>(skel, std::move(hc));
+  if (!sc.empty()) set.smooth_contacts = std::make_shared<SmoothSphereHalfSpaceForceTerm>(skel, std::move(sc));
   return set;
 }
 

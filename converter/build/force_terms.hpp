@@ -5,6 +5,8 @@
 //   TorqueActuator        TorqueActuatorTerm              CoordinateLimitForce  CoordinateLimitForceTerm
 //   SpringGeneralizedForce  SpringGeneralizedForceTerm    PointToPointSpring    PointToPointSpringTerm
 //   BushingForce          BushingForceTerm
+//   HuntCrossleyForce     HuntCrossleyForceTerm           SmoothSphereHalfSpaceForce  SmoothSphereHalfSpaceForceTerm
+//   (ContactSphere and ContactHalfSpace geometry; docs/contact.md)
 // CoordinateLimitForce's properties are in degrees for a Rotational coordinate (OpenSim's
 // extendConnectToModel): limits and transition times pi/180, stiffness and damping times 180/pi.
 // The reader (converter/osim_forces.cpp) has already refused unknown bodies and coordinates,
@@ -18,6 +20,7 @@
 #include "converter/build/build_core_model.hpp"
 #include "converter/model_description.hpp"
 #include "core/dynamics/actuator_terms.hpp"
+#include "core/dynamics/contact_force_terms.hpp"
 #include "core/dynamics/coordinate_actuator_term.hpp"
 #include "core/dynamics/passive_force_terms.hpp"
 
@@ -31,6 +34,8 @@ struct ForceTermSet {
   std::shared_ptr<const SpringGeneralizedForceTerm> generalized_springs;
   std::shared_ptr<const PointToPointSpringTerm> point_springs;
   std::shared_ptr<const BushingForceTerm> bushings;
+  std::shared_ptr<const HuntCrossleyForceTerm> hunt_crossley;
+  std::shared_ptr<const SmoothSphereHalfSpaceForceTerm> smooth_contacts;
   /// index into ModelDescription::forces of each actuator of the three actuator terms, in the
   /// terms' order
   std::vector<int> coordinate_actuator_source, point_actuator_source, torque_actuator_source;

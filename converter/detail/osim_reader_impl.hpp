@@ -102,6 +102,9 @@ class OsimReader {
   void readWrapObjects();
   void readWrapObjectSet(const XMLElement* set, const FrameNode& frame);
   void readForces();
+  /// ContactGeometrySet: spheres and half-spaces modelled, the rest listed (docs/contact.md)
+  void readContactGeometry();
+  void readContactForce(const XMLElement* e, ForceDesc& f);
   /// the forces of a ForceSet element (the model's, or a force_set_files file's: source)
   void readForceSet(const XMLElement* set, const std::string& source);
   void readModelledForce(const XMLElement* e, ForceDesc& f);

@@ -173,7 +173,7 @@ TEST(JsonDescription, FieldsOfASyntheticModel) {
       "<PathPoint name=\"i\"><socket_parent_frame>/bodyset/a</socket_parent_frame>"
       "<location>0 0 0</location></PathPoint>\n</objects></PathPointSet></GeometryPath>\n"
       "<max_isometric_force>500</max_isometric_force>\n</Thelen2003Muscle>\n"
-      "<HuntCrossleyForce name=\"contact\"/>\n</objects></ForceSet>\n";
+      "<ElasticFoundationForce name=\"contact\"/>\n</objects></ForceSet>\n";
   const auto d = readOsimModel(dir.write(
       "m.osim", test::modernOsim(test::bodyXml("a", 2.0), test::pinXml("j", "/ground", "/bodyset/a"),
                                  muscle)));
@@ -203,9 +203,9 @@ TEST(JsonDescription, FieldsOfASyntheticModel) {
   EXPECT_EQ(m["max_isometric_force"].num(), 500.0);
   // the contact force is listed and reported as not modelled
   ASSERT_EQ(j["unsupported"].arr().size(), 1u);
-  EXPECT_NE(j["unsupported"].arr()[0].str().find("HuntCrossleyForce"), std::string::npos);
+  EXPECT_NE(j["unsupported"].arr()[0].str().find("ElasticFoundationForce"), std::string::npos);
   EXPECT_EQ(j["unsupported"].arr()[0].str().rfind("line ", 0), 0u);
-  EXPECT_EQ(j["forces"].arr().at(0)["class"].str(), "HuntCrossleyForce");
+  EXPECT_EQ(j["forces"].arr().at(0)["class"].str(), "ElasticFoundationForce");
   // the summary carries the same numbers
   const std::string sum = formatSummary(d);
   EXPECT_NE(sum.find("DoF          1"), std::string::npos) << sum;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <set>
 #include <sstream>
 
@@ -51,7 +52,43 @@ void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vect
     addResolved(sys, r);
 }
 
-void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces) {
+namespace {
+
+// contact geometry that no applied contact force uses, and geometry redmax does not model
+void listUnusedContactGeometry(const osim::ModelDescription& d, const std::function<bool(const osim::ForceDesc&)>& applied,
+                               std::vector<std::string>& not_applied) {
+  std::set<std::string> used;
+  for (const osim::ForceDesc& f : d.forces)
+    if (f.modelled && applied(f))
+      for (const osim::ContactParametersDesc& cp : f.contact_parameters) used.insert(cp.geometry.begin(), cp.geometry.end());
+  for (const osim::ContactGeometryDesc& g : d.contact_geometry) {
+    const std::string where = d.source_file + ":" + std::to_string(g.line) + ": " + g.class_name + " '" + g.name + "'";
+    if (!g.modelled)
+      not_applied.push_back(where + ": this contact geometry is not modelled; ignored");
+    else if (!used.count(g.name))
+      not_applied.push_back(where + ": no applied contact force uses it; it touches nothing");
+  }
+}
+
+// forces of classes redmax does not model
+void listUnmodelledForces(const osim::ModelDescription& d, const std::function<bool(const osim::ForceDesc&)>& include,
+                          std::vector<std::string>& not_applied) {
+  for (const osim::ForceDesc& f : d.forces)
+    if (include(f) && !f.modelled)
+      not_applied.push_back(f.class_name + " '" + f.name + "' is not modelled in forward simulation; ignored");
+}
+
+bool isActuator(const osim::ForceDesc& f) {
+  return f.class_name == "CoordinateActuator" || f.class_name == "PointActuator" || f.class_name == "TorqueActuator" ||
+         f.class_name == "ActivationCoordinateActuator" || f.class_name == "BodyActuator" ||
+         f.class_name == "PointToPointActuator";
+}
+
+}  // namespace
+
+void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces,
+                      std::vector<std::string>* not_applied) {
+  std::vector<std::string>& missing = not_applied ? *not_applied : warnings;
   auto sys = std::make_shared<System>(*m.system);
   const MusculoskeletalModel& model = m.build.model;
   auto models = muscleModelsOf(model);
@@ -69,23 +106,69 @@ void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bo
       continue;
     }
     const std::string cls = k < model.muscleClasses().size() ? model.muscleClasses()[k] : "";
-    warnings.push_back("muscle '" + model.muscles()[k].name + "' (" + (cls.empty() ? "unknown class" : cls) +
-                       "): no force model, it exerts no force");
+    missing.push_back("muscle '" + model.muscles()[k].name + "' (" + (cls.empty() ? "unknown class" : cls) +
+                      "): no force model, it exerts no force");
   }
   if (any) sys->addTerm(std::make_shared<MuscleForceTerm>(model.skeleton(), model.muscles(), models));
-  // the actuators and passive forces (converter/build/force_terms.hpp); other classes are named
+  // the actuators, passive forces and contacts (converter/build/force_terms.hpp); other classes are named
   auto include = [&](const osim::ForceDesc& f) { return f.applies_force && (model_forces || !f.source_file.empty()); };
   const osim::ForceTermSet terms = osim::buildForceTerms(m.description, m.build, warnings, include);
   for (const auto& t : terms.actuatorTerms()) sys->addTerm(t);
   for (const auto& t : terms.passiveTerms()) sys->addTerm(t);
-  for (const osim::ForceDesc& f : m.description.forces)
-    if (include(f) && !f.modelled)
-      warnings.push_back(f.class_name + " '" + f.name + "' is not modelled in forward simulation; ignored");
+  listUnmodelledForces(m.description, include, missing);
+  listUnusedContactGeometry(m.description, include, missing);
   // fibre-following mass points read their muscle's states (core/dynamics/muscle_term.hpp)
   for (std::string& note : bindMuscleStates(*sys)) warnings.push_back(std::move(note));
   for (const auto& t : sys->terms())
     if (auto mt = std::dynamic_pointer_cast<const MuscleTerm>(t)) m.muscle_term = mt;
   m.system = sys;
+}
+
+std::string strictRefusal(const std::vector<std::string>& not_applied) {
+  std::string msg = "--strict: " + std::to_string(not_applied.size()) +
+                    (not_applied.size() == 1 ? " force or geometry is" : " forces or geometries are") +
+                    " not applied:";
+  for (const std::string& w : not_applied) msg += "\n  " + w;
+  return msg;
+}
+
+void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std::vector<std::string>& not_applied,
+                     bool apply) {
+  const osim::ModelDescription& d = m.description;
+  // muscles and actuators need controls: named in one line each, every name given
+  auto listNames = [&](const std::vector<std::string>& names, const std::string& what) {
+    if (names.empty()) return;
+    std::string line = std::to_string(names.size()) + " " + what + ":";
+    for (size_t k = 0; k < names.size(); ++k) line += (k ? ", " : " ") + names[k];
+    not_applied.push_back(line);
+  };
+  std::vector<std::string> muscles, actuators;
+  for (const osim::PathForceDesc& p : d.muscles)
+    if (p.applies_force) muscles.push_back(p.name + " (" + p.class_name + ")");
+  for (const osim::ForceDesc& f : d.forces)
+    if (f.applies_force && isActuator(f)) actuators.push_back(f.name + " (" + f.class_name + ")");
+  listNames(muscles, apply ? "path forces exert no force without --controls (their mass, if any, stays)"
+                           : "path forces exert no force with this engine");
+  listNames(actuators, apply ? "actuators apply nothing without --controls" : "actuators apply nothing with this engine");
+  auto passive = [&](const osim::ForceDesc& f) { return f.applies_force && !isActuator(f); };
+  if (!apply) {
+    std::vector<std::string> forces;
+    for (const osim::ForceDesc& f : d.forces)
+      if (passive(f)) forces.push_back(f.name + " (" + f.class_name + ")");
+    listNames(forces, "forces are not applied with this engine");
+    for (const osim::ContactGeometryDesc& g : d.contact_geometry)
+      not_applied.push_back(d.source_file + ":" + std::to_string(g.line) + ": " + g.class_name + " '" + g.name +
+                            "' is not applied with this engine");
+    return;
+  }
+  const osim::ForceTermSet terms = osim::buildForceTerms(d, m.build, warnings, passive);
+  if (!terms.passiveTerms().empty()) {
+    auto sys = std::make_shared<System>(*m.system);
+    for (const auto& t : terms.passiveTerms()) sys->addTerm(t);
+    m.system = sys;
+  }
+  listUnmodelledForces(d, passive, not_applied);
+  listUnusedContactGeometry(d, passive, not_applied);
 }
 
 State forwardInitialState(const SimulationModel& m, const osim::Storage& table, const std::string& file, double time) {
@@ -214,7 +297,8 @@ ForwardTool::ForwardTool(ForwardToolSettings settings) : settings_(std::move(set
     model_.build.model = b.finalize();
   }
   // replace_force_set: only the forces of force_set_files act (OpenSim)
-  addActuatorTerms(model_, warnings_, !setup_.replace_force_set);
+  addActuatorTerms(model_, warnings_, !setup_.replace_force_set, &not_applied_);
+  if (settings_.strict && !not_applied_.empty()) throw std::invalid_argument(strictRefusal(not_applied_));
   if (!setup_.external_loads_file.empty()) {
     // OpenSim's ExternalLoads, the data looked up from the setup's folder first (as the ID tool)
     osim::ExternalLoads el = osim::readExternalLoads(setup_.external_loads_file, setup_.directory);

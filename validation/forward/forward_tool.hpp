@@ -44,10 +44,25 @@ void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vect
 /// The muscles' force terms, actuators and passive forces of a loaded model, added to its
 /// system: MuscleForceTerm over the muscles that have a muscle model, then the ForceSet's
 /// CoordinateActuators, PointActuators, TorqueActuators (controls in that order), then its
-/// CoordinateLimitForces, SpringGeneralizedForces and PointToPointSprings
-/// (converter/build/force_terms.hpp). model_forces false (replace_force_set): only the forces
-/// that came from force_set_files. Forces whose class is not modelled go to warnings.
-void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces = true);
+/// CoordinateLimitForces, SpringGeneralizedForces, PointToPointSprings, BushingForces and contact
+/// forces (converter/build/force_terms.hpp, docs/contact.md). model_forces false
+/// (replace_force_set): only the forces that came from force_set_files. Muscles without a force
+/// model, forces whose class is not modelled and contact geometry that nothing applied uses go to
+/// not_applied (one line each; warnings when null).
+void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces = true,
+                      std::vector<std::string>* not_applied = nullptr);
+
+/// Plain `simulate` (no controls): the ForceSet's passive forces and contacts (CoordinateLimitForce,
+/// springs, bushings, HuntCrossleyForce, SmoothSphereHalfSpaceForce) added to m's system. What is
+/// not applied goes to not_applied: the path forces and the actuators (one line each, every name
+/// given), forces whose class is not modelled, contact geometry no applied force uses. apply
+/// false (an engine that takes no ForceSet forces): nothing is added and every force and geometry
+/// is listed.
+void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std::vector<std::string>& not_applied,
+                     bool apply = true);
+
+/// The message of a --strict refusal: the count, then every item not applied on its own line.
+std::string strictRefusal(const std::vector<std::string>& not_applied);
 
 /// A state of m's system from a states table: the closest row at or before `time` (the first row
 /// when none is), every coordinate, speed and auxiliary state the table names (OpenSim 4 paths or
@@ -69,6 +84,8 @@ struct ForwardToolSettings {
   double report_interval = 0.01;
   std::vector<double> output_times;    ///< exact output times in [initial, final] (e.g. a standard's)
   std::optional<double> tolerance;     ///< replaces integrator_error_tolerance (rtol = atol)
+  /// refuse (std::invalid_argument naming each) when a force or contact geometry is not applied
+  bool strict = false;
 };
 
 struct ForwardResult {
@@ -89,6 +106,8 @@ class ForwardTool {
   const System& system() const { return *model_.system; }
   const State& initialState() const { return initial_; }
   const std::vector<std::string>& warnings() const { return warnings_; }
+  /// forces and contact geometry the run does not apply (addActuatorTerms)
+  const std::vector<std::string>& notApplied() const { return not_applied_; }
   /// the results folder and the two output files
   std::string resultsDirectory() const;
   std::string statesPath() const;
@@ -104,6 +123,7 @@ class ForwardTool {
   SimulationModel model_;
   State initial_;
   std::vector<std::string> warnings_;
+  std::vector<std::string> not_applied_;
 };
 
 /// Integrate sys from `initial` to t1, recording states (q, qdot expanded to the skeleton, z) and

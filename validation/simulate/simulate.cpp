@@ -12,6 +12,8 @@
 #include "converter/osim_reader.hpp"
 #include "validation/simulate/spec_parse.hpp"
 #include "core/dynamics/body_loads.hpp"
+#include "core/dynamics/contact_force_terms.hpp"
+#include "core/dynamics/skeleton_dynamics.hpp"
 
 namespace redmax::validation {
 
@@ -417,11 +419,87 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
   SimulationResult res = makeStatesResult(m);
   DynamicsWorkspace ws(sys.model());
   StateRecorder recorder(res);
+  // the contact terms, watched at every row (docs/contact.md)
+  std::vector<const ContactForceTerm*> contact_terms;
+  for (const auto& t : sys.terms())
+    if (auto c = dynamic_cast<const ContactForceTerm*>(t.get())) contact_terms.push_back(c);
+  SkeletonWorkspace contact_sk(sys.model());
+  std::vector<ContactReport> reports;
+  MatX contact_M;
+  MatX contact_J(3, sys.model().nr());
+  // the effective mass of a contact along its normal, 1 / (w^T M^-1 w) with w = (J_2 - J_1)^T n
+  // (the skeleton's mass matrix: mass points only add mass, so the frequency is not underestimated)
+  auto effective_mass = [&](const ContactReport& r) {
+    const Model& model = sys.model();
+    VecX w = VecX::Zero(model.nr());
+    for (const auto& [body, sign] : {std::pair{r.body2, 1.0}, std::pair{r.body1, -1.0}}) {
+      if (body < 0) continue;
+      const Mat4& E = contact_sk.E_wi[body];
+      const Vec3 x_i = E.topLeftCorner<3, 3>().transpose() * (r.point_w - E.topRightCorner<3, 1>());
+      pointJacobian(model, contact_sk, body, x_i, contact_J);
+      w += sign * contact_J.transpose() * r.normal_w;
+    }
+    if (contact_M.rows() != model.nr()) contact_M.resize(model.nr(), model.nr());
+    calcSkeletonMass(model, contact_sk, contact_M);
+    const double inv = w.dot(contact_M.ldlt().solve(w));
+    return inv > 0.0 ? 1.0 / inv : 0.0;
+  };
+
+  // false (failed set) when a contact went deeper than its sphere's radius
+  auto watch_contacts = [&](const State& s_r) -> bool {
+    if (contact_terms.empty()) return true;
+    calcKinematics(sys.model(), s_r, contact_sk);
+    reports.clear();
+    for (const ContactForceTerm* c : contact_terms) c->contacts(contact_sk, reports);
+    ContactStats& cs = res.contacts;
+    cs.contacts = static_cast<int>(reports.size());
+    cs.active_final = 0;
+    for (const ContactReport& r : reports) {
+      if (!r.active) continue;
+      ++cs.active_final;
+      if (r.penetration > cs.max_penetration) {
+        cs.max_penetration = r.penetration;
+        cs.deepest = r.name;
+        cs.deepest_time = s_r.t;
+      }
+      // a fixed step too long for the contact's oscillation throws the body off: the explicit
+      // stability limit is omega h = 2, but impacts gain energy well before it (docs/contact.md
+      // §3: omega h = 1.24 quadrupled a ball's energy in 2 s), so h < 1 / omega is asked
+      if (!adaptive && r.stiffness > 0.0) {
+        const double m_eff = effective_mass(r);
+        const double omega = m_eff > 0.0 ? std::sqrt(r.stiffness / m_eff) : 0.0;
+        if (omega * dt > 1.0) {
+          std::ostringstream os;
+          os << "contact '" << r.name << "' at t = " << s_r.t << ": the step h = " << dt
+             << " s is too large for the contact's stiffness (" << r.stiffness << " N/m at penetration "
+             << r.penetration << " m, effective mass " << m_eff << " kg: omega = " << omega
+             << " rad/s needs h < 1 / omega = " << 1.0 / omega << " s; use a smaller --dt, or rk45)";
+          res.failed = true;
+          res.failure = os.str();
+          res.failure_time = s_r.t;
+          return false;
+        }
+      }
+      if (r.radius > 0.0 && r.penetration > r.radius) {
+        std::ostringstream os;
+        os << "contact '" << r.name << "' penetrates " << r.penetration << " m, deeper than the sphere's radius "
+           << r.radius << " m, at t = " << s_r.t << ": the step is too large for the contact's stiffness"
+           << (adaptive ? " (lower --max-step or the tolerances)" : " (use a smaller --dt, or rk45)");
+        res.failed = true;
+        res.failure = os.str();
+        res.failure_time = s_r.t;
+        return false;
+      }
+    }
+    cs.active_max = std::max(cs.active_max, cs.active_final);
+    return true;
+  };
 
   auto record = [&](const State& s) -> bool {
     const double K = sys.kineticEnergy(s, ws), V = sys.potentialEnergy(s, ws);
     const State s_r = sys.expandState(s);
     if (!recorder.add(s.t, s_r.q, s_r.qdot, K, V, "", s.z)) return false;
+    if (!watch_contacts(s_r)) return false;
     if (options.check) {
       const std::string why = options.check(s, K, V);
       if (!why.empty()) {

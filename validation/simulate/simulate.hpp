@@ -135,8 +135,19 @@ struct SimulateOptions {
   WrapFallbackMonitor* wrap_fallbacks = nullptr;
 };
 
+/// The contacts of a run (docs/contact.md), sampled at the output rows.
+struct ContactStats {
+  int contacts = 0;            ///< contact pairs the system's contact terms watch (0: none)
+  int active_final = 0;        ///< touching at the last row
+  int active_max = 0;          ///< most touching at one row
+  double max_penetration = 0.0;  ///< m, over all rows and contacts
+  std::string deepest;         ///< the contact that had it
+  double deepest_time = 0.0;
+};
+
 struct SimulationResult {
   osim::Storage states;     ///< the rows reached (up to the failure if the run failed)
+  ContactStats contacts;
   State final_state;        ///< system state at the last row
   IntegratorStats stats;    ///< summed over the run's segments
   double wall_s = 0.0;
@@ -173,7 +184,9 @@ class StateRecorder {
 };
 
 /// Integrate from `initial` for options.duration. A NaN, divergence or a failed check stops the run:
-/// failed is set, failure names the time, the coordinate (by name) and the step. Impulse end times
+/// failed is set, failure names the time, the coordinate (by name) and the step. A contact whose
+/// penetration exceeds its sphere's radius at an output row stops the run too (the step was too
+/// large for the contact's stiffness; docs/contact.md §3). Impulse end times
 /// are breakpoints: adaptive methods restart there, so the switch-off is not smoothed over. Throws
 /// std::invalid_argument for bad options (unknown integrator, non-positive dt or duration).
 SimulationResult simulate(const SimulationModel& m, const State& initial, const SimulateOptions& options);
