@@ -21,7 +21,7 @@ struct GaitStudyFlags {
   std::string report, mass_sweep, gnuplot, muscle_class;
   double reserve_force = 1.0, residual_force = 1.0;
   int step_interval = 1;
-  bool no_physiological = false, no_plots = false, quiet = false;
+  bool no_physiological = false, no_plots = false, quiet = false, view = false;
 };
 
 int runGaitStudy(const GaitStudyFlags& f, const CLI::App& app) {
@@ -43,6 +43,14 @@ int runGaitStudy(const GaitStudyFlags& f, const CLI::App& app) {
   opt.step_interval = f.step_interval;
   opt.muscle_class = f.muscle_class;
   opt.progress = !f.quiet;
+  view::ViewAssets assets;  // found before the runs: a missing page file is a usage error, not a late failure
+  if (f.view) {
+    try {
+      assets = view::findViewAssets(viewAssetFolders());
+    } catch (const std::runtime_error& e) {
+      throw UsageError{std::string("--view: ") + e.what()};
+    }
+  }
 
   validation::GaitStudyResult res;
   try {
@@ -60,6 +68,14 @@ int runGaitStudy(const GaitStudyFlags& f, const CLI::App& app) {
   ro.gnuplot = f.no_plots ? "none" : f.gnuplot;
   validation::Report report(f.report, ro);
   validation::addGaitStudy(res, opt, report);
+  if (f.view) {
+    try {
+      validation::addGaitStudyView(opt, f.report, assets, report);
+    } catch (const validation::ReportError& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 1;
+    }
+  }
   validation::ReportFiles files;
   try {
     files = report.write();
@@ -100,6 +116,9 @@ CommandRegistration reg(
            ->check(oneOf(hill::muscleModelClasses()));
        app.add_option("--report", f->report, "the report folder (required)")->type_name("DIR");
        app.add_flag("--no-plots", f->no_plots, "no gnuplot plots");
+       app.add_flag("--view", f->view,
+                    "also write the trial's `redmax view` into DIR/view (the physiological run's mass\n"
+                    "points, else the largest transfer fraction's), linked from report.md (docs/view.md)");
        app.add_option("--gnuplot", f->gnuplot, "the gnuplot executable (default: found on PATH)")->type_name("PATH");
        app.add_flag("--quiet", f->quiet, "no progress, summary or warnings");
        app.footer(std::string(

@@ -12,6 +12,7 @@
 
 #include "converter/atomic_file.hpp"
 #include "converter/osim_reader.hpp"
+#include "validation/report/trial_view.hpp"
 
 namespace redmax::validation {
 namespace fs = std::filesystem;
@@ -335,6 +336,25 @@ void addGaitStudy(const GaitStudyResult& res, const GaitStudyOptions& opt, Repor
     fig.panels.push_back(p);
     report.addPlot("transfer_sweep", fig, "Change of the force-time integral against the transfer fraction.");
   }
+}
+
+void addGaitStudyView(const GaitStudyOptions& opt, const std::string& report_dir,
+                      const view::ViewAssets& assets, Report& report) {
+  TrialView tv{opt.trial.model_file, opt.trial.coordinates_file, opt.base, "no muscle mass"};
+  if (opt.physiological) {
+    tv.mass.source = osim::MuscleMassOptions::Source::Physiological;
+    tv.mass_note = "the physiological run's";
+  } else if (!opt.transfer_body.empty() && !opt.transfer_values.empty()) {
+    tv.mass.source = osim::MuscleMassOptions::Source::Transfer;
+    tv.mass.transfer_body = opt.transfer_body;
+    tv.mass.transfer_fraction = *std::max_element(opt.transfer_values.begin(), opt.transfer_values.end());
+    std::ostringstream note;
+    note << "the largest transfer fraction, " << tv.mass.transfer_fraction;
+    tv.mass_note = note.str();
+  } else {
+    tv.mass.source = osim::MuscleMassOptions::Source::None;
+  }
+  addTrialView(report, report_dir, tv, assets);
 }
 
 }  // namespace redmax::validation

@@ -18,6 +18,7 @@
 #include "converter/build/muscle_mass.hpp"
 #include "converter/id/inverse_dynamics_tool.hpp"
 #include "validation/report/report.hpp"
+#include "view/view.hpp"
 
 namespace redmax::validation {
 
@@ -68,5 +69,10 @@ double relativeChange(double x, double x0);
 
 /// Tables, plots, checks and the text of the study into the report.
 void addGaitStudy(const GaitStudyResult& result, const GaitStudyOptions& options, Report& report);
+
+/// The trial's `redmax view` in report_dir/view, linked from report.md: the mass points of the
+/// physiological run, else of the largest transfer fraction, else none. Throws ReportError.
+void addGaitStudyView(const GaitStudyOptions& options, const std::string& report_dir,
+                      const view::ViewAssets& assets, Report& report);
 
 }  // namespace redmax::validation

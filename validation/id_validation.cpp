@@ -16,6 +16,7 @@
 #include "plugin/simbody/id_engine.hpp"
 #include "plugin/simbody/simbody_options.hpp"
 #include "validation/report/progress.hpp"
+#include "validation/report/trial_view.hpp"
 #include "validation/simbody_cross_check.hpp"
 
 namespace redmax::validation {
@@ -144,37 +145,20 @@ void addInertialEffect(InertialEffect& ie, const osim::Storage& mass, const osim
 
 namespace {
 
-// the trial's `redmax view` in report_dir/view (docs/view.md), with the muscle mass of the run
-// (a sweep's largest value), linked from report.md
-void addTrialView(const IdValidationOptions& opt, const osim::IdToolConfig& config, Report& report) {
-  view::ViewInput in;
-  in.mass = opt.muscle_mass;
-  std::string mass_note = "no muscle mass";
+// the trial's `redmax view` with the muscle mass of the run (a sweep's largest value)
+void addIdTrialView(const IdValidationOptions& opt, const osim::IdToolConfig& config, Report& report) {
+  TrialView tv{config.model_file, config.coordinates_file, opt.muscle_mass, "no muscle mass"};
   if (!opt.mass_sweep.empty()) {
     const double largest = *std::max_element(opt.mass_sweep.begin(), opt.mass_sweep.end());
-    if (in.mass.source == osim::MuscleMassOptions::Source::Transfer)
-      in.mass.transfer_fraction = largest;
+    if (tv.mass.source == osim::MuscleMassOptions::Source::Transfer)
+      tv.mass.transfer_fraction = largest;
     else
-      in.mass.density *= largest;
-    mass_note = "the sweep's largest value, " + fmt("%g", largest);
-  } else if (in.mass.source != osim::MuscleMassOptions::Source::None) {
-    mass_note = std::string("muscle mass ") + osim::toString(in.mass.source);
+      tv.mass.density *= largest;
+    tv.mass_note = "the sweep's largest value, " + fmt("%g", largest);
+  } else if (tv.mass.source != osim::MuscleMassOptions::Source::None) {
+    tv.mass_note = std::string("muscle mass ") + osim::toString(tv.mass.source);
   }
-  const std::string dir = (std::filesystem::path(opt.report_dir) / "view").string();
-  view::ViewSummary vs;
-  try {
-    in.description = osim::readOsimModel(config.model_file);
-    in.motion_file = config.coordinates_file;
-    in.motion = osim::readStorage(config.coordinates_file);
-    vs = view::writeView(in, opt.view, dir);
-  } catch (const std::runtime_error& e) {
-    throw ReportError(dir, e.what());
-  }
-  std::ostringstream md;
-  md << "[view/index.html](view/index.html): the model along the whole coordinates file (" << vs.frames
-     << " frames), muscle paths and " << vs.mass_points << " mass points (" << mass_note
-     << ") in a browser opened from disk; `view/index.html#t=SECONDS` opens at a time (docs/view.md).\n";
-  report.addMarkdown("View", md.str());
+  validation::addTrialView(report, opt.report_dir, tv, opt.view);
 }
 
 }  // namespace
@@ -475,7 +459,7 @@ IdValidationResult runIdValidation(const IdValidationOptions& opt) {
     report.addMarkdown("Warnings", w.str());
   }
 
-  if (!opt.view.index_html.empty()) addTrialView(opt, config, report);
+  if (!opt.view.index_html.empty()) addIdTrialView(opt, config, report);
 
   r.files = report.write();
   r.passed = report.passed();

@@ -254,6 +254,22 @@ def test_validate_report_links_the_trial_view(redmax_exe, tmp_path):
     assert sum(m["mass_points"] for m in data["muscles"]) == 80
 
 
+def test_gait_study_report_links_the_trial_view(redmax_exe, leg_view, tmp_path):
+    report = tmp_path / "study"
+    r = run(redmax_exe, "gait-study", "--model", LEG, "--coordinates", SWING, "--t0", "0.1", "--t1", "0.125",
+            "--no-plots", "--quiet", "--view", "--report", report)
+    assert r.returncode == 0, r.stderr
+    md = (report / "report.md").read_text()
+    assert "[view/index.html](view/index.html)" in md and "the physiological run's" in md
+    data = view_data(report / "view")
+    # the view plays the whole coordinates file (81 rows), not only the study's time range
+    assert len(data["frames"]) == 81 and data["muscle_mass"] == "physiological"
+    # the same mass points as `redmax view --muscle-mass physiological` with the same defaults
+    alone = view_data(leg_view[0])
+    assert [m["mass_points"] for m in data["muscles"]] == [m["mass_points"] for m in alone["muscles"]]
+    assert sum(m["mass_points"] for m in data["muscles"]) == 80
+
+
 def test_opensim3_display_geometry_is_found(redmax_exe, tmp_path):
     # arm26 as OpenSim 3 wrote it (<DisplayGeometry><geometry_file>): the humerus's .vtp in
     # Geometry/ is drawn, the bones without a file are named
