@@ -46,14 +46,6 @@ void writePose(osim::JsonWriter& w, const char* key, const Mat4& E) {
   w.key(key).compactNumbers(p.data(), 7, kDigits);
 }
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot read");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
 void writeText(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;
@@ -374,10 +366,9 @@ ViewSummary writeView(const ViewInput& in, const ViewAssets& assets, const std::
   try {
     fs::create_directory(tmp);
     writeText(tmp / "data.js", "window.REDMAX_VIEW = " + w.str() + ";\n");
-    writeText(tmp / "index.html", readText(assets.index_html));
-    writeText(tmp / "view.js", readText(assets.view_js));
-    writeText(tmp / "view.css", readText(assets.view_css));
-    writeText(tmp / "three.min.js", readText(assets.three_js));
+    for (const auto& [file, name] : {std::pair{&assets.index_html, "index.html"}, {&assets.view_js, "view.js"},
+                                     {&assets.view_css, "view.css"}, {&assets.three_js, "three.min.js"}})
+      fs::copy_file(*file, tmp / name);
     for (const auto& e : fs::directory_iterator(tmp)) sum.bytes += e.file_size();
     if (fs::exists(target)) fs::rename(target, old);
     fs::rename(tmp, target);

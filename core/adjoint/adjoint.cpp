@@ -1,6 +1,7 @@
 #include "core/adjoint/adjoint.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 
@@ -195,6 +196,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   y[0] = Stepper::pack(s0);
   checkFinite(s0, h, pr.integrator.c_str(), &z_names);
   double effort = 0.0;
+  const auto forward_start = std::chrono::steady_clock::now();
   for (int k = 0; k < N; ++k) {
     const VecX u = controlsAt(pr, rs, p, k, N);
     effort += h * u.squaredNorm();
@@ -203,6 +205,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   }
 
   Result res;
+  res.forward_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - forward_start).count();
   res.final = stepper.unpack(y[N], timeAt(N));
   res.steps = N;
   VecX lambda;
@@ -287,6 +290,7 @@ VecX finiteDifferenceGradient(const Problem& pr, const Objective& obj, const Vec
   // run's nonlinearity (truncation), a small one to its round-off (eps |J| / e); the pair of
   // neighbouring steps whose estimates agree best gives the finer of the two
   const double rel[4] = {1e-3, 1e-4, 1e-5, 1e-6};
+  static_assert(kDifferenceRunsPerParameter == 4 * 4, "four steps, four runs each");
   for (Eigen::Index i = 0; i < p.size(); ++i) {
     double d[4];
     for (int j = 0; j < 4; ++j) {

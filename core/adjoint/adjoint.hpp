@@ -85,6 +85,7 @@ struct Result {
   State final;               ///< y_N
   long steps = 0;
   long step_evaluations = 0; ///< calls of the integrator's step, forward and adjoint together
+  double forward_seconds = 0.0;  ///< wall time of the forward pass (the simulation alone)
 };
 
 /// Thrown for a problem that cannot be differentiated (bad sizes, unknown integrator, controls).
@@ -101,7 +102,9 @@ Result evaluate(const Problem& problem, const Objective& objective, const VecX& 
 /// The gradient by central differences of whole simulations: the reference `redmax gradient
 /// --check` compares with. Per parameter, fourth-order differences (at p_i -+ e, -+ 2e) with
 /// e = r max(1, |p_i|) for r = 1e-3, 1e-4, 1e-5, 1e-6 (a mass steps at most a quarter of itself),
-/// and of the neighbouring pair of estimates that agree best the finer: 16 runs per parameter.
+/// and of the neighbouring pair of estimates that agree best the finer: kDifferenceRunsPerParameter
+/// runs per parameter.
+inline constexpr int kDifferenceRunsPerParameter = 16;
 VecX finiteDifferenceGradient(const Problem& problem, const Objective& objective, const VecX& p);
 
 /// max_i |a_i - b_i| / max_i |b_i|: the worst component error relative to the reference's scale

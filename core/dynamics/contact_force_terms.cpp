@@ -48,6 +48,20 @@ double combine(double u1, double u2) { return u1 + u2 > 0.0 ? 2.0 * u1 * u2 / (u
 
 }  // namespace
 
+void ContactForceTerm::addForce(const Model& model, const State&, const TermContext& ctx, VecX& f) const {
+  evaluate(ctx.sk, nullptr, nullptr, &model, &f);
+}
+
+double ContactForceTerm::potentialEnergy(const Model&, const State&, const TermContext& ctx) const {
+  double V = 0.0;
+  evaluate(ctx.sk, nullptr, &V, nullptr, nullptr);
+  return V;
+}
+
+void ContactForceTerm::contacts(const SkeletonWorkspace& sk, std::vector<ContactReport>& out) const {
+  evaluate(sk, &out, nullptr, nullptr, nullptr);
+}
+
 ContactSummary ContactForceTerm::summary(const SkeletonWorkspace& sk) const {
   std::vector<ContactReport> r;
   contacts(sk, r);
@@ -186,20 +200,6 @@ void HuntCrossleyForceTerm::evaluate(const SkeletonWorkspace& sk, std::vector<Co
   }
 }
 
-void HuntCrossleyForceTerm::addForce(const Model& model, const State&, const TermContext& ctx, VecX& f) const {
-  evaluate(ctx.sk, nullptr, nullptr, &model, &f);
-}
-
-double HuntCrossleyForceTerm::potentialEnergy(const Model&, const State&, const TermContext& ctx) const {
-  double V = 0.0;
-  evaluate(ctx.sk, nullptr, &V, nullptr, nullptr);
-  return V;
-}
-
-void HuntCrossleyForceTerm::contacts(const SkeletonWorkspace& sk, std::vector<ContactReport>& out) const {
-  evaluate(sk, &out, nullptr, nullptr, nullptr);
-}
-
 // ---------------------------------------------------------------------------------------------
 
 SmoothSphereHalfSpaceForceTerm::SmoothSphereHalfSpaceForceTerm(const Model& model, std::vector<Contact> contacts)
@@ -273,20 +273,6 @@ void SmoothSphereHalfSpaceForceTerm::evaluate(const SkeletonWorkspace& sk, std::
       out->push_back(rep);
     }
   }
-}
-
-void SmoothSphereHalfSpaceForceTerm::addForce(const Model& model, const State&, const TermContext& ctx, VecX& f) const {
-  evaluate(ctx.sk, nullptr, nullptr, &model, &f);
-}
-
-double SmoothSphereHalfSpaceForceTerm::potentialEnergy(const Model&, const State&, const TermContext& ctx) const {
-  double V = 0.0;
-  evaluate(ctx.sk, nullptr, &V, nullptr, nullptr);
-  return V;
-}
-
-void SmoothSphereHalfSpaceForceTerm::contacts(const SkeletonWorkspace& sk, std::vector<ContactReport>& out) const {
-  evaluate(sk, &out, nullptr, nullptr, nullptr);
 }
 
 }  // namespace redmax

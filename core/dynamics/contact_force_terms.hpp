@@ -54,8 +54,16 @@ struct ContactSummary {
 /// suffices for penetrations).
 class ContactForceTerm : public ForceTerm {
  public:
-  virtual void contacts(const SkeletonWorkspace& sk, std::vector<ContactReport>& out) const = 0;
+  void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const final;
+  double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const final;
+  void contacts(const SkeletonWorkspace& sk, std::vector<ContactReport>& out) const;
   ContactSummary summary(const SkeletonWorkspace& sk) const;
+
+ protected:
+  /// one pass over the contacts: each report into `out`, the potential added to `V`, the forces
+  /// added to `f` (with `model`); null outputs are skipped
+  virtual void evaluate(const SkeletonWorkspace& sk, std::vector<ContactReport>* out, double* V,
+                        const Model* model, VecX* f) const = 0;
 };
 
 enum class ContactShape { Sphere, HalfSpace };
@@ -85,9 +93,6 @@ class HuntCrossleyForceTerm final : public ContactForceTerm {
   /// transition velocity, negative coefficients, non-finite values
   HuntCrossleyForceTerm(const Model& model, std::vector<Force> forces);
   std::string name() const override { return "hunt_crossley_forces"; }
-  void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
-  double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
-  void contacts(const SkeletonWorkspace& sk, std::vector<ContactReport>& out) const override;
   const std::vector<Force>& forces() const { return forces_; }
 
   /// the normal force law alone: f_H at depth d, effective radius R, for two stiffnesses (Pa)
@@ -99,9 +104,9 @@ class HuntCrossleyForceTerm final : public ContactForceTerm {
   struct Pair {
     int force, i, j;  ///< surfaces i (first: the half-space) and j of force
   };
-  /// every overlapping pair's report and potential (V added)
+  /// every overlapping pair
   void evaluate(const SkeletonWorkspace& sk, std::vector<ContactReport>* out, double* V, const Model* model,
-                VecX* f) const;
+                VecX* f) const override;
   std::vector<Force> forces_;
   std::vector<Pair> pairs_;
 };
@@ -121,14 +126,11 @@ class SmoothSphereHalfSpaceForceTerm final : public ContactForceTerm {
   /// transition velocity
   SmoothSphereHalfSpaceForceTerm(const Model& model, std::vector<Contact> contacts);
   std::string name() const override { return "smooth_sphere_half_space_forces"; }
-  void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
-  double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
-  void contacts(const SkeletonWorkspace& sk, std::vector<ContactReport>& out) const override;
   const std::vector<Contact>& contactList() const { return contacts_; }
 
  private:
   void evaluate(const SkeletonWorkspace& sk, std::vector<ContactReport>* out, double* V, const Model* model,
-                VecX* f) const;
+                VecX* f) const override;
   std::vector<Contact> contacts_;
 };
 

@@ -8,6 +8,19 @@
 
 namespace redmax {
 
+namespace {
+
+// no path-wise inverse dynamics for Type III paths, nor for fibre-following points (their placement
+// moves with the fibre): those take the compact J_ar route with a_z
+bool needsCompactId(const Muscle& m) { return pathType(m.path) == PathType::III || m.fibre.enabled(); }
+
+// fibre-following points: the fibre's own motion adds the bias acceleration a_z to each point
+bool hasFibreBias(const Muscle& m, const MuscleKinematics& mk) {
+  return m.fibre.enabled() && mk.a_z.size() == 3 * m.mass_points.size();
+}
+
+}  // namespace
+
 MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTermOptions options)
     : MuscleTerm(model, std::move(muscles), options, {}) {}
 
@@ -23,7 +36,6 @@ MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTe
     if (m.mass_points.size() == 0) continue;
     massive_.push_back(m);
     massive_states_.push_back(states.empty() ? MuscleStateIndex{} : states[k]);
-    compact_id_.push_back(pathType(m.path) == PathType::III || m.fibre.enabled());
   }
 }
 
@@ -99,8 +111,7 @@ void MuscleTerm::addForce(const Model& model, const State& s, const TermContext&
     const MuscleKinematics& mk = sc.ws.muscles[m];
     gatherColumns(s.qdot, mk, sc.qdot_c);
     sc.fc.setZero(sc.qdot_c.size());
-    // fibre-following points: the fibre's own motion adds the bias acceleration a_z
-    const bool fibre = mk.a_z.size() == 3 * mp.size() && massive_[m].fibre.enabled();
+    const bool fibre = hasFibreBias(massive_[m], mk);
     for (int a = 0; a < mp.size(); ++a) {
       Vec3 fa = mp.mass[a] * model.gravity();
       if (options_.quadratic_velocity) fa.noalias() -= mp.mass[a] * (mk.Jdot_ar.middleRows<3>(3 * a) * sc.qdot_c);
@@ -136,8 +147,8 @@ void MuscleTerm::addMassDotTimesVelocity(const Model& model, const State& s, con
 
 TermIdRoute MuscleTerm::idRoute() const {
   if (!options_.quadratic_velocity) return TermIdRoute::WrenchesWithKinematics;
-  for (char w : compact_id_)
-    if (w) return TermIdRoute::WrenchesWithKinematics;
+  for (const Muscle& m : massive_)
+    if (needsCompactId(m)) return TermIdRoute::WrenchesWithKinematics;
   return TermIdRoute::Wrenches;
 }
 
@@ -156,13 +167,13 @@ void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const Ve
   for (size_t m = 0; m < massive_.size(); ++m) {
     const Muscle& mu = massive_[m];
     MuscleKinematics& mk = sc.ws.muscles[m];
-    if (!compact_id_[m] && options_.quadratic_velocity) {
+    if (!needsCompactId(mu) && options_.quadratic_velocity) {
       addMuscleInverseDynamics(model, s, qddot, motion, model.gravity(), mu, mk, sc.id[m], wrench, tau);
       continue;
     }
     // compact J_ar: sum_a J_ar^T m_a (J_ar qddot + Jdot_ar qdot (+ a_z) - g) in the muscle's columns
     kinematicsOf(m, model, s, ctx, mk);
-    const bool fibre = mk.a_z.size() == 3 * mu.mass_points.size() && mu.fibre.enabled();
+    const bool fibre = hasFibreBias(mu, mk);
     gatherColumns(s.qdot, mk, sc.qdot_c);
     gatherColumns(qddot, mk, sc.qddot_c);
     sc.fc.setZero(sc.qdot_c.size());

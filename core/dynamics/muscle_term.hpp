@@ -101,9 +101,6 @@ class MuscleTerm final : public ForceTerm {
   std::vector<Muscle> muscles_;
   std::vector<Muscle> massive_;        // the muscles with at least one mass point
   std::vector<MuscleStateIndex> massive_states_;  // their states (fibre-following placement)
-  // per massive muscle: no path-wise ID (Type III, or fibre-following points, whose placement
-  // moves with the fibre: the compact J_ar route with a_z)
-  std::vector<char> compact_id_;
   MuscleTermOptions options_;
   int nr_ = 0;
 };

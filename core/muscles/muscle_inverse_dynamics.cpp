@@ -34,9 +34,7 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   const MassPoints& mp = muscle.mass_points;
 
   // 1. active path points: positions, velocities, accelerations [D Eq. 5.8, 5.11]
-  mk.active.clear();
-  for (int k = 0; k < static_cast<int>(path.points.size()); ++k)
-    if (isPathPointActive(path.points[k], state.q)) mk.active.push_back(k);
+  activePathPoints(path, state.q, mk.active);
   const int P = static_cast<int>(mk.active.size());
   mk.x_b.resize(P);
   mk.x_w.resize(P);

@@ -48,6 +48,12 @@ bool isPathPointActive(const PathPoint& p, const VecX& q) {
   return p.range_lo - kConditionalTolerance <= v && v <= p.range_hi + kConditionalTolerance;
 }
 
+void activePathPoints(const MusclePath& path, const VecX& q, std::vector<int>& active) {
+  active.clear();
+  for (int k = 0; k < static_cast<int>(path.points.size()); ++k)
+    if (isPathPointActive(path.points[k], q)) active.push_back(k);
+}
+
 PathType pathType(const MusclePath& path) {
   if (path.num_wraps > 0 || !path.wraps.empty()) return PathType::III;
   if (path.points.size() == 2 && path.points[0].kind == PathPointKind::Fixed &&

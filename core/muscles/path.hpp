@@ -107,6 +107,10 @@ PathType pathType(const MusclePath& path);
 /// "I", "II" or "III"
 const char* pathTypeName(PathType t);
 
+/// The indices of the points of `path` active at q (isPathPointActive), in path order, into `active`
+/// (cleared first; its capacity is kept, so per-frame callers do not allocate)
+void activePathPoints(const MusclePath& path, const VecX& q, std::vector<int>& active);
+
 /// Throws ModelError, naming `muscle_name` and the point, when the path does not fit `model`: fewer
 /// than two points, a body or coordinate index out of range, a conditional origin or insertion
 /// (the path could lose its ends), a conditional range with lo > hi, non-finite locations, a

@@ -126,9 +126,7 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
     throw std::logic_error("calcPathPoints: skeleton workspace is not at the required stage (call calcKinematics)");
 
   // active set: conditional points by OpenSim's inclusive rule (path.hpp)
-  mk.active.clear();
-  for (int k = 0; k < static_cast<int>(path.points.size()); ++k)
-    if (isPathPointActive(path.points[k], state.q)) mk.active.push_back(k);
+  activePathPoints(path, state.q, mk.active);
   const int P = static_cast<int>(mk.active.size());
 
   mk.x_b.resize(P);

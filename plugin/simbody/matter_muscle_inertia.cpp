@@ -95,9 +95,7 @@ void MatterMuscleInertia::evaluate(const SimTK::State& state, bool velocity) {
     const Muscle& mu = muscles_[e.muscle];
     const auto& points = mu.path.points;
     // active set: conditional points by OpenSim's rule, on the state's q
-    e.active.clear();
-    for (int k = 0; k < static_cast<int>(points.size()); ++k)
-      if (isPathPointActive(points[k], q_core_)) e.active.push_back(k);
+    activePathPoints(mu.path, q_core_, e.active);
     const int P = static_cast<int>(e.active.size());
     e.x.resize(P);
     e.x_b.resize(P);

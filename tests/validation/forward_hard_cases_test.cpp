@@ -228,12 +228,20 @@ TEST(ForwardHardCases, SplineKneeInertialAgainstLumped) {
   const osim::Storage& l = lumped.states;
   const int cq = l.findColumn("/jointset/knee/knee_angle/value");
   ASSERT_GE(cq, 0);
-  double q_max = -1;
-  for (int k = 0; k < l.numRows(); ++k) q_max = std::max(q_max, l.data(k, cq));
-  EXPECT_NEAR(q_max, 0.317, 0.01);  // measured 0.3172 rad at 0.4 s
+  // the scene does what it is built for: the quadriceps extends the knee through straight (0), then
+  // the hamstring flexes it again (measured peak 0.3172 rad at 0.4 s; end 0.6 s)
+  auto peakKnee = [cq](const osim::Storage& st) {
+    double q = -1e9;
+    for (int k = 0; k < st.numRows(); ++k) q = std::max(q, st.data(k, cq));
+    return q;
+  };
+  const double q_max = peakKnee(l);
+  EXPECT_GT(q_max, 0.0);
+  EXPECT_LT(l.data(l.numRows() - 1, cq), q_max);
   s.muscle_mass.source = osim::MuscleMassOptions::Source::Transfer;
   s.muscle_mass.transfer_body = "tibia";
   std::vector<osim::Storage> heavy_q;
+  double dq_uniform = 0;
   for (const auto placement : {osim::MuscleMassOptions::Placement::Uniform, osim::MuscleMassOptions::Placement::Fibre}) {
     s.muscle_mass.placement = placement;
     const char* pname = osim::toString(placement);
@@ -254,10 +262,14 @@ TEST(ForwardHardCases, SplineKneeInertialAgainstLumped) {
     double dq = 0;
     for (int k = 0; k < l.numRows(); ++k) dq = std::max(dq, std::abs(heavy.states.data(k, cq) - l.data(k, cq)));
     std::printf("[ measured ] spline knee, 30%% of the tibia in the muscles (%s): max knee change %.3e rad, "
-                "rk45 %ld steps (lumped %ld)\n", pname, dq, heavy.stats.steps, lumped.stats.steps);
-    // the shank loses 1.05 kg to muscles that span the knee: it swings further (measured 0.1263
-    // rad, both placements)
-    EXPECT_NEAR(dq, 0.1263, 0.01) << pname;
+                "peak %.4f rad (lumped %.4f), rk45 %ld steps (lumped %ld)\n", pname, dq, peakKnee(heavy.states), q_max,
+                heavy.stats.steps, lumped.stats.steps);
+    // the shank loses 1.05 kg to muscles that span the knee, whose points move less than the shank's
+    // centre of mass: the same muscle forces extend it further (measured change 0.1263 rad, both
+    // placements)
+    EXPECT_GT(peakKnee(heavy.states), q_max) << pname;
+    EXPECT_GT(dq, 1e-3) << pname;
+    if (placement == osim::MuscleMassOptions::Placement::Uniform) dq_uniform = dq;
     heavy_q.push_back(heavy.states);
   }
   // the placements differ little here (short tendons: l_ts / (l_opt + l_ts) 0.76 and 0.71, and the
@@ -266,6 +278,8 @@ TEST(ForwardHardCases, SplineKneeInertialAgainstLumped) {
   for (int k = 0; k < l.numRows(); ++k) dp = std::max(dp, std::abs(heavy_q[0].data(k, cq) - heavy_q[1].data(k, cq)));
   std::printf("[ measured ] spline knee, uniform vs fibre placement: max knee difference %.3e rad\n", dp);
   EXPECT_GT(dp, 0.0);
+  // ... so the placement changes the run by far less than the mass does (measured 3.3e-5 of 0.1263 rad)
+  EXPECT_LT(dp, 1e-3 * dq_uniform);
 }
 
 }  // namespace

@@ -426,6 +426,8 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
   SkeletonWorkspace contact_sk(sys.model());
   std::vector<ContactReport> reports;
   MatX contact_M;
+  Eigen::LDLT<MatX> contact_ldlt;
+  bool contact_factored = false;  // contact_ldlt holds this row's M
   MatX contact_J(3, sys.model().nr());
   // the effective mass of a contact along its normal, 1 / (w^T M^-1 w) with w = (J_2 - J_1)^T n
   // (the skeleton's mass matrix: mass points only add mass, so the frequency is not underestimated)
@@ -439,9 +441,13 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
       pointJacobian(model, contact_sk, body, x_i, contact_J);
       w += sign * contact_J.transpose() * r.normal_w;
     }
-    if (contact_M.rows() != model.nr()) contact_M.resize(model.nr(), model.nr());
-    calcSkeletonMass(model, contact_sk, contact_M);
-    const double inv = w.dot(contact_M.ldlt().solve(w));
+    if (!contact_factored) {  // once per row, whatever the number of contacts
+      if (contact_M.rows() != model.nr()) contact_M.resize(model.nr(), model.nr());
+      calcSkeletonMass(model, contact_sk, contact_M);
+      contact_ldlt.compute(contact_M);
+      contact_factored = true;
+    }
+    const double inv = w.dot(contact_ldlt.solve(w));
     return inv > 0.0 ? 1.0 / inv : 0.0;
   };
 
@@ -449,6 +455,13 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
   auto watch_contacts = [&](const State& s_r) -> bool {
     if (contact_terms.empty()) return true;
     calcKinematics(sys.model(), s_r, contact_sk);
+    contact_factored = false;
+    auto fail = [&](const std::string& why) {
+      res.failed = true;
+      res.failure = why;
+      res.failure_time = s_r.t;
+      return false;
+    };
     reports.clear();
     for (const ContactForceTerm* c : contact_terms) c->contacts(contact_sk, reports);
     ContactStats& cs = res.contacts;
@@ -474,10 +487,7 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
              << " s is too large for the contact's stiffness (" << r.stiffness << " N/m at penetration "
              << r.penetration << " m, effective mass " << m_eff << " kg: omega = " << omega
              << " rad/s needs h < 1 / omega = " << 1.0 / omega << " s; use a smaller --dt, or rk45)";
-          res.failed = true;
-          res.failure = os.str();
-          res.failure_time = s_r.t;
-          return false;
+          return fail(os.str());
         }
       }
       if (r.radius > 0.0 && r.penetration > r.radius) {
@@ -485,10 +495,7 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
         os << "contact '" << r.name << "' penetrates " << r.penetration << " m, deeper than the sphere's radius "
            << r.radius << " m, at t = " << s_r.t << ": the step is too large for the contact's stiffness"
            << (adaptive ? " (lower --max-step or the tolerances)" : " (use a smaller --dt, or rk45)");
-        res.failed = true;
-        res.failure = os.str();
-        res.failure_time = s_r.t;
-        return false;
+        return fail(os.str());
       }
     }
     cs.active_max = std::max(cs.active_max, cs.active_final);

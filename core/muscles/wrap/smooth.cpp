@@ -817,22 +817,34 @@ SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1
 // reference for the shared route above
 namespace smooth_reference {
 
+namespace {
+
+using D2 = Dual<Dual<double>>;
+
+// pass i of the nested-dual route: the velocity direction (p1dot, p2dot) in the inner duals, the
+// input direction e_i (i < 6: p1 then p2; i = 6: none, alpha is seeded by the caller) in the outer
+void seedReferencePass(const Vec3& p1, const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot, int i, V3<D2>& q1,
+                       V3<D2>& q2) {
+  for (int k = 0; k < 3; ++k) {
+    q1[k] = D2{Dual<double>{p1[k], p1dot[k]}, Dual<double>{i == k ? 1.0 : 0.0, 0.0}};
+    q2[k] = D2{Dual<double>{p2[k], p2dot[k]}, Dual<double>{i == k + 3 ? 1.0 : 0.0, 0.0}};
+  }
+}
+
+}  // namespace
+
 SmoothWrapPoint calcSmoothWrapPointDerivatives(const WrapSurface& surface, const Vec3& p1, const Vec3& p2,
                                                double alpha, const Vec3& p1dot, const Vec3& p2dot,
                                                const SmoothWrapOptions& options) {
   checkInputs(surface, p1, p2);
   alpha = std::clamp(alpha, 0.0, 1.0);
-  using D2 = Dual<Dual<double>>;
   const double width = widthOf(surface, options);
   SmoothWrapPoint out;
   // one pass per input direction e_i; every pass also carries the velocity direction, so b.b is
   // the mixed derivative d^2 x / (d e_i d v) = column i of Jdot
   for (int i = 0; i < 6; ++i) {
     V3<D2> q1, q2;
-    for (int k = 0; k < 3; ++k) {
-      q1[k] = D2{Dual<double>{p1[k], p1dot[k]}, Dual<double>{i == k ? 1.0 : 0.0, 0.0}};
-      q2[k] = D2{Dual<double>{p2[k], p2dot[k]}, Dual<double>{i == k + 3 ? 1.0 : 0.0, 0.0}};
-    }
+    seedReferencePass(p1, p2, p1dot, p2dot, i, q1, q2);
     D2 d, w;
     const V3<D2> x = smoothPoint(surface, q1, q2, alpha, width, &d, &w);
     for (int k = 0; k < 3; ++k) {
@@ -853,16 +865,12 @@ SmoothWrapSegmentPoint calcSmoothWrapSegmentPoint(const WrapSurface& surface, co
                                                   double alphadot, const SmoothWrapOptions& options) {
   checkInputs(surface, p1, p2);
   alpha = std::clamp(alpha, 0.0, 1.0);
-  using D2 = Dual<Dual<double>>;
   const double width = widthOf(surface, options);
   SmoothWrapSegmentPoint out;
   // as calcSmoothWrapPointDerivatives, with a seventh pass for alpha
   for (int i = 0; i < 7; ++i) {
     V3<D2> q1, q2;
-    for (int k = 0; k < 3; ++k) {
-      q1[k] = D2{Dual<double>{p1[k], p1dot[k]}, Dual<double>{i == k ? 1.0 : 0.0, 0.0}};
-      q2[k] = D2{Dual<double>{p2[k], p2dot[k]}, Dual<double>{i == k + 3 ? 1.0 : 0.0, 0.0}};
-    }
+    seedReferencePass(p1, p2, p1dot, p2dot, i, q1, q2);
     const D2 a{Dual<double>{alpha, alphadot}, Dual<double>{i == 6 ? 1.0 : 0.0, 0.0}};
     const V3<D2> x = smoothPoint<D2>(surface, q1, q2, a, width, nullptr, nullptr);
     for (int k = 0; k < 3; ++k) {
@@ -878,15 +886,11 @@ SmoothWrapSegmentPoint calcSmoothWrapSegmentPoint(const WrapSurface& surface, co
 SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, const Vec3& p1dot,
                                       const Vec3& p2dot, const SmoothWrapOptions& options) {
   checkInputs(surface, p1, p2);
-  using D2 = Dual<Dual<double>>;
   const double width = widthOf(surface, options);
   SmoothWrapLength out;
   for (int i = 0; i < 6; ++i) {
     V3<D2> q1, q2;
-    for (int k = 0; k < 3; ++k) {
-      q1[k] = D2{Dual<double>{p1[k], p1dot[k]}, Dual<double>{i == k ? 1.0 : 0.0, 0.0}};
-      q2[k] = D2{Dual<double>{p2[k], p2dot[k]}, Dual<double>{i == k + 3 ? 1.0 : 0.0, 0.0}};
-    }
+    seedReferencePass(p1, p2, p1dot, p2dot, i, q1, q2);
     D2 L;
     smoothPoint<D2>(surface, q1, q2, D2(0.0), width, nullptr, nullptr, &L);
     out.J(0, i) = L.b.a;

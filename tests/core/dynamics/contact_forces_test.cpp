@@ -14,9 +14,14 @@
 #include "core/dynamics/system.hpp"
 #include "core/integrators/integrator.hpp"
 #include "core/skeleton/kinematics.hpp"
+#include "tests/core/dynamics/term_eval.hpp"
 
 namespace redmax {
 namespace {
+
+using test::potentialGradient;
+using test::termForce;
+using test::termPotential;
 
 constexpr double kG = 9.80665;
 
@@ -52,20 +57,6 @@ HuntCrossleyForceTerm::Force ballFloor(int body, double r, double k, double c, d
   F.materials = {{k, c, us, ud, uv}, {k, c, us, ud, uv}};
   F.transition_velocity = vt;
   return F;
-}
-
-VecX termForce(const Model& m, const ForceTerm& t, const State& s) {
-  SkeletonWorkspace sk(m);
-  calcKinematics(m, s, sk);
-  VecX f = VecX::Zero(m.nr());
-  t.addForce(m, s, TermContext(sk), f);
-  return f;
-}
-
-double termPotential(const Model& m, const ForceTerm& t, const State& s) {
-  SkeletonWorkspace sk(m);
-  calcKinematics(m, s, sk);
-  return t.potentialEnergy(m, s, TermContext(sk));
 }
 
 // generalized force from the reported contact forces: sum of J_p^T F at the contact points
@@ -137,14 +128,7 @@ TEST(HuntCrossleyForceTerm, ElasticForceIsMinusGradientOfItsPotential) {
   ASSERT_EQ(active, 2) << "both pairs must overlap";
   s.qdot.setZero();  // no dissipation anyway; zero speed keeps the friction out
   const VecX f = termForce(m, term, s);
-  VecX grad(m.nr());
-  const double h = 1e-6;
-  for (int i = 0; i < m.nr(); ++i) {
-    State sp = s, sm = s;
-    sp.q[i] += h;
-    sm.q[i] -= h;
-    grad[i] = (termPotential(m, term, sp) - termPotential(m, term, sm)) / (2 * h);
-  }
+  const VecX grad = potentialGradient(m, term, s);
   std::printf("HuntCrossley: |f + dV/dq| / |f| = %.2g\n", (f + grad).norm() / f.norm());
   EXPECT_LE((f + grad).norm(), 1e-9 * f.norm())  // measured 1.4e-10
    << f.transpose() << "\n" << -grad.transpose();

@@ -15,10 +15,14 @@
 #include "core/dynamics/sampled_loads.hpp"
 #include "core/dynamics/system.hpp"
 #include "core/integrators/integrator.hpp"
+#include "tests/core/dynamics/term_eval.hpp"
 #include "validation/scenes/scenes.hpp"
 
 namespace redmax {
 namespace {
+
+using test::potentialGradient;
+using test::termForce;
 
 State randomState(const Model& m, std::uint32_t seed) {
   std::mt19937 rng(seed);
@@ -54,16 +58,6 @@ Vec3 angularVelocityByDifferences(const Model& m, const State& s, int body) {
   const auto [Ep, Em] = posesAlongMotion(m, s, body);
   const Mat3 A = Ep.topLeftCorner<3, 3>() * Em.topLeftCorner<3, 3>().transpose();  // I + [w] 2h + O(h^2)
   return Vec3(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1)) / 4e-6;
-}
-
-VecX termForce(const Model& m, const ForceTerm& t, const State& s, const VecX& controls) {
-  SkeletonWorkspace sk(m);
-  calcKinematics(m, s, sk);
-  TermContext ctx(sk);
-  ctx.controls = &controls;
-  VecX f = VecX::Zero(m.nr());
-  t.addForce(m, s, ctx, f);
-  return f;
 }
 
 TEST(PointActuatorTerm, ForceIsJacobianTransposeAndItsPowerIsForceTimesPointVelocity) {
@@ -205,20 +199,9 @@ TEST(PassiveForceTerms, SpringsAreMinusTheGradientOfTheirPotential) {
   bb.stiffness << 20, 30, 40, 500, 600, 700;
   const BushingForceTerm bu(m, {bb});
   s.q[0] = 0.25;  // inside the upper transition (10-15 deg)
-  SkeletonWorkspace sk(m);
   for (const ForceTerm* t : std::vector<const ForceTerm*>{&gs, &ps, &cl, &bu}) {
     const VecX f = termForce(m, *t, s, VecX());
-    VecX fd(m.nr());
-    const double h = 1e-6;
-    for (int k = 0; k < m.nr(); ++k) {
-      State sp = s, sm = s;
-      sp.q[k] += h;
-      sm.q[k] -= h;
-      calcKinematics(m, sp, sk);
-      const double Vp = t->potentialEnergy(m, sp, sk);
-      calcKinematics(m, sm, sk);
-      fd[k] = -(Vp - t->potentialEnergy(m, sm, sk)) / (2 * h);
-    }
+    const VecX fd = -potentialGradient(m, *t, s);
     // measured 3.9e-12 (generalized spring) .. 3.3e-10 (point-to-point spring)
     EXPECT_TRUE(nearRel(f, fd, 2e-9)) << t->name() << "\n" << f.transpose() << "\n" << fd.transpose();
     std::printf("%s: |f + grad V| / |f| = %.2g\n", t->name().c_str(), (f - fd).norm() / f.norm());
