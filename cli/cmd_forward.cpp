@@ -46,11 +46,15 @@ int runForward(const ForwardFlags& f, const CLI::App& app) {
     std::cerr << "error: " << f.setup << ": " << r.failure << "\n";
     return 1;
   }
+  view::ViewSummary vs;
   try {
-    tool->write(r);
+    vs = tool->write(r);
   } catch (const osim::ConvertError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
+  } catch (const std::runtime_error& e) {  // the view: the states and controls are written
+    std::cerr << "error: " << tool->viewPath() << ": " << e.what() << "\n";
+    return 1;
   }
   if (!f.quiet) {
     const auto& st = tool->setup();
@@ -58,6 +62,9 @@ int runForward(const ForwardFlags& f, const CLI::App& app) {
                 st.name.c_str(), st.initial_time, st.final_time, r.states.numColumns(), r.controls.numColumns(),
                 s.integrator.c_str(), r.stats.steps, r.stats.rhs_evals, r.wall_s);
     std::printf("  -> %s\n  -> %s\n", tool->statesPath().c_str(), tool->controlsPath().c_str());
+    if (vs.frames > 0)
+      std::printf("  -> %s/index.html (%d frames, %d muscles, %d mass points)\n", tool->viewPath().c_str(), vs.frames,
+                  vs.muscles, vs.mass_points);
   }
   return 0;
 }
@@ -69,10 +76,11 @@ CommandRegistration reg(
        app.footer(
            "usage: redmax forward --setup FORWARD_SETUP.xml [--out-dir DIR] [--muscle-class CLASS]\n"
            "                      [--integrator NAME] [--report-interval S] [--tolerance T]\n"
-           "                      [--strict] [MUSCLE-MASS OPTIONS]\n"
+           "                      [--strict] [--view] [MUSCLE-MASS OPTIONS]\n"
            "States are written under OpenSim 4 names: /jointset/J/C/value, /jointset/J/C/speed,\n"
            "/forceset/M/activation, /forceset/M/fiber_length.\n"
-           "Exit codes: 0 success, 1 the run failed (nothing written), 2 bad input or usage.");
+           "Exit codes: 0 success, 1 the run failed (nothing written; with --view: the view could\n"
+           "not be written, the tables are), 2 bad input or usage.");
        return [f, &app] { return runForward(*f, app); };
      }});
 

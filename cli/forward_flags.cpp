@@ -28,6 +28,9 @@ void addForwardFlags(CLI::App& app, ForwardFlags& f) {
   app.add_flag("--strict", f.strict,
                "refuse to run (exit 2) when a force or contact geometry of the model would not\n"
                "be applied (each is named)");
+  app.add_flag("--view", f.view,
+               "also write the run's `redmax view` into DIR/<name>_view (the model along the\n"
+               "states written, with the run's muscle mass; docs/view.md)");
   addMuscleMassFlags(app, f.mm);
 }
 
@@ -42,6 +45,13 @@ validation::ForwardToolSettings parseForwardFlags(const ForwardFlags& f, const C
   s.report_interval = f.report_interval;
   if (given(app, "--tolerance")) s.tolerance = f.tolerance;
   s.strict = f.strict;
+  if (f.view) {
+    try {
+      s.view = view::findViewAssets(viewAssetFolders());
+    } catch (const std::runtime_error& e) {
+      throw UsageError{std::string("--view: ") + e.what()};
+    }
+  }
   return s;
 }
 

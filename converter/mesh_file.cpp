@@ -8,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <zlib.h>
+
 #include "converter/detail/xml_util.hpp"
 
 namespace redmax::osim {
@@ -41,13 +43,21 @@ void checkMesh(const std::string& path, const TriangleMesh& m) {
 
 // --- .vtp ----------------------------------------------------------------------------------
 
-std::vector<unsigned char> decodeBase64(const std::string& path, const std::string& text) {
+// Base64 as VTK writes it: header and data may be separate streams, each padded with '=', so
+// padding ends a group and the next character starts a new stream
+std::vector<unsigned char> decodeBase64(const std::string& path, const char* text, size_t size) {
   static const std::string chars = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::vector<unsigned char> out;
   unsigned value = 0;
   int bits = 0;
-  for (char c : text) {
-    if (c == '=' || std::isspace(static_cast<unsigned char>(c))) continue;
+  for (size_t i = 0; i < size; ++i) {
+    const char c = text[i];
+    if (std::isspace(static_cast<unsigned char>(c))) continue;
+    if (c == '=') {
+      value = 0;
+      bits = 0;
+      continue;
+    }
     const size_t v = chars.find(c);
     if (v == std::string::npos) refuse(path, "binary DataArray is not base64");
     value = (value << 6) | static_cast<unsigned>(v);
@@ -60,11 +70,120 @@ std::vector<unsigned char> decodeBase64(const std::string& path, const std::stri
   return out;
 }
 
-// the numbers of one DataArray (ascii, or VTK's uncompressed binary: a UInt32/UInt64 byte count
-// then the raw little-endian values, base64 encoded as one block)
-std::vector<double> dataArray(const std::string& path, const XMLElement* a, const std::string& header_type) {
+// base64 characters (white space skipped) that encode n bytes, padding included
+size_t base64Chars(size_t n) { return 4 * ((n + 2) / 3); }
+
+// the position in text after `count` base64 characters from `from` (white space not counted)
+size_t skipBase64(const std::string& text, size_t from, size_t count) {
+  size_t i = from;
+  for (; i < text.size() && count > 0; ++i)
+    if (!std::isspace(static_cast<unsigned char>(text[i]))) --count;
+  return i;
+}
+
+// How the file's binary arrays are stored: VTK's header integer size, zlib or no compression, and
+// the <AppendedData> bytes (raw, or the base64 text) that `appended` arrays point into.
+struct VtpEncoding {
+  size_t header = 4;       // header_type UInt32 (default) or UInt64
+  bool zlib = false;       // compressor="vtkZLibDataCompressor"
+  std::string appended;    // after the '_' marker, up to </AppendedData>
+  bool appended_base64 = true;
+};
+
+std::uint64_t headerWord(const unsigned char* p, size_t header) {
+  if (header == 8) {
+    std::uint64_t k;
+    std::memcpy(&k, p, 8);
+    return k;
+  }
+  std::uint32_t k;
+  std::memcpy(&k, p, 4);
+  return k;
+}
+
+// zlib blocks -> bytes: the header (number of blocks, block size, last block's size, compressed
+// size of each block) then the compressed blocks
+std::vector<unsigned char> inflateBlocks(const std::string& path, const std::vector<unsigned char>& header_bytes,
+                                         const unsigned char* data, size_t data_size, size_t header) {
+  const size_t nblocks = headerWord(header_bytes.data(), header);
+  const size_t block = headerWord(header_bytes.data() + header, header);
+  const size_t last = headerWord(header_bytes.data() + 2 * header, header);
+  std::vector<unsigned char> out;
+  size_t at = 0;
+  for (size_t b = 0; b < nblocks; ++b) {
+    const size_t csize = headerWord(header_bytes.data() + (3 + b) * header, header);
+    const size_t usize = b + 1 == nblocks && last != 0 ? last : block;
+    if (csize > data_size - at) refuse(path, "compressed DataArray shorter than its header says");
+    // deflate expands by at most 1032:1, so a larger claim is a damaged header (not a huge array)
+    if (usize > 1032 * csize + 64) refuse(path, "a zlib block's size does not fit its compressed size");
+    const size_t start = out.size();
+    out.resize(start + usize);
+    uLongf got = static_cast<uLongf>(usize);
+    if (uncompress(out.data() + start, &got, data + at, static_cast<uLong>(csize)) != Z_OK || got != usize)
+      refuse(path, "a zlib block of a DataArray does not inflate");
+    at += csize;
+  }
+  return out;
+}
+
+// the bytes of one binary array: (header, data) base64 in `text` from `from`, or raw in `raw`
+std::vector<unsigned char> arrayBytes(const std::string& path, const VtpEncoding& enc, const std::string& text,
+                                      size_t from, bool base64) {
+  const size_t h = enc.header;
+  if (!enc.zlib) {
+    // uncompressed: a byte count, then the bytes (one base64 stream, or two: both are read)
+    std::vector<unsigned char> decoded;
+    const unsigned char* b = reinterpret_cast<const unsigned char*>(text.data()) + from;
+    size_t size = text.size() - from;
+    if (base64) {
+      decoded = decodeBase64(path, text.data() + from, text.size() - from);
+      b = decoded.data();
+      size = decoded.size();
+    }
+    if (size < h) refuse(path, "binary DataArray shorter than its header");
+    const std::uint64_t n = headerWord(b, h);
+    if (n > size - h) refuse(path, "binary DataArray shorter than its byte count");
+    return std::vector<unsigned char>(b + h, b + h + n);
+  }
+  if (!base64) {
+    if (text.size() < from + h) refuse(path, "compressed DataArray shorter than its header");
+    const auto* p = reinterpret_cast<const unsigned char*>(text.data()) + from;
+    const std::uint64_t nblocks = headerWord(p, h);
+    if (nblocks > text.size() || (3 + nblocks) * h > text.size() - from)
+      refuse(path, "compressed DataArray shorter than its header");
+    const size_t nh = (3 + nblocks) * h;
+    const std::vector<unsigned char> header_bytes(p, p + nh);
+    return inflateBlocks(path, header_bytes, p + nh, text.size() - from - nh, h);
+  }
+  // base64: the header is its own padded stream; its first word says how long it is
+  const size_t first_end = skipBase64(text, from, base64Chars(h));
+  const std::vector<unsigned char> first = decodeBase64(path, text.data() + from, first_end - from);
+  if (first.size() < h) refuse(path, "compressed DataArray shorter than its header");
+  const std::uint64_t nblocks = headerWord(first.data(), h);
+  if (nblocks > text.size()) refuse(path, "compressed DataArray shorter than its header");
+  const size_t nh = (3 + nblocks) * h;
+  const size_t header_end = skipBase64(text, from, base64Chars(nh));
+  const std::vector<unsigned char> header_bytes = decodeBase64(path, text.data() + from, header_end - from);
+  if (header_bytes.size() < nh) refuse(path, "compressed DataArray shorter than its header");
+  const std::vector<unsigned char> data = decodeBase64(path, text.data() + header_end, text.size() - header_end);
+  return inflateBlocks(path, header_bytes, data.data(), data.size(), h);
+}
+
+template <class T>
+void appendValues(const std::vector<unsigned char>& bytes, std::vector<double>& v) {
+  for (size_t i = 0; i + sizeof(T) <= bytes.size(); i += sizeof(T)) {
+    T k;
+    std::memcpy(&k, bytes.data() + i, sizeof(T));
+    v.push_back(static_cast<double>(k));
+  }
+}
+
+// the numbers of one DataArray: ascii, inline binary (base64) or appended (an offset into
+// <AppendedData>), each binary form uncompressed or zlib-compressed
+std::vector<double> dataArray(const std::string& path, const XMLElement* a, const VtpEncoding& enc) {
   const std::string format = detail::attribute(a, "format");
   const std::string type = detail::attribute(a, "type");
+  const std::string at = "line " + std::to_string(detail::lineOf(a)) + ": ";
   std::vector<double> v;
   if (format == "ascii" || format.empty()) {
     std::istringstream in(detail::textOf(a));
@@ -72,25 +191,30 @@ std::vector<double> dataArray(const std::string& path, const XMLElement* a, cons
     while (in >> x) v.push_back(x);
     return v;
   }
-  if (format != "binary")
-    refuse(path, "line " + std::to_string(detail::lineOf(a)) + ": DataArray format '" + format + "' is not read");
-  const std::vector<unsigned char> bytes = decodeBase64(path, detail::textOf(a));
-  const size_t header = header_type == "UInt64" ? 8 : 4;
-  size_t size = 0;
-  if (type == "Float32" || type == "Int32" || type == "UInt32") size = 4;
-  else if (type == "Float64" || type == "Int64" || type == "UInt64") size = 8;
-  else refuse(path, "DataArray type '" + type + "' is not read");
-  if (bytes.size() < header) refuse(path, "binary DataArray shorter than its header");
-  const size_t n = (bytes.size() - header) / size;
-  for (size_t i = 0; i < n; ++i) {
-    const unsigned char* p = bytes.data() + header + i * size;
-    if (type == "Float32") { float f; std::memcpy(&f, p, 4); v.push_back(f); }
-    else if (type == "Float64") { double d; std::memcpy(&d, p, 8); v.push_back(d); }
-    else if (type == "Int32") { std::int32_t k; std::memcpy(&k, p, 4); v.push_back(k); }
-    else if (type == "UInt32") { std::uint32_t k; std::memcpy(&k, p, 4); v.push_back(k); }
-    else if (type == "Int64") { std::int64_t k; std::memcpy(&k, p, 8); v.push_back(static_cast<double>(k)); }
-    else { std::uint64_t k; std::memcpy(&k, p, 8); v.push_back(static_cast<double>(k)); }
+  std::vector<unsigned char> bytes;
+  if (format == "binary") {
+    bytes = arrayBytes(path, enc, detail::textOf(a), 0, true);
+  } else if (format == "appended") {
+    const std::string offset = detail::attribute(a, "offset");
+    char* end = nullptr;
+    const unsigned long long off = std::strtoull(offset.c_str(), &end, 10);
+    if (offset.empty() || *end != '\0' || off >= enc.appended.size())
+      refuse(path, at + "appended DataArray offset '" + offset + "' is outside the AppendedData");
+    bytes = arrayBytes(path, enc, enc.appended, static_cast<size_t>(off), enc.appended_base64);
+  } else {
+    refuse(path, at + "DataArray format '" + format + "' is not read");
   }
+  if (type == "Float32") appendValues<float>(bytes, v);
+  else if (type == "Float64") appendValues<double>(bytes, v);
+  else if (type == "Int8") appendValues<std::int8_t>(bytes, v);
+  else if (type == "UInt8") appendValues<std::uint8_t>(bytes, v);
+  else if (type == "Int16") appendValues<std::int16_t>(bytes, v);
+  else if (type == "UInt16") appendValues<std::uint16_t>(bytes, v);
+  else if (type == "Int32") appendValues<std::int32_t>(bytes, v);
+  else if (type == "UInt32") appendValues<std::uint32_t>(bytes, v);
+  else if (type == "Int64") appendValues<std::int64_t>(bytes, v);
+  else if (type == "UInt64") appendValues<std::uint64_t>(bytes, v);
+  else refuse(path, at + "DataArray type '" + type + "' is not read");
   return v;
 }
 
@@ -100,13 +224,40 @@ const XMLElement* namedArray(const XMLElement* parent, const char* name) {
   return nullptr;
 }
 
+// Cuts <AppendedData>'s bytes out of the file's text (raw bytes are not XML) into enc.appended;
+// returns the XML that is left.
+std::string cutAppendedData(const std::string& path, std::string text, VtpEncoding& enc) {
+  const size_t tag = text.find("<AppendedData");
+  if (tag == std::string::npos) return text;
+  const size_t close = text.find('>', tag);
+  const size_t marker = close == std::string::npos ? close : text.find('_', close);
+  const size_t end = text.rfind("</AppendedData>");
+  if (marker == std::string::npos || end == std::string::npos || end < marker)
+    refuse(path, "AppendedData without its '_' marker or closing tag");
+  const std::string head = text.substr(tag, close - tag);
+  enc.appended_base64 = head.find("encoding=\"raw\"") == std::string::npos;
+  // raw data is followed by white space before the closing tag: the headers' sizes bound each array
+  enc.appended = text.substr(marker + 1, end - marker - 1);
+  text.erase(marker + 1, end - marker - 1);
+  return text;
+}
+
 TriangleMesh readVtp(const std::string& path) {
-  detail::XmlDocument doc(path);  // ConvertError on malformed XML
+  VtpEncoding enc;
+  const std::string xml = cutAppendedData(path, readAll(path), enc);
+  detail::XmlDocument doc(path, xml);  // ConvertError on malformed XML
   const XMLElement* vtk = doc.root();
   if (!vtk || std::string(vtk->Name()) != "VTKFile" || detail::attribute(vtk, "type") != "PolyData")
     refuse(path, "not a VTK XML PolyData file");
-  if (!detail::attribute(vtk, "compressor").empty()) refuse(path, "compressed data is not read");
+  const std::string compressor = detail::attribute(vtk, "compressor");
+  if (compressor == "vtkZLibDataCompressor") enc.zlib = true;
+  else if (!compressor.empty())
+    refuse(path, "compressor '" + compressor + "' is not read (only vtkZLibDataCompressor: zlib)");
+  if (detail::attribute(vtk, "byte_order") == "BigEndian") refuse(path, "big-endian data is not read");
   const std::string header_type = detail::attribute(vtk, "header_type");
+  if (header_type == "UInt64") enc.header = 8;
+  else if (!header_type.empty() && header_type != "UInt32")
+    refuse(path, "header_type '" + header_type + "' is not read (UInt32 or UInt64)");
   const XMLElement* poly = detail::firstChild(vtk, "PolyData");
   const std::vector<const XMLElement*> pieces = detail::childElements(poly, "Piece");
   if (pieces.empty()) refuse(path, "no Piece");
@@ -121,16 +272,21 @@ TriangleMesh readVtp(const std::string& path) {
     const XMLElement* conn = namedArray(polys, "connectivity");
     const XMLElement* offs = namedArray(polys, "offsets");
     if (!pts || !conn || !offs) refuse(path, "a Piece without Points or Polys connectivity/offsets");
-    const std::vector<double> x = dataArray(path, pts, header_type);
-    const std::vector<double> c = dataArray(path, conn, header_type), o = dataArray(path, offs, header_type);
+    const std::vector<double> x = dataArray(path, pts, enc);
+    const std::vector<double> c = dataArray(path, conn, enc), o = dataArray(path, offs, enc);
     const int base = m.numVertices();
     m.vertices.insert(m.vertices.end(), x.begin(), x.end() - static_cast<long>(x.size() % 3));
     size_t begin = 0;
     for (double end_d : o) {
+      if (!(end_d >= static_cast<double>(begin) && end_d <= static_cast<double>(c.size())))
+        refuse(path, "Polys offsets out of order");
       const auto end = static_cast<size_t>(end_d);
-      if (end < begin || end > c.size()) refuse(path, "Polys offsets out of order");
       std::vector<int> face;
-      for (size_t k = begin; k < end; ++k) face.push_back(base + static_cast<int>(c[k]));
+      for (size_t k = begin; k < end; ++k) {
+        if (!(c[k] >= 0 && c[k] < static_cast<double>(x.size() / 3)))
+          refuse(path, "Polys connectivity names vertex " + std::to_string(c[k]) + " of " + std::to_string(x.size() / 3));
+        face.push_back(base + static_cast<int>(c[k]));
+      }
       addFan(face, m.triangles);
       begin = end;
     }

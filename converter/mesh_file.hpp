@@ -5,8 +5,10 @@
 //
 // Formats read:
 //   .vtp  VTK XML PolyData (what OpenSim's Geometry folder holds): Points and Polys (triangles,
-//         polygons fanned into triangles), DataArrays in `ascii` or uncompressed `binary` (base64)
-//         format. Compressed or appended data, Strips and other pieces are refused with the reason.
+//         polygons fanned into triangles), DataArrays in `ascii`, inline `binary` (base64) or
+//         `appended` (raw or base64) format, uncompressed or zlib-compressed (vtkZLibDataCompressor),
+//         UInt32 or UInt64 headers, little-endian. Other compressors (LZ4, LZMA), big-endian data,
+//         Strips, Lines and Verts are refused with the reason.
 //   .obj  `v` and `f` lines (polygons fanned; `v/vt/vn` and negative indices taken).
 //   .stl  ASCII or binary.
 #include <string>

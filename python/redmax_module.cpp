@@ -425,6 +425,7 @@ py::dict forward(std::vector<std::string> flags) {
   cli::addForwardFlags(app, f);
   parseFlags(app, std::move(flags));
   const validation::ForwardToolSettings s = usage([&] { return cli::parseForwardFlags(f, app); });
+  if (f.view && !s.out_dir) throw std::invalid_argument("view=True needs out_dir (the folder the view is written into)");
   std::unique_ptr<validation::ForwardTool> tool;
   validation::ForwardResult r;
   {
@@ -448,7 +449,10 @@ py::dict forward(std::vector<std::string> flags) {
   out["failed_steps"] = r.stats.failed_steps;
   out["wall_s"] = r.wall_s;
   out["decimals"] = std::max(8, tool->setup().output_precision);  // as ForwardTool::write: %.{decimals}e
-  out["files"] = s.out_dir ? std::vector<std::string>{tool->statesPath(), tool->controlsPath()} : std::vector<std::string>{};
+  std::vector<std::string> files;
+  if (s.out_dir) files = {tool->statesPath(), tool->controlsPath()};
+  if (s.out_dir && f.view) files.push_back(tool->viewPath() + "/index.html");
+  out["files"] = files;
   out["states"] = toPython(std::move(r.states));
   out["controls"] = toPython(std::move(r.controls));
   return out;

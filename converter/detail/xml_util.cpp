@@ -33,13 +33,20 @@ XmlDocument::XmlDocument(const std::string& path) : path_(path) {
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw ConvertError(path, 0, "cannot open file");
   probe.close();
-  const tinyxml2::XMLError err = doc_.LoadFile(path.c_str());
+  check(doc_.LoadFile(path.c_str()));
+}
+
+XmlDocument::XmlDocument(const std::string& path, const std::string& text) : path_(path) {
+  check(doc_.Parse(text.data(), text.size()));
+}
+
+void XmlDocument::check(tinyxml2::XMLError err) const {
   if (err != tinyxml2::XML_SUCCESS) {
     const char* s = doc_.ErrorStr();
-    throw ConvertError(path, doc_.ErrorLineNum(),
+    throw ConvertError(path_, doc_.ErrorLineNum(),
                        std::string("malformed XML: ") + (s ? s : doc_.ErrorName()));
   }
-  if (!doc_.RootElement()) throw ConvertError(path, 0, "malformed XML: no root element");
+  if (!doc_.RootElement()) throw ConvertError(path_, 0, "malformed XML: no root element");
 }
 
 void XmlDocument::fail(const XMLElement* e, const std::string& what) const {

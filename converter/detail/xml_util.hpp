@@ -19,6 +19,8 @@ using tinyxml2::XMLElement;
 class XmlDocument {
  public:
   explicit XmlDocument(const std::string& path);
+  /// parses `text`, read from `path` by the caller (errors name `path` and the line in `text`)
+  XmlDocument(const std::string& path, const std::string& text);
   XmlDocument(const XmlDocument&) = delete;
   XmlDocument& operator=(const XmlDocument&) = delete;
 
@@ -28,6 +30,7 @@ class XmlDocument {
   [[noreturn]] void fail(const XMLElement* e, const std::string& what) const;
 
  private:
+  void check(tinyxml2::XMLError err) const;
   std::string path_;
   tinyxml2::XMLDocument doc_;
 };

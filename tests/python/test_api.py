@@ -196,6 +196,8 @@ def test_keywords_are_the_cli_flags(tmp_path):
         redmax.forward(setup=shared(FORWARD_SETUP), integrator="leapfrog")
     with pytest.raises(ValueError, match="forward needs --setup"):
         redmax.forward()
+    with pytest.raises(ValueError, match="view=True needs out_dir"):  # a view is never dropped
+        redmax.forward(setup=shared(FORWARD_SETUP), view=True)
     with pytest.raises(ValueError, match="muscle-class"):
         redmax.analyze(setup=setup, muscle_class="Nope")
     with pytest.raises(ValueError, match="--mass-sweep needs --muscle-mass"):

@@ -15,7 +15,7 @@ import zlib
 import numpy as np
 import pytest
 
-from conftest import LEG, MODELS, SWING
+from conftest import LEG, MODELS, SWING, shared
 
 WRAP_PENDULUM = os.path.join(MODELS, "double_pendulum_wrap.osim")
 
@@ -187,6 +187,57 @@ def test_screenshots_differ_where_the_model_moved(chromium, leg_view, tmp_path):
     # measured: 20.1% of the scene's pixels change between t = 0 and 0.4 s, none of the panel's
     assert 0.07 < scene.mean() < 0.6, scene.mean()
     assert panel.mean() == 0.0
+
+
+def test_times_between_frames_are_interpolated(chromium, leg_view, tmp_path):
+    out, _ = leg_view
+    data = view_data(out)
+    times, lengths = np.array(data["times"]), np.array([f["lengths"] for f in data["frames"]])
+    k = len(times) // 2
+    mid = 0.5 * (times[k] + times[k + 1])
+    url = (out / "index.html").as_uri()
+    shots = {name: tmp_path / f"{name}.png" for name in ("a", "mid", "b")}
+    res = browse(chromium, [(url + f"#t={mid!r}", "dom", None), (url + f"#t={times[k]!r}", "png", shots["a"]),
+                            (url + f"#t={mid!r}", "png", shots["mid"]),
+                            (url + f"#t={times[k + 1]!r}", "png", shots["b"])])
+    dom, err = res[url + f"#t={mid!r}"]
+    st = page_status(dom)
+    assert st["ready"] and st["errors"] == [], (st["errors"], err[-2000:])
+    assert st["between"] == [k, k + 1] and st["t"] == pytest.approx(mid, abs=1e-12)
+    # half-way lengths, to the round-off of data.js's numbers (8 significant digits)
+    assert np.max(np.abs(np.array(st["lengths"]) - 0.5 * (lengths[k] + lengths[k + 1]))) < 1e-12
+    assert np.max(np.abs(lengths[k + 1] - lengths[k])) > 1e-5  # the muscles moved between the frames
+    a, m, b = (read_png(shots[x]) for x in ("a", "mid", "b"))
+    # the in-between picture is neither frame's
+    assert np.any(m != a) and np.any(m != b)
+
+
+def test_forward_writes_the_runs_view(chromium, redmax_exe, tmp_path):
+    setup = shared("opensim-core/Applications/Forward/tests/resources/arm26_Setup_Forward.xml")
+    r = run(redmax_exe, "forward", "--setup", setup, "--muscle-class", "Thelen2003Muscle_Deprecated", "--integrator",
+            "cvode", "--muscle-mass", "physiological", "--out-dir", tmp_path / "fw", "--view")
+    assert r.returncode == 0, r.stderr
+    out = tmp_path / "fw" / "arm26_view"
+    assert f"-> {out}/index.html (101 frames, 6 muscles, 120 mass points)" in r.stdout
+    data = view_data(out)
+    states = tmp_path / "fw" / "arm26_states.sto"
+    lines = states.read_text().splitlines()
+    table = np.array([[float(x) for x in line.split()] for line in lines[lines.index("endheader") + 2:]])
+    assert np.allclose(data["times"], table[:, 0], rtol=0, atol=1e-12)
+    # the same page as `redmax view` of the model along the states file forward wrote
+    model = os.path.join(os.path.dirname(setup), "arm26.osim")
+    v = run(redmax_exe, "view", model, "--motion", states, "--muscle-mass", "physiological", "--out", tmp_path / "v")
+    assert v.returncode == 0, v.stderr
+    other = view_data(tmp_path / "v")
+    a = np.array([f["lengths"] for f in data["frames"]])
+    b = np.array([f["lengths"] for f in other["frames"]])
+    # the written states keep 9 significant digits, data.js 8: measured max difference 0 m
+    assert a.shape == b.shape and np.max(np.abs(a - b)) < 2e-8
+    assert np.ptp(a, axis=0).max() > 1e-3  # the arm moved
+    dom, err = next(iter(browse(chromium, [((out / "index.html").as_uri() + "#t=0.5", "dom", None)]).values()))
+    st = page_status(dom)
+    assert st["ready"] and st["errors"] == [], (st["errors"], err[-2000:])
+    assert st["muscles"] == [m["name"] for m in data["muscles"]] and st["mass_points"] == 120
 
 
 def test_malformed_motion_is_refused(redmax_exe, tmp_path):

@@ -341,6 +341,9 @@ std::string ForwardTool::statesPath() const {
 std::string ForwardTool::controlsPath() const {
   return (fs::path(resultsDirectory()) / (setup_.name + "_controls.sto")).string();
 }
+std::string ForwardTool::viewPath() const {
+  return (fs::path(resultsDirectory()) / (setup_.name + "_view")).string();
+}
 
 ForwardResult ForwardTool::run() const {
   const double t0 = setup_.initial_time, t1 = setup_.final_time;
@@ -365,7 +368,7 @@ ForwardResult ForwardTool::run() const {
   return r;
 }
 
-void ForwardTool::write(const ForwardResult& r) const {
+view::ViewSummary ForwardTool::write(const ForwardResult& r) const {
   const std::string dir = resultsDirectory();
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -377,6 +380,13 @@ void ForwardTool::write(const ForwardResult& r) const {
   osim::writeStorage(statesPath(), r.states, o);
   o.description = "redmax forward: controls of " + setup_.source_file;
   osim::writeStorage(controlsPath(), r.controls, o);
+  if (settings_.view.index_html.empty()) return {};
+  view::ViewInput in;
+  in.description = osim::readOsimModel(setup_.model_file);
+  in.motion_file = statesPath();
+  in.motion = r.states;
+  in.mass = settings_.muscle_mass;
+  return view::writeView(in, settings_.view, viewPath());
 }
 
 }  // namespace redmax::validation

@@ -16,7 +16,8 @@
 //   -> rk45 (or another integrator) from initial_time to final_time with rtol = atol =
 //     integrator_error_tolerance, maximum_integrator_step_size, maximum_number_of_integrator_steps
 //   -> DIR/<name>_states.sto (time, /jointset/J/C/value, .../speed, every auxiliary state under
-//     its OpenSim 4 name) and DIR/<name>_controls.sto (one column per actuator), written atomically.
+//     its OpenSim 4 name) and DIR/<name>_controls.sto (one column per actuator), written atomically;
+//     with settings.view, DIR/<name>_view (`redmax view` of the model along those states).
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,7 @@
 #include "converter/storage.hpp"
 #include "core/integrators/integrator.hpp"
 #include "validation/simulate/simulate.hpp"
+#include "view/view.hpp"
 
 namespace redmax::validation {
 
@@ -86,6 +88,10 @@ struct ForwardToolSettings {
   std::optional<double> tolerance;     ///< replaces integrator_error_tolerance (rtol = atol)
   /// refuse (std::invalid_argument naming each) when a force or contact geometry is not applied
   bool strict = false;
+  /// the page files of `redmax view` (view/view.hpp); given (index_html not empty), write() also
+  /// writes the run's view (the model along the states written, with the run's muscle mass) into
+  /// DIR/<name>_view
+  view::ViewAssets view;
 };
 
 struct ForwardResult {
@@ -112,10 +118,14 @@ class ForwardTool {
   std::string resultsDirectory() const;
   std::string statesPath() const;
   std::string controlsPath() const;
+  /// DIR/<name>_view: the folder of the run's view (written when settings.view is given)
+  std::string viewPath() const;
 
   ForwardResult run() const;
-  /// the states and controls tables, atomically (the folder is created)
-  void write(const ForwardResult& r) const;
+  /// the states and controls tables, atomically (the folder is created), then the view when
+  /// settings.view is given (view::writeView's errors pass through; the tables are kept). Returns
+  /// the view's summary (frames 0: none written).
+  view::ViewSummary write(const ForwardResult& r) const;
 
  private:
   ForwardToolSettings settings_;

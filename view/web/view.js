@@ -5,7 +5,8 @@
   "use strict";
   const started = performance.now();
   const status = { ready: false, muscles: [], mass_points: 0, bodies: 0, meshes: 0, ellipsoids: 0,
-                   wrap_surfaces: 0, joint_frames: 0, frame: 0, t: 0, messages: [], errors: [] };
+                   wrap_surfaces: 0, joint_frames: 0, frame: 0, between: [0, 0], t: 0, lengths: [],
+                   messages: [], errors: [] };
   const $ = (id) => document.getElementById(id);
 
   function say(text, cls) {
@@ -135,11 +136,41 @@
   });
 
   const scratch = new THREE.Matrix4(), unitQ = new THREE.Quaternion(), at = new THREE.Vector3(), scale = new THREE.Vector3();
-  let frame = 0, selected = -1;
+  let frame = 0, selected = -1, shown = V.frames[0];
 
-  function show(f) {
-    frame = f;
-    const F = V.frames[f];
+  // the state at time t: between two frames, body poses are slerped and positions, mass points
+  // and lengths interpolated linearly; a path whose points changed in number or kind between the
+  // two frames (a wrap that engaged, a conditional point) is drawn as the nearer frame's
+  function stateAt(t) {
+    const T = V.times, n = T.length;
+    if (!(t > T[0]) || n === 1) return { F: V.frames[0], f: 0, t: T[0], between: [0, 0] };
+    if (t >= T[n - 1]) return { F: V.frames[n - 1], f: n - 1, t: T[n - 1], between: [n - 1, n - 1] };
+    let lo = 0, hi = n - 1;
+    while (hi - lo > 1) { const mid = (lo + hi) >> 1; if (T[mid] <= t) lo = mid; else hi = mid; }
+    const w = T[hi] > T[lo] ? (t - T[lo]) / (T[hi] - T[lo]) : 0;
+    const near = w < 0.5 ? lo : hi;
+    if (w === 0) return { F: V.frames[lo], f: lo, t, between: [lo, lo] };
+    const A = V.frames[lo], B = V.frames[hi];
+    const mix = (a, b) => a.map((x, i) => x + w * (b[i] - x));
+    const bodies = mix(A.bodies, B.bodies), qa = new THREE.Quaternion(), qb = new THREE.Quaternion();
+    for (let b = 0; 7 * b < bodies.length; b++) {
+      qa.fromArray(A.bodies, 7 * b + 3).slerp(qb.fromArray(B.bodies, 7 * b + 3), w).toArray(bodies, 7 * b + 3);
+    }
+    const paths = A.paths.map((pa, k) => {
+      const pb = B.paths[k];
+      const same = pa.kind.length === pb.kind.length && pa.kind.every((x, i) => x === pb.kind[i]);
+      return same ? { x: mix(pa.x, pb.x), kind: pa.kind } : V.frames[near].paths[k];
+    });
+    const F = { bodies, paths, mass_points: A.mass_points.map((x, k) => mix(x, B.mass_points[k])),
+                lengths: mix(A.lengths, B.lengths) };
+    return { F, f: near, t, between: [lo, hi] };
+  }
+
+  const show = (f) => showTime(V.times[f]);
+  function showTime(time) {
+    const S = stateAt(time), F = S.F;
+    frame = S.f;
+    shown = F;
     bodies.forEach((g, b) => setPose(g, F.bodies.slice(7 * b, 7 * b + 7)));
     muscles.forEach((mu, k) => {
       const p = F.paths[k], n = p.x.length / 3;
@@ -165,10 +196,12 @@
       }
       mu.mass.instanceMatrix.needsUpdate = true;
     });
-    status.frame = f;
-    status.t = V.times[f];
-    $("slider").value = f;
-    $("time").textContent = "t = " + V.times[f].toFixed(3) + " s";
+    status.frame = S.f;
+    status.between = S.between;
+    status.t = S.t;
+    status.lengths = F.lengths;
+    $("slider").value = S.f;
+    $("time").textContent = "t = " + S.t.toFixed(3) + " s";
     readout();
     render();
   }
@@ -177,7 +210,7 @@
     if (selected < 0) return;
     const m = V.muscles[selected];
     let text = m.name + " (" + m.class + ", Type " + m.path_type + ")\n" +
-               "length " + V.frames[frame].lengths[selected].toFixed(5) + " m\n" +
+               "length " + shown.lengths[selected].toFixed(5) + " m\n" +
                "mass " + m.mass.toPrecision(4) + " kg in " + m.mass_points + " points";
     if (m.lumped_why) text += "\nno mass points: " + m.lumped_why;
     $("readout").textContent = text;
@@ -208,7 +241,7 @@
   const camera = new THREE.PerspectiveCamera(35, 1, size / 1000, size * 100);
   const orbit = { az: 0.35, el: 0.2, dist: 1.8 * size };
   function render() {
-    centre.fromArray(V.frames[frame].bodies, 0).add(centreOffset);
+    centre.fromArray(shown.bodies, 0).add(centreOffset);
     camera.position.set(centre.x + orbit.dist * Math.cos(orbit.el) * Math.sin(orbit.az),
                         centre.y + orbit.dist * Math.sin(orbit.el),
                         centre.z + orbit.dist * Math.cos(orbit.el) * Math.cos(orbit.az));
@@ -235,15 +268,11 @@
   renderer.domElement.addEventListener("wheel", (e) => { e.preventDefault(); orbit.dist *= e.deltaY > 0 ? 1.1 : 1 / 1.1; render(); });
   window.addEventListener("resize", resize);
 
-  // time: the frame nearest to t; #t=SECONDS in the URL picks it (#t=0.2&muscle=NAME)
-  function frameAt(t) {
-    let best = 0;
-    V.times.forEach((x, i) => { if (Math.abs(x - t) < Math.abs(V.times[best] - t)) best = i; });
-    return best;
-  }
+  // time: #t=SECONDS in the URL shows the state at that time (#t=0.2&muscle=NAME)
   function fromHash() {
     const m = /t=([-+0-9.eE]+)/.exec(location.hash);
-    return m ? frameAt(parseFloat(m[1])) : 0;
+    const t = m ? parseFloat(m[1]) : NaN;
+    return Number.isFinite(t) ? t : V.times[0];
   }
   // #muscle=NAME selects a muscle (its readout), as a click on its name does
   function selectFromHash() {
@@ -251,18 +280,18 @@
     const k = m ? V.muscles.findIndex((x) => x.name === decodeURIComponent(m[1])) : -1;
     if (k >= 0) select(k);
   }
-  window.addEventListener("hashchange", () => { selectFromHash(); show(fromHash()); });
+  window.addEventListener("hashchange", () => { selectFromHash(); showTime(fromHash()); });
   $("slider").max = V.times.length - 1;
   $("slider").addEventListener("input", (e) => show(parseInt(e.target.value, 10)));
   let playing = null;
   $("play").addEventListener("click", () => {
     if (playing) { cancelAnimationFrame(playing.id); playing = null; $("play").textContent = "play"; return; }
-    const t0 = V.times[frame] - V.times[0], wall0 = performance.now(), span = V.times[V.times.length - 1] - V.times[0];
+    const t0 = status.t - V.times[0], wall0 = performance.now(), span = V.times[V.times.length - 1] - V.times[0];
     playing = {};
     $("play").textContent = "pause";
     const step = () => {
       const t = span > 0 ? (t0 + (performance.now() - wall0) / 1000) % span : 0;
-      show(frameAt(V.times[0] + t));
+      showTime(V.times[0] + t);
       playing.id = requestAnimationFrame(step);
     };
     step();
@@ -270,7 +299,7 @@
 
   resize();
   selectFromHash();
-  show(fromHash());
+  showTime(fromHash());
   status.ready = true;
   // from navigation start (three.min.js and data.js parsed) and in this script, to the first frame
   status.load_ms = Math.round(performance.now());
