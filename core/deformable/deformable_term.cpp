@@ -254,6 +254,22 @@ void DeformableTerm::setRestState(State& s) const {
   }
 }
 
+void DeformableTerm::setRestState(const Model& model, State& s, int follow) const {
+  if (follow < 0 || follow >= model.nb()) throw ModelError("DeformableTerm::setRestState: no body " + std::to_string(follow));
+  std::vector<Mat4> E0;
+  calcBodyPoses(model, model.defaultQ(), E0);
+  SkeletonWorkspace sk(model);
+  calcKinematics(model, s, sk);
+  const Mat4 E0_inv = inverseE(E0[follow]);
+  for (int n = 0; n < body_.numNodes(); ++n) {
+    const NodeBinding& b = nodes_[n];
+    if (b.kind != NodeBinding::Kind::Free) continue;
+    const Vec3 X = transformPoint(E0_inv, body_.rest[n]);
+    s.q.segment<3>(b.index) = pointPosition(sk, follow, X);
+    s.qdot.segment<3>(b.index) = pointVelocity(sk, follow, X);
+  }
+}
+
 std::shared_ptr<const DeformableTerm> addDeformableBody(System& sys, DeformableBody body,
                                                         const std::vector<NodeAttachment>& attach,
                                                         DeformableTermOptions options) {

@@ -75,6 +75,9 @@ class DeformableTerm final : public ForceTerm {
   VecX nodePositions(const Model& model, const State& s, const TermContext& ctx) const;
   /// write the free nodes' rest positions into s.q and zero their velocities
   void setRestState(State& s) const;
+  /// the free nodes at rest carried rigidly by body `follow` from the model's default pose to its
+  /// pose at s.q, moving with its velocity at s.qdot (a soft body starting undeformed on a moved link)
+  void setRestState(const Model& model, State& s, int follow) const;
 
  private:
   DeformableScratch& evaluate(const Model& model, const State& s, const TermContext& ctx, bool stiffness,

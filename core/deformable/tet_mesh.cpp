@@ -226,7 +226,8 @@ TetMesh readVtkTetMesh(const std::string& path, VtkReadInfo* info) {
 }
 
 void writeVtkTetMesh(const std::string& path, const TetMesh& mesh, const std::vector<Vec3>& x,
-                     const std::vector<std::pair<std::string, std::vector<Vec3>>>& point_vectors) {
+                     const std::vector<std::pair<std::string, std::vector<Vec3>>>& point_vectors,
+                     const std::vector<std::array<int, 2>>& lines) {
   const std::vector<Vec3>& p = x.empty() ? mesh.nodes : x;
   if (p.size() != mesh.nodes.size()) throw std::invalid_argument("writeVtkTetMesh: positions do not match the nodes");
   std::ostringstream o;
@@ -234,10 +235,17 @@ void writeVtkTetMesh(const std::string& path, const TetMesh& mesh, const std::ve
   o << "# vtk DataFile Version 3.0\nredmax tetrahedral mesh\nASCII\nDATASET UNSTRUCTURED_GRID\n";
   o << "POINTS " << p.size() << " double\n";
   for (const Vec3& v : p) o << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
-  o << "CELLS " << mesh.tets.size() << ' ' << 5 * mesh.tets.size() << '\n';
+  const size_t cells = mesh.tets.size() + lines.size();
+  o << "CELLS " << cells << ' ' << 5 * mesh.tets.size() + 3 * lines.size() << '\n';
   for (const auto& t : mesh.tets) o << "4 " << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
-  o << "CELL_TYPES " << mesh.tets.size() << '\n';
+  for (const auto& l : lines) {
+    if (l[0] < 0 || l[1] < 0 || l[0] >= static_cast<int>(p.size()) || l[1] >= static_cast<int>(p.size()))
+      throw std::invalid_argument("writeVtkTetMesh: line cell with a node out of range");
+    o << "2 " << l[0] << ' ' << l[1] << '\n';
+  }
+  o << "CELL_TYPES " << cells << '\n';
   for (size_t i = 0; i < mesh.tets.size(); ++i) o << "10\n";
+  for (size_t i = 0; i < lines.size(); ++i) o << "3\n";
   if (!point_vectors.empty()) {
     o << "POINT_DATA " << p.size() << '\n';
     for (const auto& [name, values] : point_vectors) {

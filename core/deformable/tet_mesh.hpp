@@ -52,11 +52,13 @@ struct VtkReadInfo {
 /// degenerate tet is a MeshError "FILE:LINE: ...". Negatively oriented tets are reordered.
 TetMesh readVtkTetMesh(const std::string& path, VtkReadInfo* info = nullptr);
 
-/// Write mesh with node positions x (nodes' size; empty: the rest positions) and optional
-/// per-node vectors (name, values of the nodes' size) as legacy ASCII VTK, through a temporary
-/// file renamed into place. Throws std::runtime_error when the file cannot be written.
+/// Write mesh with node positions x (nodes' size; empty: the rest positions), optional
+/// per-node vectors (name, values of the nodes' size) and optional line cells (strands) as legacy
+/// ASCII VTK, through a temporary file renamed into place. Throws std::runtime_error when the
+/// file cannot be written.
 void writeVtkTetMesh(const std::string& path, const TetMesh& mesh, const std::vector<Vec3>& x = {},
-                     const std::vector<std::pair<std::string, std::vector<Vec3>>>& point_vectors = {});
+                     const std::vector<std::pair<std::string, std::vector<Vec3>>>& point_vectors = {},
+                     const std::vector<std::array<int, 2>>& lines = {});
 
 /// ParaView collection (.pvd) of a time series: (time, file name relative to the .pvd) per frame.
 void writePvd(const std::string& path, const std::vector<std::pair<double, std::string>>& frames);
