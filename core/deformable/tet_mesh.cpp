@@ -68,7 +68,7 @@ struct Tokens {
     } catch (const std::exception&) {
       fail(ln, "expected " + what + ", got '" + s + "'");
     }
-    if (!std::isfinite(v)) fail(ln, "non-finite " + what + " '" + s + "'");
+    if (!std::isfinite(v)) fail(ln, what + " is not finite: '" + s + "'");
     return v;
   }
 };
@@ -135,9 +135,9 @@ TetMesh readVtkTetMesh(const std::string& path, VtkReadInfo* info) {
     if (!std::getline(in, header[i])) throw MeshError(path + ":" + std::to_string(i + 1) + ": truncated VTK header");
     ++ln;
     if (!header[i].empty() && header[i].back() == '\r') header[i].pop_back();
+    if (i == 0 && header[0].rfind("# vtk DataFile Version", 0) != 0)
+      t.fail(1, "not a legacy VTK file (expected '# vtk DataFile Version ...')");
   }
-  if (header[0].rfind("# vtk DataFile Version", 0) != 0)
-    t.fail(1, "not a legacy VTK file (expected '# vtk DataFile Version ...')");
   const std::string fmt = upper(header[2]);
   if (fmt.find("BINARY") != std::string::npos) t.fail(3, "BINARY VTK files are not supported (write ASCII)");
   if (fmt.find("ASCII") == std::string::npos) t.fail(3, "expected ASCII, got '" + header[2] + "'");
