@@ -66,40 +66,42 @@ StaticResult solveStatic(const NodeSpaceProblem& p, VecX& x, double tol, int max
   }
 }
 
-void stepNodeSpace(const NodeSpaceProblem& p, VecX& x, VecX& v, double h, LinearSolve solve) {
+void implicitStepSystem(const NodeSpaceProblem& p, const VecX& x, const VecX& v, double h, SparseMat& A, VecX& rhs) {
   check(p, x);
   const std::vector<int> dofs = p.freeDofs();
   const int n = static_cast<int>(dofs.size());
   const DeformableBody& b = *p.body;
   ElasticEvaluation ev;
   evalElastic(b, x, true, ev);
-  // node force f = elastic - (alpha M + beta K) v + m g; A = M + h D + h^2 K
   VecX Mdiag(n), vf(n), f(n);
   for (int i = 0; i < n; ++i) {
     Mdiag[i] = b.mass[dofs[i] / 3];
     vf[i] = v[dofs[i]];
   }
   const SparseMat K = restrict(ev.K, dofs);
-  const VecX Kv = K * vf;
-  for (int i = 0; i < n; ++i) f[i] = ev.f[dofs[i]] + Mdiag[i] * p.gravity[dofs[i] % 3];
   // the fixed nodes do not move: their velocities add nothing to the damping of the free ones
-  f -= b.rayleigh_mass * Mdiag.cwiseProduct(vf) + b.rayleigh_stiffness * Kv;
-  const VecX Dv = b.rayleigh_mass * Mdiag.cwiseProduct(vf) + b.rayleigh_stiffness * Kv;
-  const VecX rhs = Mdiag.cwiseProduct(vf) + h * (f + Dv);
-  const double cK = h * b.rayleigh_stiffness + h * h, cM = 1.0 + h * b.rayleigh_mass;
-  VecX vnew;
+  const VecX Dv = b.rayleigh_mass * Mdiag.cwiseProduct(vf) + b.rayleigh_stiffness * (K * vf);
+  for (int i = 0; i < n; ++i) f[i] = ev.f[dofs[i]] + Mdiag[i] * p.gravity[dofs[i] % 3];
+  f -= Dv;  // node force: elastic - (alpha M + beta K) v + m g
+  rhs = Mdiag.cwiseProduct(vf) + h * (f + Dv);
+  A = (h * b.rayleigh_stiffness + h * h) * K;
+  const double cM = 1.0 + h * b.rayleigh_mass;
+  for (int i = 0; i < n; ++i) A.coeffRef(i, i) += cM * Mdiag[i];
+}
+
+void stepNodeSpace(const NodeSpaceProblem& p, VecX& x, VecX& v, double h, LinearSolve solve) {
+  SparseMat A;
+  VecX rhs, vnew;
+  implicitStepSystem(p, x, v, h, A, rhs);
   if (solve == LinearSolve::Sparse) {
-    SparseMat A = cK * K;
-    for (int i = 0; i < n; ++i) A.coeffRef(i, i) += cM * Mdiag[i];
     Eigen::SimplicialLDLT<SparseMat> ldlt(A);
     if (ldlt.info() != Eigen::Success) throw std::runtime_error("stepNodeSpace: factorisation failed");
     vnew = ldlt.solve(rhs);
   } else {
-    MatX A = cK * MatX(K);
-    A.diagonal() += cM * Mdiag;
-    vnew = A.ldlt().solve(rhs);
+    vnew = MatX(A).ldlt().solve(rhs);
   }
-  for (int i = 0; i < n; ++i) {
+  const std::vector<int> dofs = p.freeDofs();
+  for (size_t i = 0; i < dofs.size(); ++i) {
     v[dofs[i]] = vnew[i];
     x[dofs[i]] += h * vnew[i];
   }

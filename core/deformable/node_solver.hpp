@@ -30,6 +30,10 @@ StaticResult solveStatic(const NodeSpaceProblem& p, VecX& x, double tol = 1e-10,
 
 enum class LinearSolve { Dense, Sparse };
 
+/// The linear system of one step below over the free coordinates (freeDofs order): the sparse
+/// matrix A = M + h D + h^2 K and rhs = M v + h (f + D v), for callers with their own solver.
+void implicitStepSystem(const NodeSpaceProblem& p, const VecX& x, const VecX& v, double h, SparseMat& A, VecX& rhs);
+
 /// One linearly implicit Euler step [D Eq. 4.78-4.82] of the free nodes:
 ///   (M + h D + h^2 K) v+ = M v + h (f + D v),   x+ = x + h v+,
 /// K the exact stiffness, D = alpha M + beta K, f elastic + damping + gravity. Dense: Eigen's LDLT

@@ -43,10 +43,12 @@ DeformableRun simulate(const System& sys, State s, const DeformableTerm& term, c
     run.nodes.push_back(toPoints(term.nodePositions(sys.model(), s, TermContext(sk))));
   }
   for (int i = 0; i < sys.model().nr(); ++i) run.coordinates.push_back(sys.model().coordinates()[i].name);
-  for (int i = sys.model().nr(); i < sys.ndof(); ++i) {
-    const int j = i - sys.model().nr();
-    run.coordinates.push_back("x" + std::to_string(j / 3) + "_" + "xyz"[j % 3]);
-  }
+  // a free node's coordinates are its world position: node<n>_x, _y, _z
+  run.coordinates.resize(sys.ndof());
+  for (size_t n = 0; n < term.nodes().size(); ++n)
+    if (term.nodes()[n].kind == NodeBinding::Kind::Free)
+      for (int c = 0; c < 3; ++c)
+        run.coordinates[term.nodes()[n].index + c] = "node" + std::to_string(n) + "_" + "xyz"[c];
   return run;
 }
 

@@ -18,7 +18,7 @@ namespace redmax::scenes {
 struct CantileverOptions {
   double length = 1.0, width = 0.1;  // m
   double E = 1e9, nu = 0.0, rho = 1000.0, g = 9.81;
-  int refinement = 2;
+  int refinement = 4;
   CubeSplit split = CubeSplit::Six;
 };
 
