@@ -41,6 +41,7 @@ struct Tokens {
     throw MeshError(file + ":" + std::to_string(line) + ": " + what);
   }
   bool done() const { return pos >= tok.size(); }
+  size_t remaining() const { return tok.size() - pos; }
   int line() const { return done() ? lastLine() : tok[pos].second; }
   const std::string& next(const std::string& what) {
     if (done()) fail(lastLine(), "unexpected end of file, expected " + what);
@@ -162,6 +163,9 @@ TetMesh readVtkTetMesh(const std::string& path, VtkReadInfo* info) {
       const long long n = t.integer("the number of points");
       if (n < 1 || n > 100000000) t.fail(kl, "bad number of points " + std::to_string(n));
       t.next("the points' data type");
+      // never allocate for more than the file holds
+      if (static_cast<unsigned long long>(3 * n) > t.remaining())
+        t.fail(kl, std::to_string(n) + " points announced, the file ends before their coordinates");
       m.nodes.resize(static_cast<size_t>(n));
       for (auto& p : m.nodes)
         for (int c = 0; c < 3; ++c) p[c] = t.real("a point coordinate");
@@ -171,6 +175,8 @@ TetMesh readVtkTetMesh(const std::string& path, VtkReadInfo* info) {
       const long long n = t.integer("the number of cells");
       const long long size = t.integer("the CELLS list size");
       if (n < 0 || n > 100000000 || size < n) t.fail(kl, "bad CELLS counts " + std::to_string(n) + " " + std::to_string(size));
+      if (static_cast<unsigned long long>(size) > t.remaining())
+        t.fail(kl, "CELLS list of " + std::to_string(size) + " entries, the file ends before them");
       long long read = 0;
       cells.resize(static_cast<size_t>(n));
       cell_lines.resize(static_cast<size_t>(n));
