@@ -25,6 +25,7 @@
 
 #include "core/deformable/node_solver.hpp"
 #include "validation/bench/cpu_reporter.hpp"
+#include "validation/bench/fit.hpp"
 
 namespace {
 
@@ -55,15 +56,7 @@ struct Scene {
   int vertices() const { return body.numNodes(); }
 };
 
-double exponent(const std::vector<double>& x, const std::vector<double>& y) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double n = static_cast<double>(x.size());
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double a = std::log(x[i]), b = std::log(y[i]);
-    sx += a, sy += b, sxx += a * a, sxy += a * b;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
+using bench::fittedExponent;
 
 }  // namespace
 
@@ -145,7 +138,7 @@ int main(int argc, char** argv) {
   std::printf("| fitted exponent |");
   for (const auto& op : ops) {
     const auto& [x, y] = fit[op];
-    if (x.size() >= 2) std::printf(" %.2f (%g-%g) |", exponent(x, y), x.front(), x.back());
+    if (x.size() >= 2) std::printf(" %.2f (%g-%g) |", fittedExponent(x, y), x.front(), x.back());
     else std::printf(" - |");
   }
   std::printf("\n");
