@@ -16,10 +16,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// this process's scratch folder, removed at exit
 fs::path tempDir() {
-  const fs::path d = fs::temp_directory_path() / ("redmax_tet_mesh_test_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
+  struct Dir {
+    fs::path path = fs::temp_directory_path() / ("redmax_tet_mesh_test_" + std::to_string(::getpid()));
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Dir d;
+  fs::create_directories(d.path);
+  return d.path;
 }
 
 TEST(TetMesh, BoxMeshesFillTheBoxWithConformingPositiveTets) {
