@@ -13,6 +13,7 @@
 #include "converter/error.hpp"
 #include "converter/id/id_engine.hpp"
 #include "converter/signal/signal_error.hpp"
+#include "core/deformable/tet_mesh.hpp"
 #include "core/joints/joint_kinematics.hpp"
 #include "core/muscles/muscle_workspace.hpp"
 #include "core/skeleton/model.hpp"
@@ -30,7 +31,8 @@ void acceptError(const std::exception& e);
 
 /// Run one step of a target. The project's error types (osim::ConvertError: bad input with
 /// FILE:LINE; ModelError, JointError, MuscleError from the core; signal::SignalError from the ID
-/// tool's signal processing; osim::IdEngineError) are the readers' answer to bad input: accepted
+/// tool's signal processing; osim::IdEngineError; MeshError from the VTK mesh reader) are the
+/// readers' answer to bad input: accepted
 /// (acceptError) and false returned. Any other exception is not caught: it leaves the target and
 /// ends the run through std::terminate, which libFuzzer and the driver report as a crash.
 template <class Step>
@@ -49,6 +51,8 @@ bool acceptingProjectErrors(Step&& step) {
   } catch (const signal::SignalError& e) {
     acceptError(e);
   } catch (const osim::IdEngineError& e) {
+    acceptError(e);
+  } catch (const MeshError& e) {
     acceptError(e);
   }
   return false;

@@ -4,6 +4,7 @@
 //   core/muscles/hill (Hill-type muscle models: the standard library only) <- core/muscles
 //   core/dynamics <- core/model (the musculoskeletal aggregate, beside core/integrators)
 //   core/integrators <- core/adjoint (the discrete adjoint of the fixed-step integrators)
+//   core/dynamics <- core/deformable (deformable bodies as force terms, beside core/integrators)
 //   converter/, plugin/ -> core/ (plugin may also read the converter's description)
 //   tools/ -> core/ (offline work the engine never runs: wrap-network training, wrap benchmarks)
 //   view/ -> core, converter (`redmax view`, docs/view.md)
@@ -56,7 +57,7 @@ std::string layerOf(const std::string& inc) {
   static const std::vector<std::string> layers = {
       "core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles",
       "core/dynamics",
-      "core/integrators", "core/adjoint", "core/model", "converter", "plugin", "tools", "view", "validation", "cli"};
+      "core/integrators", "core/adjoint", "core/model", "core/deformable", "converter", "plugin", "tools", "view", "validation", "cli"};
   for (const auto& l : layers)
     if (inc.rfind(l + "/", 0) == 0) return l;
   return "";
@@ -91,9 +92,12 @@ std::map<std::string, std::set<std::string>> layerRules() {
       {"core/adjoint",
        {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles", "core/dynamics",
         "core/integrators", "core/adjoint"}},
+      {"core/deformable",
+       {"core/spatial", "core/geometry", "core/joints", "core/skeleton", "core/muscles/hill", "core/muscles", "core/dynamics",
+        "core/deformable"}},
   };
   std::set<std::string> core_all = rules.at("core/integrators");
-  core_all.insert({"core/model", "core/adjoint"});
+  core_all.insert({"core/model", "core/adjoint", "core/deformable"});
   std::set<std::string> converter = core_all, plugin = core_all, tools = core_all, validation = core_all,
                         view = core_all;
   converter.insert("converter");
@@ -151,6 +155,9 @@ TEST(Layering, DetectsAViolation) {
   EXPECT_FALSE(mayInclude("core/integrators", "core/model/musculoskeletal_model.hpp"));
   EXPECT_FALSE(mayInclude("core/dynamics", "core/model/musculoskeletal_model.hpp"));
   EXPECT_TRUE(mayInclude("core/model", "core/dynamics/system.hpp"));
+  EXPECT_TRUE(mayInclude("core/deformable", "core/dynamics/force_term.hpp"));
+  EXPECT_FALSE(mayInclude("core/deformable", "core/integrators/integrator.hpp"));
+  EXPECT_FALSE(mayInclude("core/dynamics", "core/deformable/deformable_term.hpp"));
   EXPECT_TRUE(mayInclude("converter", "core/model/musculoskeletal_model.hpp"));
   EXPECT_EQ(layerOf("Eigen/Core"), "");
   EXPECT_EQ(layerOf("tools/wrap_training/train.hpp"), "tools");

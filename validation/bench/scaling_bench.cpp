@@ -21,6 +21,7 @@
 #include "core/dynamics/system.hpp"
 #include "validation/scenes/humanoid.hpp"
 #include "validation/bench/cpu_reporter.hpp"
+#include "validation/bench/fit.hpp"
 
 namespace {
 
@@ -64,15 +65,7 @@ struct Scene {
 };
 
 // least-squares slope of log(y) against log(x)
-double exponent(const std::vector<double>& x, const std::vector<double>& y) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double n = static_cast<double>(x.size());
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double a = std::log(x[i]), b = std::log(y[i]);
-    sx += a, sy += b, sxx += a * a, sxy += a * b;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
+using bench::fittedExponent;
 
 }  // namespace
 
@@ -123,7 +116,7 @@ int main(int argc, char** argv) {
   for (const char* op : ops) {
     std::vector<double> x, y;
     for (int n : dofs) x.push_back(n), y.push_back(at(n, 0, op));
-    std::printf(" %.2f |", exponent(x, y));
+    std::printf(" %.2f |", fittedExponent(x, y));
   }
   std::printf("\n\n| mass points (20 DoF) |");
   for (const char* op : ops) std::printf(" %s |", op);
@@ -134,7 +127,7 @@ int main(int argc, char** argv) {
     std::printf("\n");
   }
   std::printf("| fitted exponent (500-5000 points) |");
-  for (const char* op : ops) std::printf(" %.2f |", exponent({500, 5000}, {at(20, 500, op), at(20, 5000, op)}));
+  for (const char* op : ops) std::printf(" %.2f |", fittedExponent({500, 5000}, {at(20, 500, op), at(20, 5000, op)}));
   std::printf("\n| ns per mass point (500 -> 5000) |");
   for (const char* op : ops) std::printf(" %.1f |", 1e3 * (at(20, 5000, op) - at(20, 500, op)) / 4500.0);
   std::printf("\n| 80 DoF, 5000 points |");

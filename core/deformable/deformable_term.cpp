@@ -1,0 +1,313 @@
+#include "core/deformable/deformable_term.hpp"
+
+#include <string>
+
+#include "core/dynamics/system.hpp"
+#include "core/skeleton/kinematics.hpp"
+#include "core/spatial/se3.hpp"
+
+namespace redmax {
+
+DeformableTerm::DeformableTerm(const Model& model, DeformableBody body, std::vector<NodeBinding> nodes,
+                               DeformableTermOptions options)
+    : body_(std::move(body)), nodes_(std::move(nodes)), options_(options) {
+  if (static_cast<int>(nodes_.size()) != body_.numNodes())
+    throw ModelError("DeformableTerm: " + std::to_string(nodes_.size()) + " node bindings for " +
+                     std::to_string(body_.numNodes()) + " nodes");
+  if (body_.mass.size() != body_.rest.size()) throw ModelError("DeformableTerm: one mass per node expected");
+  for (size_t n = 0; n < nodes_.size(); ++n) {
+    const NodeBinding& b = nodes_[n];
+    if (b.kind == NodeBinding::Kind::Body) {
+      if (b.index < 0 || b.index >= model.nb())
+        throw ModelError("DeformableTerm: node " + std::to_string(n) + " attached to body " + std::to_string(b.index) +
+                         " of a model with " + std::to_string(model.nb()));
+      has_body_nodes_ = true;
+    } else if (b.kind == NodeBinding::Kind::Free && b.index < model.nr()) {
+      throw ModelError("DeformableTerm: free node " + std::to_string(n) + " at coordinate " + std::to_string(b.index) +
+                       ", inside the skeleton's " + std::to_string(model.nr()));
+    }
+  }
+}
+
+std::unique_ptr<TermScratch> DeformableTerm::makeScratch(const Model&) const {
+  return std::make_unique<DeformableScratch>();
+}
+
+DeformableScratch& DeformableTerm::evaluate(const Model& model, const State& s, const TermContext& ctx,
+                                            bool stiffness, DeformableScratch& local) const {
+  auto* slot = dynamic_cast<DeformableScratch*>(ctx.scratch);
+  DeformableScratch& sc = slot ? *slot : local;
+  stiffness = stiffness || body_.rayleigh_stiffness != 0.0;  // the damping force needs K_x
+  if (slot && ctx.evaluation != 0 && sc.evaluation == ctx.evaluation && (sc.has_K || !stiffness)) return sc;
+  sc.evaluation = 0;
+  const int N = body_.numNodes(), nr = model.nr();
+  const SkeletonWorkspace& sk = ctx.sk;
+  sc.x.resize(3 * N);
+  sc.v.resize(3 * N);
+  sc.J.resize(N);
+  sc.Jdot.resize(N);
+  const VecX qdot_r = s.qdot.head(nr);
+  for (int n = 0; n < N; ++n) {
+    const NodeBinding& b = nodes_[n];
+    switch (b.kind) {
+      case NodeBinding::Kind::Free:
+        sc.x.segment<3>(3 * n) = s.q.segment<3>(b.index);
+        sc.v.segment<3>(3 * n) = s.qdot.segment<3>(b.index);
+        break;
+      case NodeBinding::Kind::World:
+        sc.x.segment<3>(3 * n) = b.point;
+        sc.v.segment<3>(3 * n).setZero();
+        break;
+      case NodeBinding::Kind::Body: {
+        // J_a = R Gamma(X) J_i [D Eq. 4.90], Jdot_a = R ([omega] Gamma(X) J_i + Gamma(X) Jdot_i) [D Eq. 4.91]
+        sc.J[n].resize(3, nr);
+        pointJacobian(model, sk, b.index, b.point, sc.J[n]);
+        const Mat3 R = sk.E_wi[b.index].topLeftCorner<3, 3>();
+        const Mat3x6 G = Gamma(b.point);
+        const auto Ji = sk.J_mr.middleRows<6>(6 * b.index);
+        const auto Jdi = sk.Jdot_mr.middleRows<6>(6 * b.index);
+        sc.Jdot[n].noalias() = R * (skew(sk.phi[b.index].head<3>()) * (G * Ji) + G * Jdi);
+        sc.x.segment<3>(3 * n) = transformPoint(sk.E_wi[b.index], b.point);
+        sc.v.segment<3>(3 * n) = sc.J[n] * qdot_r;
+        break;
+      }
+    }
+  }
+  evalElastic(body_, sc.x, stiffness, sc.el);
+  sc.has_K = stiffness;
+  // node forces: elastic, Rayleigh damping -(alpha M + beta K) v, gravity
+  sc.F = sc.el.f;
+  for (int n = 0; n < N; ++n) {
+    sc.F.segment<3>(3 * n) -= body_.rayleigh_mass * body_.mass[n] * sc.v.segment<3>(3 * n);
+    if (options_.gravity) sc.F.segment<3>(3 * n) += body_.mass[n] * model.gravity();
+  }
+  if (body_.rayleigh_stiffness != 0.0) sc.F.noalias() -= body_.rayleigh_stiffness * (sc.el.K * sc.v);
+  sc.evaluation = slot ? ctx.evaluation : 0;
+  return sc;
+}
+
+void DeformableTerm::mapForce(const VecX& F, Eigen::Ref<VecX> f, const DeformableScratch& sc, int nr) const {
+  for (int n = 0; n < body_.numNodes(); ++n) {
+    const NodeBinding& b = nodes_[n];
+    if (b.kind == NodeBinding::Kind::Free) f.segment<3>(b.index) += F.segment<3>(3 * n);
+    else if (b.kind == NodeBinding::Kind::Body) f.head(nr).noalias() += sc.J[n].transpose() * F.segment<3>(3 * n);
+  }
+}
+
+void DeformableTerm::mapMatrix(const SparseMat& A, MatX& out, const DeformableScratch& sc, int nr) const {
+  using Kind = NodeBinding::Kind;
+  for (int col = 0; col < A.outerSize(); ++col) {
+    const int nj = col / 3, cj = col % 3;
+    const NodeBinding& bj = nodes_[nj];
+    if (bj.kind == Kind::World) continue;
+    for (SparseMat::InnerIterator it(A, col); it; ++it) {
+      const int ni = static_cast<int>(it.row()) / 3, ci = static_cast<int>(it.row()) % 3;
+      const NodeBinding& bi = nodes_[ni];
+      const double a = it.value();
+      if (bi.kind == Kind::World) continue;
+      if (bi.kind == Kind::Free && bj.kind == Kind::Free) {
+        out(bi.index + ci, bj.index + cj) += a;
+      } else if (bi.kind == Kind::Free) {
+        out.row(bi.index + ci).head(nr) += a * sc.J[nj].row(cj);
+      } else if (bj.kind == Kind::Free) {
+        out.col(bj.index + cj).head(nr) += a * sc.J[ni].row(ci).transpose();
+      } else {
+        out.topLeftCorner(nr, nr).noalias() += a * sc.J[ni].row(ci).transpose() * sc.J[nj].row(cj);
+      }
+    }
+  }
+}
+
+SparseMat DeformableTerm::dampingMatrix(const DeformableScratch& sc) const {
+  const int n3 = 3 * body_.numNodes();
+  SparseMat D(n3, n3);
+  if (body_.rayleigh_stiffness != 0.0) D = body_.rayleigh_stiffness * sc.el.K;
+  if (body_.rayleigh_mass != 0.0) {
+    SparseMat Mx(n3, n3);
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < n3; ++i) t.emplace_back(i, i, body_.rayleigh_mass * body_.mass[i / 3]);
+    Mx.setFromTriplets(t.begin(), t.end());
+    D += Mx;
+  }
+  return D;
+}
+
+void DeformableTerm::addMass(const Model& model, const State& s, const TermContext& ctx, MatX& M) const {
+  DeformableScratch local;
+  const DeformableScratch& sc = evaluate(model, s, ctx, false, local);
+  const int nr = model.nr();
+  for (int n = 0; n < body_.numNodes(); ++n) {
+    const NodeBinding& b = nodes_[n];
+    if (b.kind == NodeBinding::Kind::Free) M.block<3, 3>(b.index, b.index).diagonal().array() += body_.mass[n];
+    else if (b.kind == NodeBinding::Kind::Body)
+      M.topLeftCorner(nr, nr).noalias() += body_.mass[n] * sc.J[n].transpose() * sc.J[n];
+  }
+}
+
+void DeformableTerm::addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const {
+  DeformableScratch local;
+  const DeformableScratch& sc = evaluate(model, s, ctx, false, local);
+  const int nr = model.nr();
+  mapForce(sc.F, f, sc, nr);
+  // quadratic velocity vector of the attached nodes, -m J_a^T Jdot_a qdot [D Eq. 4.95]
+  if (!options_.quadratic_velocity || !has_body_nodes_) return;
+  const VecX qdot_r = s.qdot.head(nr);
+  for (int n = 0; n < body_.numNodes(); ++n)
+    if (nodes_[n].kind == NodeBinding::Kind::Body)
+      f.head(nr).noalias() -= body_.mass[n] * (sc.J[n].transpose() * (sc.Jdot[n] * qdot_r));
+}
+
+void DeformableTerm::addStiffnessDamping(const Model& model, const State& s, const TermContext& ctx, MatX& K,
+                                         MatX& D) const {
+  DeformableScratch local;
+  const DeformableScratch& sc = evaluate(model, s, ctx, true, local);
+  const int nr = model.nr();
+  mapMatrix(sc.el.K, K, sc, nr);
+  const SparseMat Dx = dampingMatrix(sc);
+  mapMatrix(Dx, D, sc, nr);
+  if (!has_body_nodes_) return;
+  // dJ_a/dq_k: the kinematics at (q, qdot = e_k) give Jdot_mr = dJ_mr/dq_k, and dR/dq_k = R [omega_k]
+  const int N = body_.numNodes();
+  SkeletonWorkspace tmp(model);
+  State sk_state;
+  sk_state.q = s.q.head(nr);
+  const VecX qdot_r = s.qdot.head(nr);
+  VecX dv(3 * N), col(K.rows());
+  for (int k = 0; k < nr; ++k) {
+    sk_state.qdot = VecX::Unit(nr, k);
+    calcKinematics(model, sk_state, tmp);
+    dv.setZero();
+    bool any = false;
+    for (int n = 0; n < N; ++n) {
+      const NodeBinding& b = nodes_[n];
+      if (b.kind != NodeBinding::Kind::Body) continue;
+      const auto Ji = ctx.sk.J_mr.middleRows<6>(6 * b.index);
+      const Vec3 omega_k = Ji.col(k).head<3>();
+      if (omega_k.isZero(0.0) && Ji.col(k).tail<3>().isZero(0.0) &&
+          tmp.Jdot_mr.middleRows<6>(6 * b.index).isZero(0.0))
+        continue;  // coordinate k does not move this body
+      const Mat3 R = ctx.sk.E_wi[b.index].topLeftCorner<3, 3>();
+      const Mat3x6 G = Gamma(b.point);
+      const MatX dJ = R * (skew(omega_k) * (G * Ji) + G * tmp.Jdot_mr.middleRows<6>(6 * b.index));
+      // geometric stiffness of the node's force: K(:, k) -= dJ^T f_a
+      K.col(k).head(nr).noalias() -= dJ.transpose() * sc.F.segment<3>(3 * n);
+      dv.segment<3>(3 * n) = dJ * qdot_r;
+      any = true;
+    }
+    if (!any || Dx.nonZeros() == 0) continue;
+    // the damping force -D_x v through v's dependence on q: K(:, k) += J_MR^T D_x dv
+    col.setZero();
+    mapForce(Dx * dv, col, sc, nr);
+    K.col(k) += col;
+  }
+}
+
+void DeformableTerm::addMassDotTimesVelocity(const Model& model, const State& s, const TermContext& ctx,
+                                             VecX& Mdot_v) const {
+  if (!has_body_nodes_) return;
+  DeformableScratch local;
+  const DeformableScratch& sc = evaluate(model, s, ctx, false, local);
+  const int nr = model.nr();
+  const VecX qdot_r = s.qdot.head(nr);
+  for (int n = 0; n < body_.numNodes(); ++n) {
+    if (nodes_[n].kind != NodeBinding::Kind::Body) continue;
+    const Vec3 v = sc.J[n] * qdot_r, a = sc.Jdot[n] * qdot_r;
+    Mdot_v.head(nr).noalias() += body_.mass[n] * (sc.Jdot[n].transpose() * v + sc.J[n].transpose() * a);
+  }
+}
+
+double DeformableTerm::kineticEnergy(const Model& model, const State& s, const TermContext& ctx) const {
+  DeformableScratch local;
+  const DeformableScratch& sc = evaluate(model, s, ctx, false, local);
+  double T = 0;
+  for (int n = 0; n < body_.numNodes(); ++n) T += 0.5 * body_.mass[n] * sc.v.segment<3>(3 * n).squaredNorm();
+  return T;
+}
+
+double DeformableTerm::potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const {
+  DeformableScratch local;
+  const DeformableScratch& sc = evaluate(model, s, ctx, false, local);
+  double V = sc.el.energy;
+  if (options_.gravity)
+    for (int n = 0; n < body_.numNodes(); ++n) V -= body_.mass[n] * model.gravity().dot(sc.x.segment<3>(3 * n));
+  return V;
+}
+
+VecX DeformableTerm::nodePositions(const Model& model, const State& s, const TermContext& ctx) const {
+  const int N = body_.numNodes();
+  VecX x(3 * N);
+  for (int n = 0; n < N; ++n) {
+    const NodeBinding& b = nodes_[n];
+    if (b.kind == NodeBinding::Kind::Free) x.segment<3>(3 * n) = s.q.segment<3>(b.index);
+    else if (b.kind == NodeBinding::Kind::World) x.segment<3>(3 * n) = b.point;
+    else x.segment<3>(3 * n) = transformPoint(ctx.sk.E_wi[b.index], b.point);
+  }
+  return x;
+}
+
+void DeformableTerm::setRestState(State& s) const {
+  for (int n = 0; n < body_.numNodes(); ++n) {
+    const NodeBinding& b = nodes_[n];
+    if (b.kind != NodeBinding::Kind::Free) continue;
+    s.q.segment<3>(b.index) = body_.rest[n];
+    s.qdot.segment<3>(b.index).setZero();
+  }
+}
+
+void DeformableTerm::setRestState(const Model& model, State& s, int follow) const {
+  if (follow < 0 || follow >= model.nb()) throw ModelError("DeformableTerm::setRestState: no body " + std::to_string(follow));
+  std::vector<Mat4> E0;
+  calcBodyPoses(model, model.defaultQ(), E0);
+  SkeletonWorkspace sk(model);
+  calcKinematics(model, s, sk);
+  const Mat4 E0_inv = inverseE(E0[follow]);
+  for (int n = 0; n < body_.numNodes(); ++n) {
+    const NodeBinding& b = nodes_[n];
+    if (b.kind != NodeBinding::Kind::Free) continue;
+    const Vec3 X = transformPoint(E0_inv, body_.rest[n]);
+    s.q.segment<3>(b.index) = pointPosition(sk, follow, X);
+    s.qdot.segment<3>(b.index) = pointVelocity(sk, follow, X);
+  }
+}
+
+std::shared_ptr<const DeformableTerm> addDeformableBody(System& sys, DeformableBody body,
+                                                        const std::vector<NodeAttachment>& attach,
+                                                        DeformableTermOptions options) {
+  const Model& model = sys.model();
+  const int N = body.numNodes();
+  std::vector<NodeBinding> nodes(N);
+  std::vector<char> attached(N, 0);
+  std::vector<Mat4> E_wi;
+  calcBodyPoses(model, model.defaultQ(), E_wi);
+  for (const NodeAttachment& a : attach) {
+    if (a.node < 0 || a.node >= N) throw ModelError("addDeformableBody: attachment of node " + std::to_string(a.node) +
+                                                    " of " + std::to_string(N));
+    if (a.body < -1 || a.body >= model.nb())
+      throw ModelError("addDeformableBody: attachment to body " + std::to_string(a.body) + " of " +
+                       std::to_string(model.nb()));
+    NodeBinding& b = nodes[a.node];
+    if (a.body < 0) {
+      b.kind = NodeBinding::Kind::World;
+      b.point = body.rest[a.node];
+    } else {
+      b.kind = NodeBinding::Kind::Body;
+      b.index = a.body;
+      b.point = transformPoint(inverseE(E_wi[a.body]), body.rest[a.node]);
+    }
+    attached[a.node] = 1;
+  }
+  int free = 0;
+  for (int n = 0; n < N; ++n) free += attached[n] ? 0 : 1;
+  int next = sys.addExtraCoordinates(3 * free);
+  for (int n = 0; n < N; ++n)
+    if (!attached[n]) {
+      nodes[n].kind = NodeBinding::Kind::Free;
+      nodes[n].index = next;
+      next += 3;
+    }
+  auto term = std::make_shared<const DeformableTerm>(model, std::move(body), std::move(nodes), options);
+  sys.addTerm(term);
+  return term;
+}
+
+}  // namespace redmax

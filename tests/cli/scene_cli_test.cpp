@@ -1,0 +1,90 @@
+// `redmax scene NAME` end to end (docs/deformable.md §4): the cantilever's summary line parsed
+// against beam theory computed here, the files each scene writes (states, one VTK per frame, the
+// .pvd collection), the VTK frames read back by the mesh reader, and bad names.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "core/deformable/tet_mesh.hpp"
+#include "tests/cli/cli_test_util.hpp"
+
+namespace {
+
+using namespace redmax::cli_test;
+namespace fs = std::filesystem;
+
+class SceneCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to cli_tests (build target redmax)";
+    dir_ = fs::temp_directory_path() / ("redmax_scene_cli_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(SceneCli, CantileverPrintsTipDeflectionAgainstBeamTheory) {
+  const CmdResult r = runRedmax(dir_, "scene cantilever --out " + (dir_ / "c").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::smatch m;
+  const std::regex re(R"(^tip deflection ([0-9.eE+-]+) m, beam theory ([0-9.eE+-]+) m$)");
+  bool found = false;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line);)
+    if (std::regex_match(line, m, re)) {
+      found = true;
+      const double D = std::stod(m[1]), B = std::stod(m[2]);
+      // w L^4 / (8 E I) of the default beam (1 x 0.1 x 0.1 m, E 1e9, rho 1000, g 9.81)
+      EXPECT_NEAR(B, 1000 * 9.81 * 0.01 / (8 * 1e9 * 1e-4 / 12), 1e-8);
+      EXPECT_NEAR(D / B, 0.831, 0.002);  // refinement 4 (docs/deformable.md §4)
+    }
+  EXPECT_TRUE(found) << r.out;
+  EXPECT_TRUE(fs::exists(dir_ / "c" / "states.csv"));
+  EXPECT_TRUE(fs::exists(dir_ / "c" / "cantilever.pvd"));
+  const redmax::TetMesh loaded = redmax::readVtkTetMesh((dir_ / "c" / "cantilever_0001.vtk").string());
+  EXPECT_EQ(loaded.numNodes(), 41 * 5 * 5);
+}
+
+TEST_F(SceneCli, DynamicScenesWriteStatesAndAVtkSeries) {
+  for (const std::string name : {"strand", "soft-pendulum"}) {
+    const fs::path out = dir_ / name;
+    const CmdResult r = runRedmax(dir_, "scene " + name + " --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string states = slurp(out / "states.csv");
+    EXPECT_EQ(states.rfind("time,", 0), 0u);
+    int rows = 0;
+    for (char c : states) rows += c == '\n';
+    EXPECT_EQ(rows, 1 + (name == "strand" ? 101 : 51));  // header + frames every 0.02 s
+    const std::string pvd = slurp(out / (name + ".pvd"));
+    int frames = 0;
+    for (size_t at = pvd.find("<DataSet"); at != std::string::npos; at = pvd.find("<DataSet", at + 1)) ++frames;
+    EXPECT_EQ(frames, rows - 1);
+    EXPECT_TRUE(fs::exists(out / (name + "_0000.vtk")));
+    if (name == "soft-pendulum") {
+      const redmax::TetMesh last = redmax::readVtkTetMesh((out / "soft-pendulum_0050.vtk").string());
+      EXPECT_EQ(last.numNodes(), 45);
+      EXPECT_NE(r.out.find("rigid block"), std::string::npos);
+    } else {
+      EXPECT_NE(r.out.find("largest change"), std::string::npos);
+    }
+  }
+}
+
+TEST_F(SceneCli, UnknownOrMissingNameIsAUsageError) {
+  CmdResult r = runRedmax(dir_, "scene starfish");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("error: "), std::string::npos);
+  EXPECT_NE(r.err.find("cantilever, strand or soft-pendulum"), std::string::npos);
+  r = runRedmax(dir_, "scene");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(fs::is_empty(dir_) || !fs::exists(dir_ / "scene-starfish"));
+}
+
+}  // namespace

@@ -1,0 +1,230 @@
+#include "validation/scenes/deformable_scenes.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/deformable/deformable_term.hpp"
+#include "core/dynamics/system.hpp"
+#include "core/integrators/integrator.hpp"
+
+namespace redmax::scenes {
+
+namespace {
+
+std::vector<Vec3> toPoints(const VecX& x) {
+  std::vector<Vec3> p(x.size() / 3);
+  for (size_t n = 0; n < p.size(); ++n) p[n] = x.segment<3>(3 * n);
+  return p;
+}
+
+// simulate sys from s, recording every frame_interval; the term's node positions per frame
+DeformableRun simulate(const System& sys, State s, const DeformableTerm& term, const std::string& integrator,
+                       double dt, double tolerance, double duration, double frame_interval) {
+  DeformableRun run;
+  IntegratorOptions io;
+  io.dt = dt;
+  io.rtol = tolerance;
+  io.atol = 1e-2 * tolerance;
+  auto integ = makeIntegrator(integrator, io);
+  DynamicsWorkspace ws(sys);
+  SkeletonWorkspace sk(sys.model());
+  const int frames = static_cast<int>(std::llround(duration / frame_interval));
+  for (int k = 0; k <= frames; ++k) {
+    if (k > 0) integ->advance(sys, s, k * frame_interval);
+    run.t.push_back(s.t);
+    run.q.push_back(s.q);
+    run.energy.push_back(sys.kineticEnergy(s, ws) + sys.potentialEnergy(s, ws));
+    calcKinematics(sys.model(), s, sk);
+    run.nodes.push_back(toPoints(term.nodePositions(sys.model(), s, TermContext(sk))));
+  }
+  for (int i = 0; i < sys.model().nr(); ++i) run.coordinates.push_back(sys.model().coordinates()[i].name);
+  // a free node's coordinates are its world position: node<n>_x, _y, _z
+  run.coordinates.resize(sys.ndof());
+  for (size_t n = 0; n < term.nodes().size(); ++n)
+    if (term.nodes()[n].kind == NodeBinding::Kind::Free)
+      for (int c = 0; c < 3; ++c)
+        run.coordinates[term.nodes()[n].index + c] = "node" + std::to_string(n) + "_" + "xyz"[c];
+  return run;
+}
+
+void writeText(const std::filesystem::path& path, const std::string& body) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream o(tmp);
+    if (!o) throw std::runtime_error(path.string() + ": cannot write");
+    o << body;
+    if (!o) throw std::runtime_error(path.string() + ": write failed");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+// NAME_NNNN.vtk per frame (with displacement from the first frame) and NAME.pvd
+void writeSeries(const std::filesystem::path& dir, const std::string& name, const DeformableRun& run) {
+  std::vector<std::pair<double, std::string>> frames;
+  for (size_t k = 0; k < run.nodes.size(); ++k) {
+    char file[64];
+    std::snprintf(file, sizeof file, "%s_%04zu.vtk", name.c_str(), k);
+    TetMesh mesh = run.mesh;
+    mesh.nodes = run.nodes.front();
+    std::vector<Vec3> u(run.nodes[k].size());
+    for (size_t n = 0; n < u.size(); ++n) u[n] = run.nodes[k][n] - run.nodes.front()[n];
+    writeVtkTetMesh((dir / file).string(), mesh, run.nodes[k], {{"displacement", u}}, run.lines);
+    frames.emplace_back(run.t[k], file);
+  }
+  writePvd((dir / (name + ".pvd")).string(), frames);
+}
+
+void writeStates(const std::filesystem::path& path, const DeformableRun& run) {
+  std::ostringstream o;
+  o << std::setprecision(17) << "time";
+  for (const auto& c : run.coordinates) o << ',' << c;
+  o << ",energy\n";
+  for (size_t k = 0; k < run.t.size(); ++k) {
+    o << run.t[k];
+    for (int i = 0; i < run.q[k].size(); ++i) o << ',' << run.q[k][i];
+    o << ',' << run.energy[k] << '\n';
+  }
+  writeText(path, o.str());
+}
+
+}  // namespace
+
+CantileverResult solveCantilever(const CantileverOptions& opt) {
+  if (opt.refinement < 1) throw std::invalid_argument("cantilever: refinement must be >= 1");
+  const int k = opt.refinement;
+  CantileverResult r;
+  r.mesh = makeBoxTetMesh(Vec3(opt.length, opt.width, opt.width), 10 * k, k, k,
+                          Vec3(0, -opt.width / 2, -opt.width / 2), opt.split);
+  const DeformableBody body = makeFemBody(r.mesh, opt.E, opt.nu, opt.rho);
+  NodeSpaceProblem p;
+  p.body = &body;
+  p.gravity = Vec3(0, -opt.g, 0);
+  p.fixed.assign(body.numNodes(), 0);
+  for (int n = 0; n < body.numNodes(); ++n) p.fixed[n] = r.mesh.nodes[n].x() < 1e-12 * opt.length;
+  r.x = restPositions(body);
+  r.solve = solveStatic(p, r.x, 1e-9 * opt.rho * opt.g * std::pow(opt.width, 3));
+  if (!r.solve.converged) throw std::runtime_error("cantilever: Newton did not converge");
+  int tip = 0;
+  for (int n = 0; n < body.numNodes(); ++n)
+    if (r.mesh.nodes[n].x() > opt.length * (1 - 1e-12)) {
+      r.tip_deflection += r.mesh.nodes[n].y() - r.x[3 * n + 1];
+      ++tip;
+    }
+  r.tip_deflection /= tip;
+  const double A = opt.width * opt.width, I = std::pow(opt.width, 4) / 12.0;
+  r.beam_theory = opt.rho * opt.g * A * std::pow(opt.length, 4) / (8.0 * opt.E * I);
+  return r;
+}
+
+Model singlePendulum() {
+  ModelBuilder b("single_pendulum");
+  b.setGravity(Vec3(0, -9.81, 0));
+  const double m = 1.0, L = 1.0;
+  // a thin uniform rod along -y (a small inertia about its axis keeps the body inertia regular)
+  const Mat3 I = Vec3(m * L * L / 12, 1e-4, m * L * L / 12).asDiagonal();
+  const int b1 = b.addBody("link", m, Vec3(0, -L / 2, 0), I, -1, "pin", Revolute{Vec3::UnitZ()});
+  b.setCoordinateNames(b1, {"q"});
+  return b.finalize();
+}
+
+DeformableRun runStrand(const StrandOptions& opt) {
+  if (opt.segments < 1) throw std::invalid_argument("strand: segments must be >= 1");
+  std::vector<Vec3> pts;
+  for (int i = 0; i <= opt.segments; ++i) pts.emplace_back(opt.length * i / opt.segments, 0, 0);
+  // the strand alone: a model without bodies, gravity -9.81 y
+  ModelBuilder mb("strand");
+  mb.setGravity(Vec3(0, -9.81, 0));
+  System sys(mb.finalize());
+  auto term = addDeformableBody(sys, makeStrand(pts, opt.mass, opt.stiffness), {{0, -1}});
+  State s = sys.defaultState();
+  term->setRestState(s);
+  DeformableRun run = simulate(sys, s, *term, opt.integrator, opt.dt, opt.tolerance, opt.duration, opt.frame_interval);
+  run.mesh.nodes = pts;
+  for (int i = 0; i < opt.segments; ++i) run.lines.push_back({i, i + 1});
+  return run;
+}
+
+DeformableRun runSoftPendulum(const SoftPendulumOptions& opt) {
+  if (opt.refinement < 1) throw std::invalid_argument("soft-pendulum: refinement must be >= 1");
+  const int k = opt.refinement;
+  System sys(singlePendulum());
+  const TetMesh mesh = makeBoxTetMesh(Vec3(0.2, 0.1, 0.1), 2 * k, k, k, Vec3(-0.1, -1.1, -0.05));
+  DeformableBody body = makeFemBody(mesh, opt.E, opt.nu, opt.rho);
+  body.rayleigh_mass = opt.rayleigh_mass;
+  body.rayleigh_stiffness = opt.rayleigh_stiffness;
+  std::vector<NodeAttachment> att;
+  for (int n = 0; n < mesh.numNodes(); ++n)
+    if (opt.rigid || mesh.nodes[n].y() > -1.0 - 1e-12) att.push_back({n, 0});
+  auto term = addDeformableBody(sys, body, att);
+  State s = sys.defaultState();
+  s.q[0] = opt.q0;
+  term->setRestState(sys.model(), s, 0);
+  DeformableRun run = simulate(sys, s, *term, opt.integrator, opt.dt, opt.tolerance, opt.duration, opt.frame_interval);
+  run.mesh = mesh;
+  return run;
+}
+
+std::vector<std::string> deformableSceneNames() { return {"cantilever", "strand", "soft-pendulum"}; }
+
+void runDeformableScene(const std::string& name, const std::string& out_dir, std::ostream& summary) {
+  namespace fs = std::filesystem;
+  bool known = false;
+  for (const auto& n : deformableSceneNames()) known = known || n == name;
+  if (!known) throw std::invalid_argument("unknown scene '" + name + "' (expected cantilever, strand or soft-pendulum)");
+  const fs::path dir(out_dir);
+  fs::create_directories(dir);
+  summary << std::setprecision(6);
+  if (name == "cantilever") {
+    CantileverOptions opt;
+    const CantileverResult r = solveCantilever(opt);
+    DeformableRun run;
+    run.mesh = r.mesh;
+    run.t = {0.0, 1.0};  // load factor: unloaded, loaded
+    run.nodes = {r.mesh.nodes, toPoints(r.x)};
+    writeSeries(dir, name, run);
+    std::ostringstream o;
+    o << std::setprecision(17) << "node,X,Y,Z,ux,uy,uz\n";
+    for (int n = 0; n < r.mesh.numNodes(); ++n) {
+      const Vec3 X = r.mesh.nodes[n], u = r.x.segment<3>(3 * n) - X;
+      o << n << ',' << X[0] << ',' << X[1] << ',' << X[2] << ',' << u[0] << ',' << u[1] << ',' << u[2] << '\n';
+    }
+    writeText(dir / "states.csv", o.str());
+    summary << "cantilever: " << opt.length << " x " << opt.width << " x " << opt.width << " m, E " << opt.E
+            << " Pa, nu " << opt.nu << ", rho " << opt.rho << " kg/m^3, " << r.mesh.numNodes() << " nodes, "
+            << r.mesh.numTets() << " tets, Newton " << r.solve.iterations << " iterations\n";
+    summary << "tip deflection " << r.tip_deflection << " m, beam theory " << r.beam_theory << " m\n";
+    return;
+  }
+  DeformableRun run;
+  if (name == "strand") {
+    StrandOptions opt;
+    run = runStrand(opt);
+    double worst = 0;
+    for (double e : run.energy) worst = std::max(worst, std::abs(e - run.energy.front()));
+    summary << "strand: " << opt.segments << " springs, " << opt.mass << " kg, stiffness " << opt.stiffness
+            << " J, integrator " << opt.integrator << ", dt " << opt.dt << " s, " << opt.duration << " s\n";
+    summary << "energy " << run.energy.front() << " J at t = 0, " << run.energy.back() << " J at t = " << run.t.back()
+            << " s, largest change " << worst << " J\n";
+  } else {
+    SoftPendulumOptions opt;
+    run = runSoftPendulum(opt);
+    SoftPendulumOptions rigid = opt;
+    rigid.rigid = true;
+    const DeformableRun ref = runSoftPendulum(rigid);
+    double worst = 0;
+    for (size_t k = 0; k < run.t.size(); ++k) worst = std::max(worst, std::abs(run.q[k][0] - ref.q[k][0]));
+    summary << "soft-pendulum: block of " << run.mesh.numNodes() << " nodes, E " << opt.E << " Pa, integrator "
+            << opt.integrator << ", dt " << opt.dt << " s, " << opt.duration << " s\n";
+    summary << "link angle " << run.q.back()[0] << " rad at t = " << run.t.back() << " s, rigid block "
+            << ref.q.back()[0] << " rad, largest difference " << worst << " rad\n";
+  }
+  writeStates(dir / "states.csv", run);
+  writeSeries(dir, name, run);
+}
+
+}  // namespace redmax::scenes
