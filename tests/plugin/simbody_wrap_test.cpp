@@ -14,8 +14,10 @@
 //   - general Type III forward dynamics: osim_models/double_pendulum_wrap_via.osim (via point, then
 //     the cylinder) with 1 kg and 0.5 kg on its muscles: particles on the general path map against
 //     the core's rk45, q to 1e-6 rad at 0.25 .. 1 s (the cylinder wraps over part of the run);
-//   - still refused, naming the muscle: the exact wrap model on a path with a via point, and (for
-//     particles only) conditional points.
+//   - a conditional via point in the particle mode, switching on and off during the run (a
+//     Simbody event at each end of its range re-places the particles): particles against the
+//     core's rk45, q to 1e-6 rad;
+//   - taken now: the exact wrap model on a path with a via point, conditional points in particles.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -278,35 +280,51 @@ TEST(SimbodyParticleMuscles, WrappingDoublePendulumMatchesCoreRk45) {
   EXPECT_GT(max_pen, 0.0);  // wraps during part of the run
 }
 
+// the wrap + via pendulum's muscles with mass (1 kg on the wrapping one, 0.5 kg on the straight
+// one, 10 points each), its default pose at rest, and the wrapping muscle's index
+struct WrapViaPendulum {
+  osim::BuildResult build;
+  std::vector<Muscle> muscles;
+  State s0;
+  int gastroc = -1;
+};
+
+WrapViaPendulum wrapViaPendulum() {
+  WrapViaPendulum w;
+  const osim::ModelDescription d =
+      osim::readOsimModel(std::string(REDMAX_SOURCE_DIR) + "/osim_models/double_pendulum_wrap_via.osim");
+  osim::BuildOptions bo;
+  bo.constraints = false;
+  w.build = osim::buildCoreModel(d, bo);
+  const Model& m = w.build.model;
+  w.muscles = w.build.model.muscles();
+  MassPointOptions opt;
+  opt.count = 10;
+  for (size_t k = 0; k < w.muscles.size(); ++k) {
+    Muscle& mu = w.muscles[k];
+    const bool wraps = pathType(mu.path) == PathType::III;
+    if (wraps) w.gastroc = static_cast<int>(k);
+    mu.mass_points = makeMassPoints(wraps ? 1.0 : 0.5, mu.optimal_fiber_length, mu.tendon_slack_length, opt);
+  }
+  w.s0.q.resize(m.nr());
+  for (int c = 0; c < m.nr(); ++c) w.s0.q[c] = m.coordinates()[c].default_value;
+  w.s0.qdot = VecX::Zero(m.nr());
+  return w;
+}
+
 // general Type III forward dynamics: osim_models/double_pendulum_wrap_via.osim (origin, via point,
 // cylinder on the via -> insertion segment) with 1 kg on its wrapping muscle and 0.5 kg on its
 // straight one (10 points each), released from its default pose (compareParticlesWithCore); the
 // cylinder wraps over part of the run
 TEST(SimbodyParticleMuscles, WrapViaPendulumMatchesCoreRk45) {
-  const osim::ModelDescription d =
-      osim::readOsimModel(std::string(REDMAX_SOURCE_DIR) + "/osim_models/double_pendulum_wrap_via.osim");
-  osim::BuildOptions bo;
-  bo.constraints = false;
-  const osim::BuildResult r = osim::buildCoreModel(d, bo);
-  const Model& m = r.model;
-  std::vector<Muscle> muscles = r.model.muscles();
-  MassPointOptions opt;
-  opt.count = 10;
-  int gastroc = -1;
-  for (size_t k = 0; k < muscles.size(); ++k) {
-    Muscle& mu = muscles[k];
-    const bool wraps = pathType(mu.path) == PathType::III;
-    if (wraps) gastroc = static_cast<int>(k);
-    mu.mass_points = makeMassPoints(wraps ? 1.0 : 0.5, mu.optimal_fiber_length, mu.tendon_slack_length, opt);
-  }
+  const WrapViaPendulum w = wrapViaPendulum();
+  const Model& m = w.build.model;
+  const std::vector<Muscle>& muscles = w.muscles;
+  const int gastroc = w.gastroc;
   ASSERT_GE(gastroc, 0);
   ASSERT_EQ(muscles[gastroc].path.points.size(), 3u);
-  State s0;
-  s0.q.resize(m.nr());
-  for (int c = 0; c < m.nr(); ++c) s0.q[c] = m.coordinates()[c].default_value;
-  s0.qdot = VecX::Zero(m.nr());
   double min_pen = 1e9, max_pen = -1e9;
-  compareParticlesWithCore(m, muscles, r.model.muscles(), s0, "wrap + via pendulum", [&](const State& s) {
+  compareParticlesWithCore(m, muscles, w.build.model.muscles(), w.s0, "wrap + via pendulum", [&](const State& s) {
     const double pen = segmentPenetration(m, muscles[gastroc], s, 1);
     min_pen = std::min(min_pen, pen);
     max_pen = std::max(max_pen, pen);
@@ -315,41 +333,75 @@ TEST(SimbodyParticleMuscles, WrapViaPendulumMatchesCoreRk45) {
   EXPECT_GT(max_pen, 0.0);  // wraps during part of the run
 }
 
-// what the Simbody side still refuses, by muscle name: the exact wrap model on a path with a via
-// point (its J is taken by differences in q over OpenSim's whole path); the smooth model on the same
-// path is taken; particles also refuse conditional points (a switch would make them jump)
-TEST(SimbodyParticleMuscles, ExactModelOnViaPathsAndConditionalParticlesAreRefusedByName) {
+// a conditional via point in the particle mode: the wrap + via pendulum's via point made
+// conditional on q2 over a range that q2 enters and leaves during the run (its values at 0.3 s and
+// 0.6 s along the run with the via point fixed), so the path switches between origin -> via ->
+// (cylinder) -> insertion and origin -> (cylinder) -> insertion. Particles (re-placed at each
+// switch event) against the core's rk45, q to 1e-6 rad at 0.25 .. 1 s (compareParticlesWithCore);
+// the core's run switches at least twice (checked every 0.01 s).
+TEST(SimbodyParticleMuscles, ConditionalViaPointSwitchingMatchesCoreRk45) {
+  WrapViaPendulum w = wrapViaPendulum();
+  const Model& m = w.build.model;
+  const int q2 = 1;
+  // q2 along the run with the via point always on
+  double lo = 0.0, hi = 0.0;
+  {
+    System sys(m);
+    sys.addTerm(std::make_shared<MuscleTerm>(m, w.muscles));
+    IntegratorOptions o;
+    o.rtol = 1e-10;
+    auto integ = makeIntegrator("rk45", o);
+    State s = w.s0;
+    integ->advance(sys, s, 0.3);
+    lo = s.q[q2];
+    integ->advance(sys, s, 0.6);
+    hi = s.q[q2];
+    if (lo > hi) std::swap(lo, hi);
+  }
+  std::vector<Muscle> muscles = w.muscles;
+  auto& pts = muscles[w.gastroc].path.points;
+  ASSERT_EQ(pts.size(), 3u);
+  pts[1] = makeConditionalPoint(pts[1].body, pts[1].location, q2, lo, hi, "cvia");
+  for (const Muscle& mu : muscles) validateMuscle(m, mu);
+  int switches = 0;
+  bool was_on = isPathPointActive(pts[1], w.s0.q);
+  compareParticlesWithCore(m, muscles, w.build.model.muscles(), w.s0, "conditional via point", [&](const State& s) {
+    const bool on = isPathPointActive(pts[1], s.q);
+    switches += on != was_on;
+    was_on = on;
+  });
+  std::printf("  via point range [%.4f, %.4f] rad of q2, %d switches over the core's run\n", lo, hi, switches);
+  EXPECT_GE(switches, 2);
+}
+
+// the shapes the Simbody side used to refuse, now taken: the exact wrap model on a path with a via
+// point (OpenSim's whole path, differences in v: tests/plugin/muscle_inertia_test.cpp compares it
+// with the core), and conditional points in the particles; a mass point without mass is still refused
+TEST(SimbodyParticleMuscles, ExactModelOnViaPathsAndConditionalParticlesAreTaken) {
   WrapPendulum w = wrapPendulum(1.0);
   const Model& m = w.build.model;
   Muscle mu = w.muscles[0];
   mu.path.points.insert(mu.path.points.begin() + 1, makeFixedPoint(0, Vec3(-0.12, -0.8, 0.0), "via"));
-  validateMuscle(m, mu);
-  auto sm = simbody::makeSimbodyModel(m);
-  EXPECT_EQ(simbody::simbodyWrapShapeUnsupportedReason(mu), "");
-  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, makeMusculoskeletalModel(m, {mu})));
   mu.wrap.model = WrapModel::Exact;
-  validateMuscle(m, mu);  // the core takes it
-  const std::string why = simbody::simbodyWrapShapeUnsupportedReason(mu);
-  EXPECT_NE(why.find("exact wrap model"), std::string::npos) << why;
-  EXPECT_NE(why.find(mu.name), std::string::npos) << why;
-  try {
-    simbody::MuscleInertia mi(*sm, makeMusculoskeletalModel(m, {mu}));
-    ADD_FAILURE() << "MuscleInertia took the exact model on a via path";
-  } catch (const ModelError& e) {
-    EXPECT_NE(std::string(e.what()).find(mu.name), std::string::npos) << e.what();
-  }
-  EXPECT_THROW(simbody::ParticleMuscles(*sm, m, {mu}), simbody::SimbodyBuildError);
-  // origin -> one surface -> insertion keeps the exact model
-  Muscle one = w.muscles[0];
-  one.wrap.model = WrapModel::Exact;
-  EXPECT_EQ(simbody::simbodyWrapShapeUnsupportedReason(one), "");
-  // a conditional via point: ID takes it, particles do not
+  validateMuscle(m, mu);
+  EXPECT_EQ(simbody::simbodyWrapShapeUnsupportedReason(mu), "");
+  auto sm = simbody::makeSimbodyModel(m);
+  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, makeMusculoskeletalModel(m, {mu})));
+  EXPECT_NO_THROW(simbody::ParticleMuscles(*sm, m, {mu}));
   Muscle cond = w.muscles[0];
   cond.path.points.insert(cond.path.points.begin() + 1, makeConditionalPoint(0, Vec3(-0.12, -0.8, 0.0), 1, -1.0, 1.0, "cvia"));
   validateMuscle(m, cond);
-  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, makeMusculoskeletalModel(m, {cond})));
   auto sm2 = simbody::makeSimbodyModel(m);
-  EXPECT_THROW(simbody::ParticleMuscles(*sm2, m, {cond}), simbody::SimbodyBuildError);
+  EXPECT_NO_THROW(simbody::ParticleMuscles(*sm2, m, {cond}));
+  Muscle massless = w.muscles[0];
+  massless.mass_points.mass[0] = 0.0;
+  auto sm3 = simbody::makeSimbodyModel(m);
+  try {
+    simbody::ParticleMuscles p(*sm3, m, {massless});
+    ADD_FAILURE() << "a massless particle was taken";
+  } catch (const simbody::SimbodyBuildError& e) {
+    EXPECT_NE(std::string(e.what()).find(massless.name), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
