@@ -20,6 +20,7 @@
 //   - taken now: the exact wrap model on a path with a via point, conditional points in particles.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <functional>
@@ -372,6 +373,51 @@ TEST(SimbodyParticleMuscles, ConditionalViaPointSwitchingMatchesCoreRk45) {
   });
   std::printf("  via point range [%.4f, %.4f] rad of q2, %d switches over the core's run\n", lo, hi, switches);
   EXPECT_GE(switches, 2);
+}
+
+// the exact wrap model on origin -> via -> (cylinder) -> insertion in the particle mode: the wrap +
+// via pendulum over the part of its run before the first contact change of the via -> insertion
+// segment (the exact model's J jumps there, which particles cannot follow), particles against the
+// core's rk45 at four times in it, q to 1e-6 rad
+TEST(SimbodyParticleMuscles, ExactModelOnWrapViaPendulumMatchesCoreRk45) {
+  WrapViaPendulum w = wrapViaPendulum();
+  const Model& m = w.build.model;
+  std::vector<Muscle> muscles = w.muscles;
+  muscles[w.gastroc].wrap.model = WrapModel::Exact;
+  System sys(m);
+  sys.addTerm(std::make_shared<MuscleTerm>(m, muscles));
+  IntegratorOptions o;
+  o.rtol = 1e-11;
+  o.atol = 1e-12;
+  auto integ = makeIntegrator("rk45", o);
+  State s = w.s0;
+  const bool wrapped0 = segmentPenetration(m, muscles[w.gastroc], s, 1) > 0.0;
+  double t_change = 1.0;
+  std::vector<State> samples;
+  for (int k = 1; k <= 100; ++k) {
+    integ->advance(sys, s, 0.01 * k);
+    if ((segmentPenetration(m, muscles[w.gastroc], s, 1) > 0.0) != wrapped0) {
+      t_change = 0.01 * (k - 1);
+      break;
+    }
+    samples.push_back(s);
+  }
+  std::printf("  exact model: the via -> insertion segment %s until %.2f s\n", wrapped0 ? "wraps" : "is free", t_change);
+  ASSERT_GE(t_change, 0.1);
+  simbody::ParticleSimulationOptions po;
+  po.accuracy = 1e-10;
+  po.constraint_tolerance = 1e-11;
+  simbody::ParticleSimulation sim(makeMusculoskeletalModel(m, muscles), w.s0, po);
+  double worst = 0.0;
+  for (int j = 1; j <= 4; ++j) {
+    const int k = static_cast<int>(std::lround(j * 0.25 * t_change / 0.01)) - 1;
+    const State& sb = sim.advance(samples[k].t);
+    const double err = (sb.q - samples[k].q).cwiseAbs().maxCoeff();
+    worst = std::max(worst, err);
+    EXPECT_LT(err, 1e-6) << "t = " << samples[k].t;
+  }
+  std::printf("  exact model, particles vs core rk45 up to %.2f s: max |dq| %.3e rad (%ld Simbody steps)\n",
+              samples[static_cast<int>(std::lround(t_change / 0.01)) - 1].t, worst, sim.steps());
 }
 
 // the shapes the Simbody side used to refuse, now taken: the exact wrap model on a path with a via
