@@ -204,6 +204,19 @@ WrapPendulum wrapPendulum(double mass) {
   return w;
 }
 
+// the core's System with the muscles' MuscleTerm and rk45 (rtol 1e-11, atol 1e-12)
+struct CoreRk45 {
+  System sys;
+  std::unique_ptr<Integrator> integ;
+  CoreRk45(const Model& m, const std::vector<Muscle>& muscles) : sys(m) {
+    sys.addTerm(std::make_shared<MuscleTerm>(m, muscles));
+    IntegratorOptions o;
+    o.rtol = 1e-11;
+    o.atol = 1e-12;
+    integ = makeIntegrator("rk45", o);
+  }
+};
+
 // the core's MuscleTerm by rk45 (rtol 1e-11) and Simbody particles (accuracy 1e-10) from s0 over
 // 1 s: q to 1e-6 rad at 0.25, 0.5, 0.75 and 1 s, and the muscles' mass matters (q differs from the
 // run with the massless `plain` muscles by > 1e-3 rad at 1 s). on_core_state sees the core's state
@@ -213,12 +226,9 @@ void compareParticlesWithCore(const Model& m, const std::vector<Muscle>& muscles
                               const std::function<void(const State&)>& on_core_state) {
   const std::vector<double> times{0.25, 0.5, 0.75, 1.0};
   auto core_run = [&](const std::vector<Muscle>& ms, double& cpu, bool watch) {
-    System sys(m);
-    sys.addTerm(std::make_shared<MuscleTerm>(m, ms));
-    IntegratorOptions o;
-    o.rtol = 1e-11;
-    o.atol = 1e-12;
-    auto integ = makeIntegrator("rk45", o);
+    CoreRk45 core(m, ms);
+    auto& integ = core.integ;
+    auto& sys = core.sys;
     State s = s0;
     std::vector<VecX> q;
     const std::clock_t t0 = std::clock();
@@ -347,15 +357,11 @@ TEST(SimbodyParticleMuscles, ConditionalViaPointSwitchingMatchesCoreRk45) {
   // q2 along the run with the via point always on
   double lo = 0.0, hi = 0.0;
   {
-    System sys(m);
-    sys.addTerm(std::make_shared<MuscleTerm>(m, w.muscles));
-    IntegratorOptions o;
-    o.rtol = 1e-10;
-    auto integ = makeIntegrator("rk45", o);
+    CoreRk45 core(m, w.muscles);
     State s = w.s0;
-    integ->advance(sys, s, 0.3);
+    core.integ->advance(core.sys, s, 0.3);
     lo = s.q[q2];
-    integ->advance(sys, s, 0.6);
+    core.integ->advance(core.sys, s, 0.6);
     hi = s.q[q2];
     if (lo > hi) std::swap(lo, hi);
   }
@@ -384,18 +390,13 @@ TEST(SimbodyParticleMuscles, ExactModelOnWrapViaPendulumMatchesCoreRk45) {
   const Model& m = w.build.model;
   std::vector<Muscle> muscles = w.muscles;
   muscles[w.gastroc].wrap.model = WrapModel::Exact;
-  System sys(m);
-  sys.addTerm(std::make_shared<MuscleTerm>(m, muscles));
-  IntegratorOptions o;
-  o.rtol = 1e-11;
-  o.atol = 1e-12;
-  auto integ = makeIntegrator("rk45", o);
+  CoreRk45 core(m, muscles);
   State s = w.s0;
   const bool wrapped0 = segmentPenetration(m, muscles[w.gastroc], s, 1) > 0.0;
   double t_change = 1.0;
   std::vector<State> samples;
   for (int k = 1; k <= 100; ++k) {
-    integ->advance(sys, s, 0.01 * k);
+    core.integ->advance(core.sys, s, 0.01 * k);
     if ((segmentPenetration(m, muscles[w.gastroc], s, 1) > 0.0) != wrapped0) {
       t_change = 0.01 * (k - 1);
       break;
