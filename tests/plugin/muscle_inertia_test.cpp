@@ -6,7 +6,9 @@
 //     mobilizers) with Type I, Type II (1-5 via points), moving and conditional points, and Type III
 //     (one cylinder or sphere on the origin's body, a third body or the world; fixed or moving ends;
 //     and two surfaces on the two segments of origin -> middle point -> insertion, the middle point
-//     fixed, moving, or conditional on or off);
+//     fixed, moving, or conditional on or off); the exact wrap model on longer paths (via + wrap +
+//     via, two surfaces on one segment, two on different segments) against the core's exact and
+//     smooth models, to the differences' error (kExactTol, kExactVsSmoothTol);
 //   - engine: SimbodyIdEngine(model, muscles) == core System + MuscleTerm inverse dynamics on the
 //     project's scenes (double pendulums with a Type I, II and III muscle, finger, running leg with its
 //     wrapping gastrocnemii; double_pendulum_wrap_via with a via point before the cylinder, as
