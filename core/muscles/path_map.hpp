@@ -101,7 +101,8 @@ void calcWrapPathMap(const WrapSurface& surface, const WrapMassOptions& wrap, co
 // of its geometric length and differentiates it in q. That path depends on q only through the
 // active points' world positions and the surfaces' poses (calcWrappedPathAt), so here x_a is the
 // same function of the inputs, J its central differences in v's coordinates (step 1e-6 m or rad)
-// and the bias its fourth-order second difference along v (displacements of 1e-4 per unit |v|).
+// and the bias its fourth-order second difference along v (displacements of 1e-4 per unit |v|,
+// 1e-5 where that stencil straddles a kink of OpenSim's passes).
 // Both are differences: they agree with the core's to the differences' error, not to round-off
 // (docs/simbody.md gives the measured agreement).
 

@@ -584,9 +584,9 @@ TEST(SimbodyMuscleInertia, TwoWrapsMatchCoreMuscleTermOnRandomTrees) {
 // Where the smooth model takes the path (0, 2, 3; every random state here is outside its blend
 // band or the surface is not in contact) its analytic J and Jdot give the same path: the Simbody
 // side agrees with that to kExactVsSmoothTol, the core's exact model (a wider stencil in q) less
-// closely. Two surfaces on one segment (1): 1e-5 except where a kink of OpenSim's iteration
-// falls inside a stencil (at most one state).
-constexpr double kExactTol = 5e-6, kExactVsSmoothTol = 3e-7;
+// closely. Two surfaces on one segment (1): kSameSegmentTol (one state sits near a kink of
+// OpenSim's iteration, where path_map.cpp's bias stencil shrinks and is noisier).
+constexpr double kExactTol = 5e-6, kExactVsSmoothTol = 3e-7, kSameSegmentTol = 2e-5;
 
 Muscle randomViaWrapViaMuscle(const Model& m, std::mt19937& rng, const State& s, bool two_surfaces) {
   Muscle mu;
@@ -622,7 +622,7 @@ TEST(SimbodyMuscleInertia, ExactModelOnLongerPathsMatchesCoreMuscleTerm) {
                                 {scenes::randomTree(8, 29, TreeJoints::SimbodyComparable), simbody::SphericalAs::Ball}};
   std::mt19937 rng(515);
   double worst_smooth = 0.0, worst_core = 0.0, worst_same_segment = 0.0;
-  int compared = 0, same_segment = 0, kinked = 0, wrapped = 0;
+  int compared = 0, same_segment = 0, wrapped = 0;
   for (const Case& c : cases) {
     const Model& m = c.model;
     simbody::SimbodyBuildOptions opt;
@@ -655,15 +655,10 @@ TEST(SimbodyMuscleInertia, ExactModelOnLongerPathsMatchesCoreMuscleTerm) {
         ++compared;
         if (variant == 1) {
           // two surfaces on one segment: no smooth reference; OpenSim's passes make the path
-          // piecewise smooth at a fine scale, where either side's differences may straddle a kink
+          // piecewise smooth at a fine scale (path_map.cpp shrinks its bias stencil at a kink)
           ++same_segment;
-          if (d_core > 1e-5) {
-            ++kinked;
-            std::printf("  two surfaces on one segment, a state where the differences disagree: %.2e of the peak\n",
-                        d_core);
-          } else {
-            worst_same_segment = std::max(worst_same_segment, d_core);
-          }
+          worst_same_segment = std::max(worst_same_segment, d_core);
+          EXPECT_LT(d_core, kSameSegmentTol);
           continue;
         }
         // the smooth model's analytic map on the same path: the exact path outside its blend band
@@ -678,12 +673,11 @@ TEST(SimbodyMuscleInertia, ExactModelOnLongerPathsMatchesCoreMuscleTerm) {
     }
   }
   std::printf("  %d states (%d with a surface in the path); vs the core's smooth model %.2e, vs the core's exact "
-              "model %.2e of the peak; two surfaces on one segment %.2e in %d of %d states\n",
-              compared, wrapped, worst_smooth, worst_core, worst_same_segment, same_segment - kinked, same_segment);
+              "model %.2e of the peak; two surfaces on one segment %.2e (%d states)\n",
+              compared, wrapped, worst_smooth, worst_core, worst_same_segment, same_segment);
   EXPECT_GE(compared, 20);
   EXPECT_GE(wrapped, 16);
   EXPECT_GE(same_segment, 4);
-  EXPECT_LE(kinked, 1);
 }
 
 // CPU time per inverse-dynamics call (printed, not asserted): Simbody with and without the muscles,
