@@ -17,6 +17,8 @@
 //   - a conditional via point in the particle mode, switching on and off during the run (a
 //     Simbody event at each end of its range re-places the particles): particles against the
 //     core's rk45, q to 1e-6 rad;
+//   - the exact wrap model on the same via path in the particle mode, over the part of the run
+//     before its first contact change (where its J jumps): particles against the core, 1e-6 rad;
 //   - taken now: the exact wrap model on a path with a via point, conditional points in particles.
 #include <gtest/gtest.h>
 
