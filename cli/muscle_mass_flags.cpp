@@ -25,9 +25,7 @@ void addWrapFlags(CLI::App& app, WrapFlags& f, bool with_model, const std::strin
                                  "massless. smooth takes paths with at most one wrap object per segment\n"
                                  "over the surfaces it supports, exact any path OpenSim wraps; other\n"
                                  "wrapping muscles stay lumped and the summary says why (\"wrapping\n"
-                                 "(Type III): W of N carry mass\"). Simbody engines take the same paths\n"
-                                 "except exact beyond origin -> one wrap -> insertion, and name the\n"
-                                 "muscles they refuse")
+                                 "(Type III): W of N carry mass\"). Simbody engines take the same paths")
                       ->type_name("smooth|exact|neural|lumped")
                       ->check(oneOf({"smooth", "exact", "neural", "lumped"}))
                       ->group(group);

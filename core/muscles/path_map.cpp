@@ -5,6 +5,7 @@
 
 #include "core/muscles/muscle_kinematics.hpp"
 #include "core/muscles/path_kinematics.hpp"
+#include "core/muscles/wrap/wrap_path.hpp"
 #include "core/muscles/wrap_muscle.hpp"
 #include "core/spatial/se3.hpp"
 
@@ -111,15 +112,118 @@ void calcWrapPathMap(const WrapSurface& surface, const WrapMassOptions& wrap, co
   }
 }
 
-std::string generalPathMapUnsupportedReason(const Muscle& muscle) {
-  const MusclePath& path = muscle.path;
-  if (path.wraps.empty() || muscle.wrap.model != WrapModel::Exact) return "";
-  if (path.points.size() == 2 && path.wraps.size() == 1) return "";
-  return "the exact wrap model on a path other than origin -> one wrap surface -> insertion (this one has " +
-         std::to_string(path.points.size()) + " points and " + std::to_string(path.wraps.size()) +
-         " wrap objects) differentiates OpenSim's whole wrapped path in the coordinates, which a map over "
-         "path points and surface frames cannot do: use the smooth or neural wrap model, or the core";
+namespace {
+
+// the exact model on a path other than origin -> one surface -> insertion: OpenSim's whole wrapped
+// path (core/muscles/wrap/wrap_path.hpp) on the map's inputs, x_a at fractions alpha of its
+// geometric length (what the core's calcExactPathMassPointsFd evaluates at each q)
+void exactPathPoints(const Muscle& mu, const std::vector<int>& active, const std::vector<Vec3>& x,
+                     const std::vector<Mat4>& E_ws, std::vector<Vec3>& x_a) {
+  const WrappedPath wp = calcWrappedPathAt(mu.path, active, x, E_ws);
+  const MassPoints& mp = mu.mass_points;
+  x_a.resize(mp.size());
+  for (int a = 0; a < mp.size(); ++a) x_a[a] = calcWrappedPathPointAt(wp, E_ws, mp.alpha[a]);
 }
+
+Mat4 framePose(const Mat3& R, const Vec3& p) {
+  Mat4 E = Mat4::Identity();
+  E.topLeftCorner<3, 3>() = R;
+  E.topRightCorner<3, 1>() = p;
+  return E;
+}
+
+// the inputs moved along v for time t with vdot = 0: x_i + t xdot_i, R_w -> exp(t [omega_w]) R_w,
+// p_w + t pdot_w (v's columns: a frame's angular velocity is a left, world-axis rotation)
+void moveInputs(const std::vector<Vec3>& x, const std::vector<SurfaceFrameState>& f, const VecX& v, double t,
+                std::vector<Vec3>& xt, std::vector<Mat4>& Et) {
+  const int P = static_cast<int>(x.size());
+  xt.resize(P);
+  for (int i = 0; i < P; ++i) xt[i] = x[i] + t * v.segment<3>(3 * i);
+  Et.resize(f.size());
+  for (size_t w = 0; w < f.size(); ++w) {
+    const int c = 3 * P + 6 * static_cast<int>(w);
+    Et[w] = framePose(expSO3(Vec3(t * v.segment<3>(c))) * f[w].R, f[w].p + t * v.segment<3>(c + 3));
+  }
+}
+
+// J by central differences in v's coordinates (step h: m for the points and the frames' origins,
+// rad for the frames' rotations; the core's step in q) and, with velocities, the bias b = xddot_a at
+// vdot = 0 = d^2/dt^2 x_a(inputs moved along v) by the fourth-order central second difference over
+// displacements of 1e-4 (m or rad) per unit |v| (1e-5 where that stencil straddles a kink). The core differentiates the same points in q (J:
+// central, step 1e-6; Jdot: a mixed stencil of 1e-5): the two agree to those differences' error.
+void calcExactGeneralPathMapFd(const Muscle& mu, const std::vector<int>& active, const std::vector<Vec3>& x,
+                               const std::vector<Vec3>* xdot, const std::vector<SurfaceFrameState>& surfaces,
+                               GeneralPathMap& out) {
+  const int P = static_cast<int>(x.size()), W = static_cast<int>(surfaces.size());
+  const int N = mu.mass_points.size(), k = 3 * P + 6 * W;
+  std::vector<Mat4> E_ws(W);
+  for (int w = 0; w < W; ++w) E_ws[w] = framePose(surfaces[w].R, surfaces[w].p);
+  exactPathPoints(mu, active, x, E_ws, out.x_a);
+  out.J.resize(3 * N, k);
+  const double h = 1e-6;
+  std::vector<Vec3> xs = x, xp, xm;
+  std::vector<Mat4> Es = E_ws;
+  auto column = [&](int c) {
+    for (int a = 0; a < N; ++a) out.J.block<3, 1>(3 * a, c) = (xp[a] - xm[a]) / (2.0 * h);
+  };
+  for (int i = 0; i < P; ++i)
+    for (int d = 0; d < 3; ++d) {
+      xs[i][d] = x[i][d] + h;
+      exactPathPoints(mu, active, xs, E_ws, xp);
+      xs[i][d] = x[i][d] - h;
+      exactPathPoints(mu, active, xs, E_ws, xm);
+      xs[i][d] = x[i][d];
+      column(3 * i + d);
+    }
+  for (int w = 0; w < W; ++w)
+    for (int d = 0; d < 3; ++d) {
+      const Vec3 e = Vec3::Unit(d) * h;
+      Es[w].topLeftCorner<3, 3>() = expSO3(e) * surfaces[w].R;
+      exactPathPoints(mu, active, x, Es, xp);
+      Es[w].topLeftCorner<3, 3>() = expSO3(Vec3(-e)) * surfaces[w].R;
+      exactPathPoints(mu, active, x, Es, xm);
+      Es[w] = E_ws[w];
+      column(3 * P + 6 * w + d);
+      Es[w].topRightCorner<3, 1>() = surfaces[w].p + e;
+      exactPathPoints(mu, active, x, Es, xp);
+      Es[w].topRightCorner<3, 1>() = surfaces[w].p - e;
+      exactPathPoints(mu, active, x, Es, xm);
+      Es[w] = E_ws[w];
+      column(3 * P + 6 * w + 3 + d);
+    }
+  if (!xdot) return;
+  out.bias.setZero(3 * N);
+  const VecX v = stackGeneralVelocities(*xdot, surfaces);
+  const double speed = v.norm();
+  if (!(speed > 0.0)) return;
+  // second differences along v over displacements s per unit |v|: the fourth-order estimate, and
+  // whether its two second-order parts (steps tau and 2 tau) agree. With several surfaces on one
+  // segment OpenSim's passes make the path only piecewise smooth at a fine scale; a stencil that
+  // straddles such a kink shows as disagreeing parts, and the step shrinks (noisier, but on one
+  // side of the kink)
+  std::vector<std::vector<Vec3>> xa(5);
+  auto secondDifference = [&](double s) {
+    const double tau = s / speed;
+    for (int j = -2; j <= 2; ++j) {
+      moveInputs(x, surfaces, v, j * tau, xs, Es);
+      exactPathPoints(mu, active, xs, Es, xa[j + 2]);
+    }
+    double gap = 0.0, size = 0.0;
+    for (int a = 0; a < N; ++a) {
+      const Vec3 d1 = (xa[1][a] - 2.0 * xa[2][a] + xa[3][a]) / (tau * tau);
+      const Vec3 d2 = (xa[0][a] - 2.0 * xa[2][a] + xa[4][a]) / (4.0 * tau * tau);
+      out.bias.segment<3>(3 * a) = (4.0 * d1 - d2) / 3.0;  // = (-x_-2 + 16 x_-1 - 30 x_0 + 16 x_1 - x_2) / 12 tau^2
+      gap = std::max(gap, (d1 - d2).cwiseAbs().maxCoeff());
+      size = std::max(size, d1.cwiseAbs().maxCoeff());
+    }
+    return gap <= 1e-3 * size;
+  };
+  // 1e-4: the best agreement with the smooth model's analytic bias where both apply
+  // (tests/plugin/general_path_map_test.cpp); 1e-5 where a kink is seen
+  if (!secondDifference(1e-4)) secondDifference(1e-5);
+}
+
+}  // namespace
 
 void calcGeneralPathMap(const Muscle& muscle, const std::vector<int>& active, const std::vector<Vec3>& x,
                         const std::vector<Vec3>* xdot, const std::vector<SurfaceFrameState>& surfaces,
@@ -144,8 +248,6 @@ void calcGeneralPathMap(const Muscle& muscle, const std::vector<int>& active, co
     out.seg_wrap.clear();
     return;
   }
-  const std::string why = generalPathMapUnsupportedReason(muscle);
-  if (!why.empty()) throw std::invalid_argument("calcGeneralPathMap: muscle '" + name + "': " + why);
   if (P < 2) throw std::invalid_argument("calcGeneralPathMap: muscle '" + name + "' needs at least two path points");
   if (vel && static_cast<int>(xdot->size()) != P)
     throw std::invalid_argument("calcGeneralPathMap: muscle '" + name + "': " + std::to_string(P) + " points but " +
@@ -165,6 +267,12 @@ void calcGeneralPathMap(const Muscle& muscle, const std::vector<int>& active, co
     out.J = out.wmap.J;
     if (vel) out.bias = out.wmap.bias;
     out.seg_wrap.assign(1, 0);
+    return;
+  }
+  // the exact model on any other path: OpenSim's whole path, differentiated in v (no segment choice)
+  if (muscle.wrap.model == WrapModel::Exact && !(path.points.size() == 2 && W == 1)) {
+    calcExactGeneralPathMapFd(muscle, active, x, xdot, surfaces, out);
+    out.seg_wrap.clear();
     return;
   }
 

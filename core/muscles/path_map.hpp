@@ -97,7 +97,14 @@ void calcWrapPathMap(const WrapSurface& surface, const WrapMassOptions& wrap, co
 // Origin -> one active surface -> insertion goes through calcWrapPathMap, which that construction
 // reduces to (beta = alpha; equal to 1e-13 in tests/plugin/general_path_map_test.cpp).
 // Nothing is re-derived here. The exact wrap model on a path other than origin -> one surface ->
-// insertion differentiates OpenSim's whole path in q, which has no such form: refused.
+// insertion: the core takes OpenSim's whole wrapped path (core/muscles/wrap/wrap_path.hpp) at alpha
+// of its geometric length and differentiates it in q. That path depends on q only through the
+// active points' world positions and the surfaces' poses (calcWrappedPathAt), so here x_a is the
+// same function of the inputs, J its central differences in v's coordinates (step 1e-6 m or rad)
+// and the bias its fourth-order second difference along v (displacements of 1e-4 per unit |v|,
+// 1e-5 where that stencil straddles a kink of OpenSim's passes).
+// Both are differences: they agree with the core's to the differences' error, not to round-off
+// (docs/simbody.md gives the measured agreement).
 
 /// Pose and spatial velocity of one wrap surface frame s (world): an input of calcGeneralPathMap.
 struct SurfaceFrameState {
@@ -113,7 +120,8 @@ struct GeneralPathMap {
   MatX J;                     ///< d xdot_a / d v                                (3N x (3P + 6W))
   VecX bias;                  ///< xddot_a at vdot = 0 (valid with velocity)                (3N)
   bool velocity = false;      ///< true when bias is valid
-  std::vector<int> seg_wrap;  ///< per segment, the wrap object acting on it or -1 (W > 0)  (P-1)
+  std::vector<int> seg_wrap;  ///< per segment, the wrap object acting on it or -1 (W > 0;  (P-1)
+                              ///< empty for the exact model beyond one wrapped segment)
   PathMap pm;                 ///< scratch: Types I and II
   WrapPathMap wmap;           ///< scratch: origin -> one surface -> insertion (calcWrapPathMap)
   MuscleKinematics mk;        ///< scratch: the segment construction in v's coordinates
@@ -123,16 +131,11 @@ struct GeneralPathMap {
 /// the frames' omega, pdot: the vector calcGeneralPathMap's J multiplies.
 VecX stackGeneralVelocities(const std::vector<Vec3>& xdot, const std::vector<SurfaceFrameState>& frames);
 
-/// "" when calcGeneralPathMap takes `muscle` (any path validateMuscle accepts, except the exact
-/// wrap model on a path other than origin -> one surface -> insertion), else why not.
-std::string generalPathMapUnsupportedReason(const Muscle& muscle);
-
 /// Mass points of `muscle` (its path, mass points and wrap options) for its active points `active`
 /// (indices into muscle.path.points, P >= 2) at world positions x (P) with, when xdot is non-null,
 /// velocities xdot (P), and its wrap surface frames `surfaces` (W = muscle.path.wraps.size(): every
 /// wrap object, world; omega, pdot read only with xdot). Throws MuscleError naming the muscle for a
-/// degenerate path, std::invalid_argument for sizes that do not fit or an unsupported muscle
-/// (generalPathMapUnsupportedReason).
+/// degenerate path, std::invalid_argument for sizes that do not fit.
 void calcGeneralPathMap(const Muscle& muscle, const std::vector<int>& active, const std::vector<Vec3>& x,
                         const std::vector<Vec3>* xdot, const std::vector<SurfaceFrameState>& surfaces,
                         GeneralPathMap& out);

@@ -19,8 +19,7 @@ std::string simbodyWrapShapeUnsupportedReason(const Muscle& mu) {
   if (mu.fibre.enabled())
     return "muscle '" + mu.name + "': fibre-following mass placement is computed by the core only (--engine core, "
            "or --mass-placement uniform)";
-  const std::string why = generalPathMapUnsupportedReason(mu);
-  return why.empty() ? "" : "muscle '" + mu.name + "': the Simbody side cannot carry these mass points: " + why;
+  return "";
 }
 
 MatterMuscleInertia::MatterMuscleInertia(const SimTK::SimbodyMatterSubsystem& matter, MatterMap map,

@@ -26,9 +26,10 @@
 // Simbody's frame Jacobian and its bias; the path map is calcGeneralPathMap
 // (core/muscles/path_map.hpp: the core's segment construction and wrap model), v = (xdot, (omega_w,
 // pdot_w) per wrap), a_a = J vdot + b, and each wrap's (omega, pdot) part of J^T f_a is a spatial
-// force (torque, force at the surface origin) that JF^T takes to u [D Eq. 5.45-5.57]. Refused
-// (simbodyWrapShapeUnsupportedReason): the exact wrap model on a path other than origin -> one
-// surface -> insertion, whose J the core takes by differences in q.
+// force (torque, force at the surface origin) that JF^T takes to u [D Eq. 5.45-5.57]. The exact
+// wrap model on paths other than origin -> one surface -> insertion is OpenSim's whole path, its J
+// and bias differences in v (path_map.hpp), so it agrees with the core (differences in q) to
+// the differences' error (docs/simbody.md).
 //
 // Simbody comes through plugin/simbody/simbody_include.hpp, whose C++20 fix for index comparisons
 // is needed by Debian's Simbody 3.7 and harmless with OpenSim's newer one (its member operator== is
@@ -47,8 +48,7 @@
 namespace redmax::simbody {
 
 /// "" when a muscle with mass points can be carried by the Simbody side, else why not: every path
-/// the core takes except the exact wrap model on a path other than origin -> one wrap surface ->
-/// insertion (generalPathMapUnsupportedReason).
+/// the core takes, with mass points at fixed arc fractions (not fibre-following placement).
 std::string simbodyWrapShapeUnsupportedReason(const Muscle& muscle);
 
 /// Where a core model's bodies and coordinates are in a Simbody system.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <memory>
 
 #include <Eigen/LU>
 
@@ -29,9 +30,9 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
                  const std::vector<SimTK::MobilizedBody>& point_bodies,
                  const std::vector<const SimTK::MobilizedBody*>& coord_mobods, const std::vector<int>& coord_in_mobod,
                  const std::vector<SimTK::MobilizedBody>& particles,
-                 const std::vector<SimTK::MobilizedBody>& surface_bodies)
+                 const std::vector<SimTK::MobilizedBody>& surface_bodies, std::shared_ptr<const std::vector<int>> active)
       : Implementation(matter, 3 * mu.mass_points.size(), 0, 0), mu_(mu), points_(mu.path.points),
-        mp_(mu.mass_points) {
+        mp_(mu.mass_points), active_(std::move(active)) {
     // a body (mobilizer) carrying several points (coordinates) is constrained once
     std::map<int, SimTK::ConstrainedBodyIndex> cb_of;
     std::map<int, SimTK::ConstrainedMobilizerIndex> cm_of;
@@ -58,13 +59,9 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       X_bs_.push_back(toTransform(mu.path.wraps.at(w).E_bs));
     }
     for (const SimTK::MobilizedBody& p : particles) particle_cb_.push_back(addConstrainedBody(p));
-    x_.resize(P);
-    xdot_.resize(P);
     x_b_.resize(P);
     dx_b_.resize(P);
     ddx_b_.resize(P);
-    active_.resize(P);
-    for (int i = 0; i < P; ++i) active_[i] = i;  // conditional points are refused: all active
     frames_.resize(surface_cb_.size());
   }
 
@@ -73,9 +70,12 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   void calcPositionErrors(const SimTK::State& s, const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>& X_AB,
                           const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& cq,
                           SimTK::Array_<SimTK::Real>& perr) const override {
-    for (size_t i = 0; i < x_.size(); ++i) {
+    const std::vector<int>& act = *active_;
+    x_.resize(act.size());
+    for (size_t j = 0; j < act.size(); ++j) {
+      const int i = act[j];
       locate(i, moving(i) ? getOneQ(s, cq, cm_[i], mq_[i]) : 0.0);
-      x_[i] = fromSimTKVec3(findStationLocation(X_AB, point_cb_[i], toSimTKVec3(x_b_[i])));
+      x_[j] = fromSimTKVec3(findStationLocation(X_AB, point_cb_[i], toSimTKVec3(x_b_[i])));
     }
     for (size_t w = 0; w < frames_.size(); ++w) setPose(w, X_AB[surface_cb_[w]]);
     mapPositions();
@@ -88,14 +88,18 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   void calcPositionDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& V_AB,
                              const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& cqdot,
                              SimTK::Array_<SimTK::Real>& pverr) const override {
-    for (size_t i = 0; i < x_.size(); ++i) {
+    const std::vector<int>& act = *active_;
+    x_.resize(act.size());
+    xdot_.resize(act.size());
+    for (size_t j = 0; j < act.size(); ++j) {
+      const int i = act[j];
       locate(i, moving(i) ? getOneQFromState(s, cm_[i], mq_[i]) : 0.0);
       const SimTK::Vec3 station = toSimTKVec3(x_b_[i]);
-      x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station));
+      x_[j] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station));
       SimTK::Vec3 v = findStationVelocity(s, V_AB, point_cb_[i], station);
       if (moving(i))
         v += getBodyRotationFromState(s, point_cb_[i]) * toSimTKVec3(dx_b_[i]) * getOneQDot(s, cqdot, cm_[i], mq_[i]);
-      xdot_[i] = fromSimTKVec3(v);
+      xdot_[j] = fromSimTKVec3(v);
     }
     // xdot_a = J v [D Eq. 5.4], v = (xdot, (omega_w, pdot_w) per wrap) (path_map.hpp)
     for (size_t w = 0; w < frames_.size(); ++w) {
@@ -114,12 +118,16 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   void calcPositionDotDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& A_AB,
                                 const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& cqddot,
                                 SimTK::Array_<SimTK::Real>& paerr) const override {
-    const int P = static_cast<int>(x_.size()), W = static_cast<int>(frames_.size());
+    const std::vector<int>& act = *active_;
+    const int P = static_cast<int>(act.size()), W = static_cast<int>(frames_.size());
+    x_.resize(P);
+    xdot_.resize(P);
     VecX vdot(3 * P + 6 * W);
-    for (int i = 0; i < P; ++i) {
+    for (int j = 0; j < P; ++j) {
+      const int i = act[j];
       locate(i, moving(i) ? getOneQFromState(s, cm_[i], mq_[i]) : 0.0);
       const SimTK::Vec3 station = toSimTKVec3(x_b_[i]);
-      x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station));
+      x_[j] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], station));
       SimTK::Vec3 v = findStationVelocityFromState(s, point_cb_[i], station);
       SimTK::Vec3 acc = findStationAcceleration(s, A_AB, point_cb_[i], station);
       if (moving(i)) {
@@ -131,8 +139,8 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
         acc += 2.0 * SimTK::cross(getBodyAngularVelocityFromState(s, point_cb_[i]), v_rel) +
                R * toSimTKVec3(ddx_b_[i] * qd * qd + dx_b_[i] * qdd);
       }
-      xdot_[i] = fromSimTKVec3(v);
-      vdot.segment<3>(3 * i) = fromSimTKVec3(acc);
+      xdot_[j] = fromSimTKVec3(v);
+      vdot.segment<3>(3 * j) = fromSimTKVec3(acc);
     }
     // a_a = J vdot + bias [D Eq. 5.5], vdot = (xddot, (alpha_w, pddot_w) per wrap) (path_map.hpp)
     for (int w = 0; w < W; ++w) {
@@ -143,7 +151,7 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       vdot.segment<6>(3 * P + 6 * w) << fromSimTKVec3(getBodyAngularAcceleration(A_AB, cb)),
           fromSimTKVec3(findStationAcceleration(s, A_AB, cb, X_bs_[w].p()));
     }
-    calcGeneralPathMap(mu_, active_, x_, &xdot_, frames_, map_);
+    calcGeneralPathMap(mu_, act, x_, &xdot_, frames_, map_);
     keyMap();
     const VecX a_a = map_.J * vdot + map_.bias;
     for (int a = 0; a < mp_.size(); ++a) {
@@ -155,10 +163,13 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   void addInPositionConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& lambda,
                                      SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& bodyForcesInA,
                                      SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qForces) const override {
-    const int P = static_cast<int>(x_.size());
-    for (int i = 0; i < P; ++i) {
+    const std::vector<int>& act = *active_;
+    const int P = static_cast<int>(act.size());
+    x_.resize(P);
+    for (int j = 0; j < P; ++j) {
+      const int i = act[j];
       locate(i, moving(i) ? getOneQFromState(s, cm_[i], mq_[i]) : 0.0);
-      x_[i] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], toSimTKVec3(x_b_[i])));
+      x_[j] = fromSimTKVec3(findStationLocationFromState(s, point_cb_[i], toSimTKVec3(x_b_[i])));
     }
     for (size_t w = 0; w < frames_.size(); ++w) setPose(w, getBodyTransformFromState(s, surface_cb_[w]));
     mapPositions();
@@ -174,8 +185,9 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
       addInBodyTorque(s, surface_cb_[w], toSimTKVec3(F.segment<3>(c)), bodyForcesInA);
       addInStationForce(s, surface_cb_[w], X_bs_[w].p(), toSimTKVec3(F.segment<3>(c + 3)), bodyForcesInA);
     }
-    for (int i = 0; i < P; ++i) {
-      const SimTK::Vec3 Fi = toSimTKVec3(F.segment<3>(3 * i));
+    for (int j = 0; j < P; ++j) {
+      const int i = act[j];
+      const SimTK::Vec3 Fi = toSimTKVec3(F.segment<3>(3 * j));
       addInStationForce(s, point_cb_[i], toSimTKVec3(x_b_[i]), Fi, bodyForcesInA);
       // a moving point's column through its coordinate: (R x_b')^T F
       if (moving(i))
@@ -189,14 +201,15 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   // constraint row while it assembles G M^-1 G^T (30 rows on the finger), always at the same
   // positions: reuse the last map when its inputs are bit-identical (it is a function of them)
   void mapPositions() const {
-    bool same = map_valid_ && map_x_ == x_ && map_frames_.size() == frames_.size();
+    bool same = map_valid_ && map_active_ == *active_ && map_x_ == x_ && map_frames_.size() == frames_.size();
     for (size_t w = 0; same && w < frames_.size(); ++w)
       same = map_frames_[w].R == frames_[w].R && map_frames_[w].p == frames_[w].p;
     if (same) return;
-    calcGeneralPathMap(mu_, active_, x_, nullptr, frames_, map_);
+    calcGeneralPathMap(mu_, *active_, x_, nullptr, frames_, map_);
     keyMap();
   }
   void keyMap() const {
+    map_active_ = *active_;
     map_x_ = x_;
     map_frames_ = frames_;
     map_valid_ = true;
@@ -223,7 +236,9 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   Muscle mu_;
   std::vector<PathPoint> points_;
   MassPoints mp_;
-  std::vector<int> active_;
+  // the active points (indices into points_): ParticleMuscles's, changed only by placeParticles
+  // (at the start and at a conditional point's switch), so the constraint is smooth between switches
+  std::shared_ptr<const std::vector<int>> active_;
   std::vector<SimTK::ConstrainedBodyIndex> point_cb_, particle_cb_;
   std::vector<SimTK::ConstrainedMobilizerIndex> cm_;  // per point; invalid for non-moving points
   std::vector<SimTK::MobilizerQIndex> mq_;
@@ -236,23 +251,79 @@ class PathConstraint : public SimTK::Constraint::Custom::Implementation {
   mutable GeneralPathMap map_;
   // the inputs map_ was computed for (mapPositions)
   mutable bool map_valid_ = false;
+  mutable std::vector<int> map_active_;
   mutable std::vector<Vec3> map_x_;
   mutable std::vector<SurfaceFrameState> map_frames_;
 };
 
+// a conditional point's switch: the witness q_c - bound changes sign where the point turns on or
+// off (bound: an end of its range widened by kConditionalTolerance, isPathPointActive's rule);
+// Simbody localizes the crossing, then the handler takes the new active sets and puts the
+// particles on the new paths with the skeleton's q and u unchanged, as the core's q and qdot are
+class ConditionalSwitch : public SimTK::TriggeredEventHandler {
+ public:
+  ConditionalSwitch(std::shared_ptr<const detail::ParticlePlacer> placer, int simbody_q, double bound)
+      : TriggeredEventHandler(SimTK::Stage::Position), placer_(std::move(placer)), q_(simbody_q), bound_(bound) {}
+  SimTK::Real getValue(const SimTK::State& s) const override { return placer_->sm->matter.getQ(s)[q_] - bound_; }
+  void handleEvent(SimTK::State& s, SimTK::Real, bool& terminate) const override {
+    terminate = false;
+    placer_->place(s);
+  }
+
+ private:
+  std::shared_ptr<const detail::ParticlePlacer> placer_;
+  int q_;
+  double bound_;
+};
+
+// the Simbody q index of core coordinate c (Euler angles on: Simbody q = core q per mobilizer)
+int simbodyQOf(const SimbodyModel& sm, int c) {
+  for (const MobilizerMap& m : sm.map)
+    if (c >= m.q_index && c < m.q_index + m.nq) return m.simbody_q + (c - m.q_index);
+  return -1;
+}
+
 }  // namespace
 
+namespace detail {
+
+void ParticlePlacer::place(SimTK::State& sb) const {
+  // the active sets at this q (isPathPointActive, the core's rule), which the constraints then keep
+  const SimTK::Vector& q_sb = sm->matter.getQ(sb);
+  for (const MobilizerMap& m : sm->map)
+    for (int k = 0; k < m.nq; ++k) q_core[m.q_index + k] = q_sb[m.simbody_q + k];
+  for (size_t e = 0; e < massive.size(); ++e) {
+    const auto& pts = muscles[massive[e]].path.points;
+    std::vector<int>& act = *active[e];
+    act.clear();
+    for (int k = 0; k < static_cast<int>(pts.size()); ++k)
+      if (isPathPointActive(pts[k], q_core)) act.push_back(k);
+  }
+  sm->system.realize(sb, SimTK::Stage::Velocity);
+  // the mass points' positions and velocities as inverse dynamics computes them (same path maps)
+  std::vector<Vec3> x, xdot;
+  motion->calcMassPointMotion(sb, x, xdot);
+  // set after every read: writing q invalidates the stage the reads above need
+  for (size_t k = 0; k < particles.size(); ++k) {
+    particles[k].setQToFitTranslation(sb, toSimTKVec3(x[k]));
+    particles[k].setUToFitLinearVelocity(sb, toSimTKVec3(xdot[k]));
+  }
+}
+
+}  // namespace detail
+
 ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles)
-    : sm_(sm), muscles_(std::move(muscles)) {
-  for (const Muscle& mu : muscles_) {
+    : sm_(sm), muscles_(std::move(muscles)), placer_(std::make_shared<detail::ParticlePlacer>()) {
+  detail::ParticlePlacer& placer = *placer_;
+  placer.sm = &sm;
+  placer.muscles = muscles_;
+  placer.q_core.setZero(model.nr());
+  for (int mi = 0; mi < static_cast<int>(muscles_.size()); ++mi) {
+    const Muscle& mu = muscles_[mi];
     validateMuscle(model, mu);
     if (mu.mass_points.size() == 0) continue;
     const std::string why = simbodyWrapShapeUnsupportedReason(mu);
     if (!why.empty()) throw SimbodyBuildError(why);
-    for (const PathPoint& p : mu.path.points)
-      if (p.kind == PathPointKind::Conditional)
-        throw SimbodyBuildError("muscle '" + mu.name + "': point '" + p.name +
-                                "' is conditional; Simbody particles support fixed and moving path points only");
     for (double m : mu.mass_points.mass)
       if (!(m > 0.0))
         throw SimbodyBuildError("muscle '" + mu.name + "': a mass point without mass cannot be a Simbody particle");
@@ -287,12 +358,29 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
     std::vector<SimTK::MobilizedBody> surface_bodies;
     for (const PathWrap& w : mu.path.wraps)
       surface_bodies.push_back(w.body >= 0 ? sm.mobods[w.body] : SimTK::MobilizedBody(sm.matter.updGround()));
+    // the active set, all points until placeParticles reads q
+    auto active = std::make_shared<std::vector<int>>();
+    for (int k = 0; k < static_cast<int>(mu.path.points.size()); ++k) active->push_back(k);
+    placer.massive.push_back(mi);
+    placer.active.push_back(active);
     SimTK::Constraint::Custom(
-        new PathConstraint(sm.matter, mu, point_bodies, coord_mobods, coord_in_mobod, mine, surface_bodies));
+        new PathConstraint(sm.matter, mu, point_bodies, coord_mobods, coord_in_mobod, mine, surface_bodies, active));
+    // conditional points: an event at each end of the range (an unconnected one is never active)
+    for (const PathPoint& p : mu.path.points) {
+      if (p.kind != PathPointKind::Conditional || p.coordinate < 0) continue;
+      const int q_sb = simbodyQOf(sm, p.coordinate);
+      if (q_sb < 0)
+        throw SimbodyBuildError("muscle '" + mu.name + "': point '" + p.name + "' is conditional on a coordinate "
+                                "the Simbody system has no q for");
+      for (double bound : {p.range_lo - kConditionalTolerance, p.range_hi + kConditionalTolerance})
+        sm.system.addEventHandler(new ConditionalSwitch(placer_, q_sb, bound));
+    }
   }
+  placer.particles = particles_;
   // the mass points' motion on the skeleton (placeParticles): the skeleton's bodies and q slots,
   // which the particles added above do not move
-  motion_ = std::make_unique<MatterMuscleInertia>(sm.matter, makeMatterMap(sm, model), model, muscles_, model.gravity());
+  placer.motion = std::make_unique<MatterMuscleInertia>(sm.matter, makeMatterMap(sm, model), model, muscles_,
+                                                        model.gravity());
   // the topology changed: a new default state, Euler angles on as makeSimbodyModel sets them
   try {
     sm.default_state = sm.system.realizeTopology();
@@ -303,17 +391,7 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
   }
 }
 
-void ParticleMuscles::placeParticles(SimTK::State& sb) const {
-  sm_.system.realize(sb, SimTK::Stage::Velocity);
-  // the mass points' positions and velocities as inverse dynamics computes them (same path maps)
-  std::vector<Vec3> x, xdot;
-  motion_->calcMassPointMotion(sb, x, xdot);
-  // set after every read: writing q invalidates the stage the reads above need
-  for (size_t k = 0; k < particles_.size(); ++k) {
-    particles_[k].setQToFitTranslation(sb, toSimTKVec3(x[k]));
-    particles_[k].setUToFitLinearVelocity(sb, toSimTKVec3(xdot[k]));
-  }
-}
+void ParticleMuscles::placeParticles(SimTK::State& sb) const { placer_->place(sb); }
 
 State ParticleMuscles::coreState(const Model& model, const SimTK::State& sb) const {
   const SimTK::Vector& q_sb = sm_.matter.getQ(sb);

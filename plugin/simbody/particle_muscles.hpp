@@ -19,11 +19,15 @@
 // (omega_w, pdot_w) per wrap), paerr J vdot + b, and each surface's share of G^T lambda is a torque
 // and a force at its origin. With the smooth model the path map is C2 within a segment choice, so
 // the constraint is smooth across contact changes; the exact model's finite-difference J jumps
-// there, and the exact model on paths other than origin -> one surface -> insertion is refused
-// (simbodyWrapShapeUnsupportedReason).
-// Limits: conditional points are rejected (switching would change the path, and the particles'
-// velocities would have to jump); so is a mass point without mass. Muscles without mass points are
-// skipped.
+// there (on any path: the whole OpenSim path differentiated in v, path_map.hpp), so a run with the
+// exact model is only meant to stay on one side of every contact change.
+// Conditional points: a point's switch changes the path, so the mass points' positions and
+// velocities jump where the core's (functions of q and qdot) do. Particles cannot follow a jump
+// continuously; each end of a conditional point's range is a Simbody event (a witness q_c - bound),
+// and at the event the active sets are taken again and every particle is put on its new path with
+// the skeleton's q and u unchanged (the core's q and qdot are continuous there). Between events
+// each constraint keeps its active set, so it stays smooth while Simbody localizes a crossing.
+// Limits: a mass point without mass. Muscles without mass points are skipped.
 #include <memory>
 #include <vector>
 
@@ -34,17 +38,35 @@
 
 namespace redmax::simbody {
 
+namespace detail {
+/// The particles' placement (ParticleMuscles::placeParticles), owned jointly by the ParticleMuscles
+/// and the system's conditional-point event handlers.
+struct ParticlePlacer {
+  const SimbodyModel* sm = nullptr;
+  std::vector<Muscle> muscles;                          // every muscle, in order
+  std::vector<int> massive;                             // per path constraint: its muscle
+  std::vector<std::shared_ptr<std::vector<int>>> active;  // per path constraint: its active points
+  std::vector<SimTK::MobilizedBody> particles;          // muscles in order, their mass points in order
+  std::unique_ptr<MatterMuscleInertia> motion;          // the mass points' motion on the skeleton
+  mutable VecX q_core;                                  // scratch: the core q of a state
+  /// take the active sets at sb's q and put the particles on their paths (header)
+  void place(SimTK::State& sb) const;
+};
+}  // namespace detail
+
 /// Adds the particles and constraints to `sm` (before any state other than its default is made):
 /// realizes the topology again and replaces sm.default_state (Euler angles kept on). The particles'
 /// q and u come after the skeleton's in Simbody's vectors; sm.nq and sm.nu keep the skeleton's counts.
 class ParticleMuscles {
  public:
   /// Throws ModelError for a muscle that does not fit `model` (validateMuscle), SimbodyBuildError for
-  /// one with conditional points or a massless mass point.
+  /// a massless mass point.
   ParticleMuscles(SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles);
 
   /// Put every particle at its mass point's position and velocity for the skeleton state already in
   /// `sb` (q and u of the skeleton set, e.g. by setSimbodyState): the constraints then hold exactly.
+  /// Also takes the active sets of conditional points at that q, which the constraints keep until
+  /// the next switch event (the system's, so one run at a time per ParticleMuscles).
   void placeParticles(SimTK::State& sb) const;
 
   /// The skeleton's core state (t, q, qdot = T^-1 u) from a state of the system with particles
@@ -59,8 +81,8 @@ class ParticleMuscles {
   const SimbodyModel& sm_;
   std::vector<Muscle> muscles_;
   std::vector<SimTK::MobilizedBody> particles_;  // muscles in order, their mass points in order
-  // the mass points' positions and velocities on the skeleton (placeParticles)
-  std::unique_ptr<MatterMuscleInertia> motion_;
+  // placeParticles' work, shared with the conditional points' event handlers
+  std::shared_ptr<detail::ParticlePlacer> placer_;
 };
 
 }  // namespace redmax::simbody

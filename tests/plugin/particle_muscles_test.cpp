@@ -257,16 +257,8 @@ TEST(SimbodyParticleSimulation, EnergyMatchesCoreAndIsConserved) {
   std::printf("  particle simulation: energy drift %.3e J of %.3f J over 1 s, %ld steps\n", drift, E0, sim.steps());
 }
 
-// the finger scene over 1 s: tests/plugin/particle_finger_test.cpp
-
-TEST(SimbodyParticleMuscles, RejectsConditionalPoints) {
-  const Model m = scenes::doublePendulum();
-  auto sm = simbody::makeSimbodyModel(m);
-  std::vector<Muscle> muscles = pendulumMuscles();
-  muscles[1].path.points.insert(muscles[1].path.points.begin() + 1,
-                                makeConditionalPoint(0, Vec3(0.1, -0.9, 0), 1, -1.0, 1.0, "cond"));
-  EXPECT_THROW(simbody::ParticleMuscles(*sm, m, muscles), simbody::SimbodyBuildError);
-}
+// the finger scene over 1 s: tests/plugin/particle_finger_test.cpp; conditional points (switching
+// during a run): tests/plugin/simbody_wrap_test.cpp
 
 }  // namespace
 }  // namespace redmax

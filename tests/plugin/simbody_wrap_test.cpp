@@ -14,10 +14,15 @@
 //   - general Type III forward dynamics: osim_models/double_pendulum_wrap_via.osim (via point, then
 //     the cylinder) with 1 kg and 0.5 kg on its muscles: particles on the general path map against
 //     the core's rk45, q to 1e-6 rad at 0.25 .. 1 s (the cylinder wraps over part of the run);
-//   - still refused, naming the muscle: the exact wrap model on a path with a via point, and (for
-//     particles only) conditional points.
+//   - a conditional via point in the particle mode, switching on and off during the run (a
+//     Simbody event at each end of its range re-places the particles): particles against the
+//     core's rk45, q to 1e-6 rad;
+//   - the exact wrap model on the same via path in the particle mode, over the part of the run
+//     before its first contact change (where its J jumps): particles against the core, 1e-6 rad;
+//   - taken now: the exact wrap model on a path with a via point, conditional points in particles.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <functional>
@@ -201,6 +206,19 @@ WrapPendulum wrapPendulum(double mass) {
   return w;
 }
 
+// the core's System with the muscles' MuscleTerm and rk45 (rtol 1e-11, atol 1e-12)
+struct CoreRk45 {
+  System sys;
+  std::unique_ptr<Integrator> integ;
+  CoreRk45(const Model& m, const std::vector<Muscle>& muscles) : sys(m) {
+    sys.addTerm(std::make_shared<MuscleTerm>(m, muscles));
+    IntegratorOptions o;
+    o.rtol = 1e-11;
+    o.atol = 1e-12;
+    integ = makeIntegrator("rk45", o);
+  }
+};
+
 // the core's MuscleTerm by rk45 (rtol 1e-11) and Simbody particles (accuracy 1e-10) from s0 over
 // 1 s: q to 1e-6 rad at 0.25, 0.5, 0.75 and 1 s, and the muscles' mass matters (q differs from the
 // run with the massless `plain` muscles by > 1e-3 rad at 1 s). on_core_state sees the core's state
@@ -210,12 +228,9 @@ void compareParticlesWithCore(const Model& m, const std::vector<Muscle>& muscles
                               const std::function<void(const State&)>& on_core_state) {
   const std::vector<double> times{0.25, 0.5, 0.75, 1.0};
   auto core_run = [&](const std::vector<Muscle>& ms, double& cpu, bool watch) {
-    System sys(m);
-    sys.addTerm(std::make_shared<MuscleTerm>(m, ms));
-    IntegratorOptions o;
-    o.rtol = 1e-11;
-    o.atol = 1e-12;
-    auto integ = makeIntegrator("rk45", o);
+    CoreRk45 core(m, ms);
+    auto& integ = core.integ;
+    auto& sys = core.sys;
     State s = s0;
     std::vector<VecX> q;
     const std::clock_t t0 = std::clock();
@@ -278,35 +293,51 @@ TEST(SimbodyParticleMuscles, WrappingDoublePendulumMatchesCoreRk45) {
   EXPECT_GT(max_pen, 0.0);  // wraps during part of the run
 }
 
+// the wrap + via pendulum's muscles with mass (1 kg on the wrapping one, 0.5 kg on the straight
+// one, 10 points each), its default pose at rest, and the wrapping muscle's index
+struct WrapViaPendulum {
+  osim::BuildResult build;
+  std::vector<Muscle> muscles;
+  State s0;
+  int gastroc = -1;
+};
+
+WrapViaPendulum wrapViaPendulum() {
+  WrapViaPendulum w;
+  const osim::ModelDescription d =
+      osim::readOsimModel(std::string(REDMAX_SOURCE_DIR) + "/osim_models/double_pendulum_wrap_via.osim");
+  osim::BuildOptions bo;
+  bo.constraints = false;
+  w.build = osim::buildCoreModel(d, bo);
+  const Model& m = w.build.model;
+  w.muscles = w.build.model.muscles();
+  MassPointOptions opt;
+  opt.count = 10;
+  for (size_t k = 0; k < w.muscles.size(); ++k) {
+    Muscle& mu = w.muscles[k];
+    const bool wraps = pathType(mu.path) == PathType::III;
+    if (wraps) w.gastroc = static_cast<int>(k);
+    mu.mass_points = makeMassPoints(wraps ? 1.0 : 0.5, mu.optimal_fiber_length, mu.tendon_slack_length, opt);
+  }
+  w.s0.q.resize(m.nr());
+  for (int c = 0; c < m.nr(); ++c) w.s0.q[c] = m.coordinates()[c].default_value;
+  w.s0.qdot = VecX::Zero(m.nr());
+  return w;
+}
+
 // general Type III forward dynamics: osim_models/double_pendulum_wrap_via.osim (origin, via point,
 // cylinder on the via -> insertion segment) with 1 kg on its wrapping muscle and 0.5 kg on its
 // straight one (10 points each), released from its default pose (compareParticlesWithCore); the
 // cylinder wraps over part of the run
 TEST(SimbodyParticleMuscles, WrapViaPendulumMatchesCoreRk45) {
-  const osim::ModelDescription d =
-      osim::readOsimModel(std::string(REDMAX_SOURCE_DIR) + "/osim_models/double_pendulum_wrap_via.osim");
-  osim::BuildOptions bo;
-  bo.constraints = false;
-  const osim::BuildResult r = osim::buildCoreModel(d, bo);
-  const Model& m = r.model;
-  std::vector<Muscle> muscles = r.model.muscles();
-  MassPointOptions opt;
-  opt.count = 10;
-  int gastroc = -1;
-  for (size_t k = 0; k < muscles.size(); ++k) {
-    Muscle& mu = muscles[k];
-    const bool wraps = pathType(mu.path) == PathType::III;
-    if (wraps) gastroc = static_cast<int>(k);
-    mu.mass_points = makeMassPoints(wraps ? 1.0 : 0.5, mu.optimal_fiber_length, mu.tendon_slack_length, opt);
-  }
+  const WrapViaPendulum w = wrapViaPendulum();
+  const Model& m = w.build.model;
+  const std::vector<Muscle>& muscles = w.muscles;
+  const int gastroc = w.gastroc;
   ASSERT_GE(gastroc, 0);
   ASSERT_EQ(muscles[gastroc].path.points.size(), 3u);
-  State s0;
-  s0.q.resize(m.nr());
-  for (int c = 0; c < m.nr(); ++c) s0.q[c] = m.coordinates()[c].default_value;
-  s0.qdot = VecX::Zero(m.nr());
   double min_pen = 1e9, max_pen = -1e9;
-  compareParticlesWithCore(m, muscles, r.model.muscles(), s0, "wrap + via pendulum", [&](const State& s) {
+  compareParticlesWithCore(m, muscles, w.build.model.muscles(), w.s0, "wrap + via pendulum", [&](const State& s) {
     const double pen = segmentPenetration(m, muscles[gastroc], s, 1);
     min_pen = std::min(min_pen, pen);
     max_pen = std::max(max_pen, pen);
@@ -315,41 +346,111 @@ TEST(SimbodyParticleMuscles, WrapViaPendulumMatchesCoreRk45) {
   EXPECT_GT(max_pen, 0.0);  // wraps during part of the run
 }
 
-// what the Simbody side still refuses, by muscle name: the exact wrap model on a path with a via
-// point (its J is taken by differences in q over OpenSim's whole path); the smooth model on the same
-// path is taken; particles also refuse conditional points (a switch would make them jump)
-TEST(SimbodyParticleMuscles, ExactModelOnViaPathsAndConditionalParticlesAreRefusedByName) {
+// a conditional via point in the particle mode: the wrap + via pendulum's via point made
+// conditional on q2 over a range that q2 enters and leaves during the run (its values at 0.3 s and
+// 0.6 s along the run with the via point fixed), so the path switches between origin -> via ->
+// (cylinder) -> insertion and origin -> (cylinder) -> insertion. Particles (re-placed at each
+// switch event) against the core's rk45, q to 1e-6 rad at 0.25 .. 1 s (compareParticlesWithCore);
+// the core's run switches at least twice (checked every 0.01 s).
+TEST(SimbodyParticleMuscles, ConditionalViaPointSwitchingMatchesCoreRk45) {
+  WrapViaPendulum w = wrapViaPendulum();
+  const Model& m = w.build.model;
+  const int q2 = 1;
+  // q2 along the run with the via point always on
+  double lo = 0.0, hi = 0.0;
+  {
+    CoreRk45 core(m, w.muscles);
+    State s = w.s0;
+    core.integ->advance(core.sys, s, 0.3);
+    lo = s.q[q2];
+    core.integ->advance(core.sys, s, 0.6);
+    hi = s.q[q2];
+    if (lo > hi) std::swap(lo, hi);
+  }
+  std::vector<Muscle> muscles = w.muscles;
+  auto& pts = muscles[w.gastroc].path.points;
+  ASSERT_EQ(pts.size(), 3u);
+  pts[1] = makeConditionalPoint(pts[1].body, pts[1].location, q2, lo, hi, "cvia");
+  for (const Muscle& mu : muscles) validateMuscle(m, mu);
+  int switches = 0;
+  bool was_on = isPathPointActive(pts[1], w.s0.q);
+  compareParticlesWithCore(m, muscles, w.build.model.muscles(), w.s0, "conditional via point", [&](const State& s) {
+    const bool on = isPathPointActive(pts[1], s.q);
+    switches += on != was_on;
+    was_on = on;
+  });
+  std::printf("  via point range [%.4f, %.4f] rad of q2, %d switches over the core's run\n", lo, hi, switches);
+  EXPECT_GE(switches, 2);
+}
+
+// the exact wrap model on origin -> via -> (cylinder) -> insertion in the particle mode: the wrap +
+// via pendulum over the part of its run before the first contact change of the via -> insertion
+// segment (the exact model's J jumps there, which particles cannot follow), particles against the
+// core's rk45 at four times in it, q to 1e-6 rad
+TEST(SimbodyParticleMuscles, ExactModelOnWrapViaPendulumMatchesCoreRk45) {
+  WrapViaPendulum w = wrapViaPendulum();
+  const Model& m = w.build.model;
+  std::vector<Muscle> muscles = w.muscles;
+  muscles[w.gastroc].wrap.model = WrapModel::Exact;
+  CoreRk45 core(m, muscles);
+  State s = w.s0;
+  const bool wrapped0 = segmentPenetration(m, muscles[w.gastroc], s, 1) > 0.0;
+  double t_change = 1.0;
+  std::vector<State> samples;
+  for (int k = 1; k <= 100; ++k) {
+    core.integ->advance(core.sys, s, 0.01 * k);
+    if ((segmentPenetration(m, muscles[w.gastroc], s, 1) > 0.0) != wrapped0) {
+      t_change = 0.01 * (k - 1);
+      break;
+    }
+    samples.push_back(s);
+  }
+  std::printf("  exact model: the via -> insertion segment %s until %.2f s\n", wrapped0 ? "wraps" : "is free", t_change);
+  ASSERT_GE(t_change, 0.1);
+  simbody::ParticleSimulationOptions po;
+  po.accuracy = 1e-10;
+  po.constraint_tolerance = 1e-11;
+  simbody::ParticleSimulation sim(makeMusculoskeletalModel(m, muscles), w.s0, po);
+  double worst = 0.0;
+  for (int j = 1; j <= 4; ++j) {
+    const int k = static_cast<int>(std::lround(j * 0.25 * t_change / 0.01)) - 1;
+    const State& sb = sim.advance(samples[k].t);
+    const double err = (sb.q - samples[k].q).cwiseAbs().maxCoeff();
+    worst = std::max(worst, err);
+    EXPECT_LT(err, 1e-6) << "t = " << samples[k].t;
+  }
+  std::printf("  exact model, particles vs core rk45 up to %.2f s: max |dq| %.3e rad (%ld Simbody steps)\n",
+              samples[static_cast<int>(std::lround(t_change / 0.01)) - 1].t, worst, sim.steps());
+}
+
+// the shapes the Simbody side used to refuse, now taken: the exact wrap model on a path with a via
+// point (OpenSim's whole path, differences in v: tests/plugin/muscle_inertia_test.cpp compares it
+// with the core), and conditional points in the particles; a mass point without mass is still refused
+TEST(SimbodyParticleMuscles, ExactModelOnViaPathsAndConditionalParticlesAreTaken) {
   WrapPendulum w = wrapPendulum(1.0);
   const Model& m = w.build.model;
   Muscle mu = w.muscles[0];
   mu.path.points.insert(mu.path.points.begin() + 1, makeFixedPoint(0, Vec3(-0.12, -0.8, 0.0), "via"));
-  validateMuscle(m, mu);
-  auto sm = simbody::makeSimbodyModel(m);
-  EXPECT_EQ(simbody::simbodyWrapShapeUnsupportedReason(mu), "");
-  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, makeMusculoskeletalModel(m, {mu})));
   mu.wrap.model = WrapModel::Exact;
-  validateMuscle(m, mu);  // the core takes it
-  const std::string why = simbody::simbodyWrapShapeUnsupportedReason(mu);
-  EXPECT_NE(why.find("exact wrap model"), std::string::npos) << why;
-  EXPECT_NE(why.find(mu.name), std::string::npos) << why;
-  try {
-    simbody::MuscleInertia mi(*sm, makeMusculoskeletalModel(m, {mu}));
-    ADD_FAILURE() << "MuscleInertia took the exact model on a via path";
-  } catch (const ModelError& e) {
-    EXPECT_NE(std::string(e.what()).find(mu.name), std::string::npos) << e.what();
-  }
-  EXPECT_THROW(simbody::ParticleMuscles(*sm, m, {mu}), simbody::SimbodyBuildError);
-  // origin -> one surface -> insertion keeps the exact model
-  Muscle one = w.muscles[0];
-  one.wrap.model = WrapModel::Exact;
-  EXPECT_EQ(simbody::simbodyWrapShapeUnsupportedReason(one), "");
-  // a conditional via point: ID takes it, particles do not
+  validateMuscle(m, mu);
+  EXPECT_EQ(simbody::simbodyWrapShapeUnsupportedReason(mu), "");
+  auto sm = simbody::makeSimbodyModel(m);
+  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, makeMusculoskeletalModel(m, {mu})));
+  EXPECT_NO_THROW(simbody::ParticleMuscles(*sm, m, {mu}));
   Muscle cond = w.muscles[0];
   cond.path.points.insert(cond.path.points.begin() + 1, makeConditionalPoint(0, Vec3(-0.12, -0.8, 0.0), 1, -1.0, 1.0, "cvia"));
   validateMuscle(m, cond);
-  EXPECT_NO_THROW(simbody::MuscleInertia(*sm, makeMusculoskeletalModel(m, {cond})));
   auto sm2 = simbody::makeSimbodyModel(m);
-  EXPECT_THROW(simbody::ParticleMuscles(*sm2, m, {cond}), simbody::SimbodyBuildError);
+  EXPECT_NO_THROW(simbody::ParticleMuscles(*sm2, m, {cond}));
+  Muscle massless = w.muscles[0];
+  massless.mass_points.mass[0] = 0.0;
+  auto sm3 = simbody::makeSimbodyModel(m);
+  try {
+    simbody::ParticleMuscles p(*sm3, m, {massless});
+    ADD_FAILURE() << "a massless particle was taken";
+  } catch (const simbody::SimbodyBuildError& e) {
+    EXPECT_NE(std::string(e.what()).find(massless.name), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "core/muscles/path_kinematics.hpp"
 #include "core/spatial/se3.hpp"
@@ -30,25 +32,16 @@ struct Entry {
   int which = 0;   // 1 or 2
 };
 
+// OpenSim's algorithm on the path's inputs: each point's activity and world position, each wrap
+// surface's pose (the only ways q and the body poses enter)
 class PathWrapper {
  public:
-  PathWrapper(const MusclePath& path, const VecX& q, const std::vector<Mat4>& E_wi)
-      : path_(path), q_(q), E_wi_(E_wi) {
+  PathWrapper(const MusclePath& path, std::vector<bool> active, std::vector<Vec3> point_w, std::vector<Mat4> E_ws)
+      : path_(path), E_ws_(std::move(E_ws)), point_w_(std::move(point_w)), active_(std::move(active)) {
     const int nw = static_cast<int>(path.wraps.size());
     results_.assign(nw, WrapResult{});
     used_.assign(nw, false);
-    E_ws_.resize(nw);
     ground_cache_.assign(nw, {});
-    for (int k = 0; k < nw; ++k) E_ws_[k] = surfacePose(path.wraps[k], E_wi);
-    point_w_.resize(path.points.size());
-    active_.resize(path.points.size());
-    for (size_t i = 0; i < path.points.size(); ++i) {
-      const PathPoint& p = path.points[i];
-      active_[i] = isPathPointActive(p, q);
-      Vec3 x_b, dx, ddx;
-      calcPointLocation(p, q, x_b, dx, ddx);
-      point_w_[i] = p.body >= 0 ? applyPose(E_wi[p.body], x_b) : x_b;
-    }
   }
 
   Vec3 world(const Entry& e) const {
@@ -210,8 +203,6 @@ class PathWrapper {
 
  private:
   const MusclePath& path_;
-  const VecX& q_;
-  const std::vector<Mat4>& E_wi_;
   std::vector<Mat4> E_ws_;
   std::vector<Vec3> point_w_;
   std::vector<bool> active_;
@@ -230,12 +221,50 @@ class PathWrapper {
 WrappedPath calcWrappedPath(const Model& model, const MusclePath& path, const VecX& q,
                             const std::vector<Mat4>& E_wi) {
   (void)model;
-  PathWrapper w(path, q, E_wi);
+  const size_t np = path.points.size();
+  std::vector<bool> active(np);
+  std::vector<Vec3> point_w(np);
+  for (size_t i = 0; i < np; ++i) {
+    const PathPoint& p = path.points[i];
+    active[i] = isPathPointActive(p, q);
+    Vec3 x_b, dx, ddx;
+    calcPointLocation(p, q, x_b, dx, ddx);
+    point_w[i] = p.body >= 0 ? applyPose(E_wi[p.body], x_b) : x_b;
+  }
+  std::vector<Mat4> E_ws(path.wraps.size());
+  for (size_t k = 0; k < E_ws.size(); ++k) E_ws[k] = surfacePose(path.wraps[k], E_wi);
+  PathWrapper w(path, std::move(active), std::move(point_w), std::move(E_ws));
+  return w.run();
+}
+
+WrappedPath calcWrappedPathAt(const MusclePath& path, const std::vector<int>& active, const std::vector<Vec3>& x_w,
+                              const std::vector<Mat4>& E_ws) {
+  const size_t np = path.points.size();
+  if (active.size() != x_w.size() || E_ws.size() != path.wraps.size())
+    throw std::invalid_argument("calcWrappedPathAt: " + std::to_string(active.size()) + " active points with " +
+                                std::to_string(x_w.size()) + " positions, " + std::to_string(E_ws.size()) +
+                                " surface poses for " + std::to_string(path.wraps.size()) + " wrap objects");
+  std::vector<bool> on(np, false);
+  std::vector<Vec3> point_w(np, Vec3::Zero());
+  for (size_t i = 0; i < active.size(); ++i) {
+    if (active[i] < 0 || active[i] >= static_cast<int>(np))
+      throw std::invalid_argument("calcWrappedPathAt: active index " + std::to_string(active[i]) + " of " +
+                                  std::to_string(np) + " points");
+    on[active[i]] = true;
+    point_w[active[i]] = x_w[i];
+  }
+  PathWrapper w(path, std::move(on), std::move(point_w), E_ws);
   return w.run();
 }
 
 Vec3 calcWrappedPathPointWorld(const MusclePath& path, const WrappedPath& wp,
                                const std::vector<Mat4>& E_wi, double alpha) {
+  std::vector<Mat4> E_ws(path.wraps.size());
+  for (size_t k = 0; k < E_ws.size(); ++k) E_ws[k] = surfacePose(path.wraps[k], E_wi);
+  return calcWrappedPathPointAt(wp, E_ws, alpha);
+}
+
+Vec3 calcWrappedPathPointAt(const WrappedPath& wp, const std::vector<Mat4>& E_ws, double alpha) {
   const size_t n = wp.points.size();
   if (n == 0) return Vec3::Zero();
   if (n == 1) return wp.points[0].x_w;
@@ -260,7 +289,7 @@ Vec3 calcWrappedPathPointWorld(const MusclePath& path, const WrappedPath& wp,
     const double f = seg[i] > 0.0 ? std::clamp(s / seg[i], 0.0, 1.0) : 0.0;
     if (is_arc(i)) {
       const int k = wp.points[i].wrap;
-      return applyPose(surfacePose(path.wraps[k], E_wi), wp.results[k].arcPoint(f));
+      return applyPose(E_ws[k], wp.results[k].arcPoint(f));
     }
     return wp.points[i].x_w + f * (wp.points[i + 1].x_w - wp.points[i].x_w);
   }

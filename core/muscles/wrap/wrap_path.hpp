@@ -50,9 +50,19 @@ struct WrappedPath {
 WrappedPath calcWrappedPath(const Model& model, const MusclePath& path, const VecX& q,
                             const std::vector<Mat4>& E_wi);
 
+/// The same from the path's inputs alone: the active points `active` (indices into path.points,
+/// in order) at world positions x_w, and every wrap surface's pose E_ws (world, one per
+/// path.wraps). calcWrappedPath is this with the inputs taken from q and E_wi; engines that move
+/// the points and surfaces themselves (core/muscles/path_map.hpp) call it. Throws
+/// std::invalid_argument for sizes that do not fit or an index out of range.
+WrappedPath calcWrappedPathAt(const MusclePath& path, const std::vector<int>& active, const std::vector<Vec3>& x_w,
+                              const std::vector<Mat4>& E_ws);
+
 /// The world position of the point at fraction alpha in [0, 1] of the wrapped path's geometric
 /// length (straight segments and surface arcs; a sphere's negative length counts as its arc).
 Vec3 calcWrappedPathPointWorld(const MusclePath& path, const WrappedPath& wp,
                                const std::vector<Mat4>& E_wi, double alpha);
+/// The same with the surfaces' world poses E_ws (one per wrap object) instead of the body poses.
+Vec3 calcWrappedPathPointAt(const WrappedPath& wp, const std::vector<Mat4>& E_ws, double alpha);
 
 }  // namespace redmax
