@@ -1,5 +1,7 @@
 #include "cli/flags.hpp"
 
+#include <dlfcn.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -174,6 +176,13 @@ std::vector<std::string> viewAssetFolders() {
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) folders.push_back((exe.parent_path().parent_path() / "view").string());
+  // inside the Python module the executable is Python's: the build's view/ beside the module's
+  // folder (build/python/redmax/_core*.so -> build/view)
+  Dl_info info;
+  if (dladdr(reinterpret_cast<void*>(&viewAssetFolders), &info) && info.dli_fname) {
+    const fs::path object = fs::absolute(info.dli_fname, ec);
+    if (!ec && object != exe) folders.push_back((object.parent_path().parent_path().parent_path() / "view").string());
+  }
   if (*REDMAX_SOURCE_DIR) folders.push_back((fs::path(REDMAX_SOURCE_DIR) / "view" / "web").string());
   return folders;
 }

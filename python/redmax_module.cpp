@@ -424,8 +424,9 @@ py::dict forward(std::vector<std::string> flags) {
   cli::ForwardFlags f;
   cli::addForwardFlags(app, f);
   parseFlags(app, std::move(flags));
+  if (f.view && !cli::given(app, "--out-dir"))
+    throw std::invalid_argument("view=True needs out_dir (the folder the view is written into)");
   const validation::ForwardToolSettings s = usage([&] { return cli::parseForwardFlags(f, app); });
-  if (f.view && !s.out_dir) throw std::invalid_argument("view=True needs out_dir (the folder the view is written into)");
   std::unique_ptr<validation::ForwardTool> tool;
   validation::ForwardResult r;
   {

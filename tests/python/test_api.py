@@ -140,9 +140,13 @@ def test_forward_equals_cli(tmp_path, redmax_exe):
     setup = shared(FORWARD_SETUP)
     flags = dict(muscle_class="Thelen2003Muscle_Deprecated", integrator="cvode")
     p = run(redmax_exe, "forward", "--setup", setup, "--muscle-class", flags["muscle_class"], "--integrator", "cvode",
-            "--out-dir", str(tmp_path / "cli"))
+            "--out-dir", str(tmp_path / "cli"), "--view")
     assert p.returncode == 0, p.stderr
-    f = redmax.forward(setup=setup, out_dir=tmp_path / "py", **flags)
+    f = redmax.forward(setup=setup, out_dir=tmp_path / "py", view=True, **flags)
+    # the module finds the page files as the executable does, and writes the same view
+    assert f.files[-1] == str(tmp_path / "py" / "arm26_view" / "index.html")
+    assert (tmp_path / "py" / "arm26_view" / "data.js").read_bytes() == \
+        (tmp_path / "cli" / "arm26_view" / "data.js").read_bytes()
     assert f.states.values.shape == (101, 16) and f.controls.values.shape[1] == 6
     assert f"{f.steps} steps, {f.rhs_evals} rhs" in p.stdout  # the same integration
     for table, name in ((f.states, "arm26_states.sto"), (f.controls, "arm26_controls.sto")):
