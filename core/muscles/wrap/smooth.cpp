@@ -312,6 +312,27 @@ struct EllipsoidArc {
   }
 };
 
+// The library's test for a wrong-way wrap on a quadrant ellipsoid: its polyline's first or last
+// segment (1 mm long, unscaled; checked only when there are two or more) bending back toward its
+// end point. Decided on values, with the library's own segment count.
+template <class T>
+bool wrongWayOnEllipsoid(const EllipsoidArc<T>& arc, const Vec3& p1, const Vec3& p2, const Vec3& r1, const Vec3& r2,
+                         double factor) {
+  const double len = (r1 - r2).norm() / factor;
+  if (len < 0.001) return false;
+  const int nseg = std::min(static_cast<int>(len / 0.001), 499);
+  if (nseg < 2) return false;
+  const EllipsoidArc<double> av{arc.a, constant<double>(values(arc.a0)), constant<double>(values(arc.ar1)),
+                                constant<double>(values(arc.vsy)), constant<double>(values(arc.f2)), value(arc.phi0)};
+  const double dphi = av.phi0 / nseg;
+  V3<double> x1, x2;
+  av.eval(dphi, &x1, nullptr);
+  av.eval((nseg - 1) * dphi, &x2, nullptr);
+  const Vec3 w1 = values(x1), w2 = values(x2);
+  return (p1 - r1).normalized().dot((w1 - r1).normalized()) > 0.0 ||
+         (p2 - r2).normalized().dot((w2 - r2).normalized()) > 0.0;
+}
+
 // everything of the ellipsoid path that does not depend on alpha, in the library's scaled
 // coordinates
 template <class T>
@@ -362,8 +383,11 @@ bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, E
     const std::array<int, 3> axes{(best + 1) % 3, (best + 2) % 3, best};
     closestOnEllipsoid(a, r1c + tb * r1r2, axes, 2, c1);
   }
+  const std::array<int, 3> all{0, 1, 2};
+  // the fan's weight in c1 (the library's fan_weight; none without the fan)
+  bool fan_used = false;
+  T fan_weight(0.0);
   if (value(mub) < kMuBlendMax) {
-    const std::array<int, 3> all{0, 1, 2};
     // solved on values once per setup (no memo across calls: core/ keeps no per-thread state)
     FanParameters fan;
     for (int i = 1; i < kFanSamples - 1; ++i)
@@ -375,21 +399,50 @@ bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, E
       v_sum = v_sum + normalize(cp - svi);
     }
     const V3<T> tc = (r1c + 0.5 * r1r2) + normalize(v_sum);
+    fan_used = true;
     if (value(mub) <= kMuBlendMin) {
       closestOnEllipsoid(a, tc, all, 3, c1);
+      fan_weight = T(1.0);
     } else {
       const T tt = (mub - kMuBlendMin) / (kMuBlendMax - kMuBlendMin);
       V3<T> t1 = tc;
       closestOnEllipsoid(a, tc, all, 3, t1);
       const V3<T> t2 = tt * c1 + (1.0 - tt) * t1;
       closestOnEllipsoid(a, t2, all, 3, c1);
+      fan_weight = 1.0 - tt;
     }
+  }
+  // quadrant: c1 mirrored onto the active side, then pulled toward the quadrant plane (the
+  // bisection of c1 and its mirror) by the fan weight and put back on the surface, as the library
+  // does (which never pulls without the fan: core/geometry/ellipsoid.cpp)
+  const int qaxis = surf.quadrant_axis, qsign = surf.quadrant_sign;
+  Vec3 start;  // where the library's tangent searches start: c1 before the pull
+  if (qsign != 0 && dsign(value(c1[qaxis])) != qsign) {
+    c1[qaxis] = -c1[qaxis];
+    start = values(c1);
+    if (fan_used && value(fan_weight) > 0.0) {
+      c1[qaxis] = (1.0 - fan_weight) * c1[qaxis];
+      const V3<T> pulled = c1;
+      closestOnEllipsoid(a, pulled, all, 3, c1);
+    }
+  } else {
+    start = values(c1);
   }
   // the wrapping plane through p1, p2 and c1, and the tangent points in it
   const V3<T> vs = normalize(cross(p1p2, p1 - c1));
   const T vs4 = -dot(vs, c1);
-  const Vec3 c1v = values(c1);
-  const V3<T> r1 = tangentPoint(a, p1, vs, vs4, c1v), r2 = tangentPoint(a, p2, vs, vs4, c1v);
+  // of the two tangent points from each end, the library takes the one its search from `start`
+  // converges to; with a quadrant that need not be the nearer (c1 was mirrored), so the library's
+  // own search is run on values and its roots are followed
+  Vec3 start1 = start, start2 = start;
+  if (qsign != 0) {
+    const WrapResult lib = calcWrap(surf, values(P1), values(P2));
+    if (lib.wraps() && lib.r1.allFinite() && lib.r2.allFinite()) {
+      start1 = factor * lib.r1;
+      start2 = factor * lib.r2;
+    }
+  }
+  const V3<T> r1 = tangentPoint(a, p1, vs, vs4, start1), r2 = tangentPoint(a, p2, vs, vs4, start2);
   // the surface curve from r1 to r2 (rays from a0 where the plane meets the axis most normal to it)
   int imax = 0;
   for (int i = 1; i < 3; ++i)
@@ -403,6 +456,12 @@ bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, E
   arc.phi0 = dacos(dot(arc.ar1, ar2));
   arc.vsy = cross(normalize(cross(arc.ar1, ar2)), arc.ar1);
   arc.f2 = cdiv(arc.a0, a);
+  if (qsign != 0 && wrongWayOnEllipsoid(arc, values(p1), values(p2), values(r1), values(r2), factor)) {
+    // the library's far-side wrap: the same plane, swept the long way round (phi from 0 to
+    // -(2 pi - phi0), i.e. 2 pi - phi0 along -vsy)
+    arc.vsy = -1.0 * arc.vsy;
+    arc.phi0 = 2.0 * kPi - arc.phi0;
+  }
   // arc length at the panel boundaries (composite 8-point Gauss-Legendre)
   ew.cum[0] = T(0.0);
   for (int k = 0; k < kArcPanels; ++k)
@@ -564,7 +623,6 @@ void smoothSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, doub
     // continuous across d = 0 there); with neither end active it always wraps. Those wraps are
     // the exact path (w = 1); only the contact-driven one is blended.
     const int axis = surf.quadrant_axis, sign = surf.quadrant_sign;
-    auto dsign = [](double v) { return v >= 0.0 ? 1 : -1; };
     const Vec3 a = values(p1), b = values(p2);
     const bool s1 = dsign(a[axis]) == sign, s2 = dsign(b[axis]) == sign;
     const V3<T> u = p2 - p1;
@@ -663,7 +721,6 @@ std::string smoothWrapUnsupportedReason(const WrapSurface& s) {
   if (!s.active) return "the surface is inactive";
   if (s.type == WrapType::Ellipsoid) {
     if (!(s.dimensions.minCoeff() > 0.0)) return "the ellipsoid's semi-axes must be positive";
-    if (s.quadrant_sign != 0) return "quadrant-constrained ellipsoids are not supported";
     return "";
   }
   if (s.type == WrapType::Torus) {

@@ -22,7 +22,7 @@
 // once per segment and shared by its mass points (calcSmoothWrapPoints). The earlier route
 // (nested duals, one pass per input direction, per point) stays as smooth_reference.
 //
-// Supported: Cylinder (also with a quadrant), Sphere and Ellipsoid without a quadrant, and Torus,
+// Supported: Cylinder and Ellipsoid (also with a quadrant), Sphere without a quadrant, and Torus,
 // single wrap (OpenSim's algorithms as the exact library reproduces them).
 // Quadrant cylinders. The library wraps on contact (d > 0) when an end lies on the active side;
 // it also forces a wrap round the active side when neither end is active, or when the ends lie on
@@ -45,7 +45,7 @@
 // (the library's search locates those only to ~1e-9 in u; the residual is flat there). Not
 // smoothed: the switch between the two ends' solutions, and an end entering the local cylinder
 // (the library then gives no wrap).
-// Ellipsoids (hybrid method, the library's default; no quadrant). In the library's scaled
+// Ellipsoids (hybrid method, the library's default). In the library's scaled
 // coordinates: the chord's crossing points, the plane point c1 (axial cross-section closest point,
 // fan of 298 closest points, their linear blends and fades by the chord direction), the plane
 // through p1, p2 and c1, the tangent points in it, the surface curve between them. Each closest
@@ -63,10 +63,22 @@
 // in the chord direction (mu in [0.7073, 0.9]) and its fade near the chord's ends, a fan sample
 // switching between roots of the closest-point equation (interior points), and the library's
 // "same direction seen from the centre" cut-off.
+// Quadrant ellipsoids. The library wraps on the same contact as without a quadrant, but c1 is
+// mirrored onto the active side when it lies on the other, then pulled toward the quadrant plane
+// by the fan's weight and put back on the surface; its tangent searches start from the mirrored
+// c1 (whose basin need not hold the nearer root, so the model runs the library's search on values
+// and takes, in closed form, the roots it converged to); and where the near arc's first or last
+// 1 mm segment bends back toward its end point the library goes round the far side (the same
+// plane swept 2 pi - phi0 the other way), which the model decides on values the same way. Equal
+// to the library outside the band (default box, random quadrants: median 6.2e-6, 99th percentile
+// 1.2e-4, max 5.4e-4 of the smallest semi-axis) except where the library's own construction
+// breaks (its rays' origin outside the ellipsoid: its polyline jumps; or a tangent search that
+// does not converge: NaN), 6 of 409 wrapped samples, where neither is a path. Not smoothed, as
+// in the library: the mirror switching sides, the roots' basins, the far-side switch.
 // Cost: measured in docs/performance.md §7 (validation/bench/wrap_model_bench.cpp).
 // Penetration of an ellipsoid: 1 - the line's distance from the centre in coordinates divided by
 // the semi-axes, times the smallest semi-axis (> 0 exactly when the library wraps).
-// Not supported (smoothWrapUnsupportedReason() says why): spheres and ellipsoids with a quadrant.
+// Not supported (smoothWrapUnsupportedReason() says why): spheres with a quadrant.
 // Also not smoothed: a mass point crossing a tangent point (the path's curvature changes there;
 // OpenSim's cylinder construction is not exactly tangent, so J has a small jump there too), and
 // the cylinder's finite length (both tangent points beyond the ends: the exact library stops

@@ -216,9 +216,9 @@ TEST(WrapMuscle, ValidationNamesTheUnsupportedShape) {
   expectThrow(two_wraps, "one wrap object per segment");
   two_wraps.wrap.model = WrapModel::Exact;  // the exact model composes them as OpenSim does
   EXPECT_NO_THROW(validateMuscle(m, two_wraps));
-  Muscle ellipsoid = pendulumWrapMuscle(WrapModel::Smooth);
-  ellipsoid.path.wraps[0].surface = WrapSurface::makeEllipsoid(Vec3(0.08, 0.1, 0.2), 0, -1);
-  expectThrow(ellipsoid, "quadrant-constrained ellipsoids are not supported");
+  Muscle sphere = pendulumWrapMuscle(WrapModel::Smooth);
+  sphere.path.wraps[0].surface = WrapSurface::makeSphere(0.1, 0, -1);
+  expectThrow(sphere, "quadrant-constrained spheres are not supported");
   Muscle counted = pendulumWrapMuscle(WrapModel::Smooth);
   counted.path.wraps.clear();
   expectThrow(counted, "only counts its wrap objects");
@@ -226,8 +226,8 @@ TEST(WrapMuscle, ValidationNamesTheUnsupportedShape) {
   range.path.wraps[0].range_begin = range.path.wraps[0].range_end = 2;
   expectThrow(range, "excludes the origin-insertion segment");
   // the exact library takes any surface; massless Type III muscles stay valid whatever the shape
-  ellipsoid.wrap.model = WrapModel::Exact;
-  EXPECT_NO_THROW(validateMuscle(m, ellipsoid));
+  sphere.wrap.model = WrapModel::Exact;
+  EXPECT_NO_THROW(validateMuscle(m, sphere));
   three.mass_points = {};
   EXPECT_NO_THROW(validateMuscle(m, three));
 }

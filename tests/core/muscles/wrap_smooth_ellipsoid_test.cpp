@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "core/muscles/wrap/smooth.hpp"
@@ -20,14 +21,43 @@ bool insideEllipsoid(const WrapSurface& s, const Vec3& p, double margin) {
   return p.cwiseQuotient(s.dimensions).norm() < 1.0 + margin;
 }
 
-TEST(WrapSmoothEllipsoid, EqualsExactLibraryAwayFromTheTransition) {
+// The library's path is not a path where its construction breaks: the point where the wrapping
+// plane meets the coordinate axis most normal to it (the rays' origin) lies outside the ellipsoid,
+// so its rays after the first tangent point hit the far side (the polyline jumps), or the tangent
+// search does not converge (NaN). Seen only with a quadrant (c1 mirrored onto the other side).
+bool brokenPolyline(const WrapResult& r) {
+  if (!r.r1.allFinite() || !r.r2.allFinite() || !std::isfinite(r.length)) return true;
+  double longest = 0.0, total = 0.0;
+  for (size_t i = 0; i + 1 < r.polyline.size(); ++i) {
+    const double seg = (r.polyline[i + 1] - r.polyline[i]).norm();
+    longest = std::max(longest, seg);
+    total += seg;
+  }
+  const size_t n = r.polyline.size() > 1 ? r.polyline.size() - 1 : 1;
+  return n > 2 && longest > 10.0 * total / n;
+}
+
+// quadrant 0: none; otherwise a random axis and sign per sample (OpenSim's wrap on the active side,
+// the far-side wrap where the near one would bend back)
+class WrapSmoothEllipsoidQ : public ::testing::TestWithParam<bool> {};
+
+WrapSurface randomEllipsoid(std::mt19937& rng, bool quadrant) {
+  std::uniform_real_distribution<double> ud(0.5, 1.5);
+  std::uniform_int_distribution<int> axis(0, 2), sign(0, 1);
+  const Vec3 d(ud(rng), ud(rng), ud(rng));
+  if (!quadrant) return WrapSurface::makeEllipsoid(d);
+  const int ax = axis(rng);
+  return WrapSurface::makeEllipsoid(d, ax, sign(rng) ? 1 : -1);
+}
+
+TEST_P(WrapSmoothEllipsoidQ, EqualsExactLibraryAwayFromTheTransition) {
   // the default training box: semi-axes in [0.5, 1.5], end points in [-3, 3]^3
   std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-3.0, 3.0), ua(0.0, 1.0), ud(0.5, 1.5);
+  std::uniform_real_distribution<double> u(-3.0, 3.0), ua(0.0, 1.0);
   std::vector<double> errs;
-  int straight = 0;
+  int straight = 0, broken = 0;
   for (int k = 0; k < 3000; ++k) {
-    const WrapSurface s = WrapSurface::makeEllipsoid(Vec3(ud(rng), ud(rng), ud(rng)));
+    const WrapSurface s = randomEllipsoid(rng, GetParam());
     const Vec3 p1(u(rng), u(rng), u(rng)), p2(u(rng), u(rng), u(rng));
     const double alpha = ua(rng);
     if (insideEllipsoid(s, p1, 0.0) || insideEllipsoid(s, p2, 0.0)) continue;
@@ -42,15 +72,23 @@ TEST(WrapSmoothEllipsoid, EqualsExactLibraryAwayFromTheTransition) {
       EXPECT_LE((sp.x - exact).norm(), 1e-14);
       continue;
     }
+    if (brokenPolyline(r)) {
+      ++broken;
+      continue;
+    }
     // the library's path and length against the model's, relative to the smallest semi-axis
     errs.push_back((sp.x - exact).norm() / s.dimensions.minCoeff());
   }
   ASSERT_GT(errs.size(), 300u);
   EXPECT_GT(straight, 1000);
+  // measured: none without a quadrant, 6 of 409 wrapped samples with one
+  std::printf("ellipsoid%s: %d wrapped samples where the library's own path is broken\n",
+              GetParam() ? " with a quadrant" : "", broken);
+  EXPECT_LE(broken, GetParam() ? 12 : 0);
   std::sort(errs.begin(), errs.end());
   const double median = errs[errs.size() / 2], p99 = errs[errs.size() * 99 / 100], worst = errs.back();
-  std::printf("ellipsoid: %zu wrapped samples, |smooth - exact| / min semi-axis: median %.1e, 99%% %.1e, max %.1e\n",
-              errs.size(), median, p99, worst);
+  std::printf("ellipsoid%s: %zu wrapped samples, |smooth - exact| / min semi-axis: median %.1e, 99%% %.1e, max %.1e\n",
+              GetParam() ? " with a quadrant" : "", errs.size(), median, p99, worst);
   // the library's tangent points stop at a residual of 1e-4 and its arc is a polyline (measured:
   // median 5.7e-6, 99th percentile 9.6e-5, max 1.5e-3)
   EXPECT_LT(median, 2e-5);
@@ -58,12 +96,12 @@ TEST(WrapSmoothEllipsoid, EqualsExactLibraryAwayFromTheTransition) {
   EXPECT_LT(worst, 5e-3);
 }
 
-TEST(WrapSmoothEllipsoid, JacobianAndJdotMatchCentralDifferences) {
+TEST_P(WrapSmoothEllipsoidQ, JacobianAndJdotMatchCentralDifferences) {
   std::mt19937 rng(41);
-  std::uniform_real_distribution<double> u(-3.0, 3.0), ua(0.05, 0.95), uv(-1.0, 1.0), ud(0.5, 1.5);
+  std::uniform_real_distribution<double> u(-3.0, 3.0), ua(0.05, 0.95), uv(-1.0, 1.0);
   int in_band = 0, wrapped = 0, tested = 0;
   for (int k = 0; k < 3000 && tested < 120; ++k) {
-    const WrapSurface s = WrapSurface::makeEllipsoid(Vec3(ud(rng), ud(rng), ud(rng)));
+    const WrapSurface s = randomEllipsoid(rng, GetParam());
     const SmoothWrapOptions opt{0.3 * s.dimensions.minCoeff()};  // a wide band so that many samples land inside it
     const Vec3 p1(u(rng), u(rng), u(rng)), p2(u(rng), u(rng), u(rng));
     const Vec3 v1(uv(rng), uv(rng), uv(rng)), v2(uv(rng), uv(rng), uv(rng));
@@ -88,6 +126,9 @@ TEST(WrapSmoothEllipsoid, JacobianAndJdotMatchCentralDifferences) {
   EXPECT_GE(in_band, 10);
   EXPECT_GE(wrapped, 30);
 }
+
+INSTANTIATE_TEST_SUITE_P(Quadrant, WrapSmoothEllipsoidQ, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "WithQuadrant" : "None"; });
 
 // the insertion moves so that the line approaches the ellipsoid and wraps on it; the first and
 // second derivatives along the sweep are continuous at both edges of the band, where the exact
@@ -148,7 +189,7 @@ TEST(WrapSmoothEllipsoid, ArcLengthQuadratureConverged) {
   const SmoothWrapLength L = calcSmoothWrapLength(s, p1, p2, Vec3::Zero(), Vec3::Zero());
   EXPECT_NEAR(L.length, calcWrappedPathLength(r, p1, p2), 1e-6);
   EXPECT_EQ(smoothWrapUnsupportedReason(s), "");
-  EXPECT_NE(smoothWrapUnsupportedReason(WrapSurface::makeEllipsoid(Vec3(1, 2, 3), 0, 1)), "");
+  EXPECT_EQ(smoothWrapUnsupportedReason(WrapSurface::makeEllipsoid(Vec3(1, 2, 3), 0, 1)), "");
   EXPECT_THROW(calcSmoothWrapPoint(s, Vec3(0.01, 0, 0), p2, 0.5), std::invalid_argument);
 }
 

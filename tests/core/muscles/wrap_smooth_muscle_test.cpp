@@ -51,12 +51,15 @@ bool checkAgainstFd(const Model& m, const Muscle& mu, const State& s, const char
 TEST(WrapSmoothMuscle, EllipsoidAndTorusOnAMovingBody) {
   const Model m = scenes::revoluteChain(3);
   std::mt19937 rng(19);
-  const WrapSurface surfaces[] = {WrapSurface::makeEllipsoid(Vec3(0.14, 0.1, 0.12)), WrapSurface::makeTorus(0.05, 0.15)};
+  const WrapSurface surfaces[] = {WrapSurface::makeEllipsoid(Vec3(0.14, 0.1, 0.12)), WrapSurface::makeTorus(0.05, 0.15),
+                                  WrapSurface::makeEllipsoid(Vec3(0.14, 0.1, 0.12), 0, 1)};
   for (const WrapSurface& surface : surfaces) {
     const Muscle mu = chainMuscle(surface, WrapModel::Smooth);
     EXPECT_EQ(wrapMassPointsUnsupportedReason(mu), "");
     validateMuscle(m, mu);
-    const char* what = surface.type == WrapType::Ellipsoid ? "chain ellipsoid" : "chain torus";
+    const char* what = surface.type == WrapType::Torus ? "chain torus"
+                       : surface.quadrant_sign != 0    ? "chain quadrant ellipsoid"
+                                                       : "chain ellipsoid";
     int n_wrapped = 0, n_straight = 0, tested = 0;
     for (int trial = 0; trial < 300 && tested < 10; ++trial) {
       const State s = test::randomState(m.nr(), rng, 1.2, 2.0);
@@ -79,8 +82,8 @@ TEST(WrapSmoothMuscle, EllipsoidAndTorusOnAMovingBody) {
     EXPECT_GE(n_wrapped, 4) << what;
     EXPECT_GE(tested, 6) << what;
   }
-  // quadrant ellipsoids stay refused, with the reason
-  Muscle q = chainMuscle(WrapSurface::makeEllipsoid(Vec3(0.14, 0.1, 0.12), 0, 1), WrapModel::Smooth);
+  // quadrant spheres stay refused, with the reason
+  Muscle q = chainMuscle(WrapSurface::makeSphere(0.1, 0, 1), WrapModel::Smooth);
   EXPECT_NE(wrapMassPointsUnsupportedReason(q), "");
 }
 
