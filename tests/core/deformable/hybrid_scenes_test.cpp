@@ -1,0 +1,87 @@
+// The hybrid-dynamics scenes of [D Sec. 6.1.2-6.1.3] (validation/scenes/hybrid_scenes, docs/
+// deformable.md §6): what their prescriptions achieve, with the levels explained.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "core/skeleton/kinematics.hpp"
+#include "validation/scenes/hybrid_scenes.hpp"
+
+namespace redmax {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+TEST(Hand, PrescribedPointsAndAngleHoldToRoundOffWithProjection) {
+  const scenes::HandOptions opt;  // bdf1, dt 1e-3 s, 2 s, projection every step
+  const scenes::HandResult r = scenes::runHand(opt);
+  EXPECT_EQ(r.nr, 19);
+  EXPECT_EQ(r.nR, 15);   // four DIPs eliminated
+  EXPECT_EQ(r.rows, 13);
+  // the projection's Newton steps stop at max |C| <= 1e-14 per row (measured 1.7e-16 m); the
+  // elbow row is linear in q, so one Newton step meets it exactly
+  EXPECT_LE(r.point_error, 2e-14);
+  EXPECT_EQ(r.angle_error, 0.0);
+  // DIP = 0.5 PIP by the coordinate map, exactly in floating point
+  EXPECT_EQ(r.coupling_deviation, 0.0);
+  // within a step (before its projection) the velocity-level rows leave the position error of
+  // one step: for the elbow q_p(t+h) - q_p(t) - h qdot_p(t+h) = -h^2/2 qddot_p, largest
+  // A w^2 h^2 / 2
+  const double w = 2 * kPi * opt.elbow_frequency;
+  EXPECT_NEAR(r.angle_step_error, opt.elbow_amplitude * w * w * opt.dt * opt.dt / 2, 1e-3 * r.angle_step_error);
+  // and the fingertips' is second order too (measured 8.63e-8 m at dt 1e-3, 2.19e-8 m at 5e-4)
+  scenes::HandOptions half = opt;
+  half.dt = opt.dt / 2;
+  const scenes::HandResult rh = scenes::runHand(half);
+  EXPECT_NEAR(r.point_step_error / rh.point_step_error, 4.0, 0.1);
+  EXPECT_NEAR(r.point_step_error, 8.63e-8, 0.1e-8);
+}
+
+TEST(Hand, WithoutProjectionTheElbowDriftsByTheFirstOrderStepError) {
+  scenes::HandOptions opt;
+  opt.project = false;
+  const scenes::HandResult r = scenes::runHand(opt);
+  // the per-step errors -h^2/2 qddot_p add up to -h/2 (qdot_p(t) - qdot_p(0)) (the velocity is
+  // exact after every step), largest h A w
+  const double w = 2 * kPi * opt.elbow_frequency;
+  EXPECT_NEAR(r.angle_error, opt.dt * opt.elbow_amplitude * w, 1e-2 * r.angle_error);
+  // the fingertips drift at the same first-order rate (measured 2.04e-5 m at dt 1e-3)
+  EXPECT_NEAR(r.point_error, 2.04e-5, 0.05e-5);
+  EXPECT_EQ(r.coupling_deviation, 0.0);
+}
+
+TEST(Hand, AtRestTheMultipliersBalanceGravityAboutTheElbow) {
+  // elbow and tips held still: once the passive wrist has settled, the elbow torque and the tip
+  // forces (the prescriptions' multipliers) balance the weights: about the elbow axis (z through
+  // the origin) lambda_elbow + sum (x_tip x F_tip)_z + sum (x_com x m g)_z = 0
+  scenes::HandOptions opt;
+  opt.elbow_amplitude = 0.0;
+  opt.tip_radius = 0.0;
+  opt.duration = 3.0;
+  const scenes::HandResult r = scenes::runHand(opt);
+  const Model m = scenes::handModel();
+  const VecX& row = r.run.rows.back();
+  std::vector<Mat4> E;
+  calcBodyPoses(m, row.head(m.nr()), E);
+  double moment = row[m.nr()], weight_moment = 0.0;
+  for (int i = 0; i < m.nb(); ++i) {
+    const Vec3 c = E[i].topLeftCorner<3, 3>() * m.bodies()[i].com + E[i].topRightCorner<3, 1>();
+    weight_moment += c.cross(m.bodies()[i].mass * m.gravity())[2];
+  }
+  moment += weight_moment;
+  const auto& pts = r.run.points.back();
+  for (int f = 0; f < 4; ++f) moment += pts[2 + 4 * f + 3].cross(Vec3(row.segment<3>(m.nr() + 1 + 3 * f)))[2];
+  EXPECT_LE(std::abs(moment), 1e-13 * std::abs(weight_moment)) << moment << " of " << weight_moment;
+  std::printf("hand at rest: moment residual %.2e N m of a weight moment %.4f N m\n", moment, weight_moment);
+  // (measured 5.6e-17 N m: the wrist has settled, so the residual is round-off)
+  // the net vertical force the tips take is less than the hand's weight (the elbow's joint
+  // reaction carries the rest); it is upward
+  double tips_y = 0;
+  for (int f = 0; f < 4; ++f) tips_y += row[m.nr() + 1 + 3 * f + 1];
+  EXPECT_GT(tips_y, 0.0);
+}
+
+}  // namespace
+}  // namespace redmax

@@ -1,0 +1,59 @@
+#pragma once
+// Hybrid-dynamics scenes of [D Sec. 6.1.2-6.1.3] built in code (docs/deformable.md §6): the hand
+// (DIP = 0.5 PIP by hyper-reduced coordinates, fingertips prescribed in maximal coordinates, the
+// elbow prescribed in reduced coordinates) and the starfish (a 20-joint skeleton inside a
+// co-rotated FEM mesh, some joints prescribed, fully implicit). Used by `redmax scene NAME`.
+#include <array>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "core/deformable/tet_mesh.hpp"
+#include "core/skeleton/model.hpp"
+
+namespace redmax::scenes {
+
+/// A recorded run: skeleton coordinates, extra columns and points (for the VTK series) per frame.
+struct HybridRun {
+  std::vector<double> t;
+  std::vector<std::string> columns;          // names of each row's entries (after time)
+  std::vector<VecX> rows;                    // per frame: the values of `columns`
+  std::vector<std::vector<Vec3>> points;     // per frame
+  TetMesh mesh;                              // tets over `points` (empty for the hand)
+  std::vector<std::array<int, 2>> lines;     // segments over `points`
+};
+
+/// The hand [D Sec. 6.1.3]: an upper arm fixed in the world, the forearm on an elbow hinge (z),
+/// a palm on a 2-dof wrist (flexion z, deviation y), four fingers each with a 2-dof MCP
+/// (flexion, abduction), PIP and DIP hinges; gravity -9.81 y. Coordinate order: elbow, wrist
+/// flexion, wrist deviation, then per finger MCP flexion, MCP abduction, PIP, DIP.
+Model handModel();
+
+struct HandOptions {
+  double dt = 1e-3, duration = 2.0, frame_interval = 0.02;
+  std::string integrator = "bdf1";
+  double elbow_amplitude = 0.02, elbow_frequency = 0.5;   // rad, Hz: elbow(t) = e0 + A sin(2 pi f t)
+  double tip_radius = 0.002, tip_frequency = 1.0;        // m, Hz: each tip circles in the xy-plane
+  bool project = true;  // project positions (tolerance 1e-14) and velocities after every step
+};
+
+struct HandResult {
+  HybridRun run;
+  int nr = 0, nR = 0, rows = 0;          // skeleton and hyper-reduced coordinates, constraint rows
+  // largest errors over all steps, after the step's projection and within the step before it
+  double point_error = 0.0, angle_error = 0.0;            // m, rad
+  double point_step_error = 0.0, angle_step_error = 0.0;  // m, rad
+  double coupling_deviation = 0.0;  // largest |DIP - 0.5 PIP| (rad)
+  double max_elbow_torque = 0.0;    // N m, the elbow prescription's multiplier
+  double max_tip_force = 0.0;       // N, largest fingertip prescription force
+};
+HandResult runHand(const HandOptions& opt);
+
+/// the names `redmax scene` accepts from here
+std::vector<std::string> hybridSceneNames();
+
+/// Run scene `name` with its defaults, write out_dir/states.csv and a VTK series (NAME_NNNN.vtk,
+/// NAME.pvd) and a summary on `summary`. Throws std::invalid_argument for an unknown name.
+void runHybridScene(const std::string& name, const std::string& out_dir, std::ostream& summary);
+
+}  // namespace redmax::scenes
