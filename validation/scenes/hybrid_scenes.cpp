@@ -1,11 +1,14 @@
 #include "validation/scenes/hybrid_scenes.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <numbers>
 #include <stdexcept>
 
+#include "core/deformable/deformable_term.hpp"
 #include "core/dynamics/constraints/prescribed_coordinate.hpp"
 #include "core/dynamics/constraints/prescribed_point.hpp"
 #include "core/dynamics/system.hpp"
@@ -205,7 +208,170 @@ HandResult runHand(const HandOptions& opt) {
   return res;
 }
 
-std::vector<std::string> hybridSceneNames() { return {"hand"}; }
+TetMesh makeStarTetMesh(int arms, double r_in, double r_out, double thickness, int angles, int rings, int layers) {
+  if (arms < 1 || angles < 3 || rings < 1 || layers < 1 || !(r_in > 0) || !(r_out > r_in) || !(thickness > 0))
+    throw std::invalid_argument("star mesh: bad parameters");
+  TetMesh mesh;
+  // one layer: the centre, then ring i (1..rings) at angle j: index 1 + (i - 1) angles + j
+  const int per_layer = 1 + rings * angles;
+  for (int l = 0; l <= layers; ++l) {
+    const double y = thickness * (static_cast<double>(l) / layers - 0.5);
+    mesh.nodes.emplace_back(0, y, 0);
+    for (int i = 1; i <= rings; ++i)
+      for (int j = 0; j < angles; ++j) {
+        const double a = kTwoPi * j / angles, c = (1 + std::cos(arms * a)) / 2;
+        const double R = (r_in + (r_out - r_in) * c * c) * i / rings;
+        mesh.nodes.emplace_back(R * std::cos(a), y, R * std::sin(a));
+      }
+  }
+  auto id = [&](int i, int j) { return i == 0 ? 0 : 1 + (i - 1) * angles + (j % angles); };
+  std::vector<std::array<int, 3>> tris;
+  for (int j = 0; j < angles; ++j) tris.push_back({id(0, 0), id(1, j), id(1, j + 1)});
+  for (int i = 1; i < rings; ++i)
+    for (int j = 0; j < angles; ++j) {
+      tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  for (int l = 0; l < layers; ++l)
+    for (auto t : tris) {
+      std::sort(t.begin(), t.end());
+      const int a = t[0] + l * per_layer, b = t[1] + l * per_layer, c = t[2] + l * per_layer;
+      const int A = a + per_layer, B = b + per_layer, C = c + per_layer;
+      // each quad face is cut from its smallest-index corner (a bottom one), so neighbours agree
+      for (std::array<int, 4> tet : {std::array<int, 4>{a, b, c, C}, {a, b, B, C}, {a, A, B, C}}) {
+        const Vec3 e1 = mesh.nodes[tet[1]] - mesh.nodes[tet[0]], e2 = mesh.nodes[tet[2]] - mesh.nodes[tet[0]],
+                   e3 = mesh.nodes[tet[3]] - mesh.nodes[tet[0]];
+        if (e1.cross(e2).dot(e3) < 0) std::swap(tet[2], tet[3]);
+        mesh.tets.push_back(tet);
+      }
+    }
+  return mesh;
+}
+
+namespace {
+
+// signed volume of tet t at positions x
+double tetVolume(const std::array<int, 4>& t, const std::vector<Vec3>& x) {
+  return (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).dot(x[t[3]] - x[t[0]]) / 6.0;
+}
+
+}  // namespace
+
+StarfishResult runStarfish(const StarfishOptions& opt) {
+  if (!(opt.dt > 0) || !(opt.duration > 0) || !(opt.frame_interval >= opt.dt))
+    throw std::invalid_argument("starfish: need dt > 0, duration > 0 and frame_interval >= dt");
+  constexpr int kArms = 5, kLinks = 4;
+  constexpr double kDisc = 0.05, kLink = 0.1;
+  // skeleton: per arm a chain of hinges about the horizontal normal of the arm (the arm curls up
+  // and down), the first at the rim of the disc (the world)
+  ModelBuilder b("starfish");
+  b.setGravity(Vec3(0, -9.81, 0));
+  std::vector<Vec3> dir(kArms);
+  for (int a = 0; a < kArms; ++a) {
+    const double phi = kTwoPi * a / kArms;
+    dir[a] = Vec3(std::cos(phi), 0, std::sin(phi));
+    // local x along the arm, local z = (-sin phi, 0, cos phi)
+    const Mat3 R = Eigen::AngleAxisd(-phi, Vec3::UnitY()).toRotationMatrix();
+    const auto [c, I] = rod(opt.link_mass, kLink, 0.01);
+    int parent = -1;
+    for (int k = 0; k < kLinks; ++k) {
+      const std::string n = "arm" + std::to_string(a) + "_" + std::to_string(k);
+      const Mat4 E_pf = k == 0 ? makeE(R, kDisc * dir[a]) : makeTranslation(Vec3(kLink, 0, 0));
+      parent = b.addBody(n, opt.link_mass, c, I, parent, n, Revolute{Vec3::UnitZ()}, E_pf);
+      b.setCoordinateNames(parent, {n});
+    }
+  }
+  const Model m = b.finalize();
+  System sys(m);
+  // the mesh: disc nodes fixed, nodes within 0.035 m of a link attached to it
+  const TetMesh mesh = makeStarTetMesh(kArms, kDisc, kDisc + kLinks * kLink);
+  DeformableBody body = makeFemBody(mesh, opt.E, opt.nu, opt.rho);
+  body.rayleigh_mass = opt.rayleigh_mass;
+  body.rayleigh_stiffness = opt.rayleigh_stiffness;
+  std::vector<NodeAttachment> att;
+  for (int n = 0; n < mesh.numNodes(); ++n) {
+    const Vec3& x = mesh.nodes[n];
+    if (Vec3(x.x(), 0, x.z()).norm() < kDisc - 1e-12) {
+      att.push_back({n, -1});
+      continue;
+    }
+    for (int a = 0; a < kArms; ++a) {
+      const double s = x.dot(dir[a]), d = (x - s * dir[a]).norm();
+      const int k = static_cast<int>(std::floor((s - kDisc) / kLink));
+      if (d < 0.035 && s >= kDisc && k >= 0) {
+        att.push_back({n, a * kLinks + std::min(k, kLinks - 1)});
+        break;
+      }
+    }
+  }
+  auto term = addDeformableBody(sys, body, att);
+  // the first joint of every arm prescribed
+  const double A = opt.amplitude, w = kTwoPi * opt.frequency;
+  std::vector<std::shared_ptr<const PrescribedCoordinate>> pres;
+  for (int a = 0; a < kArms; ++a) {
+    const double ph = kTwoPi * a / kArms;
+    auto c = std::make_shared<PrescribedCoordinate>(
+        m, a * kLinks,
+        makeConstraintFunction1([=](double t) { return A * std::sin(w * t + ph) - A * std::sin(ph); },
+                                [=](double t) { return A * w * std::cos(w * t + ph); },
+                                [=](double t) { return -A * w * w * std::sin(w * t + ph); }));
+    pres.push_back(c);
+    sys.addConstraint(c);
+  }
+  StarfishResult res;
+  res.joints = m.nr();
+  res.prescribed = kArms;
+  res.nodes = mesh.numNodes();
+  res.attached = static_cast<int>(att.size());
+  res.tets = mesh.numTets();
+  res.ndof = sys.ndof();
+  DynamicsWorkspace ws(sys);
+  State s = sys.defaultState();
+  term->setRestState(s);
+  sys.projectVelocities(s, ws);  // start on the prescribed velocities
+
+  IntegratorOptions io;
+  io.dt = opt.dt;
+  auto integ = makeIntegrator(opt.integrator, io);
+  SkeletonWorkspace sk(m);
+  std::vector<double> V0(mesh.numTets());
+  for (int e = 0; e < mesh.numTets(); ++e) V0[e] = tetVolume(mesh.tets[e], mesh.nodes);
+  res.min_volume_ratio = 1.0;
+  for (const auto& c : m.coordinates()) res.run.columns.push_back(c.name);
+  for (const char* c : {"kinetic_energy", "potential_energy"}) res.run.columns.push_back(c);
+  res.run.mesh = mesh;
+  auto record = [&] {
+    const double T = sys.kineticEnergy(s, ws), V = sys.potentialEnergy(s, ws);
+    VecX row(m.nr() + 2);
+    row << s.q.head(m.nr()), T, V;
+    res.run.t.push_back(s.t);
+    res.run.rows.push_back(row);
+    calcKinematics(m, s, sk);
+    const VecX x = term->nodePositions(m, s, TermContext(sk));
+    std::vector<Vec3> pts(mesh.numNodes());
+    for (int n = 0; n < mesh.numNodes(); ++n) pts[n] = x.segment<3>(3 * n);
+    for (int e = 0; e < mesh.numTets(); ++e)
+      res.min_volume_ratio = std::min(res.min_volume_ratio, tetVolume(mesh.tets[e], pts) / V0[e]);
+    res.run.points.push_back(std::move(pts));
+    res.max_kinetic = std::max(res.max_kinetic, T);
+    res.final_kinetic = T;
+  };
+  record();
+  res.steps = static_cast<int>(std::llround(opt.duration / opt.dt));
+  const int every = std::max(1, static_cast<int>(std::llround(opt.frame_interval / opt.dt)));
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 1; k <= res.steps; ++k) {
+    integ->advance(sys, s, k * opt.dt);
+    if (!s.q.allFinite() || !s.qdot.allFinite())
+      throw std::runtime_error("starfish: non-finite state at t = " + std::to_string(s.t) + " s");
+    for (const auto& c : pres) res.prescribed_error = std::max(res.prescribed_error, std::abs(s.q[c->coordinate()] - c->position(s.t)));
+    if (k % every == 0) record();
+  }
+  res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+std::vector<std::string> hybridSceneNames() { return {"hand", "starfish"}; }
 
 void runHybridScene(const std::string& name, const std::string& out_dir, std::ostream& summary) {
   namespace fs = std::filesystem;
@@ -225,6 +391,18 @@ void runHybridScene(const std::string& name, const std::string& out_dir, std::os
     summary << "largest DIP - 0.5 PIP deviation " << r.coupling_deviation << " rad\n";
     summary << "largest elbow torque " << r.max_elbow_torque << " N m, largest fingertip force " << r.max_tip_force
             << " N\n";
+    run = std::move(r.run);
+  } else if (name == "starfish") {
+    StarfishOptions opt;
+    StarfishResult r = runStarfish(opt);
+    summary << "starfish: " << r.joints << " joints (" << r.prescribed << " prescribed, the rest passive), mesh of "
+            << r.nodes << " nodes (" << r.attached << " attached to the disc and the links) and " << r.tets
+            << " tets, " << r.ndof << " coordinates, E " << opt.E << " Pa, integrator " << opt.integrator << ", dt "
+            << opt.dt << " s\n";
+    summary << "steps " << r.steps << ", wall time " << r.wall_seconds << " s\n";
+    summary << "largest prescribed-joint error " << r.prescribed_error << " rad\n";
+    summary << "kinetic energy largest " << r.max_kinetic << " J, final " << r.final_kinetic
+            << " J; smallest tet volume / rest volume " << r.min_volume_ratio << "\n";
     run = std::move(r.run);
   } else {
     throw std::invalid_argument("unknown hybrid scene '" + name + "'");
