@@ -49,7 +49,11 @@ CommandRegistration reg({"scene", "run a deformable-body or hybrid-dynamics scen
                                "  hand           arm, elbow and four fingers with DIP = 0.5 PIP (hyper-reduced\n"
                                "                 coordinates), fingertips prescribed on circles (maximal\n"
                                "                 inverse dynamics), elbow angle prescribed; prints the largest\n"
-                               "                 prescribed-point and prescribed-angle errors");
+                               "                 prescribed-point and prescribed-angle errors\n"
+                               "  starfish       five arms of four hinges inside a co-rotated FEM star (243\n"
+                               "                 nodes), first joints prescribed, the rest passive (bdf1,\n"
+                               "                 fully implicit); prints steps, wall time, the prescribed-joint\n"
+                               "                 error, kinetic energy and the smallest tet volume ratio");
                            return [f] {
                              const std::string out = f->out.empty() ? "scene-" + f->name : f->out;
                              if (isHybrid(f->name))
