@@ -16,12 +16,17 @@ PrescribedPoint::PrescribedPoint(const Model& model, int body, const Vec3& point
   if (!traj_) throw ModelError(name_ + ": no trajectory");
 }
 
+PointSample PrescribedPoint::evaluate(const Model& model, const State& s, const SkeletonWorkspace& ws,
+                                      detail::PointKinematics& p) const {
+  detail::checkModelSize(model, nb_, nr_, name_);
+  detail::calcPointKinematics(model, ws, s.qdot, body_, x_, p);
+  return traj_(s.t);
+}
+
 void PrescribedPoint::calcAcceleration(const Model& model, const State& s, const SkeletonWorkspace& ws,
                                        Eigen::Ref<MatX> G, Eigen::Ref<VecX> rhs) const {
-  detail::checkModelSize(model, nb_, nr_, name_);
   detail::PointKinematics p;
-  detail::calcPointKinematics(model, ws, s.qdot, body_, x_, p);
-  const PointSample tgt = traj_(s.t);
+  const PointSample tgt = evaluate(model, s, ws, p);
   // -(J qddot + a_bias) = -xddot_p: the sign makes lambda the applied force (see the header)
   G = -p.J;
   rhs = p.a_bias - tgt.a;
@@ -29,10 +34,8 @@ void PrescribedPoint::calcAcceleration(const Model& model, const State& s, const
 
 void PrescribedPoint::calcErrors(const Model& model, const State& s, const SkeletonWorkspace& ws,
                                  Eigen::Ref<VecX> pos_err, Eigen::Ref<VecX> vel_err) const {
-  detail::checkModelSize(model, nb_, nr_, name_);
   detail::PointKinematics p;
-  detail::calcPointKinematics(model, ws, s.qdot, body_, x_, p);
-  const PointSample tgt = traj_(s.t);
+  const PointSample tgt = evaluate(model, s, ws, p);
   pos_err = tgt.x - p.p;
   vel_err = tgt.v - p.v;
 }

@@ -15,6 +15,10 @@
 
 namespace redmax {
 
+namespace detail {
+struct PointKinematics;
+}
+
 /// A point trajectory at one time: position, velocity, acceleration (world frame).
 struct PointSample {
   Vec3 x = Vec3::Zero(), v = Vec3::Zero(), a = Vec3::Zero();
@@ -41,6 +45,9 @@ class PrescribedPoint final : public Constraint {
   PointSample target(double t) const { return traj_(t); }
 
  private:
+  // the point's kinematics into p and the target at s.t
+  PointSample evaluate(const Model& model, const State& s, const SkeletonWorkspace& ws,
+                       detail::PointKinematics& p) const;
   std::string name_;
   int body_;
   Vec3 x_;

@@ -4,10 +4,10 @@
 
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <numbers>
 
 #include "core/skeleton/kinematics.hpp"
+#include "mesh_checks.hpp"
 #include "validation/scenes/hybrid_scenes.hpp"
 
 namespace redmax {
@@ -88,27 +88,16 @@ TEST(StarMesh, TetsArePositiveAndFacesConform) {
   const TetMesh mesh = scenes::makeStarTetMesh();  // 5 arms, 20 angles, 4 rings, 3 node layers
   EXPECT_EQ(mesh.numNodes(), 3 * (1 + 4 * 20));
   EXPECT_EQ(mesh.numTets(), 2 * 3 * (20 + 3 * 20 * 2));
-  std::map<std::array<int, 3>, int> faces;
   double volume = 0;
   for (const auto& t : mesh.tets) {
     const Vec3& x0 = mesh.nodes[t[0]];
     const double v = (mesh.nodes[t[1]] - x0).cross(mesh.nodes[t[2]] - x0).dot(mesh.nodes[t[3]] - x0) / 6;
     EXPECT_GT(v, 0.0);
     volume += v;
-    for (int k = 0; k < 4; ++k) {
-      std::array<int, 3> f{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
-      std::sort(f.begin(), f.end());
-      ++faces[f];
-    }
   }
   // conforming: every face is shared by two tets or lies on the boundary, which is the top and
   // bottom (140 triangles each) and the rim (20 quads per layer, 2 triangles each)
-  int boundary = 0;
-  for (const auto& [f, n] : faces) {
-    EXPECT_LE(n, 2);
-    boundary += n == 1;
-  }
-  EXPECT_EQ(boundary, 2 * 140 + 2 * 20 * 2);
+  EXPECT_EQ(testing::boundaryFaces(mesh), 2 * 140 + 2 * 20 * 2);
   // the slab's volume is its top area times the thickness: the polygon's area by the shoelace
   double area = 0;
   for (int j = 0; j < 20; ++j) {
