@@ -339,11 +339,15 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
   res.min_volume_ratio = 1.0;
   for (const auto& c : m.coordinates()) res.run.columns.push_back(c.name);
   for (const char* c : {"kinetic_energy", "potential_energy"}) res.run.columns.push_back(c);
+  for (int a = 0; a < kArms; ++a) res.run.columns.push_back("torque_arm" + std::to_string(a) + "_0");
   res.run.mesh = mesh;
   auto record = [&] {
     const double T = sys.kineticEnergy(s, ws), V = sys.potentialEnergy(s, ws);
-    VecX row(m.nr() + 2);
-    row << s.q.head(m.nr()), T, V;
+    // the prescribed joints' torques: the multipliers of the acceleration-level KKT solve
+    sys.forwardDynamics(s, ws);
+    VecX row(m.nr() + 2 + kArms);
+    row << s.q.head(m.nr()), T, V, ws.lambda;
+    res.max_torque = std::max(res.max_torque, ws.lambda.lpNorm<Eigen::Infinity>());
     res.run.t.push_back(s.t);
     res.run.rows.push_back(row);
     calcKinematics(m, s, sk);
@@ -400,7 +404,8 @@ void runHybridScene(const std::string& name, const std::string& out_dir, std::os
             << " tets, " << r.ndof << " coordinates, E " << opt.E << " Pa, integrator " << opt.integrator << ", dt "
             << opt.dt << " s\n";
     summary << "steps " << r.steps << ", wall time " << r.wall_seconds << " s\n";
-    summary << "largest prescribed-joint error " << r.prescribed_error << " rad\n";
+    summary << "largest prescribed-joint error " << r.prescribed_error << " rad, largest prescribed-joint torque "
+            << r.max_torque << " N m\n";
     summary << "kinetic energy largest " << r.max_kinetic << " J, final " << r.final_kinetic
             << " J; smallest tet volume / rest volume " << r.min_volume_ratio << "\n";
     run = std::move(r.run);

@@ -76,6 +76,7 @@ struct StarfishResult {
   int joints = 0, prescribed = 0, nodes = 0, attached = 0, tets = 0, ndof = 0, steps = 0;
   double wall_seconds = 0.0;            // measured, not asserted
   double prescribed_error = 0.0;        // largest |q_k - q_p(t)| of the prescribed joints (rad)
+  double max_torque = 0.0;              // largest prescribed-joint torque at the frames (N m)
   double min_volume_ratio = 0.0;        // smallest tet volume / rest volume over all frames
   double max_kinetic = 0.0, final_kinetic = 0.0;  // J (kinetic energy of skeleton and mesh)
 };
