@@ -30,7 +30,10 @@ struct SceneFlags {
   std::string out;
 };
 
-CommandRegistration reg({"scene", "run a deformable-body or hybrid-dynamics scene (cantilever, strand, soft-pendulum, hand, starfish)", [](CLI::App& app) {
+constexpr const char* kSummary =
+    "run a deformable-body or hybrid-dynamics scene (cantilever, strand, soft-pendulum, hand, starfish)";
+
+CommandRegistration reg({"scene", kSummary, [](CLI::App& app) {
                            auto f = std::make_shared<SceneFlags>();
                            app.add_option("name", f->name, "the scene")
                                ->required()

@@ -1,6 +1,7 @@
 // `redmax scene NAME` end to end (docs/deformable.md §4, §6): the cantilever's summary line parsed
-// against beam theory computed here, the hand's prescription errors, the files each scene writes (states, one VTK per frame, the
-// .pvd collection), the VTK frames read back by the mesh reader, and bad names.
+// against beam theory computed here, the hand's prescription errors, the files each scene writes
+// (states, one VTK per frame, the .pvd collection), the VTK frames read back by the mesh reader,
+// and bad names.
 #include <gtest/gtest.h>
 #include <unistd.h>
 

@@ -159,7 +159,6 @@ HandResult runHand(const HandOptions& opt) {
     for (int f = 0; f < 4; ++f) point = std::max(point, ws.pos_err.segment<3>(1 + 3 * f).norm());
   };
   // output: expanded coordinates, the elbow torque and the tip forces (the multipliers)
-  res.run.columns = {};
   for (const auto& c : m.coordinates()) res.run.columns.push_back(c.name);
   res.run.columns.push_back("elbow_torque");
   for (int f = 0; f < 4; ++f)
@@ -368,7 +367,8 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
     integ->advance(sys, s, k * opt.dt);
     if (!s.q.allFinite() || !s.qdot.allFinite())
       throw std::runtime_error("starfish: non-finite state at t = " + std::to_string(s.t) + " s");
-    for (const auto& c : pres) res.prescribed_error = std::max(res.prescribed_error, std::abs(s.q[c->coordinate()] - c->position(s.t)));
+    for (const auto& c : pres)
+      res.prescribed_error = std::max(res.prescribed_error, std::abs(s.q[c->coordinate()] - c->position(s.t)));
     if (k % every == 0) record();
   }
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -183,7 +183,8 @@ TEST(Starfish, RunsStablyTheJointsFollowAndNoTetInverts) {
   EXPECT_GT(r.min_volume_ratio, 0.0);
   EXPECT_NEAR(r.min_volume_ratio, 0.7625, 0.005);
   EXPECT_NEAR(r.max_kinetic, 0.3527, 0.002);
-  std::printf("starfish 0.3 s: prescribed error %.3e rad (predicted %.3e), smallest volume ratio %.4f, largest kinetic %.4f J\n",
+  std::printf("starfish 0.3 s: prescribed error %.3e rad (predicted %.3e), smallest volume ratio %.4f, "
+              "largest kinetic %.4f J\n",
               r.prescribed_error, predicted, r.min_volume_ratio, r.max_kinetic);
 }
 
