@@ -53,10 +53,11 @@ CommandRegistration reg({"scene", kSummary, [](CLI::App& app) {
                                "                 coordinates), fingertips prescribed on circles (maximal\n"
                                "                 inverse dynamics), elbow angle prescribed; prints the largest\n"
                                "                 prescribed-point and prescribed-angle errors\n"
-                               "  starfish       five arms of four hinges inside a co-rotated FEM star (243\n"
-                               "                 nodes), first joints prescribed, the rest passive (bdf1,\n"
-                               "                 fully implicit); prints steps, wall time, the prescribed-joint\n"
-                               "                 error, kinetic energy and the smallest tet volume ratio");
+                               "  starfish       a free disc and five arms of four hinges inside a co-rotated\n"
+                               "                 FEM star (243 nodes); the disc's centre and the first joints\n"
+                               "                 prescribed, the rest passive (bdf1, fully implicit); prints\n"
+                               "                 steps, wall time, the prescribed-joint and -point errors,\n"
+                               "                 kinetic energy and the smallest tet volume ratio");
                            return [f] {
                              const std::string out = f->out.empty() ? "scene-" + f->name : f->out;
                              if (isHybrid(f->name))

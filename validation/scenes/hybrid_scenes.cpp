@@ -261,10 +261,16 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
     throw std::invalid_argument("starfish: need dt > 0, duration > 0 and frame_interval >= dt");
   constexpr int kArms = 5, kLinks = 4;
   constexpr double kDisc = 0.05, kLink = 0.1;
-  // skeleton: per arm a chain of hinges about the horizontal normal of the arm (the arm curls up
-  // and down), the first at the rim of the disc (the world)
+  // skeleton: a disc on a free joint, and per arm a chain of hinges about the horizontal normal
+  // of the arm (the arm curls up and down), the first at the rim of the disc
   ModelBuilder b("starfish");
   b.setGravity(Vec3(0, -9.81, 0));
+  const double md = opt.disc_mass, hd = 0.02;
+  const Mat3 Id = Vec3(md * (3 * kDisc * kDisc + hd * hd) / 12, md * kDisc * kDisc / 2,
+                       md * (3 * kDisc * kDisc + hd * hd) / 12).asDiagonal();
+  const int disc = b.addBody("disc", md, Vec3::Zero(), Id, -1, "disc", Free3D{});
+  b.setCoordinateNames(disc, {"disc_x", "disc_y", "disc_z", "disc_rx", "disc_ry", "disc_rz"});
+  constexpr int kFree = 6;  // the disc's coordinates come first: translation, then rotation
   std::vector<Vec3> dir(kArms);
   for (int a = 0; a < kArms; ++a) {
     const double phi = kTwoPi * a / kArms;
@@ -272,7 +278,7 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
     // local x along the arm, local z = (-sin phi, 0, cos phi)
     const Mat3 R = Eigen::AngleAxisd(-phi, Vec3::UnitY()).toRotationMatrix();
     const auto [c, I] = rod(opt.link_mass, kLink, 0.01);
-    int parent = -1;
+    int parent = disc;
     for (int k = 0; k < kLinks; ++k) {
       const std::string n = "arm" + std::to_string(a) + "_" + std::to_string(k);
       const Mat4 E_pf = k == 0 ? makeE(R, kDisc * dir[a]) : makeTranslation(Vec3(kLink, 0, 0));
@@ -282,7 +288,7 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
   }
   const Model m = b.finalize();
   System sys(m);
-  // the mesh: disc nodes fixed, nodes within 0.035 m of a link attached to it
+  // the mesh: disc nodes on the disc, nodes within 0.035 m of a link attached to it
   const TetMesh mesh = makeStarTetMesh(kArms, kDisc, kDisc + kLinks * kLink);
   DeformableBody body = makeFemBody(mesh, opt.E, opt.nu, opt.rho);
   body.rayleigh_mass = opt.rayleigh_mass;
@@ -291,14 +297,14 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
   for (int n = 0; n < mesh.numNodes(); ++n) {
     const Vec3& x = mesh.nodes[n];
     if (Vec3(x.x(), 0, x.z()).norm() < kDisc - 1e-12) {
-      att.push_back({n, -1});
+      att.push_back({n, disc});
       continue;
     }
     for (int a = 0; a < kArms; ++a) {
       const double s = x.dot(dir[a]), d = (x - s * dir[a]).norm();
       const int k = static_cast<int>(std::floor((s - kDisc) / kLink));
       if (d < 0.035 && s >= kDisc && k >= 0) {
-        att.push_back({n, a * kLinks + std::min(k, kLinks - 1)});
+        att.push_back({n, 1 + a * kLinks + std::min(k, kLinks - 1)});
         break;
       }
     }
@@ -310,15 +316,26 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
   for (int a = 0; a < kArms; ++a) {
     const double ph = kTwoPi * a / kArms;
     auto c = std::make_shared<PrescribedCoordinate>(
-        m, a * kLinks,
+        m, kFree + a * kLinks,
         makeConstraintFunction1([=](double t) { return A * std::sin(w * t + ph) - A * std::sin(ph); },
                                 [=](double t) { return A * w * std::cos(w * t + ph); },
                                 [=](double t) { return -A * w * w * std::sin(w * t + ph); }));
     pres.push_back(c);
     sys.addConstraint(c);
   }
+  // the disc's centre prescribed in maximal coordinates: it bobs up and down; its orientation
+  // stays passive
+  const double B = opt.disc_amplitude, wd = kTwoPi * opt.disc_frequency;
+  auto disc_path = [=](double t) {
+    PointSample p;
+    p.x = Vec3(0, B * std::sin(wd * t), 0);
+    p.v = Vec3(0, B * wd * std::cos(wd * t), 0);
+    p.a = Vec3(0, -B * wd * wd * std::sin(wd * t), 0);
+    return p;
+  };
+  sys.addConstraint(std::make_shared<PrescribedPoint>(m, disc, Vec3::Zero(), disc_path, "prescribed_disc"));
   StarfishResult res;
-  res.joints = m.nr();
+  res.joints = m.nr() - kFree;
   res.prescribed = kArms;
   res.nodes = mesh.numNodes();
   res.attached = static_cast<int>(att.size());
@@ -339,14 +356,17 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
   for (const auto& c : m.coordinates()) res.run.columns.push_back(c.name);
   for (const char* c : {"kinetic_energy", "potential_energy"}) res.run.columns.push_back(c);
   for (int a = 0; a < kArms; ++a) res.run.columns.push_back("torque_arm" + std::to_string(a) + "_0");
+  for (const char* c : {"disc_force_x", "disc_force_y", "disc_force_z"}) res.run.columns.push_back(c);
   res.run.mesh = mesh;
   auto record = [&] {
     const double T = sys.kineticEnergy(s, ws), V = sys.potentialEnergy(s, ws);
-    // the prescribed joints' torques: the multipliers of the acceleration-level KKT solve
+    // the prescribed joints' torques and the disc's force: the multipliers of the
+    // acceleration-level KKT solve
     sys.forwardDynamics(s, ws);
-    VecX row(m.nr() + 2 + kArms);
+    VecX row(m.nr() + 2 + kArms + 3);
     row << s.q.head(m.nr()), T, V, ws.lambda;
-    res.max_torque = std::max(res.max_torque, ws.lambda.lpNorm<Eigen::Infinity>());
+    res.max_torque = std::max(res.max_torque, ws.lambda.head(kArms).lpNorm<Eigen::Infinity>());
+    res.max_disc_force = std::max(res.max_disc_force, ws.lambda.tail<3>().norm());
     res.run.t.push_back(s.t);
     res.run.rows.push_back(row);
     calcKinematics(m, s, sk);
@@ -369,6 +389,8 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
       throw std::runtime_error("starfish: non-finite state at t = " + std::to_string(s.t) + " s");
     for (const auto& c : pres)
       res.prescribed_error = std::max(res.prescribed_error, std::abs(s.q[c->coordinate()] - c->position(s.t)));
+    // the disc's origin is its translation coordinates (free joint, translation first, in the world)
+    res.point_error = std::max(res.point_error, (s.q.head<3>() - disc_path(s.t).x).norm());
     if (k % every == 0) record();
   }
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -399,13 +421,16 @@ void runHybridScene(const std::string& name, const std::string& out_dir, std::os
   } else if (name == "starfish") {
     StarfishOptions opt;
     StarfishResult r = runStarfish(opt);
-    summary << "starfish: " << r.joints << " joints (" << r.prescribed << " prescribed, the rest passive), mesh of "
+    summary << "starfish: disc on a free joint, its centre prescribed; " << r.joints << " joints (" << r.prescribed
+            << " prescribed, the rest passive), mesh of "
             << r.nodes << " nodes (" << r.attached << " attached to the disc and the links) and " << r.tets
             << " tets, " << r.ndof << " coordinates, E " << opt.E << " Pa, integrator " << opt.integrator << ", dt "
             << opt.dt << " s\n";
     summary << "steps " << r.steps << ", wall time " << r.wall_seconds << " s\n";
     summary << "largest prescribed-joint error " << r.prescribed_error << " rad, largest prescribed-joint torque "
             << r.max_torque << " N m\n";
+    summary << "largest prescribed-point error " << r.point_error << " m (disc centre), largest force on it "
+            << r.max_disc_force << " N\n";
     summary << "kinetic energy largest " << r.max_kinetic << " J, final " << r.final_kinetic
             << " J; smallest tet volume / rest volume " << r.min_volume_ratio << "\n";
     run = std::move(r.run);

@@ -164,28 +164,38 @@ TEST(Starfish, RunsStablyTheJointsFollowAndNoTetInverts) {
   EXPECT_EQ(r.prescribed, 5);
   EXPECT_EQ(r.nodes, 243);
   EXPECT_EQ(r.tets, 840);
-  EXPECT_EQ(r.ndof, 20 + 3 * (r.nodes - r.attached));
+  EXPECT_EQ(r.ndof, 6 + 20 + 3 * (r.nodes - r.attached));  // the disc's free joint, hinges, free nodes
   EXPECT_EQ(r.steps, 150);
   for (const VecX& row : r.run.rows) EXPECT_TRUE(row.allFinite());
-  // bdf1 meets the prescribed joints at the velocity level; the position error is the sum of
-  // the steps' h^2/2 qddot_p, i.e. h/2 |qdot_p(t) - qdot_p(0)|, largest over arms and t here
-  const double w = 2 * kPi * opt.frequency;
-  double predicted = 0;
-  for (int a = 0; a < 5; ++a)
-    for (double t = 0; t <= opt.duration + 1e-12; t += opt.dt) {
-      const double ph = 2 * kPi * a / 5;
-      predicted = std::max(predicted, opt.dt / 2 * opt.amplitude * w * std::abs(std::cos(w * t + ph) - std::cos(ph)));
+  // bdf1 meets a prescribed row at the velocity level [D Eq. 4.110]: whatever the dynamics, the
+  // step from t_k sets qdot = qdot_p(t_k) + h qddot_p(t_k) and q += h qdot, so the error
+  // q_p(t_n) - q_n follows from the trajectory alone (first order in h). Both kinds of rows here are
+  // linear in q (the joints; the disc centre is its free joint's translation), so the prediction
+  // holds to round-off.
+  auto drift = [&](double A, double w, double ph) {
+    double q = 0, worst = 0;  // q_n - q_p(0)
+    for (int k = 0; k < r.steps; ++k) {
+      const double t = k * opt.dt;
+      q += opt.dt * (A * w * std::cos(w * t + ph) - opt.dt * A * w * w * std::sin(w * t + ph));
+      const double tn = (k + 1) * opt.dt;
+      worst = std::max(worst, std::abs(A * std::sin(w * tn + ph) - A * std::sin(ph) - q));
     }
-  EXPECT_NEAR(r.prescribed_error, predicted, 0.01 * predicted);
-  // no tet inverts: the smallest volume / rest volume is measured (0.7625 over these 0.3 s, 0.63
+    return worst;
+  };
+  double predicted = 0;
+  for (int a = 0; a < 5; ++a) predicted = std::max(predicted, drift(opt.amplitude, 2 * kPi * opt.frequency, 2 * kPi * a / 5));
+  const double predicted_point = drift(opt.disc_amplitude, 2 * kPi * opt.disc_frequency, 0.0);
+  EXPECT_NEAR(r.prescribed_error, predicted, 1e-9 * predicted);
+  EXPECT_NEAR(r.point_error, predicted_point, 1e-9 * predicted_point);
+  // no tet inverts: the smallest volume / rest volume is measured (0.7633 over these 0.3 s, 0.63
   // over the scene's 2 s) and asserted near it; the motion is bounded (largest kinetic energy
-  // measured 0.3527 J, the same over 2 s)
+  // measured 0.0243 J here, 0.039 J over 2 s)
   EXPECT_GT(r.min_volume_ratio, 0.0);
-  EXPECT_NEAR(r.min_volume_ratio, 0.7625, 0.005);
-  EXPECT_NEAR(r.max_kinetic, 0.3527, 0.002);
-  std::printf("starfish 0.3 s: prescribed error %.3e rad (predicted %.3e), smallest volume ratio %.4f, "
-              "largest kinetic %.4f J\n",
-              r.prescribed_error, predicted, r.min_volume_ratio, r.max_kinetic);
+  EXPECT_NEAR(r.min_volume_ratio, 0.7633, 0.005);
+  EXPECT_NEAR(r.max_kinetic, 0.0243, 0.0005);
+  std::printf("starfish 0.3 s: prescribed error %.3e rad (predicted %.3e), point %.3e m (predicted %.3e), "
+              "smallest volume ratio %.4f, largest kinetic %.4f J\n",
+              r.prescribed_error, predicted, r.point_error, predicted_point, r.min_volume_ratio, r.max_kinetic);
 }
 
 }  // namespace
