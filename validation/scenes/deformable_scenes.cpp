@@ -11,6 +11,7 @@
 #include "core/deformable/deformable_term.hpp"
 #include "core/dynamics/system.hpp"
 #include "core/integrators/integrator.hpp"
+#include "validation/scenes/scene_io.hpp"
 
 namespace redmax::scenes {
 
@@ -52,44 +53,17 @@ DeformableRun simulate(const System& sys, State s, const DeformableTerm& term, c
   return run;
 }
 
-void writeText(const std::filesystem::path& path, const std::string& body) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream o(tmp);
-    if (!o) throw std::runtime_error(path.string() + ": cannot write");
-    o << body;
-    if (!o) throw std::runtime_error(path.string() + ": write failed");
-  }
-  std::filesystem::rename(tmp, path);
-}
-
-// NAME_NNNN.vtk per frame (with displacement from the first frame) and NAME.pvd
-void writeSeries(const std::filesystem::path& dir, const std::string& name, const DeformableRun& run) {
-  std::vector<std::pair<double, std::string>> frames;
-  for (size_t k = 0; k < run.nodes.size(); ++k) {
-    char file[64];
-    std::snprintf(file, sizeof file, "%s_%04zu.vtk", name.c_str(), k);
-    TetMesh mesh = run.mesh;
-    mesh.nodes = run.nodes.front();
-    std::vector<Vec3> u(run.nodes[k].size());
-    for (size_t n = 0; n < u.size(); ++n) u[n] = run.nodes[k][n] - run.nodes.front()[n];
-    writeVtkTetMesh((dir / file).string(), mesh, run.nodes[k], {{"displacement", u}}, run.lines);
-    frames.emplace_back(run.t[k], file);
-  }
-  writePvd((dir / (name + ".pvd")).string(), frames);
-}
-
 void writeStates(const std::filesystem::path& path, const DeformableRun& run) {
-  std::ostringstream o;
-  o << std::setprecision(17) << "time";
-  for (const auto& c : run.coordinates) o << ',' << c;
-  o << ",energy\n";
+  std::vector<std::string> columns{"time"};
+  columns.insert(columns.end(), run.coordinates.begin(), run.coordinates.end());
+  columns.push_back("energy");
+  std::vector<VecX> rows;
   for (size_t k = 0; k < run.t.size(); ++k) {
-    o << run.t[k];
-    for (int i = 0; i < run.q[k].size(); ++i) o << ',' << run.q[k][i];
-    o << ',' << run.energy[k] << '\n';
+    VecX r(run.q[k].size() + 2);
+    r << run.t[k], run.q[k], run.energy[k];
+    rows.push_back(r);
   }
-  writeText(path, o.str());
+  writeCsv(path, columns, rows);
 }
 
 }  // namespace
@@ -186,7 +160,7 @@ void runDeformableScene(const std::string& name, const std::string& out_dir, std
     run.mesh = r.mesh;
     run.t = {0.0, 1.0};  // load factor: unloaded, loaded
     run.nodes = {r.mesh.nodes, toPoints(r.x)};
-    writeSeries(dir, name, run);
+    writeSeries(dir, name, run.mesh, run.lines, run.t, run.nodes);
     std::ostringstream o;
     o << std::setprecision(17) << "node,X,Y,Z,ux,uy,uz\n";
     for (int n = 0; n < r.mesh.numNodes(); ++n) {
@@ -224,7 +198,7 @@ void runDeformableScene(const std::string& name, const std::string& out_dir, std
             << ref.q.back()[0] << " rad, largest difference " << worst << " rad\n";
   }
   writeStates(dir / "states.csv", run);
-  writeSeries(dir, name, run);
+  writeSeries(dir, name, run.mesh, run.lines, run.t, run.nodes);
 }
 
 }  // namespace redmax::scenes

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "core/deformable/tet_mesh.hpp"
+#include "mesh_checks.hpp"
 
 namespace redmax {
 namespace {
@@ -44,22 +45,7 @@ TEST(TetMesh, BoxMeshesFillTheBoxWithConformingPositiveTets) {
     EXPECT_NEAR(vol, 1.0, 1e-13);
     // conforming: every face is shared by two tets, or lies on the boundary (2 triangles per
     // boundary square of the 3 x 2 x 2 grid: 2 (6 + 6 + 4) squares)
-    std::map<std::array<int, 3>, int> faces;
-    for (const auto& t : m.tets)
-      for (int skip = 0; skip < 4; ++skip) {
-        std::array<int, 3> f;
-        int k = 0;
-        for (int a = 0; a < 4; ++a)
-          if (a != skip) f[k++] = t[a];
-        std::sort(f.begin(), f.end());
-        ++faces[f];
-      }
-    int boundary = 0;
-    for (const auto& [f, count] : faces) {
-      EXPECT_LE(count, 2);
-      boundary += count == 1;
-    }
-    EXPECT_EQ(boundary, 2 * 2 * (3 * 2 + 3 * 2 + 2 * 2));
+    EXPECT_EQ(testing::boundaryFaces(m), 2 * 2 * (3 * 2 + 3 * 2 + 2 * 2));
   }
   EXPECT_THROW(makeBoxTetMesh(Vec3(1, 1, 1), 0, 1, 1), std::invalid_argument);
   EXPECT_THROW(makeBoxTetMesh(Vec3(1, -1, 1), 1, 1, 1), std::invalid_argument);
