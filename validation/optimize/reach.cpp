@@ -184,7 +184,7 @@ ReachSetup makeReachSetup(const ReachOptions& options) {
     // "--params 'torques:x': no coordinate named 'x'" in the reach command's words
     std::string what = e.what();
     const std::string p = "--params";
-    if (what.rfind(p, 0) == 0) what = "--coordinates" + what.substr(p.size());
+    if (what.rfind(p + " 'torques:", 0) == 0) what = "--coordinates '" + what.substr(p.size() + 10);
     throw std::invalid_argument(what);
   }
   const Model& model = s.gradient.model.system->model();
