@@ -108,6 +108,7 @@ class Tracker {
 
 struct NloptData {
   Tracker* tracker = nullptr;
+  nlopt_opt opt = nullptr;
   bool reached = false, exhausted = false;
   std::exception_ptr error;
 };
@@ -123,8 +124,9 @@ double nloptObjective(unsigned n, const double* x, double* /*grad*/, void* data)
   } catch (...) {
     d->error = std::current_exception();
   }
-  // a C callback must not throw: ask NLopt to stop and say why afterwards
-  return std::numeric_limits<double>::quiet_NaN();  // NLopt stops on NaN (forced stop)
+  // a C callback must not throw: stop NLopt here (a NaN return alone does not stop Nelder-Mead)
+  nlopt_force_stop(d->opt);
+  return std::numeric_limits<double>::infinity();
 }
 
 void runNlopt(const ReachSetup& setup, nlopt_algorithm algorithm, Tracker& tracker, ReachResult& res) {
@@ -133,6 +135,7 @@ void runNlopt(const ReachSetup& setup, nlopt_algorithm algorithm, Tracker& track
   if (!opt) throw std::runtime_error("NLopt: cannot create the optimizer");
   NloptData data;
   data.tracker = &tracker;
+  data.opt = opt;
   const double box = setup.options.max_torque;
   std::vector<double> lo(n), hi(n), x(n, 0.0);
   for (unsigned i = 0; i < n; ++i) {
