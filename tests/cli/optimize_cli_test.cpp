@@ -5,8 +5,6 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "tests/cli/cli_test_util.hpp"
@@ -32,13 +30,6 @@ class OptimizeCli : public ::testing::Test {
   }
   fs::path dir_;
 };
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 const std::string kReach = "--point 0,-0.08,0 --target 0.2,-0.5,0.05 --duration 0.3 --dt 0.01";
 
