@@ -172,6 +172,10 @@ const std::vector<SceneCounts>& scenes() {
        {"pelvis_tilt", "pelvis_list", "pelvis_rotation", "pelvis_tx", "pelvis_ty", "pelvis_tz",
         "hip_flexion_r", "hip_adduction_r", "hip_rotation_r", "knee_angle_r", "ankle_angle_r"},
        1, 1, 2, 1},
+      {"reach_arm.osim",
+       {"scapula", "humerus", "forearm", "hand"},
+       {"shoulder_flexion", "shoulder_adduction", "shoulder_rotation", "elbow_flexion"},
+       0, 0, 6, 2},
   };
   return s;
 }

@@ -10,7 +10,8 @@
 //   view/ -> core, converter (`redmax view`, docs/view.md)
 //   validation/ -> core, converter, plugin, view;  cli/ -> anything
 // External libraries: tinyxml2 only in converter/; Simbody only in plugin/, validation/ and
-// tests; SUNDIALS only in core/integrators/*.cpp (never a header).
+// tests; SUNDIALS only in core/integrators/*.cpp (never a header); LBFGSpp and NLopt only in
+// validation/optimize/*.cpp.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -137,6 +138,12 @@ TEST(Layering, IncludesPointDownOnly) {
       }
       if (isSimbody(inc.target)) {
         EXPECT_TRUE(dir == "plugin" || dir == "validation") << where << " (Simbody outside plugin/validation)";
+      }
+      if (inc.target == "LBFGS.h" || inc.target.rfind("LBFGSpp/", 0) == 0 || inc.target.rfind("nlopt", 0) == 0) {
+        // the reaching task's optimizers (docs/design.md §10), in its .cpp only
+        EXPECT_TRUE(inc.file.rfind("validation/optimize/", 0) == 0 && inc.file.size() > 4 &&
+                    inc.file.substr(inc.file.size() - 4) == ".cpp")
+            << where << " (LBFGSpp and NLopt only in validation/optimize/*.cpp)";
       }
       if (isSundials(inc.target)) {
         EXPECT_TRUE(dir == "core/integrators" && inc.file.size() > 4 &&

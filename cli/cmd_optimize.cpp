@@ -1,0 +1,191 @@
+// `redmax optimize --task reach`: constant shoulder and elbow torques that bring the hand to a
+// target, by L-BFGS on adjoint gradients and gradient-free (docs/gradients.md §7). The task and the
+// report are validation/optimize; this file parses flags, prints progress and the summary.
+// Exit codes: 0 success (also when a method did not reach the tolerance: the report says so),
+// 1 a run diverged or the report could not be written, 2 bad input or usage.
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "cli/muscle_mass_flags.hpp"
+#include "converter/osim_reader.hpp"
+#include "validation/optimize/reach.hpp"
+#include "validation/simulate/spec_parse.hpp"
+
+namespace redmax::cli {
+namespace {
+
+struct OptimizeFlags {
+  std::string task, model, body = "hand", target, point = "0,0,0", integrator = "euler", method = "lbfgs,bobyqa";
+  std::string coordinates, report, muscle_mass_kg;
+  double duration = 0.0, dt = 0.01, rest = 0.0, tolerance = 1e-3, max_torque = 100.0, initial_step = 1.0;
+  long max_simulations = 2000;
+  bool quiet = false;
+  MuscleMassFlags mm;
+};
+
+int runOptimize(OptimizeFlags& f, const CLI::App& app) {
+  for (const char* n : {"--task", "--model", "--target", "--duration"})
+    if (!given(app, n)) throw UsageError{std::string("optimize needs ") + n};
+  validation::ReachOptions o;
+  o.model_path = f.model;
+  o.body = f.body;
+  if (!validation::parseVec3(f.target, o.target)) {
+    std::cerr << "error: --target '" << f.target << "': must be three numbers X,Y,Z (m, ground)\n";
+    return 2;
+  }
+  if (!validation::parseVec3(f.point, o.point)) {
+    std::cerr << "error: --point '" << f.point << "': must be three numbers x,y,z (m, in the body's frame)\n";
+    return 2;
+  }
+  if (!f.coordinates.empty()) o.coordinates = splitList(f.coordinates);
+  o.duration = f.duration;
+  o.dt = f.dt;
+  o.integrator = f.integrator;
+  o.rest_weight = f.rest;
+  o.tolerance = f.tolerance;
+  o.max_torque = f.max_torque;
+  o.initial_step = f.initial_step;
+  o.max_simulations = f.max_simulations;
+  const std::vector<std::string> methods = splitList(f.method);
+  for (const auto& m : methods) {
+    bool known = false;
+    for (const auto& k : validation::reachMethods()) known = known || k == m;
+    if (!known) {
+      std::cerr << "error: --method '" << m << "': unknown (" << joinChoices(validation::reachMethods()) << ")\n";
+      return 2;
+    }
+  }
+  if (methods.empty()) throw UsageError{"--method: no method"};
+  applyMuscleMassOptions(app, f.mm, f.muscle_mass_kg, o.model_options);
+
+  validation::ReachSetup setup;
+  try {
+    setup = validation::makeReachSetup(o);
+  } catch (const osim::ConvertError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const ModelError& e) {
+    std::cerr << "error: " << f.model << ": " << e.what() << "\n";
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+  for (const auto& w : setup.gradient.model.build.warnings) std::cerr << "warning: " << w << "\n";
+  if (!f.quiet)
+    std::fprintf(stderr, "reach: %s, %zu torques, hand at (%.4g, %.4g, %.4g) m, target (%.4g, %.4g, %.4g) m, %.4g kg of muscle mass\n",
+                 setup.gradient.model.description.name.c_str(), setup.gradient.param_names.size(), setup.start_point[0],
+                 setup.start_point[1], setup.start_point[2], o.target[0], o.target[1], o.target[2],
+                 setup.gradient.model.muscle_mass);
+
+  std::vector<validation::ReachResult> results;
+  const validation::ReachProgress progress = [&f](const std::string& m, const validation::ReachEvaluation& e) {
+    if (!f.quiet)
+      std::fprintf(stderr, "%s: simulation %ld, J = %.6e (best %.6e), error %.4e m, %.3f s\n", m.c_str(), e.simulations,
+                   e.objective, e.best_objective, e.error, e.seconds);
+  };
+  for (const auto& m : methods) {
+    try {
+      results.push_back(validation::optimizeReach(setup, m, progress));
+    } catch (const SimulationError& e) {
+      std::cerr << "error: " << f.model << ": " << m << ": simulation failed: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  std::printf("%-12s %12s %16s %12s %14s %14s %8s  %s\n", "method", "simulations", "step evaluations", "wall (s)",
+              "objective", "error (m)", "reached", "stop");
+  for (const auto& r : results)
+    std::printf("%-12s %12ld %16ld %12.4f %14.6e %14.6e %8s  %s\n", r.method.c_str(), r.simulations, r.step_evaluations,
+                r.seconds, r.objective, r.error, r.reached ? "yes" : "no", r.stop.c_str());
+  for (const auto& r : results) {
+    std::printf("%s torques (N m):", r.method.c_str());
+    for (Eigen::Index i = 0; i < r.torques.size(); ++i) std::printf(" %s=%.8g", setup.gradient.param_names[i].c_str(), r.torques[i]);
+    std::printf("\n");
+  }
+  if (!f.report.empty()) {
+    try {
+      const std::string plot = validation::writeReachReport(f.report, setup, results, commandLine(app));
+      std::printf("report: %s (%s)\n", f.report.c_str(), plot.c_str());
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  return 0;
+}
+
+CommandRegistration reg(
+    {"optimize", "optimize a task through the simulation's adjoint gradient (--task reach)",
+     [](CLI::App& app) {
+       auto f = std::make_shared<OptimizeFlags>();
+       app.add_option("--task", f->task, "the task: reach (constant torques bring a hand point to a target); required")
+           ->type_name("reach")
+           ->check(oneOf({"reach"}));
+       app.add_option("--model", f->model, "the OpenSim model (.osim), e.g. osim_models/reach_arm.osim; required")
+           ->type_name("M.osim")
+           ->check(existingFile());
+       app.add_option("--target", f->target, "the target in ground (m); required")->type_name("X,Y,Z");
+       app.add_option("--body", f->body, "the body that reaches (default hand)")->type_name("BODY");
+       app.add_option("--point", f->point, "the point of BODY that reaches, in its frame (m; default 0,0,0)")
+           ->type_name("x,y,z");
+       app.add_option("--coordinates", f->coordinates,
+                      "the coordinates that get a constant torque (default: all of the model's)")
+           ->type_name("C,...");
+       app.add_option("--duration", f->duration, "simulated seconds; the hand is judged at the end; required")
+           ->type_name("S")
+           ->check(positive());
+       app.add_option("--dt", f->dt, "fixed step (default 0.01)")->type_name("H")->check(positive());
+       app.add_option("--integrator", f->integrator, "euler (default), bdf1 or sdirk2")
+           ->type_name("euler|bdf1|sdirk2")
+           ->check(oneOf({"euler", "bdf1", "sdirk2"}));
+       app.add_option("--method", f->method,
+                      "the methods, each from zero torques, comma-separated (default lbfgs,bobyqa):\n"
+                      "lbfgs (L-BFGS on the adjoint gradient), nelder-mead or bobyqa (NLopt, gradient-free)")
+           ->type_name("M,...");
+       app.add_option("--rest", f->rest, "weight W of W/2 |qdot|^2 at the end: the hand also comes to rest (default 0)")
+           ->type_name("WEIGHT")
+           ->check(nonNegative());
+       app.add_option("--tolerance", f->tolerance,
+                      "the reach error (m) that counts as reached; the methods stop at the objective\n"
+                      "1/2 T^2 (default 0.001)")
+           ->type_name("T")
+           ->check(positive());
+       app.add_option("--max-simulations", f->max_simulations, "per method (default 2000)")
+           ->type_name("N")
+           ->check(between(1, 1e9, true));
+       app.add_option("--max-torque", f->max_torque,
+                      "N m: the gradient-free methods' bounds on each torque, +-T (default 100)")
+           ->type_name("T")
+           ->check(positive());
+       app.add_option("--initial-step", f->initial_step, "rad/s^2: the gradient-free methods' first step in joint acceleration (each\n"
+                      "torque divided by its coordinate's diagonal mass-matrix entry at the start; default 1)")
+           ->type_name("T")
+           ->check(positive());
+       app.add_option("--report", f->report,
+                      "write DIR/report.md, DIR/<method>_iterations.csv, DIR/objective.png (gnuplot)")
+           ->type_name("DIR");
+       app.add_flag("--quiet", f->quiet, "no progress on stderr");
+       app.add_option("--muscle-mass-kg", f->muscle_mass_kg,
+                      "give these muscles KG each in mass points, ADDED to the model; excludes --muscle-mass")
+           ->type_name("NAME=KG,...")
+           ->group("Muscle mass");
+       addMuscleMassFlags(app, f->mm);
+       app.footer(std::string(
+           "usage: redmax optimize --task reach --model M.osim --target X,Y,Z --duration S\n"
+           "                       [--body BODY] [--point x,y,z] [--dt H] [--integrator euler|bdf1|sdirk2]\n"
+           "                       [--method lbfgs,nelder-mead,bobyqa] [--rest WEIGHT] [--tolerance T]\n"
+           "                       [MUSCLE-MASS OPTIONS] [--report DIR]\n"
+           "Finds constant generalized forces on the model's coordinates that bring the point to the target\n"
+           "at the end of a run from the default pose (gravity, muscle inertia; the muscles pull no force),\n"
+           "[D Sec. 6.2.11]: minimizes 1/2 |p - target|^2 (+ WEIGHT/2 |qdot|^2) with each method from zero\n"
+           "and prints simulations, wall time and final error per method (docs/gradients.md §7).\n"
+           "e.g. redmax optimize --task reach --model osim_models/reach_arm.osim --point 0,-0.08,0\n"
+           "       --target 0.25,-0.35,0.1 --duration 0.4 --muscle-mass physiological --report reach\n") +
+           muscleMassFooter());
+       return [f, &app] { return runOptimize(*f, app); };
+     }});
+
+}  // namespace
+}  // namespace redmax::cli

@@ -1,0 +1,79 @@
+// `redmax optimize --task reach` end to end (docs/gradients.md §7): the report folder (report.md
+// with every method, one CSV per method whose rows are the simulations the table counts, the plot
+// when gnuplot exists, no temporary folder left), and bad input exiting 2 with `error: ...`.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "tests/cli/cli_test_util.hpp"
+
+namespace {
+
+using namespace redmax::cli_test;
+namespace fs = std::filesystem;
+
+class OptimizeCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to cli_tests (build target redmax)";
+    dir_ = fs::temp_directory_path() / ("redmax_optimize_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  CmdResult run(const std::string& args) const {
+    return runRedmax(dir_, "optimize --task reach --model " + scene("reach_arm.osim") + " " + args);
+  }
+  fs::path dir_;
+};
+
+const std::string kReach = "--point 0,-0.08,0 --target 0.2,-0.5,0.05 --duration 0.3 --dt 0.01";
+
+TEST_F(OptimizeCli, WritesTheReport) {
+  const fs::path report = dir_ / "reach";
+  const CmdResult r = run(kReach + " --method lbfgs,nelder-mead --report " + report.string());
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.err.find("lbfgs: simulation 1, J = "), std::string::npos) << r.err;  // progress
+  const std::string md = slurp(report / "report.md");
+  for (const std::string m : {"lbfgs", "nelder-mead"}) {
+    EXPECT_NE(md.find("| " + m + " | "), std::string::npos) << md;
+    // one CSV row per simulation the summary counts
+    const std::string csv = slurp(report / (m + "_iterations.csv"));
+    long rows = -1;  // the header
+    for (char c : csv) rows += c == '\n';
+    const auto at = r.out.find("\n" + m + " ");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    EXPECT_EQ(std::stol(r.out.substr(at + 1 + m.size())), rows) << r.out;
+    EXPECT_EQ(csv.rfind("evaluation,simulations,step_evaluations,seconds,objective,best_objective,error_m\n", 0), 0u);
+  }
+  EXPECT_NE(md.find("torque elbow_flexion"), std::string::npos) << md;
+  if (md.find("plot skipped") == std::string::npos) {
+    EXPECT_TRUE(fs::exists(report / "objective.png") || fs::exists(report / "objective.svg")) << md;
+  }
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+}
+
+TEST_F(OptimizeCli, BadInputExitsTwo) {
+  CmdResult r = run(kReach + " --body foot");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.rfind("error: --body 'foot': no body named so in ", 0), 0u) << r.err;
+  r = run("--target 0.2,-0.5 --duration 0.3");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: --target '0.2,-0.5': must be three numbers X,Y,Z (m, ground)\n");
+  r = run("--target 0.2,nan,0 --duration 0.3");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.rfind("error: --target", 0), 0u) << r.err;
+  r = run(kReach + " --method gradient-descent");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.rfind("error: --method 'gradient-descent': unknown", 0), 0u) << r.err;
+  r = run("--duration 0.3");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("optimize needs --target"), std::string::npos) << r.err;
+}
+
+}  // namespace

@@ -1,0 +1,108 @@
+// The reaching task (validation/optimize/reach.hpp, docs/gradients.md §7) on osim_models/reach_arm.osim
+// with the physiological mass of all six wrapping muscles: L-BFGS on the adjoint gradient and BOBYQA
+// both bring the hand to the target from zero torques, L-BFGS with fewer simulations; the objective
+// that the hand also comes to rest slows it; bad input is refused with the flag named.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "core/skeleton/kinematics.hpp"
+#include "validation/optimize/reach.hpp"
+
+namespace redmax::validation {
+namespace {
+
+ReachOptions reachOptions() {
+  ReachOptions o;
+  o.model_path = std::string(REDMAX_SOURCE_DIR) + "/osim_models/reach_arm.osim";
+  o.model_options.muscle_mass.source = osim::MuscleMassOptions::Source::Physiological;
+  o.model_options.muscle_mass.wrap_mass = true;  // the deltoids and triceps over the smooth wrap model
+  o.body = "hand";
+  o.point = Vec3(0.0, -0.08, 0.0);
+  o.target = Vec3(0.2, -0.5, 0.05);  // 0.1 m from the hand's start (0.168, -0.607, 0)
+  o.duration = 0.3;
+  o.dt = 0.01;
+  return o;
+}
+
+// the hand point at the end of a run at the given torques, computed here from the final state
+Vec3 finalPoint(const ReachSetup& s, const VecX& torques) {
+  const adjoint::Result r = adjoint::evaluate(s.gradient.problem, s.gradient.objective, torques, false);
+  const Model& model = s.gradient.model.system->model();
+  SkeletonWorkspace sk(model);
+  calcKinematics(model, r.final, sk);
+  const auto& pt = s.gradient.objective.points.front();
+  return transformPoint(sk.E_wi[pt.body], pt.x_i);
+}
+
+TEST(Reach, LbfgsAndBobyqaReachTheTargetLbfgsWithFewerSimulations) {
+  const ReachSetup s = makeReachSetup(reachOptions());
+  ASSERT_EQ(s.gradient.param_names.size(), 4u);  // three shoulder rotations and the elbow
+  EXPECT_GT(s.gradient.model.muscle_mass, 0.5);    // 0.82 kg in the six muscles' mass points
+  EXPECT_GT((s.start_point - s.options.target).norm(), 0.09);
+  const ReachResult lbfgs = optimizeReach(s, "lbfgs");
+  const ReachResult bobyqa = optimizeReach(s, "bobyqa");
+  for (const ReachResult* r : {&lbfgs, &bobyqa}) {
+    // reached: the hand within the 1 mm tolerance, checked on a fresh run of the returned torques
+    const double error = (finalPoint(s, r->torques) - s.options.target).norm();
+    EXPECT_LE(error, 1e-3) << r->method << ": " << r->stop;
+    EXPECT_TRUE(r->reached) << r->method;
+    EXPECT_NEAR(r->error, error, 1e-12) << r->method;
+    EXPECT_NEAR(r->objective, 0.5 * error * error, 1e-15) << r->method;
+    EXPECT_EQ(r->simulations, static_cast<long>(r->evaluations.size()));
+    EXPECT_EQ(r->failed_simulations, 0) << r->method;
+    // the best objective never rises and ends at the result
+    for (size_t i = 1; i < r->evaluations.size(); ++i)
+      EXPECT_LE(r->evaluations[i].best_objective, r->evaluations[i - 1].best_objective);
+    EXPECT_EQ(r->evaluations.back().best_objective, r->objective);
+  }
+  // the dissertation's comparison: far fewer simulations with the gradient
+  EXPECT_LT(lbfgs.simulations, bobyqa.simulations) << lbfgs.simulations << " vs " << bobyqa.simulations;
+  // an L-BFGS evaluation runs the adjoint too: more integrator steps per simulation
+  EXPECT_GT(lbfgs.step_evaluations / lbfgs.simulations, bobyqa.step_evaluations / bobyqa.simulations);
+}
+
+TEST(Reach, TheRestObjectiveSlowsTheHand) {
+  ReachOptions o = reachOptions();
+  o.model_options = SimulationModelOptions{};  // lumped muscles: the objective's wiring, quickly
+  o.max_simulations = 60;
+  const ReachResult free = optimizeReach(makeReachSetup(o), "lbfgs");
+  o.rest_weight = 1e-3;
+  const ReachSetup rest_setup = makeReachSetup(o);
+  const ReachResult rest = optimizeReach(rest_setup, "lbfgs");
+  ASSERT_TRUE(free.reached);
+  // the speed term is in the objective: J = 1/2 e^2 + w/2 |qdot|^2 at the returned torques
+  const adjoint::Result r = adjoint::evaluate(rest_setup.gradient.problem, rest_setup.gradient.objective, rest.torques, false);
+  EXPECT_NEAR(rest.objective, 0.5 * rest.error * rest.error + 0.5e-3 * r.final.qdot.squaredNorm(), 1e-14);
+  EXPECT_NEAR(rest.final_speed, r.final.qdot.norm(), 1e-12);
+  EXPECT_LT(rest.final_speed, 0.5 * free.final_speed) << rest.final_speed << " vs " << free.final_speed;
+}
+
+TEST(Reach, BadInputNamesTheFlag) {
+  ReachOptions o = reachOptions();
+  o.body = "foot";
+  try {
+    makeReachSetup(o);
+    FAIL() << "unknown body accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--body 'foot': no body named so"), std::string::npos) << e.what();
+  }
+  o = reachOptions();
+  o.target[1] = std::nan("");
+  EXPECT_THROW(makeReachSetup(o), std::invalid_argument);
+  o = reachOptions();
+  o.coordinates = {"shoulder_flexion", "wrist"};
+  try {
+    makeReachSetup(o);
+    FAIL() << "unknown coordinate accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "--coordinates 'wrist': no coordinate named 'wrist'");
+  }
+  const ReachSetup s = makeReachSetup(reachOptions());
+  EXPECT_THROW(optimizeReach(s, "newton"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace redmax::validation

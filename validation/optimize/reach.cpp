@@ -1,0 +1,387 @@
+// The reaching task (validation/optimize/reach.hpp, docs/gradients.md §7).
+#include "validation/optimize/reach.hpp"
+
+#include <LBFGS.h>
+#include <nlopt.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <exception>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "converter/atomic_file.hpp"
+#include "core/skeleton/kinematics.hpp"
+#include "validation/report/plot.hpp"
+
+namespace redmax::validation {
+namespace {
+
+std::string joined(const std::vector<std::string>& v, const std::string& sep) {
+  std::string s;
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+Vec3 bodyPoint(const Model& model, const State& s, int body, const Vec3& x_i) {
+  SkeletonWorkspace sk(model);
+  calcKinematics(model, s, sk);
+  return transformPoint(sk.E_wi[body], x_i);
+}
+
+// thrown from inside an objective evaluation to end a method once the stop objective is met
+struct Reached {};
+
+// the evaluations of one method: counts, timing, the best point so far
+class Tracker {
+ public:
+  Tracker(const ReachSetup& setup, ReachResult& result, const ReachProgress& progress)
+      : setup_(setup), result_(result), progress_(progress), t0_(std::chrono::steady_clock::now()) {
+    const ReachOptions& o = setup.options;
+    stop_ = o.stop_objective >= 0.0 ? o.stop_objective : 0.5 * o.tolerance * o.tolerance;
+    best_ = std::numeric_limits<double>::infinity();
+  }
+
+  /// x: the scaled parameters (u = scale x); gradient: dJ/dx
+  double evaluate(const VecX& x, VecX* gradient) {
+    const VecX u = setup_.scale.cwiseProduct(x);
+    if (result_.simulations >= setup_.options.max_simulations) throw Exhausted{};
+    adjoint::Result r;
+    bool failed = false;
+    try {
+      r = adjoint::evaluate(setup_.gradient.problem, setup_.gradient.objective, u, gradient != nullptr);
+    } catch (const SimulationError&) {
+      // torques that make the arm spin until the fixed step diverges: an infinite objective, so
+      // that line searches step back and simplex methods move away; the start must run
+      if (result_.simulations == 0) throw;
+      failed = true;
+      ++result_.failed_simulations;
+    }
+    ReachEvaluation e;
+    e.simulations = ++result_.simulations;
+    e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+    if (failed) {
+      if (gradient) *gradient = VecX::Zero(u.size());
+      e.objective = std::numeric_limits<double>::infinity();
+      e.error = std::numeric_limits<double>::infinity();
+      e.step_evaluations = result_.step_evaluations;
+      e.best_objective = best_;
+      result_.evaluations.push_back(e);
+      if (progress_) progress_(result_.method, e);
+      return e.objective;
+    }
+    if (gradient) *gradient = setup_.scale.cwiseProduct(r.gradient);
+    result_.step_evaluations += r.step_evaluations;
+    e.step_evaluations = result_.step_evaluations;
+    e.objective = r.objective;
+    const auto& pt = setup_.gradient.objective.points.front();
+    e.error = (bodyPoint(setup_.gradient.model.system->model(), r.final, pt.body, pt.x_i) - pt.target).norm();
+    if (r.objective < best_) {
+      best_ = r.objective;
+      result_.torques = u;
+      result_.objective = r.objective;
+      result_.error = e.error;
+      result_.final_speed = r.final.qdot.norm();
+    }
+    e.best_objective = best_;
+    result_.evaluations.push_back(e);
+    if (progress_) progress_(result_.method, e);
+    if (r.objective <= stop_) throw Reached{};
+    return r.objective;
+  }
+
+  double stopObjective() const { return stop_; }
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+  struct Exhausted {};
+
+ private:
+  const ReachSetup& setup_;
+  ReachResult& result_;
+  const ReachProgress& progress_;
+  std::chrono::steady_clock::time_point t0_;
+  double stop_ = 0.0, best_ = 0.0;
+};
+
+struct NloptData {
+  Tracker* tracker = nullptr;
+  nlopt_opt opt = nullptr;
+  bool reached = false, exhausted = false;
+  std::exception_ptr error;
+};
+
+double nloptObjective(unsigned n, const double* x, double* /*grad*/, void* data) {
+  auto* d = static_cast<NloptData*>(data);
+  try {
+    return d->tracker->evaluate(Eigen::Map<const VecX>(x, n), nullptr);
+  } catch (const Reached&) {
+    d->reached = true;
+  } catch (const Tracker::Exhausted&) {
+    d->exhausted = true;
+  } catch (...) {
+    d->error = std::current_exception();
+  }
+  // a C callback must not throw: stop NLopt here (a NaN return alone does not stop Nelder-Mead)
+  nlopt_force_stop(d->opt);
+  return std::numeric_limits<double>::infinity();
+}
+
+void runNlopt(const ReachSetup& setup, nlopt_algorithm algorithm, Tracker& tracker, ReachResult& res) {
+  const unsigned n = static_cast<unsigned>(setup.gradient.p0.size());
+  nlopt_opt opt = nlopt_create(algorithm, n);
+  if (!opt) throw std::runtime_error("NLopt: cannot create the optimizer");
+  NloptData data;
+  data.tracker = &tracker;
+  data.opt = opt;
+  const double box = setup.options.max_torque;
+  std::vector<double> lo(n), hi(n), x(n, 0.0);
+  for (unsigned i = 0; i < n; ++i) {
+    hi[i] = box / setup.scale[i];
+    lo[i] = -hi[i];
+  }
+  nlopt_set_lower_bounds(opt, lo.data());
+  nlopt_set_upper_bounds(opt, hi.data());
+  nlopt_set_min_objective(opt, nloptObjective, &data);
+  nlopt_set_xtol_rel(opt, 1e-10);
+  nlopt_set_initial_step1(opt, setup.options.initial_step);  // rad/s^2
+  double f = 0.0;
+  const nlopt_result r = nlopt_optimize(opt, x.data(), &f);
+  nlopt_destroy(opt);
+  if (data.reached) res.stop = "reached the stop objective";
+  else if (data.exhausted) res.stop = "max simulations";
+  else if (data.error) std::rethrow_exception(data.error);
+  else res.stop = std::string("NLopt: ") + nlopt_result_to_string(r);
+}
+
+}  // namespace
+
+const std::vector<std::string>& reachMethods() {
+  static const std::vector<std::string> m{"lbfgs", "nelder-mead", "bobyqa"};
+  return m;
+}
+
+ReachSetup makeReachSetup(const ReachOptions& options) {
+  ReachSetup s;
+  s.options = options;
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(options.target[k])) throw std::invalid_argument("--target: must be three finite numbers X,Y,Z (m)");
+  if (!(options.tolerance > 0.0)) throw std::invalid_argument("--tolerance: must be > 0");
+  // the coordinates: all of the model's unless named; validated by the gradient SPEC
+  SimulationModel probe_model;
+  std::vector<std::string> coords = options.coordinates;
+  if (coords.empty()) {
+    probe_model = loadSimulationModel(options.model_path, SimulationModelOptions{});
+    coords = probe_model.coordinate_names;
+    if (coords.empty()) throw std::invalid_argument(options.model_path + ": the model has no coordinates to drive");
+  }
+  for (const auto& c : coords)
+    if (c.empty() || c.find_first_of(",;@=") != std::string::npos)
+      throw std::invalid_argument("--coordinates '" + c + "': not a coordinate name");
+  try {
+    s.gradient = makeGradientSetup(options.model_path, options.model_options, options.integrator, options.duration,
+                                   options.dt, "torques:" + joined(coords, ","), "speed");
+  } catch (const std::invalid_argument& e) {
+    // "--params 'torques:x': no coordinate named 'x'" in the reach command's words
+    std::string what = e.what();
+    const std::string p = "--params";
+    if (what.rfind(p + " 'torques:", 0) == 0) what = "--coordinates '" + what.substr(p.size() + 10);
+    throw std::invalid_argument(what);
+  }
+  const Model& model = s.gradient.model.system->model();
+  adjoint::Objective::Point pt;
+  pt.body = model.findBody(options.body);
+  if (pt.body < 0) throw std::invalid_argument("--body '" + options.body + "': no body named so in " + options.model_path);
+  pt.x_i = options.point;
+  pt.target = options.target;
+  s.gradient.objective = adjoint::Objective{};
+  s.gradient.objective.points.push_back(pt);
+  s.gradient.objective.speed_weight = options.rest_weight;
+  s.start_point = bodyPoint(model, s.gradient.problem.initial, pt.body, pt.x_i);
+  const System& system = *s.gradient.model.system;
+  DynamicsWorkspace ws(system);
+  system.calcMassAndForce(s.gradient.problem.initial, ws);
+  const auto& forces = s.gradient.problem.forces;
+  s.scale.resize(static_cast<Eigen::Index>(forces.size()));
+  for (size_t i = 0; i < forces.size(); ++i) {
+    const double m = ws.M(forces[i].coordinate, forces[i].coordinate);
+    if (!(m > 0.0)) throw std::invalid_argument("--coordinates '" + s.gradient.param_names[i] + "': no inertia to drive");
+    s.scale[static_cast<Eigen::Index>(i)] = m;
+  }
+  return s;
+}
+
+ReachResult optimizeReach(const ReachSetup& setup, const std::string& method, const ReachProgress& progress) {
+  ReachResult res;
+  res.method = method;
+  res.names = setup.gradient.param_names;
+  res.torques = setup.gradient.p0;
+  Tracker tracker(setup, res, progress);
+  if (method == "lbfgs") {
+    LBFGSpp::LBFGSParam<double> param;
+    param.epsilon = 1e-10;
+    param.epsilon_rel = 1e-10;
+    param.max_iterations = 0;  // bounded by max_simulations instead
+    // Wolfe steps keep s'y > 0, so the quasi-Newton matrix stays positive definite on this
+    // non-convex objective (Armijo steps alone let LBFGSpp 0.1 produce ascent directions)
+    param.linesearch = LBFGSpp::LBFGS_LINESEARCH_BACKTRACKING_STRONG_WOLFE;
+    param.max_linesearch = 40;
+    auto f = [&](const VecX& x, VecX& g) { return tracker.evaluate(x, &g); };
+    // a failed line search restarts from the best point with an empty memory, as long as the
+    // previous attempt improved the objective
+    VecX x = VecX::Zero(setup.gradient.p0.size());
+    double last_best = std::numeric_limits<double>::infinity();
+    for (;;) {
+      LBFGSpp::LBFGSSolver<double> solver(param);
+      double fx = 0.0;
+      try {
+        solver.minimize(f, x, fx);
+        res.stop = "gradient below 1e-10";
+        break;
+      } catch (const Reached&) {
+        res.stop = "reached the stop objective";
+        break;
+      } catch (const Tracker::Exhausted&) {
+        res.stop = "max simulations";
+        break;
+      } catch (const SimulationError&) {
+        throw;
+      } catch (const std::exception& e) {
+        res.stop = std::string("line search: ") + e.what();
+      }
+      if (!(res.objective < last_best)) break;
+      last_best = res.objective;
+      x = res.torques.cwiseQuotient(setup.scale);
+      ++res.restarts;
+    }
+  } else if (method == "nelder-mead") {
+    runNlopt(setup, NLOPT_LN_NELDERMEAD, tracker, res);
+  } else if (method == "bobyqa") {
+    runNlopt(setup, NLOPT_LN_BOBYQA, tracker, res);
+  } else {
+    throw std::invalid_argument("--method '" + method + "': unknown (lbfgs, nelder-mead or bobyqa)");
+  }
+  res.seconds = tracker.seconds();
+  res.reached = res.error <= setup.options.tolerance;
+  return res;
+}
+
+namespace {
+
+std::string fmt(double v, int digits = 6) {
+  std::ostringstream o;
+  o.precision(digits);
+  o << v;
+  return o.str();
+}
+
+std::string vec3(const Vec3& v) { return fmt(v[0]) + ", " + fmt(v[1]) + ", " + fmt(v[2]); }
+
+}  // namespace
+
+std::string writeReachReport(const std::string& dir, const ReachSetup& setup, const std::vector<ReachResult>& results,
+                             const std::string& command_line) {
+  namespace fs = std::filesystem;
+  const fs::path target(dir);
+  const fs::path tmp = target.parent_path() / (target.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+  if (!fs::create_directories(tmp, ec) && ec) throw std::runtime_error(tmp.string() + ": " + ec.message());
+  const ReachOptions& o = setup.options;
+
+  // per method: one row per objective evaluation
+  for (const ReachResult& r : results) {
+    std::ostringstream c;
+    c.precision(12);
+    c << "evaluation,simulations,step_evaluations,seconds,objective,best_objective,error_m\n";
+    for (size_t i = 0; i < r.evaluations.size(); ++i) {
+      const ReachEvaluation& e = r.evaluations[i];
+      c << i + 1 << "," << e.simulations << "," << e.step_evaluations << "," << e.seconds << "," << e.objective << ","
+        << e.best_objective << "," << e.error << "\n";
+    }
+    osim::writeFileAtomic((tmp / (r.method + "_iterations.csv")).string(), c.str());
+  }
+
+  // the best objective so far against simulations, every method on one log-scale panel
+  PlotFigure fig;
+  fig.title = "reaching task: " + setup.gradient.model.description.name;
+  PlotPanel panel;
+  panel.title = "best objective so far";
+  panel.xlabel = "simulations (forward runs)";
+  panel.ylabel = "J";
+  panel.log_y = true;
+  for (const ReachResult& r : results) {
+    std::vector<double> x, y;
+    for (const ReachEvaluation& e : r.evaluations) {
+      x.push_back(static_cast<double>(e.simulations));
+      y.push_back(e.best_objective);
+    }
+    panel.lines.push_back(makePlotLine(r.method, x, y, "linespoints"));
+  }
+  fig.panels.push_back(panel);
+  std::string plot_status, plot_file;
+  const GnuplotInfo gp = findGnuplot();
+  if (!gp.available) {
+    plot_status = "plot skipped: " + gp.why_not;
+  } else {
+    const PlotOutcome out = renderPlot(gp, PlotFormat::Auto, fig, (tmp / "objective").string());
+    if (out.ok) {
+      plot_file = fs::path(out.file).filename().string();
+      plot_status = "plot: " + plot_file;
+    } else {
+      plot_status = "plot failed: " + out.error;
+    }
+  }
+
+  std::ostringstream md;
+  md << "# Reaching task: " << setup.gradient.model.description.name << "\n\n";
+  md << "Command: `" << command_line << "`\n\n";
+  md << "Constant generalized forces on " << setup.gradient.param_names.size()
+     << " coordinates from zero; objective `1/2 |p - target|^2";
+  if (o.rest_weight > 0.0) md << " + " << fmt(o.rest_weight) << "/2 |qdot|^2";
+  md << "` at t = " << fmt(o.duration) << " s (" << setup.gradient.problem.integrator << ", dt " << fmt(o.dt)
+     << " s, " << setup.gradient.model.muscle_mass << " kg of muscle mass in mass points).\n\n";
+  md << "- point " << vec3(o.point) << " m of body `" << o.body << "`, at the start " << vec3(setup.start_point)
+     << " m, target " << vec3(o.target) << " m (distance " << fmt((o.target - setup.start_point).norm()) << " m)\n";
+  md << "- stop: objective <= " << fmt(o.stop_objective >= 0.0 ? o.stop_objective : 0.5 * o.tolerance * o.tolerance)
+     << ", a method's own convergence test, or " << o.max_simulations << " simulations; reached means error <= "
+     << fmt(o.tolerance) << " m\n\n";
+  md << "| method | simulations (diverged) | step evaluations | wall time (s) | final objective | final error (m) | final |qdot| (rad/s) | reached | stop |\n";
+  md << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const ReachResult& r : results)
+    md << "| " << r.method << " | " << r.simulations << " (" << r.failed_simulations << ") | " << r.step_evaluations << " | " << fmt(r.seconds, 4) << " | "
+       << fmt(r.objective) << " | " << fmt(r.error) << " | " << fmt(r.final_speed) << " | " << (r.reached ? "yes" : "no")
+       << " | " << r.stop << " |\n";
+  md << "\nOne simulation is one forward run; an L-BFGS evaluation also runs the adjoint sweep, whose cost is in the "
+        "step evaluations (docs/gradients.md §5).\n\n## Converged parameters (N m)\n\n| parameter |";
+  for (const ReachResult& r : results) md << " " << r.method << " |";
+  md << "\n|---|";
+  for (size_t k = 0; k < results.size(); ++k) md << "---|";
+  md << "\n";
+  for (size_t i = 0; i < setup.gradient.param_names.size(); ++i) {
+    md << "| " << setup.gradient.param_names[i] << " |";
+    for (const ReachResult& r : results) md << " " << fmt(r.torques[static_cast<Eigen::Index>(i)], 10) << " |";
+    md << "\n";
+  }
+  md << "\n## Objective per evaluation\n\n";
+  for (const ReachResult& r : results) md << "- [" << r.method << "_iterations.csv](" << r.method << "_iterations.csv)\n";
+  if (!plot_file.empty()) md << "\n![objective against simulations](" << plot_file << ")\n";
+  else md << "\n(" << plot_status << ")\n";
+  osim::writeFileAtomic((tmp / "report.md").string(), md.str());
+
+  // swap the finished folder into place
+  const fs::path old = target.parent_path() / (target.filename().string() + ".old-" + std::to_string(::getpid()));
+  const bool had = fs::exists(target);
+  if (had) {
+    fs::rename(target, old, ec);
+    if (ec) throw std::runtime_error(target.string() + ": " + ec.message());
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) throw std::runtime_error(target.string() + ": " + ec.message());
+  if (had) fs::remove_all(old, ec);
+  return plot_status;
+}
+
+}  // namespace redmax::validation

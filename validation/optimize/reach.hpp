@@ -1,0 +1,106 @@
+#pragma once
+// The reaching task of [D Sec. 6.2.11] (`redmax optimize --task reach`, docs/gradients.md §7):
+// constant generalized forces on an arm's coordinates (the shoulder and elbow torques) that bring a
+// point of the hand to a target at the final time of a fixed-step run from the model's default
+// state, optionally with the hand at rest there. The objective is
+//   J(u) = 1/2 |p(q_N) - target|^2 + rest/2 |qdot_N|^2
+// (the `point` and `speed` terms of core/adjoint). Minimized either by L-BFGS on the adjoint
+// gradient (LBFGSpp, Debian's liblbfgspp-dev) or gradient-free by NLopt's Nelder-Mead or BOBYQA
+// (libnlopt-dev), as the dissertation compared fminunc with and without its derivatives.
+//
+// Every method works in the scaled variables x = u / diag(M(q_0)) (ReachSetup::scale), starts
+// from zero torques and stops at the first of: J <= stop_objective (by
+// default 1/2 tolerance^2: the hand within `tolerance` of the target when rest = 0), its own
+// convergence test (L-BFGS: |g| <= 1e-10, or a failed line search after which a restart from
+// the best point with an empty memory no longer improves; NLopt: relative x change
+// <= 1e-10), or max_simulations runs. A run that diverges (torques that spin the arm until the
+// fixed step blows up) counts as a simulation with an infinite objective. One "simulation" is one forward run; an L-BFGS evaluation
+// also runs the adjoint sweep, whose cost is counted apart in step evaluations.
+//
+// The report (writeReachReport) in DIR: report.md (setup, per method: converged torques,
+// simulations, step evaluations, wall time, final error and speed), <method>_iterations.csv (one
+// row per objective evaluation), objective.png|svg (best objective against simulations, every
+// method, log scale; needs gnuplot). Written into a temporary folder beside DIR and renamed into
+// place, so DIR is either the whole report or untouched.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "validation/gradient/gradient.hpp"
+#include "validation/simulate/simulate.hpp"
+
+namespace redmax::validation {
+
+struct ReachOptions {
+  std::string model_path;
+  SimulationModelOptions model_options;
+  std::string body = "hand";
+  Vec3 point = Vec3::Zero();   ///< in the body's frame (m)
+  Vec3 target = Vec3::Zero();  ///< in ground (m)
+  std::vector<std::string> coordinates;  ///< torqued coordinates; empty: all of the model's
+  double duration = 0.3, dt = 0.01;
+  std::string integrator = "euler";      ///< euler, bdf1 or sdirk2
+  double rest_weight = 0.0;              ///< weight of 1/2 |qdot_N|^2
+  double tolerance = 1e-3;               ///< m: the reach error that counts as reached
+  double stop_objective = -1.0;          ///< < 0: 1/2 tolerance^2
+  double max_torque = 100.0;             ///< N m: the gradient-free methods' box +-max_torque
+  double initial_step = 1.0;             ///< rad/s^2: the gradient-free methods' first step (scaled)
+  long max_simulations = 2000;
+};
+
+/// The task resolved against the model.
+struct ReachSetup {
+  ReachOptions options;
+  GradientSetup gradient;  ///< the adjoint problem (torque parameters) and the objective
+  Vec3 start_point = Vec3::Zero();  ///< the hand point at the start (default pose)
+  /// N m per optimization unit, per torque: the coordinate's diagonal entry of the mass matrix at
+  /// the start (kg m^2), so that every method works in joint accelerations (rad/s^2), u = scale x.
+  /// The shoulder's long-axis rotation has about a tenth of the flexion's inertia; in torques the
+  /// problem is that badly scaled and L-BFGS's first steps fling the arm round.
+  VecX scale;
+};
+
+/// Throws std::invalid_argument ("--body 'x': ...", "--coordinates 'c': ...", "--target: ...")
+/// for bad input, osim::ConvertError / ModelError for the model.
+ReachSetup makeReachSetup(const ReachOptions& options);
+
+/// One objective evaluation of an optimization.
+struct ReachEvaluation {
+  long simulations = 0;        ///< forward runs so far, this one included
+  long step_evaluations = 0;   ///< integrator steps so far (forward and adjoint)
+  double seconds = 0.0;        ///< since the method started
+  double objective = 0.0;
+  double best_objective = 0.0; ///< the lowest so far
+  double error = 0.0;          ///< |p - target| of this run (m)
+};
+
+struct ReachResult {
+  std::string method;          ///< lbfgs, nelder-mead or bobyqa
+  VecX torques;                ///< the best parameters found (per setup coordinate)
+  std::vector<std::string> names;
+  std::vector<ReachEvaluation> evaluations;
+  long simulations = 0, step_evaluations = 0;
+  long restarts = 0;           ///< L-BFGS restarts after a failed line search
+  long failed_simulations = 0; ///< runs that diverged (counted in simulations, objective +inf)
+  double seconds = 0.0;
+  double objective = 0.0, error = 0.0, final_speed = 0.0;  ///< at the best parameters (|qdot_N|)
+  bool reached = false;        ///< error <= tolerance
+  std::string stop;            ///< why it stopped
+};
+
+/// Progress: called after every evaluation.
+using ReachProgress = std::function<void(const std::string& method, const ReachEvaluation&)>;
+
+/// Run one method (lbfgs, nelder-mead, bobyqa) from zero torques. Throws std::invalid_argument
+/// for an unknown method and SimulationError when a run diverges.
+ReachResult optimizeReach(const ReachSetup& setup, const std::string& method, const ReachProgress& progress = {});
+
+/// The methods optimizeReach takes.
+const std::vector<std::string>& reachMethods();
+
+/// Write the report into dir (see the top of this file); returns the plot's status line. Throws
+/// std::runtime_error "PATH: why" when the folder cannot be written.
+std::string writeReachReport(const std::string& dir, const ReachSetup& setup, const std::vector<ReachResult>& results,
+                             const std::string& command_line);
+
+}  // namespace redmax::validation
