@@ -33,18 +33,10 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
   applyMuscleMassOptions(app, f.mm, f.muscle_mass_kg, mo);
 
   validation::GradientSetup g;
-  try {
-    g = validation::makeGradientSetup(f.model, mo, f.integrator, f.duration, f.dt, f.params, f.objective);
-  } catch (const osim::ConvertError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  } catch (const ModelError& e) {
-    std::cerr << "error: " << f.model << ": " << e.what() << "\n";
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  }
+  if (const int rc = loadOrExit2(f.model, [&] {
+        g = validation::makeGradientSetup(f.model, mo, f.integrator, f.duration, f.dt, f.params, f.objective);
+      }))
+    return rc;
   for (const auto& w : g.model.build.warnings) std::cerr << "warning: " << w << "\n";
 
   adjoint::Result res;

@@ -61,18 +61,7 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
   applyMuscleMassOptions(app, f.mm, f.muscle_mass_kg, o.model_options);
 
   validation::ReachSetup setup;
-  try {
-    setup = validation::makeReachSetup(o);
-  } catch (const osim::ConvertError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  } catch (const ModelError& e) {
-    std::cerr << "error: " << f.model << ": " << e.what() << "\n";
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  }
+  if (const int rc = loadOrExit2(f.model, [&] { setup = validation::makeReachSetup(o); })) return rc;
   for (const auto& w : setup.gradient.model.build.warnings) std::cerr << "warning: " << w << "\n";
   if (!f.quiet)
     std::fprintf(stderr, "reach: %s, %zu torques, hand at (%.4g, %.4g, %.4g) m, target (%.4g, %.4g, %.4g) m, %.4g kg of muscle mass\n",

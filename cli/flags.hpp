@@ -8,10 +8,14 @@
 // wording the CLI tests hold (docs/commands.md §1).
 #include <CLI/CLI.hpp>
 
+#include <iostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "cli/command.hpp"
+#include "converter/error.hpp"
+#include "core/skeleton/model.hpp"
 
 namespace redmax::cli {
 
@@ -35,6 +39,24 @@ CLI::Validator oneOf(const std::vector<std::string>& names);
 
 /// true when `flag` ("--name") was given on the command line
 bool given(const CLI::App& app, const std::string& flag);
+
+/// Runs `load` (reading `file` and building what the command needs). Bad input is printed as
+/// `error: ...` and gives exit code 2: osim::ConvertError ("FILE:LINE: what"), ModelError (named
+/// by `file`), std::invalid_argument (bad settings, the message names them). 0 when it loaded.
+template <class F>
+int loadOrExit2(const std::string& file, F&& load) {
+  try {
+    load();
+    return 0;
+  } catch (const osim::ConvertError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+  } catch (const ModelError& e) {
+    std::cerr << "error: " << file << ": " << e.what() << "\n";
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: " << e.what() << "\n";
+  }
+  return 2;
+}
 
 /// Where `redmax view` and `validate --view` look for the page's files (view/view.hpp
 /// findViewAssets), in order: $REDMAX_VIEW_ASSETS, build/view/ beside this executable's build tree
