@@ -408,6 +408,7 @@ void wrapEllipsoid(const WrapSurface& s, const Vec3& P1, const Vec3& P2, WrapMet
   r.r2 = r2 / factor;
   r.length = length / factor;
   r.arc = ArcKind::Polyline;
+  r.far_side = far_side_wrap;
   r.polyline.resize(pts.size());
   for (size_t i = 0; i < pts.size(); ++i) r.polyline[i] = pts[i] * (1.0 / factor);
   r.code = WrapCode::MandatoryWrap;

@@ -101,6 +101,9 @@ struct WrapResult {
   double arc_angle = 0.0;               ///< Helix: signed total rotation phi (rad)
   double arc_rise = 0.0;                ///< Helix: total advance h along the axis (m)
   std::vector<Vec3> polyline;           ///< Polyline: r1, interior points, r2
+  /// Ellipsoid with a quadrant: the arc goes round the far side of its plane (the near arc would
+  /// bend back toward an end point)
+  bool far_side = false;
 
   /// Wrapped or MandatoryWrap: the path goes over the surface
   bool wraps() const { return code == WrapCode::Wrapped || code == WrapCode::MandatoryWrap; }

@@ -312,27 +312,6 @@ struct EllipsoidArc {
   }
 };
 
-// The library's test for a wrong-way wrap on a quadrant ellipsoid: its polyline's first or last
-// segment (1 mm long, unscaled; checked only when there are two or more) bending back toward its
-// end point. Decided on values, with the library's own segment count.
-template <class T>
-bool wrongWayOnEllipsoid(const EllipsoidArc<T>& arc, const Vec3& p1, const Vec3& p2, const Vec3& r1, const Vec3& r2,
-                         double factor) {
-  const double len = (r1 - r2).norm() / factor;
-  if (len < 0.001) return false;
-  const int nseg = std::min(static_cast<int>(len / 0.001), 499);
-  if (nseg < 2) return false;
-  const EllipsoidArc<double> av{arc.a, constant<double>(values(arc.a0)), constant<double>(values(arc.ar1)),
-                                constant<double>(values(arc.vsy)), constant<double>(values(arc.f2)), value(arc.phi0)};
-  const double dphi = av.phi0 / nseg;
-  V3<double> x1, x2;
-  av.eval(dphi, &x1, nullptr);
-  av.eval((nseg - 1) * dphi, &x2, nullptr);
-  const Vec3 w1 = values(x1), w2 = values(x2);
-  return (p1 - r1).normalized().dot((w1 - r1).normalized()) > 0.0 ||
-         (p2 - r2).normalized().dot((w2 - r2).normalized()) > 0.0;
-}
-
 // everything of the ellipsoid path that does not depend on alpha, in the library's scaled
 // coordinates
 template <class T>
@@ -432,14 +411,16 @@ bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, E
   const V3<T> vs = normalize(cross(p1p2, p1 - c1));
   const T vs4 = -dot(vs, c1);
   // of the two tangent points from each end, the library takes the one its search from `start`
-  // converges to; with a quadrant that need not be the nearer (c1 was mirrored), so the library's
-  // own search is run on values and its roots are followed
+  // converges to; with a quadrant that need not be the nearer (c1 was mirrored), so the library
+  // is run on values and its roots, and its choice of the far side, are followed
   Vec3 start1 = start, start2 = start;
+  bool far_side = false;
   if (qsign != 0) {
     const WrapResult lib = calcWrap(surf, values(P1), values(P2));
     if (lib.wraps() && lib.r1.allFinite() && lib.r2.allFinite()) {
       start1 = factor * lib.r1;
       start2 = factor * lib.r2;
+      far_side = lib.far_side;
     }
   }
   const V3<T> r1 = tangentPoint(a, p1, vs, vs4, start1), r2 = tangentPoint(a, p2, vs, vs4, start2);
@@ -456,7 +437,7 @@ bool ellipsoidSetup(const WrapSurface& surf, const V3<T>& P1, const V3<T>& P2, E
   arc.phi0 = dacos(dot(arc.ar1, ar2));
   arc.vsy = cross(normalize(cross(arc.ar1, ar2)), arc.ar1);
   arc.f2 = cdiv(arc.a0, a);
-  if (qsign != 0 && wrongWayOnEllipsoid(arc, values(p1), values(p2), values(r1), values(r2), factor)) {
+  if (far_side) {
     // the library's far-side wrap: the same plane, swept the long way round (phi from 0 to
     // -(2 pi - phi0), i.e. 2 pi - phi0 along -vsy)
     arc.vsy = -1.0 * arc.vsy;

@@ -66,10 +66,10 @@
 // Quadrant ellipsoids. The library wraps on the same contact as without a quadrant, but c1 is
 // mirrored onto the active side when it lies on the other, then pulled toward the quadrant plane
 // by the fan's weight and put back on the surface; its tangent searches start from the mirrored
-// c1 (whose basin need not hold the nearer root, so the model runs the library's search on values
-// and takes, in closed form, the roots it converged to); and where the near arc's first or last
-// 1 mm segment bends back toward its end point the library goes round the far side (the same
-// plane swept 2 pi - phi0 the other way), which the model decides on values the same way. Equal
+// c1 (whose basin need not hold the nearer root, so the model runs the library on values and takes,
+// in closed form, the roots it converged to); and where the near arc's first or last 1 mm segment
+// bends back toward its end point the library goes round the far side (the same plane swept
+// 2 pi - phi0 the other way), which the model takes from that run (WrapResult::far_side). Equal
 // to the library outside the band (default box, random quadrants: median 6.2e-6, 99th percentile
 // 1.2e-4, max 5.4e-4 of the smallest semi-axis) except where the library's own construction
 // breaks (its rays' origin outside the ellipsoid: its polyline jumps; or a tangent search that
