@@ -79,11 +79,9 @@ void implicitStepSystem(const NodeSpaceProblem& p, const VecX& x, const VecX& v,
     vf[i] = v[dofs[i]];
   }
   const SparseMat K = restrict(ev.K, dofs);
-  // the fixed nodes do not move: their velocities add nothing to the damping of the free ones
-  const VecX Dv = b.rayleigh_mass * Mdiag.cwiseProduct(vf) + b.rayleigh_stiffness * (K * vf);
+  // f + D v with f = elastic - D v + m g: the damping force cancels, leaving elastic + gravity
   for (int i = 0; i < n; ++i) f[i] = ev.f[dofs[i]] + Mdiag[i] * p.gravity[dofs[i] % 3];
-  f -= Dv;  // node force: elastic - (alpha M + beta K) v + m g
-  rhs = Mdiag.cwiseProduct(vf) + h * (f + Dv);
+  rhs = Mdiag.cwiseProduct(vf) + h * f;
   A = (h * b.rayleigh_stiffness + h * h) * K;
   const double cM = 1.0 + h * b.rayleigh_mass;
   for (int i = 0; i < n; ++i) A.coeffRef(i, i) += cM * Mdiag[i];

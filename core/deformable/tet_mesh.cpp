@@ -17,20 +17,6 @@ void orient(const std::vector<Vec3>& x, std::array<int, 4>& t) {
   if (tetVolume(x, t) < 0) std::swap(t[2], t[3]);
 }
 
-// write `body` to path through a temporary file renamed into place (no half-written outputs)
-void writeAtomically(const std::string& path, const std::string& body) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error(path + ": cannot write");
-    out << body;
-    if (!out) throw std::runtime_error(path + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw std::runtime_error(path + ": cannot rename the temporary file: " + ec.message());
-}
-
 // whitespace-separated tokens with the line each sits on
 struct Tokens {
   std::string file;
@@ -80,6 +66,19 @@ std::string upper(std::string s) {
 }
 
 }  // namespace
+
+void writeAtomically(const std::string& path, const std::string& body) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw std::runtime_error(path + ": cannot write");
+    out << body;
+    if (!out) throw std::runtime_error(path + ": write failed");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw std::runtime_error(path + ": cannot rename the temporary file: " + ec.message());
+}
 
 double tetVolume(const std::vector<Vec3>& x, const std::array<int, 4>& t) {
   Mat3 D;

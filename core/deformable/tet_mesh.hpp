@@ -60,6 +60,10 @@ void writeVtkTetMesh(const std::string& path, const TetMesh& mesh, const std::ve
                      const std::vector<std::pair<std::string, std::vector<Vec3>>>& point_vectors = {},
                      const std::vector<std::array<int, 2>>& lines = {});
 
+/// Write body to path through path.tmp renamed into place (no half-written outputs). Throws
+/// std::runtime_error when the file cannot be written.
+void writeAtomically(const std::string& path, const std::string& body);
+
 /// ParaView collection (.pvd) of a time series: (time, file name relative to the .pvd) per frame.
 void writePvd(const std::string& path, const std::vector<std::pair<double, std::string>>& frames);
 

@@ -167,7 +167,7 @@ void runDeformableScene(const std::string& name, const std::string& out_dir, std
       const Vec3 X = r.mesh.nodes[n], u = r.x.segment<3>(3 * n) - X;
       o << n << ',' << X[0] << ',' << X[1] << ',' << X[2] << ',' << u[0] << ',' << u[1] << ',' << u[2] << '\n';
     }
-    writeText(dir / "states.csv", o.str());
+    writeAtomically((dir / "states.csv").string(), o.str());
     summary << "cantilever: " << opt.length << " x " << opt.width << " x " << opt.width << " m, E " << opt.E
             << " Pa, nu " << opt.nu << ", rho " << opt.rho << " kg/m^3, " << r.mesh.numNodes() << " nodes, "
             << r.mesh.numTets() << " tets, Newton " << r.solve.iterations << " iterations\n";

@@ -1,23 +1,11 @@
 #include "validation/scenes/scene_io.hpp"
 
 #include <cstdio>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
 namespace redmax::scenes {
-
-void writeText(const std::filesystem::path& path, const std::string& body) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream o(tmp);
-    if (!o) throw std::runtime_error(path.string() + ": cannot write");
-    o << body;
-    if (!o) throw std::runtime_error(path.string() + ": write failed");
-  }
-  std::filesystem::rename(tmp, path);
-}
 
 void writeCsv(const std::filesystem::path& path, const std::vector<std::string>& columns,
               const std::vector<VecX>& rows) {
@@ -32,7 +20,7 @@ void writeCsv(const std::filesystem::path& path, const std::vector<std::string>&
     for (int c = 0; c < r.size(); ++c) o << (c ? "," : "") << r[c];
     o << '\n';
   }
-  writeText(path, o.str());
+  writeAtomically(path.string(), o.str());
 }
 
 void writeSeries(const std::filesystem::path& dir, const std::string& name, const TetMesh& mesh,

@@ -1,6 +1,7 @@
 #pragma once
 // Output shared by the scenes that `redmax scene` runs (deformable_scenes, hybrid_scenes): files
-// are written to a temporary name and renamed, so a failed run leaves no half-written output.
+// go through writeAtomically (core/deformable/tet_mesh.hpp), so a failed run leaves no
+// half-written output.
 #include <array>
 #include <filesystem>
 #include <string>
@@ -9,9 +10,6 @@
 #include "core/deformable/tet_mesh.hpp"
 
 namespace redmax::scenes {
-
-/// write `body` to path (through path.tmp and a rename); throws std::runtime_error
-void writeText(const std::filesystem::path& path, const std::string& body);
 
 /// CSV with a header of `columns` and one row per entry of `rows` (each columns.size() long)
 void writeCsv(const std::filesystem::path& path, const std::vector<std::string>& columns,
