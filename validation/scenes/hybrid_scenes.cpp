@@ -29,8 +29,6 @@ std::pair<Vec3, Mat3> rod(double m, double L, double r) {
   return {Vec3(L / 2, 0, 0), Vec3(ia, it, it).asDiagonal()};
 }
 
-Vec3 transformPoint(const Mat4& E, const Vec3& x) { return E.topLeftCorner<3, 3>() * x + E.topRightCorner<3, 1>(); }
-
 // hand geometry (m)
 constexpr double kForearm = 0.25, kPalm = 0.08;
 constexpr double kPhalanx[3] = {0.045, 0.028, 0.02};
@@ -117,8 +115,7 @@ HandResult runHand(const HandOptions& opt) {
       "prescribed_elbow"));
   // fingertips prescribed in maximal coordinates: small circles from where they start
   State s_r;
-  s_r.q = VecX(m.nr());
-  for (int k = 0; k < m.nr(); ++k) s_r.q[k] = m.coordinates()[k].default_value;
+  s_r.q = m.defaultQ();
   s_r.qdot = VecX::Zero(m.nr());
   std::vector<Mat4> E;
   calcBodyPoses(m, s_r.q, E);
@@ -238,23 +235,12 @@ TetMesh makeStarTetMesh(int arms, double r_in, double r_out, double thickness, i
       const int A = a + per_layer, B = b + per_layer, C = c + per_layer;
       // each quad face is cut from its smallest-index corner (a bottom one), so neighbours agree
       for (std::array<int, 4> tet : {std::array<int, 4>{a, b, c, C}, {a, b, B, C}, {a, A, B, C}}) {
-        const Vec3 e1 = mesh.nodes[tet[1]] - mesh.nodes[tet[0]], e2 = mesh.nodes[tet[2]] - mesh.nodes[tet[0]],
-                   e3 = mesh.nodes[tet[3]] - mesh.nodes[tet[0]];
-        if (e1.cross(e2).dot(e3) < 0) std::swap(tet[2], tet[3]);
+        if (tetVolume(mesh.nodes, tet) < 0) std::swap(tet[2], tet[3]);
         mesh.tets.push_back(tet);
       }
     }
   return mesh;
 }
-
-namespace {
-
-// signed volume of tet t at positions x
-double tetVolume(const std::array<int, 4>& t, const std::vector<Vec3>& x) {
-  return (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).dot(x[t[3]] - x[t[0]]) / 6.0;
-}
-
-}  // namespace
 
 StarfishResult runStarfish(const StarfishOptions& opt) {
   if (!(opt.dt > 0) || !(opt.duration > 0) || !(opt.frame_interval >= opt.dt))
@@ -351,7 +337,7 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
   auto integ = makeIntegrator(opt.integrator, io);
   SkeletonWorkspace sk(m);
   std::vector<double> V0(mesh.numTets());
-  for (int e = 0; e < mesh.numTets(); ++e) V0[e] = tetVolume(mesh.tets[e], mesh.nodes);
+  for (int e = 0; e < mesh.numTets(); ++e) V0[e] = tetVolume(mesh.nodes, mesh.tets[e]);
   res.min_volume_ratio = 1.0;
   for (const auto& c : m.coordinates()) res.run.columns.push_back(c.name);
   for (const char* c : {"kinetic_energy", "potential_energy"}) res.run.columns.push_back(c);
@@ -374,7 +360,7 @@ StarfishResult runStarfish(const StarfishOptions& opt) {
     std::vector<Vec3> pts(mesh.numNodes());
     for (int n = 0; n < mesh.numNodes(); ++n) pts[n] = x.segment<3>(3 * n);
     for (int e = 0; e < mesh.numTets(); ++e)
-      res.min_volume_ratio = std::min(res.min_volume_ratio, tetVolume(mesh.tets[e], pts) / V0[e]);
+      res.min_volume_ratio = std::min(res.min_volume_ratio, tetVolume(pts, mesh.tets[e]) / V0[e]);
     res.run.points.push_back(std::move(pts));
     res.max_kinetic = std::max(res.max_kinetic, T);
     res.final_kinetic = T;

@@ -9,6 +9,7 @@
 #include "core/dynamics/constraints/prescribed_coordinate.hpp"
 #include "core/dynamics/system.hpp"
 #include "core/skeleton/kinematics.hpp"
+#include "core/spatial/se3.hpp"
 #include "mesh_checks.hpp"
 #include "validation/scenes/hybrid_scenes.hpp"
 
@@ -70,7 +71,7 @@ TEST(Hand, AtRestTheMultipliersBalanceGravityAboutTheElbow) {
   calcBodyPoses(m, row.head(m.nr()), E);
   double moment = row[m.nr()], weight_moment = 0.0;
   for (int i = 0; i < m.nb(); ++i) {
-    const Vec3 c = E[i].topLeftCorner<3, 3>() * m.bodies()[i].com + E[i].topRightCorner<3, 1>();
+    const Vec3 c = transformPoint(E[i], m.bodies()[i].com);
     weight_moment += c.cross(m.bodies()[i].mass * m.gravity())[2];
   }
   moment += weight_moment;
@@ -139,8 +140,7 @@ TEST(StarMesh, TetsArePositiveAndFacesConform) {
   EXPECT_EQ(mesh.numTets(), 2 * 3 * (20 + 3 * 20 * 2));
   double volume = 0;
   for (const auto& t : mesh.tets) {
-    const Vec3& x0 = mesh.nodes[t[0]];
-    const double v = (mesh.nodes[t[1]] - x0).cross(mesh.nodes[t[2]] - x0).dot(mesh.nodes[t[3]] - x0) / 6;
+    const double v = tetVolume(mesh.nodes, t);
     EXPECT_GT(v, 0.0);
     volume += v;
   }

@@ -11,6 +11,7 @@
 #include "core/dynamics/constraints/prescribed_point.hpp"
 #include "core/dynamics/system.hpp"
 #include "core/skeleton/kinematics.hpp"
+#include "core/spatial/se3.hpp"
 #include "validation/scenes/deformable_scenes.hpp"
 #include "validation/scenes/scenes.hpp"
 
@@ -136,7 +137,7 @@ TEST(PrescribedPoint, BaumgarteKeepsADoublePendulumTipOnItsPath) {
   const VecX q0 = Vec2(0.3, 0.8);
   calcBodyPoses(m, q0, E);
   const Vec3 tip_local(0, -1, 0);
-  const Vec3 x0 = E[1].topLeftCorner<3, 3>() * tip_local + E[1].topRightCorner<3, 1>();
+  const Vec3 x0 = transformPoint(E[1], tip_local);
   const double r = 0.05, w = 3.0;
   auto path = [=](double t) {
     PointSample p;
