@@ -382,6 +382,7 @@ view::ViewSummary ForwardTool::write(const ForwardResult& r) const {
   osim::writeStorage(controlsPath(), r.controls, o);
   if (settings_.view.index_html.empty()) return {};
   view::ViewInput in;
+  // the model as written: model_.description has the muscle mass moved already, writeView moves it
   in.description = osim::readOsimModel(setup_.model_file);
   in.motion_file = statesPath();
   in.motion = r.states;
