@@ -313,13 +313,13 @@ void ParticlePlacer::place(SimTK::State& sb) const {
 }  // namespace detail
 
 ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vector<Muscle> muscles)
-    : sm_(sm), muscles_(std::move(muscles)), placer_(std::make_shared<detail::ParticlePlacer>()) {
+    : sm_(sm), placer_(std::make_shared<detail::ParticlePlacer>()) {
   detail::ParticlePlacer& placer = *placer_;
   placer.sm = &sm;
-  placer.muscles = muscles_;
+  placer.muscles = std::move(muscles);
   placer.q_core.setZero(model.nr());
-  for (int mi = 0; mi < static_cast<int>(muscles_.size()); ++mi) {
-    const Muscle& mu = muscles_[mi];
+  for (int mi = 0; mi < static_cast<int>(placer.muscles.size()); ++mi) {
+    const Muscle& mu = placer.muscles[mi];
     validateMuscle(model, mu);
     if (mu.mass_points.size() == 0) continue;
     const std::string why = simbodyWrapShapeUnsupportedReason(mu);
@@ -334,7 +334,7 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
       SimTK::Body::Rigid body(SimTK::MassProperties(m, SimTK::Vec3(0), SimTK::Inertia(0)));
       SimTK::MobilizedBody::Translation p(sm.matter.updGround(), SimTK::Transform(), body, SimTK::Transform());
       mine.push_back(p);
-      particles_.push_back(p);
+      placer.particles.push_back(p);
     }
     std::vector<SimTK::MobilizedBody> point_bodies;
     std::vector<const SimTK::MobilizedBody*> coord_mobods;
@@ -376,11 +376,10 @@ ParticleMuscles::ParticleMuscles(SimbodyModel& sm, const Model& model, std::vect
         sm.system.addEventHandler(new ConditionalSwitch(placer_, q_sb, bound));
     }
   }
-  placer.particles = particles_;
   // the mass points' motion on the skeleton (placeParticles): the skeleton's bodies and q slots,
   // which the particles added above do not move
-  placer.motion = std::make_unique<MatterMuscleInertia>(sm.matter, makeMatterMap(sm, model), model, muscles_,
-                                                        model.gravity());
+  placer.motion = std::make_unique<MatterMuscleInertia>(sm.matter, makeMatterMap(sm, model), model,
+                                                        placer.muscles, model.gravity());
   // the topology changed: a new default state, Euler angles on as makeSimbodyModel sets them
   try {
     sm.default_state = sm.system.realizeTopology();

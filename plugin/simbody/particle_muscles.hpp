@@ -73,14 +73,12 @@ class ParticleMuscles {
   /// (model_to_simbody.hpp's getCoreState expects the skeleton's u alone).
   State coreState(const Model& model, const SimTK::State& sb) const;
 
-  int numParticles() const { return static_cast<int>(particles_.size()); }
+  int numParticles() const { return static_cast<int>(placer_->particles.size()); }
   /// particle k (muscles in order, their mass points in order)
-  const SimTK::MobilizedBody& particle(int k) const { return particles_.at(k); }
+  const SimTK::MobilizedBody& particle(int k) const { return placer_->particles.at(k); }
 
  private:
   const SimbodyModel& sm_;
-  std::vector<Muscle> muscles_;
-  std::vector<SimTK::MobilizedBody> particles_;  // muscles in order, their mass points in order
   // placeParticles' work, shared with the conditional points' event handlers
   std::shared_ptr<detail::ParticlePlacer> placer_;
 };

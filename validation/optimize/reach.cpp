@@ -33,6 +33,11 @@ Vec3 bodyPoint(const Model& model, const State& s, int body, const Vec3& x_i) {
   return transformPoint(sk.E_wi[body], x_i);
 }
 
+// the objective at which every method stops (ReachOptions::stop_objective)
+double stopObjective(const ReachOptions& o) {
+  return o.stop_objective >= 0.0 ? o.stop_objective : 0.5 * o.tolerance * o.tolerance;
+}
+
 // thrown from inside an objective evaluation to end a method once the stop objective is met
 struct Reached {};
 
@@ -41,8 +46,7 @@ class Tracker {
  public:
   Tracker(const ReachSetup& setup, ReachResult& result, const ReachProgress& progress)
       : setup_(setup), result_(result), progress_(progress), t0_(std::chrono::steady_clock::now()) {
-    const ReachOptions& o = setup.options;
-    stop_ = o.stop_objective >= 0.0 ? o.stop_objective : 0.5 * o.tolerance * o.tolerance;
+    stop_ = stopObjective(setup.options);
     best_ = std::numeric_limits<double>::infinity();
   }
 
@@ -94,7 +98,6 @@ class Tracker {
     return r.objective;
   }
 
-  double stopObjective() const { return stop_; }
   double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
   struct Exhausted {};
 
@@ -345,7 +348,7 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
      << " s, " << setup.gradient.model.muscle_mass << " kg of muscle mass in mass points).\n\n";
   md << "- point " << vec3(o.point) << " m of body `" << o.body << "`, at the start " << vec3(setup.start_point)
      << " m, target " << vec3(o.target) << " m (distance " << fmt((o.target - setup.start_point).norm()) << " m)\n";
-  md << "- stop: objective <= " << fmt(o.stop_objective >= 0.0 ? o.stop_objective : 0.5 * o.tolerance * o.tolerance)
+  md << "- stop: objective <= " << fmt(stopObjective(o))
      << ", a method's own convergence test, or " << o.max_simulations << " simulations; reached means error <= "
      << fmt(o.tolerance) << " m\n\n";
   md << "| method | simulations (diverged) | step evaluations | wall time (s) | final objective | final error (m) | final |qdot| (rad/s) | reached | stop |\n";
