@@ -1,22 +1,36 @@
 // `redmax scene NAME`: the deformable-body and hybrid-dynamics scenes built in code
-// (docs/deformable.md §4, §6); this file only parses and calls validation/scenes/deformable_scenes
-// and validation/scenes/hybrid_scenes.
+// (docs/deformable.md §4, §6) and the muscle-driven spline-leg scene (docs/forward.md §6); this
+// file only parses and calls validation/scenes/deformable_scenes, validation/scenes/hybrid_scenes
+// and validation/forward/spline_leg_scene.
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "cli/flags.hpp"
+#include "validation/forward/spline_leg_scene.hpp"
 #include "validation/scenes/deformable_scenes.hpp"
 #include "validation/scenes/hybrid_scenes.hpp"
 
 namespace redmax::cli {
 namespace {
 
+constexpr const char* kSplineLeg = "spline-leg";
+
 std::vector<std::string> sceneNames() {
   std::vector<std::string> v = scenes::deformableSceneNames();
   for (const auto& n : scenes::hybridSceneNames()) v.push_back(n);
+  v.push_back(kSplineLeg);
   return v;
+}
+
+// the bundled model: ./osim_models (run from the repository) or the source tree's
+std::string bundledModel(const std::string& file) {
+  namespace fs = std::filesystem;
+  const fs::path here = fs::path("osim_models") / file;
+  if (fs::is_regular_file(here)) return here.string();
+  return (fs::path(REDMAX_SOURCE_DIR) / "osim_models" / file).string();
 }
 
 bool isHybrid(const std::string& name) {
@@ -28,18 +42,27 @@ bool isHybrid(const std::string& name) {
 struct SceneFlags {
   std::string name;
   std::string out;
+  std::string model;
+  double duration = 0.0;  // 0: the scene's own
 };
 
 constexpr const char* kSummary =
-    "run a deformable-body or hybrid-dynamics scene (cantilever, strand, soft-pendulum, hand, starfish)";
+    "run a deformable-body, hybrid-dynamics or muscle-driven scene (cantilever, strand, soft-pendulum, hand,\n"
+    "starfish, spline-leg)";
 
 CommandRegistration reg({"scene", kSummary, [](CLI::App& app) {
                            auto f = std::make_shared<SceneFlags>();
                            app.add_option("name", f->name, "the scene")
                                ->required()
-                               ->type_name("cantilever|strand|soft-pendulum|hand|starfish")
+                               ->type_name("cantilever|strand|soft-pendulum|hand|starfish|spline-leg")
                                ->check(oneOf(sceneNames()));
                            app.add_option("--out", f->out, "output folder (default: ./scene-NAME)")->type_name("DIR");
+                           app.add_option("--model", f->model,
+                                          "spline-leg only: the model (default: osim_models/spline_leg.osim)")
+                               ->type_name("FILE");
+                           app.add_option("--duration", f->duration, "spline-leg only: simulated seconds (default 1.2)")
+                               ->type_name("S")
+                               ->check(CLI::PositiveNumber);
                            app.footer(
                                "Runs the scene and prints its summary; writes DIR/states.csv and a VTK series\n"
                                "(DIR/NAME_NNNN.vtk per output frame, DIR/NAME.pvd for ParaView).\n"
@@ -57,9 +80,31 @@ CommandRegistration reg({"scene", kSummary, [](CLI::App& app) {
                                "                 FEM star (243 nodes); the disc's centre and the first joints\n"
                                "                 prescribed, the rest passive (bdf1, fully implicit); prints\n"
                                "                 steps, wall time, the prescribed-joint and -point errors,\n"
-                               "                 kinetic energy and the smallest tet volume ratio");
+                               "                 kinetic energy and the smallest tet volume ratio\n"
+                               "  spline-leg     the dissertation's 6.2.10 leg: spline knee, six Hill muscles\n"
+                               "                 (gastrocnemii constant, soleus and tibialis anterior on an ankle\n"
+                               "                 controller, rectus femoris then semimembranosus by hand), lumped\n"
+                               "                 against inertial and spline against revolute knee; writes states,\n"
+                               "                 muscle forces, summary.txt and plots (docs/forward.md §6)");
                            return [f] {
                              const std::string out = f->out.empty() ? "scene-" + f->name : f->out;
+                             if (f->name == kSplineLeg) {
+                               validation::SplineLegOptions o;
+                               o.model_path = f->model.empty() ? bundledModel("spline_leg.osim") : f->model;
+                               o.out_dir = out;
+                               if (f->duration > 0) o.duration = f->duration;
+                               validation::SplineLegResult r;
+                               try {
+                                 r = validation::runSplineLegScene(o, std::cout);
+                               } catch (const osim::ConvertError& e) {  // the model is the user's input
+                                 std::cerr << "error: " << e.what() << "\n";
+                                 return 2;
+                               }
+                               std::cout << "wrote " << r.files.size() << " files to " << out << "\n";
+                               return 0;
+                             }
+                             if (!f->model.empty() || f->duration > 0)
+                               throw UsageError{"--model and --duration are for the spline-leg scene"};
                              if (isHybrid(f->name))
                                scenes::runHybridScene(f->name, out, std::cout);
                              else

@@ -183,6 +183,11 @@ ResolvedController resolveControlsFile(const std::string& file, const std::vecto
       warnings.push_back(file + ": no control for actuator '" + names[k] + "' (its control stays 0)");
       continue;
     }
+    // OpenSim's ControlLinear::getControlValue returns NaN without nodes; refuse before a run does
+    if (c->type == "ControlLinear" && c->x_nodes.empty())
+      throw ConvertError(file, c->line, "ControlLinear '" + c->name + "' drives actuator '" + names[k] +
+                                            "' but has no x_nodes (OpenSim evaluates it as NaN); give it nodes or "
+                                            "use a ControlConstant");
     used.insert(c->name);
     out.entries.push_back({k, makeControlFunction(*c)});
   }

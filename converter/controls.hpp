@@ -1,7 +1,8 @@
 #pragma once
 // OpenSim controls (docs/forward.md §3): ControlSet XML files (ControlLinear, ControlConstant),
 // controls .sto files, and their evaluation as OpenSim's ControlLinear::getControlValue does:
-//   no nodes                          the control's default (ControlConstant: its value; else 0)
+//   no nodes                          ControlConstant: its value; a ControlLinear without x_nodes
+//                                     that drives an actuator is refused (OpenSim's value is NaN)
 //   t before the first node           extrapolate (and not use_steps): the line through the first
 //                                     two nodes (one node: its value); otherwise the first node's value
 //   t at or after the last node       the same with the last two nodes / the last value

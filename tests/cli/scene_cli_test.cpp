@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -120,9 +121,21 @@ TEST_F(SceneCli, UnknownOrMissingNameIsAUsageError) {
   CmdResult r = runRedmax(dir_, "scene octopus");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("error: "), std::string::npos);
-  EXPECT_NE(r.err.find("cantilever, strand, soft-pendulum, hand or starfish"), std::string::npos);
+  EXPECT_NE(r.err.find("cantilever, strand, soft-pendulum, hand, starfish or spline-leg"), std::string::npos);
   r = runRedmax(dir_, "scene");
   EXPECT_EQ(r.code, 2);
+  // the spline-leg options are refused for the other scenes; a model that cannot be read is the
+  // user's error, with nothing written
+  r = runRedmax(dir_, "scene strand --duration 1 --out " + (dir_ / "s").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("error: --model and --duration are for the spline-leg scene"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "s"));
+  const fs::path bad = dir_ / "bad.osim";
+  { std::ofstream(bad) << "<OpenSimDocument Version=\"40000\">\n<Model name=\"m\">\n<BodySet>\n"; }
+  r = runRedmax(dir_, "scene spline-leg --model " + bad.string() + " --out " + (dir_ / "leg").string());
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("error: " + bad.string(), 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "leg"));
   EXPECT_TRUE(fs::is_empty(dir_) || !fs::exists(dir_ / "scene-octopus"));
 }
 

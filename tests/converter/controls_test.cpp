@@ -136,6 +136,28 @@ TEST(Controls, MalformedFilesNameFileAndLine) {
   EXPECT_THROW(readControlSet(dir.write("trunc.xml", "<ControlSet><objects>")), ConvertError);
 }
 
+TEST(Controls, ControlLinearWithoutNodesIsRefusedWhereItDrivesAnActuator) {
+  // OpenSim's ControlLinear::getControlValue is NaN without nodes; a ControlConstant has a value
+  test::TempDir dir;
+  const std::string f = dir.write("c.xml",
+                                  "<ControlSet>\n<objects>\n<ControlConstant name=\"K\"><value>0.3</value></ControlConstant>\n"
+                                  "<ControlLinear name=\"E.excitation\"/>\n</objects>\n</ControlSet>\n");
+  std::vector<std::string> warnings;
+  const ResolvedController k = resolveControlsFile(f, {"K"}, warnings);
+  ASSERT_EQ(k.entries.size(), 1u);
+  VecJ t(1);
+  t[0] = 0.7;
+  EXPECT_EQ(k.entries[0].function->value(t), 0.3);
+  try {
+    resolveControlsFile(f, {"K", "E"}, warnings);
+    ADD_FAILURE() << "no error";
+  } catch (const ConvertError& e) {
+    EXPECT_EQ(e.file(), f);
+    EXPECT_EQ(e.line(), 4) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no x_nodes"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ForwardSetup, Arm26SetupAndControlsReadAsOpenSimReadsThem) {
   REDMAX_REQUIRE_SHARED();
   const std::string dir = test::sharedOpenSim("opensim-core/Applications/Forward/tests/resources");

@@ -268,6 +268,32 @@ ForwardResult runForward(const SimulationModel& m, const State& initial, const s
   return res;
 }
 
+namespace {
+// the rules as one ProportionalController, names resolved against the system and the skeleton
+void addFeedback(System& sys, const SimulationModel& m, const std::vector<FeedbackRule>& rules) {
+  const std::vector<std::string> controls = sys.controlNames();
+  std::vector<ProportionalController::Rule> out;
+  for (const FeedbackRule& f : rules) {
+    ProportionalController::Rule r;
+    for (size_t k = 0; k < controls.size(); ++k)
+      if (controls[k] == f.actuator) r.control = static_cast<int>(k);
+    for (size_t k = 0; k < m.coordinate_names.size(); ++k)
+      if (m.coordinate_names[k] == f.coordinate) r.coordinate = static_cast<int>(k);
+    if (r.control < 0) throw std::invalid_argument("feedback: no actuator named '" + f.actuator + "'");
+    if (r.coordinate < 0) throw std::invalid_argument("feedback: no coordinate named '" + f.coordinate + "'");
+    if (!(f.min <= f.max)) throw std::invalid_argument("feedback for '" + f.actuator + "': min > max");
+    r.target = f.target;
+    r.kp = f.kp;
+    r.kd = f.kd;
+    r.bias = f.bias;
+    r.min = f.min;
+    r.max = f.max;
+    out.push_back(r);
+  }
+  sys.addController(std::make_shared<ProportionalController>(std::move(out)));
+}
+}  // namespace
+
 ForwardTool::ForwardTool(ForwardToolSettings settings) : settings_(std::move(settings)) {
   setup_ = osim::readForwardSetup(settings_.setup_file);
   warnings_ = setup_.warnings;
@@ -316,6 +342,7 @@ ForwardTool::ForwardTool(ForwardToolSettings settings) : settings_(std::move(set
   System& sys = *model_.system;
   addSetupControllers(sys, setup_, warnings_);
   if (!setup_.controls_file.empty()) addControlsFile(sys, setup_.controls_file, warnings_);
+  if (!settings_.feedback.empty()) addFeedback(sys, model_, settings_.feedback);
   // initial state
   initial_ = defaultInitialState(model_);
   initial_.z = sys.defaultState().z;

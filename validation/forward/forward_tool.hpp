@@ -76,6 +76,15 @@ State forwardInitialState(const SimulationModel& m, const osim::Storage& table, 
 /// naming `file` for a non-finite value.
 void readAuxiliaryStates(const System& sys, const osim::Storage& table, int row, const std::string& file, State& s);
 
+/// A feedback law for a scene (OpenSim has no such controller class, so it is not read from XML):
+/// the actuator's control gets bias + kp (target - q) + kd (0 - qdot) of the named coordinate,
+/// clamped to [min, max], on top of the setup's controllers (core's ProportionalController).
+struct FeedbackRule {
+  std::string actuator, coordinate;
+  double target = 0.0, kp = 0.0, kd = 0.0, bias = 0.0;
+  double min = 0.0, max = 1.0;
+};
+
 struct ForwardToolSettings {
   std::string setup_file;
   std::optional<std::string> out_dir;  ///< replaces the setup's results_directory
@@ -92,6 +101,8 @@ struct ForwardToolSettings {
   /// writes the run's view (the model along the states written, with the run's muscle mass) into
   /// DIR/<name>_view
   view::ViewAssets view;
+  /// feedback controllers added after the setup's (std::invalid_argument for an unknown name)
+  std::vector<FeedbackRule> feedback;
 };
 
 struct ForwardResult {
