@@ -19,6 +19,7 @@
 #include "core/muscles/wrap/network_model.hpp"
 #include "validation/forward/forward_tool.hpp"
 #include "validation/report/progress.hpp"
+#include "validation/simulate/prescribe_motion.hpp"
 #include "validation/simulate/simulate.hpp"
 #include "validation/simulate/simulate_simbody.hpp"
 
@@ -30,6 +31,8 @@ const std::vector<std::string> kIntegrators = {"euler", "symplectic", "bdf1", "s
 
 struct SimulateFlags {
   std::string model, out, initial, muscle_mass_kg, impulse, engine = "core", controls;
+  std::string prescribe, prescribe_coordinates, prescribed_forces;
+  double prescribe_lowpass = -1.0;
   validation::SimulateOptions so;
   double initial_time = 0.0;
   bool no_qvv = false, progress = false, quiet = false, full_precision = false, strict = false;
@@ -45,6 +48,10 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   for (const char* n : {"--simbody-method", "--simbody-norm"})
     if (given(app, n) && engine != "simbody") throw UsageError{std::string(n) + " needs --engine simbody"};
   if (given(app, "--controls") && engine != "core") throw UsageError{"--controls needs --engine core"};
+  const bool prescribing = given(app, "--prescribe");
+  if (prescribing && engine != "core") throw UsageError{"--prescribe needs --engine core"};
+  for (const char* n : {"--prescribe-coordinates", "--prescribe-lowpass", "--prescribed-forces"})
+    if (given(app, n) && !prescribing) throw UsageError{std::string(n) + " needs --prescribe MOTION"};
   validation::SimbodyEngineOptions simbody_flags;
   simbody_flags.method = f.simbody_method;
   simbody_flags.infinity_norm = f.simbody_norm == "inf";
@@ -63,6 +70,7 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
 
   // model and initial state: every problem here is the user's input (exit 2)
   validation::SimulationModel model;
+  validation::MotionPrescription prescription;
   State initial;
   std::vector<std::string> control_warnings, not_applied;
   try {
@@ -74,6 +82,14 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
     } else {
       // the passive forces and contacts; the Simbody engine takes none of them (docs/contact.md)
       validation::addPassiveTerms(model, control_warnings, not_applied, engine == "core");
+    }
+    if (prescribing) {
+      // hybrid dynamics: the chosen coordinates follow the motion (validation/simulate/prescribe_motion.hpp)
+      validation::MotionPrescriptionOptions po;
+      if (given(app, "--prescribe-coordinates")) po.coordinates = splitList(f.prescribe_coordinates, ",");
+      po.lowpass_cutoff_hz = f.prescribe_lowpass;
+      prescription = validation::prescribeMotion(model, osim::readStorage(f.prescribe), f.prescribe, po);
+      for (const auto& w : prescription.warnings) control_warnings.push_back(w);
     }
     if (given(app, "--initial")) {
       const osim::Storage table = osim::readStorage(f.initial);
@@ -90,6 +106,17 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
       if (given(app, "--initial-time")) throw UsageError{"--initial-time needs --initial STATE.sto"};
       initial = validation::defaultInitialState(model);
       initial.z = model.system->defaultState().z;
+      if (prescribing) initial.t = prescription.t_first;  // the run starts where the motion does
+    }
+    if (prescribing) {
+      const double t_end = initial.t + so.duration;
+      if (initial.t < prescription.t_first - 1e-9 || t_end > prescription.t_last + 1e-9) {
+        std::ostringstream os;
+        os << "the run spans [" << initial.t << ", " << t_end << "] s, outside the motion's ["
+           << prescription.t_first << ", " << prescription.t_last << "] s (the splines would extrapolate)";
+        throw osim::ConvertError(f.prescribe, 0, os.str());
+      }
+      validation::applyPrescription(model, prescription, initial);
     }
   } catch (const osim::ConvertError& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -141,6 +168,11 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
     const std::string why = validation::simbodyEngineUnsupportedReason(model, so, mo.quadratic_velocity);
     if (!why.empty()) throw UsageError{why};
   }
+  std::unique_ptr<validation::PrescribedForceRecorder> prescribed_forces;
+  if (prescribing) {
+    prescribed_forces = std::make_unique<validation::PrescribedForceRecorder>(model, prescription);
+    so.check = prescribed_forces->check(so.check);
+  }
   const std::clock_t cpu_start = std::clock();
   validation::SimulationResult res;
   if (engine == "simbody") {
@@ -180,6 +212,12 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
       desc << " (dt " << io.dt << " s)";
     desc << ", muscle mass " << model.muscle_mass << " kg" << (mo.quadratic_velocity ? "" : ", no muscle QVV")
          << "\n";
+    if (prescribed_forces && given(app, "--prescribed-forces")) {
+      std::ostringstream pd;
+      pd << "redmax simulate: generalized forces of the coordinates prescribed by " << f.prescribe << " ("
+         << model_path << ")\n";
+      osim::writeResultStorage(f.prescribed_forces, prescribed_forces->table(), f.full_precision, pd.str());
+    }
     osim::writeResultStorage(out_path, res.states, f.full_precision, desc.str());
   } catch (const osim::ConvertError& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -191,6 +229,15 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
                 so.duration, (simbody_flags.method.empty() ? so.integrator : simbody_flags.method).c_str(), engine.c_str(), res.stats.steps, res.stats.rhs_evals,
                 res.stats.failed_steps, res.wall_s, cpu_s, res.energy_initial, res.energy_final, res.energy_drift_rel, res.energy_drift_abs,
                 out_path.c_str());
+    if (prescribed_forces) {
+      // the largest generalized force each prescription took
+      std::printf("prescribed from %s: %zu coordinates", f.prescribe.c_str(), prescription.coordinates.size());
+      const osim::Storage& t = prescribed_forces->table();
+      for (int c = 0; c < t.numColumns(); ++c)
+        std::printf("%s %s max |%.4g|", c == 0 ? ";" : ",", t.labels[c].c_str(),
+                    t.numRows() > 0 ? t.data.col(c).cwiseAbs().maxCoeff() : 0.0);
+      std::printf("%s\n", given(app, "--prescribed-forces") ? (" -> " + f.prescribed_forces).c_str() : "");
+    }
     // contacts, sampled at the output rows (docs/contact.md)
     if (res.contacts.contacts > 0)
       std::printf("contacts: %d pairs, %d active at the end (at most %d at once), largest penetration %.4g m (%s at t = %g)\n",
@@ -289,6 +336,26 @@ CommandRegistration reg(
                       "--rtol 3e-12 --atol 3e-13")
            ->type_name("rms|inf")
            ->check(oneOf({"rms", "inf"}));
+       app.add_option("--prescribe", f->prescribe,
+                      "hybrid dynamics: coordinates of this motion (.mot/.sto; columns named as\n"
+                      "coordinates or /jointset/J/C/value, degrees converted) follow it exactly, the\n"
+                      "others move forward; q(t) is the ID tool's spline of each column (natural\n"
+                      "quintic), the run starts at the motion's first time (or --initial's) and may\n"
+                      "not run past its last")
+           ->type_name("MOTION");
+       app.add_option("--prescribe-coordinates", f->prescribe_coordinates,
+                      "with --prescribe: only these coordinates (default: every free coordinate the\n"
+                      "motion has a column for)")
+           ->type_name("C1,C2,...");
+       app.add_option("--prescribe-lowpass", f->prescribe_lowpass,
+                      "with --prescribe: low-pass cutoff (Hz) before the splines, as the ID tool's\n"
+                      "lowpass_cutoff_frequency_for_coordinates (default: none)")
+           ->type_name("HZ");
+       app.add_option("--prescribed-forces", f->prescribed_forces,
+                      "with --prescribe: write the generalized force each prescription takes at every\n"
+                      "output row (columns <coord>_moment / <coord>_force, as redmax id names them;\n"
+                      "with every coordinate prescribed they are the motion's inverse dynamics)")
+           ->type_name("FORCES.sto");
        app.add_flag("--progress", f->progress, "progress on stderr (otherwise shown once a run takes over 2 s)");
        app.add_flag("--quiet", f->quiet, "no summary and no progress");
        app.add_flag("--strict", f->strict,
@@ -302,6 +369,8 @@ CommandRegistration reg(
            "                       [--integrator euler|symplectic|bdf1|sdirk2|rk45|cvode] [--dt S]\n"
            "                       [--rtol R] [--atol A] [--max-step S] [--output-dt S]\n"
            "                       [--initial STATE.sto [--initial-time T]] [--controls FILE]\n"
+           "                       [--prescribe MOTION [--prescribe-coordinates LIST] [--prescribe-lowpass HZ]\n"
+           "                        [--prescribed-forces FORCES.sto]]\n"
            "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
            "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
            "                       [--engine core|simbody [--simbody-method M] [--simbody-norm rms|inf]]\n"

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -156,6 +157,10 @@ TEST_F(SimulateCli, BadInputExitsTwoWithAClearMessageAndWritesNothing) {
       {model + " --duration 1 --initial " + path("missing.sto") + out, "missing.sto"},
       {model + " --duration 1 --initial-time 1" + out, "--initial-time needs --initial"},
       {"--model " + path("missing.osim") + " --duration 1" + out, "missing.osim"},
+      {model + " --duration 1 --prescribed-forces " + path("f.sto") + out, "--prescribed-forces needs --prescribe"},
+      {model + " --duration 1 --prescribe-coordinates q1" + out, "--prescribe-coordinates needs --prescribe"},
+      {model + " --duration 1 --prescribe " + path("missing.mot") + out, "missing.mot"},
+      {model + " --duration 1 --engine simbody --prescribe " + path("q.mot") + out, "--prescribe needs --engine core"},
   };
   for (const auto& [args, message] : cases) {
     const CmdResult r = run(args);
@@ -170,6 +175,32 @@ TEST_F(SimulateCli, BadInputExitsTwoWithAClearMessageAndWritesNothing) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("bad.sto"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("never.sto")));
+}
+
+TEST_F(SimulateCli, PrescribedMotionWritesTheForcesItTakes) {
+  // q1 follows a sine (the pendulum's hinge driven), q2 swings; the run may not outlast the motion
+  std::ostringstream mot;
+  mot << "drive\nversion=1\nnRows=101\nnColumns=2\ninDegrees=no\nendheader\ntime\tq1\n";
+  for (int k = 0; k <= 100; ++k) mot << 0.01 * k << "\t" << 0.5 * std::sin(2.0 * 0.01 * k) << "\n";
+  std::ofstream(path("q.mot")) << mot.str();
+  const std::string base = "--model " + scene("double_pendulum_via.osim") + " --prescribe " + path("q.mot") +
+                           " --rtol 1e-10 --atol 1e-10 --full-precision --prescribed-forces " + path("f.sto");
+  CmdResult r = run(base + " --duration 1 --out " + path("s.sto"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("prescribed from"), std::string::npos) << r.out;
+  const Storage s = readStorage(path("s.sto")), f = readStorage(path("f.sto"));
+  EXPECT_EQ(f.labels, (std::vector<std::string>{"q1_moment"}));
+  ASSERT_EQ(f.numRows(), s.numRows());
+  for (int row = 0; row < s.numRows(); ++row) EXPECT_NEAR(s.data(row, 0), 0.5 * std::sin(2.0 * s.time[row]), 1e-4);
+  EXPECT_GT(s.data.col(1).cwiseAbs().maxCoeff(), 0.1);  // q2 moves forward
+  // past the motion's last time: bad input, nothing written
+  fs::remove(path("s.sto"));
+  fs::remove(path("f.sto"));
+  r = run(base + " --duration 1.5 --out " + path("s.sto"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("outside the motion's [0, 1] s"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("s.sto")));
+  EXPECT_FALSE(fs::exists(path("f.sto")));
 }
 
 TEST_F(SimulateCli, DivergenceExitsOneNamingTimeCoordinateAndStepAndWritesNothing) {
