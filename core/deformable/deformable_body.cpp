@@ -27,7 +27,7 @@ DeformableBody makeStrand(const std::vector<Vec3>& points, double mass, double s
   return b;
 }
 
-DeformableBody makeFemBody(const TetMesh& mesh, double E, double nu, double rho) {
+DeformableBody makeFemBody(const TetMesh& mesh, double E, double nu, double rho, MassModel mass_model) {
   if (!(E > 0) || !(rho > 0) || !(nu >= 0 && nu < 0.5))
     throw std::invalid_argument("makeFemBody: need E > 0, rho > 0 and 0 <= nu < 0.5");
   DeformableBody b;
@@ -35,6 +35,7 @@ DeformableBody makeFemBody(const TetMesh& mesh, double E, double nu, double rho)
   b.mass.assign(mesh.nodes.size(), 0.0);
   b.mesh = mesh;
   const double mu = lameMu(E, nu), lambda = lameLambda(E, nu);
+  std::vector<Eigen::Triplet<double>> consistent;
   for (int t = 0; t < mesh.numTets(); ++t) {
     Tet tet;
     tet.n = mesh.tets[t];
@@ -47,9 +48,33 @@ DeformableBody makeFemBody(const TetMesh& mesh, double E, double nu, double rho)
     tet.mu = mu;
     tet.lambda = lambda;
     for (int a = 0; a < 4; ++a) b.mass[tet.n[a]] += 0.25 * rho * tet.volume;
+    if (mass_model == MassModel::Consistent)
+      for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 4; ++c) consistent.emplace_back(tet.n[a], tet.n[c], rho * tet.volume / (a == c ? 10.0 : 20.0));
     b.tets.push_back(tet);
   }
+  if (mass_model == MassModel::Consistent) {
+    const int N = static_cast<int>(mesh.nodes.size());
+    b.node_mass.resize(N, N);
+    b.node_mass.setFromTriplets(consistent.begin(), consistent.end());
+  }
   return b;
+}
+
+SparseMat nodeMassMatrix(const DeformableBody& body) {
+  const int N = body.numNodes();
+  SparseMat M(3 * N, 3 * N);
+  std::vector<Eigen::Triplet<double>> t;
+  if (body.node_mass.nonZeros() > 0) {
+    for (int col = 0; col < body.node_mass.outerSize(); ++col)
+      for (SparseMat::InnerIterator it(body.node_mass, col); it; ++it)
+        for (int c = 0; c < 3; ++c) t.emplace_back(3 * static_cast<int>(it.row()) + c, 3 * col + c, it.value());
+  } else {
+    for (int n = 0; n < N; ++n)
+      for (int c = 0; c < 3; ++c) t.emplace_back(3 * n + c, 3 * n + c, body.mass[n]);
+  }
+  M.setFromTriplets(t.begin(), t.end());
+  return M;
 }
 
 VecX restPositions(const DeformableBody& body) {

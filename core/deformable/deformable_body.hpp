@@ -30,9 +30,18 @@ struct Tet {
   double mu = 0.0, lambda = 0.0;
 };
 
+/// How a tet's mass reaches its nodes: lumped (a quarter to each node: a diagonal mass matrix) or
+/// consistent (the linear shape functions' mass matrix rho V / 20 (1 + delta_ab) per node pair)
+enum class MassModel { Lumped, Consistent };
+
 struct DeformableBody {
   std::vector<Vec3> rest;    // rest positions X (world, m)                (N)
-  std::vector<double> mass;  // lumped node masses (kg)                    (N)
+  /// node masses (kg) (N): the lumped masses, which are also the row sums of a consistent mass
+  /// matrix, so gravity loads (M_x g = mass g per node) are the same in both models
+  std::vector<double> mass;
+  /// the consistent node mass matrix (N x N, kg; one entry per node pair, times I3 per coordinate);
+  /// empty: the diagonal of `mass`
+  SparseMat node_mass;
   std::vector<Spring> springs;
   std::vector<Tet> tets;
   double rayleigh_mass = 0.0;       // alpha (1/s)
@@ -48,9 +57,12 @@ struct DeformableBody {
 DeformableBody makeStrand(const std::vector<Vec3>& points, double mass, double stiffness);
 
 /// Co-rotated FEM body of `mesh` with Young's modulus E (Pa), Poisson's ratio nu in [0, 0.5) and
-/// density rho (kg/m^3): lumped mass (a quarter of each tet's mass to each of its nodes).
+/// density rho (kg/m^3), with lumped (default) or consistent mass.
 /// Throws std::invalid_argument for bad parameters or a degenerate tet.
-DeformableBody makeFemBody(const TetMesh& mesh, double E, double nu, double rho);
+DeformableBody makeFemBody(const TetMesh& mesh, double E, double nu, double rho, MassModel mass = MassModel::Lumped);
+
+/// The 3N x 3N node-coordinate mass matrix M_x: node_mass (x) I3, or diag(mass) (x) I3.
+SparseMat nodeMassMatrix(const DeformableBody& body);
 
 /// Node-space evaluation at positions x (3N): elastic energy, elastic forces f (3N) and, when
 /// asked, the stiffness K = -df/dx (3N x 3N, symmetric: the exact Hessian of the energy).

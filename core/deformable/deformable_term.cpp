@@ -15,6 +15,10 @@ DeformableTerm::DeformableTerm(const Model& model, DeformableBody body, std::vec
     throw ModelError("DeformableTerm: " + std::to_string(nodes_.size()) + " node bindings for " +
                      std::to_string(body_.numNodes()) + " nodes");
   if (body_.mass.size() != body_.rest.size()) throw ModelError("DeformableTerm: one mass per node expected");
+  if (body_.node_mass.nonZeros() > 0 &&
+      (body_.node_mass.rows() != body_.numNodes() || body_.node_mass.cols() != body_.numNodes()))
+    throw ModelError("DeformableTerm: the node mass matrix is not N x N");
+  Mx_ = nodeMassMatrix(body_);
   for (size_t n = 0; n < nodes_.size(); ++n) {
     const NodeBinding& b = nodes_[n];
     if (b.kind == NodeBinding::Kind::Body) {
@@ -77,10 +81,9 @@ DeformableScratch& DeformableTerm::evaluate(const Model& model, const State& s, 
   sc.has_K = stiffness;
   // node forces: elastic, Rayleigh damping -(alpha M + beta K) v, gravity
   sc.F = sc.el.f;
-  for (int n = 0; n < N; ++n) {
-    sc.F.segment<3>(3 * n) -= body_.rayleigh_mass * body_.mass[n] * sc.v.segment<3>(3 * n);
-    if (options_.gravity) sc.F.segment<3>(3 * n) += body_.mass[n] * model.gravity();
-  }
+  if (body_.rayleigh_mass != 0.0) sc.F.noalias() -= body_.rayleigh_mass * (Mx_ * sc.v);
+  if (options_.gravity)
+    for (int n = 0; n < N; ++n) sc.F.segment<3>(3 * n) += body_.mass[n] * model.gravity();  // M_x g: row sums
   if (body_.rayleigh_stiffness != 0.0) sc.F.noalias() -= body_.rayleigh_stiffness * (sc.el.K * sc.v);
   sc.evaluation = slot ? ctx.evaluation : 0;
   return sc;
@@ -122,26 +125,21 @@ SparseMat DeformableTerm::dampingMatrix(const DeformableScratch& sc) const {
   const int n3 = 3 * body_.numNodes();
   SparseMat D(n3, n3);
   if (body_.rayleigh_stiffness != 0.0) D = body_.rayleigh_stiffness * sc.el.K;
-  if (body_.rayleigh_mass != 0.0) {
-    SparseMat Mx(n3, n3);
-    std::vector<Eigen::Triplet<double>> t;
-    for (int i = 0; i < n3; ++i) t.emplace_back(i, i, body_.rayleigh_mass * body_.mass[i / 3]);
-    Mx.setFromTriplets(t.begin(), t.end());
-    D += Mx;
-  }
+  if (body_.rayleigh_mass != 0.0) D += body_.rayleigh_mass * Mx_;
   return D;
 }
 
 void DeformableTerm::addMass(const Model& model, const State& s, const TermContext& ctx, MatX& M) const {
   DeformableScratch local;
   const DeformableScratch& sc = evaluate(model, s, ctx, false, local);
-  const int nr = model.nr();
-  for (int n = 0; n < body_.numNodes(); ++n) {
-    const NodeBinding& b = nodes_[n];
-    if (b.kind == NodeBinding::Kind::Free) M.block<3, 3>(b.index, b.index).diagonal().array() += body_.mass[n];
-    else if (b.kind == NodeBinding::Kind::Body)
-      M.topLeftCorner(nr, nr).noalias() += body_.mass[n] * sc.J[n].transpose() * sc.J[n];
-  }
+  mapMatrix(Mx_, M, sc, model.nr());
+}
+
+VecX DeformableTerm::nodeBiasAcceleration(const DeformableScratch& sc, const VecX& qdot_r) const {
+  VecX a = VecX::Zero(3 * body_.numNodes());
+  for (int n = 0; n < body_.numNodes(); ++n)
+    if (nodes_[n].kind == NodeBinding::Kind::Body) a.segment<3>(3 * n).noalias() = sc.Jdot[n] * qdot_r;
+  return a;
 }
 
 void DeformableTerm::addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const {
@@ -151,10 +149,8 @@ void DeformableTerm::addForce(const Model& model, const State& s, const TermCont
   mapForce(sc.F, f, sc, nr);
   // quadratic velocity vector of the attached nodes, -m J_a^T Jdot_a qdot [D Eq. 4.95]
   if (!options_.quadratic_velocity || !has_body_nodes_) return;
-  const VecX qdot_r = s.qdot.head(nr);
-  for (int n = 0; n < body_.numNodes(); ++n)
-    if (nodes_[n].kind == NodeBinding::Kind::Body)
-      f.head(nr).noalias() -= body_.mass[n] * (sc.J[n].transpose() * (sc.Jdot[n] * qdot_r));
+  // (with consistent mass a free node sharing a tet with attached ones takes its share too)
+  mapForce(-(Mx_ * nodeBiasAcceleration(sc, s.qdot.head(nr))), f, sc, nr);
 }
 
 void DeformableTerm::addStiffnessDamping(const Model& model, const State& s, const TermContext& ctx, MatX& K,
@@ -208,20 +204,18 @@ void DeformableTerm::addMassDotTimesVelocity(const Model& model, const State& s,
   DeformableScratch local;
   const DeformableScratch& sc = evaluate(model, s, ctx, false, local);
   const int nr = model.nr();
-  const VecX qdot_r = s.qdot.head(nr);
-  for (int n = 0; n < body_.numNodes(); ++n) {
-    if (nodes_[n].kind != NodeBinding::Kind::Body) continue;
-    const Vec3 v = sc.J[n] * qdot_r, a = sc.Jdot[n] * qdot_r;
-    Mdot_v.head(nr).noalias() += body_.mass[n] * (sc.Jdot[n].transpose() * v + sc.J[n].transpose() * a);
-  }
+  // d/dt (J_MR^T M_x J_MR) qdot = Jdot_MR^T M_x v + J_MR^T M_x Jdot_MR qdot (v = J_MR qdot: node velocities)
+  const VecX Mv = Mx_ * sc.v;
+  for (int n = 0; n < body_.numNodes(); ++n)
+    if (nodes_[n].kind == NodeBinding::Kind::Body)
+      Mdot_v.head(nr).noalias() += sc.Jdot[n].transpose() * Mv.segment<3>(3 * n);
+  mapForce(Mx_ * nodeBiasAcceleration(sc, s.qdot.head(nr)), Mdot_v, sc, nr);
 }
 
 double DeformableTerm::kineticEnergy(const Model& model, const State& s, const TermContext& ctx) const {
   DeformableScratch local;
   const DeformableScratch& sc = evaluate(model, s, ctx, false, local);
-  double T = 0;
-  for (int n = 0; n < body_.numNodes(); ++n) T += 0.5 * body_.mass[n] * sc.v.segment<3>(3 * n).squaredNorm();
-  return T;
+  return 0.5 * sc.v.dot(Mx_ * sc.v);
 }
 
 double DeformableTerm::potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const {

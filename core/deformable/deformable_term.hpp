@@ -5,6 +5,8 @@
 // [D Eq. 4.90], Jdot_a = R ([omega] Gamma J_i + Gamma Jdot_i) [D Eq. 4.91]) and nodes fixed in the
 // world take no part. With J_MR the stack of identity (free) and J_a (attached) rows:
 //   M += J_MR^T M_x J_MR,   f += J_MR^T (f_x - M_x Jdot_MR qdot)          [D Eq. 4.95]
+// M_x is diagonal for lumped mass and couples the nodes of each tet for consistent mass
+// (DeformableBody::node_mass); every product with it below is the general sparse one.
 // where f_x = elastic + Rayleigh damping -(alpha M_x + beta K_x(x)) xdot + gravity m g.
 //
 // Stiffness and damping for the linearly implicit integrators (K = -df/dq, D = -df/dqdot):
@@ -89,7 +91,11 @@ class DeformableTerm final : public ForceTerm {
   // D_x = alpha M_x + beta K_x (needs sc.el.K)
   SparseMat dampingMatrix(const DeformableScratch& sc) const;
 
+  // Jdot_MR qdot stacked per node (3N): Jdot_a qdot for attached nodes, zero for the others
+  VecX nodeBiasAcceleration(const DeformableScratch& sc, const VecX& qdot_r) const;
+
   DeformableBody body_;
+  SparseMat Mx_;  // node-coordinate mass matrix (3N x 3N): diagonal (lumped) or consistent
   std::vector<NodeBinding> nodes_;
   DeformableTermOptions options_;
   bool has_body_nodes_ = false;

@@ -66,6 +66,35 @@ StaticResult solveStatic(const NodeSpaceProblem& p, VecX& x, double tol, int max
   }
 }
 
+ModalResult lowestMode(const NodeSpaceProblem& p, const VecX& x, double tol, int max_iter) {
+  check(p, x);
+  const std::vector<int> dofs = p.freeDofs();
+  ElasticEvaluation ev;
+  evalElastic(*p.body, x, true, ev);
+  const SparseMat K = restrict(ev.K, dofs), M = restrict(nodeMassMatrix(*p.body), dofs);
+  Eigen::SimplicialLDLT<SparseMat> ldlt(K);
+  if (ldlt.info() != Eigen::Success) throw std::runtime_error("lowestMode: stiffness factorisation failed");
+  // inverse iteration: v <- K^-1 M v converges to the mode of the smallest omega^2 (a degenerate
+  // pair, such as a square beam's two bending modes, gives one vector of their plane: same omega)
+  VecX v = VecX::Ones(static_cast<Eigen::Index>(dofs.size()));
+  ModalResult r;
+  double last = 0.0;
+  for (r.iterations = 1; r.iterations <= max_iter; ++r.iterations) {
+    v = ldlt.solve(M * v);
+    v /= std::sqrt(v.dot(M * v));
+    const double rq = v.dot(K * v);  // omega^2 (v is M-normalised)
+    if (!(rq > 0)) throw std::runtime_error("lowestMode: the stiffness is not positive definite");
+    if (r.iterations > 1 && std::abs(rq - last) <= tol * rq) {
+      r.omega = std::sqrt(rq);
+      r.converged = true;
+      return r;
+    }
+    last = rq;
+  }
+  r.omega = std::sqrt(last);
+  return r;
+}
+
 void implicitStepSystem(const NodeSpaceProblem& p, const VecX& x, const VecX& v, double h, SparseMat& A, VecX& rhs) {
   check(p, x);
   const std::vector<int> dofs = p.freeDofs();
@@ -73,18 +102,17 @@ void implicitStepSystem(const NodeSpaceProblem& p, const VecX& x, const VecX& v,
   const DeformableBody& b = *p.body;
   ElasticEvaluation ev;
   evalElastic(b, x, true, ev);
-  VecX Mdiag(n), vf(n), f(n);
-  for (int i = 0; i < n; ++i) {
-    Mdiag[i] = b.mass[dofs[i] / 3];
-    vf[i] = v[dofs[i]];
-  }
+  VecX vf(n), f(n);
+  for (int i = 0; i < n; ++i) vf[i] = v[dofs[i]];
   const SparseMat K = restrict(ev.K, dofs);
-  // f + D v with f = elastic - D v + m g: the damping force cancels, leaving elastic + gravity
-  for (int i = 0; i < n; ++i) f[i] = ev.f[dofs[i]] + Mdiag[i] * p.gravity[dofs[i] % 3];
-  rhs = Mdiag.cwiseProduct(vf) + h * f;
-  A = (h * b.rayleigh_stiffness + h * h) * K;
-  const double cM = 1.0 + h * b.rayleigh_mass;
-  for (int i = 0; i < n; ++i) A.coeffRef(i, i) += cM * Mdiag[i];
+  // the free rows and columns of M_x: lumped (diagonal) or consistent; fixed nodes do not move, so
+  // their columns do not act
+  const SparseMat M = restrict(nodeMassMatrix(b), dofs);
+  // f + D v with f = elastic - D v + M g: the damping force cancels, leaving elastic + gravity
+  // (M_x g per node is the node's lumped mass times g, for both mass models)
+  for (int i = 0; i < n; ++i) f[i] = ev.f[dofs[i]] + b.mass[dofs[i] / 3] * p.gravity[dofs[i] % 3];
+  rhs = M * vf + h * f;
+  A = (h * b.rayleigh_stiffness + h * h) * K + (1.0 + h * b.rayleigh_mass) * M;
 }
 
 void stepNodeSpace(const NodeSpaceProblem& p, VecX& x, VecX& v, double h, LinearSolve solve) {

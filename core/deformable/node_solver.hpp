@@ -24,6 +24,18 @@ struct StaticResult {
   bool converged = false;
 };
 
+/// The lowest natural angular frequency (rad/s) of small vibrations about positions x (3N, usually
+/// the rest positions): the smallest eigenvalue of K phi = omega^2 M phi over the moving
+/// coordinates, with the body's mass matrix (lumped or consistent, DeformableBody::node_mass) and
+/// its exact stiffness at x, by inverse iteration (sparse LDLT of K) until the Rayleigh quotient
+/// changes by less than tol relative. Throws std::runtime_error when K is singular (a free body).
+struct ModalResult {
+  double omega = 0.0;  // rad/s
+  int iterations = 0;
+  bool converged = false;
+};
+ModalResult lowestMode(const NodeSpaceProblem& p, const VecX& x, double tol = 1e-12, int max_iter = 500);
+
 /// Static equilibrium of elastic forces and gravity by Newton's method with the exact stiffness
 /// (sparse LDLT), starting from x (3N), which it updates; stops when max |f| <= tol (N).
 StaticResult solveStatic(const NodeSpaceProblem& p, VecX& x, double tol = 1e-10, int max_iter = 50);
