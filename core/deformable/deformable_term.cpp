@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "core/deformable/node_constraint.hpp"
 #include "core/dynamics/system.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "core/spatial/se3.hpp"
@@ -266,7 +267,7 @@ void DeformableTerm::setRestState(const Model& model, State& s, int follow) cons
 
 std::shared_ptr<const DeformableTerm> addDeformableBody(System& sys, DeformableBody body,
                                                         const std::vector<NodeAttachment>& attach,
-                                                        DeformableTermOptions options) {
+                                                        DeformableTermOptions options, AttachBy attach_by) {
   const Model& model = sys.model();
   const int N = body.numNodes();
   std::vector<NodeBinding> nodes(N);
@@ -290,6 +291,14 @@ std::shared_ptr<const DeformableTerm> addDeformableBody(System& sys, DeformableB
     }
     attached[a.node] = 1;
   }
+  // with constraints, body-attached nodes keep coordinates of their own and are tied afterwards
+  std::vector<NodeBinding> tied(N);
+  if (attach_by == AttachBy::Constraint)
+    for (int n = 0; n < N; ++n)
+      if (nodes[n].kind == NodeBinding::Kind::Body) {
+        tied[n] = nodes[n];
+        attached[n] = 0;
+      }
   int free = 0;
   for (int n = 0; n < N; ++n) free += attached[n] ? 0 : 1;
   int next = sys.addExtraCoordinates(3 * free);
@@ -299,8 +308,13 @@ std::shared_ptr<const DeformableTerm> addDeformableBody(System& sys, DeformableB
       nodes[n].index = next;
       next += 3;
     }
-  auto term = std::make_shared<const DeformableTerm>(model, std::move(body), std::move(nodes), options);
+  auto term = std::make_shared<const DeformableTerm>(model, std::move(body), nodes, options);
   sys.addTerm(term);
+  for (int n = 0; n < N; ++n)
+    if (tied[n].kind == NodeBinding::Kind::Body)
+      sys.addConstraint(std::make_shared<NodeConstraint>(model, nodes[n].index, tied[n].index, tied[n].point,
+                                                         "node_" + std::to_string(n) + "_on_body_" +
+                                                             std::to_string(tied[n].index)));
   return term;
 }
 

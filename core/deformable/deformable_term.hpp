@@ -107,11 +107,18 @@ struct NodeAttachment {
   int body = -1;
 };
 
+/// How nodes attached to a body are held: carried by the body through J_am [D Eq. 4.90-4.91]
+/// (no coordinates of their own), or free nodes tied to the body point by a NodeConstraint
+/// (core/deformable/node_constraint.hpp; 3 constraint rows each, the multipliers are the forces).
+enum class AttachBy { Jacobian, Constraint };
+
 /// Add `body` to `sys`: the nodes in `attach` are fixed to their bodies where they are at the
 /// model's default pose (or to the world), every other node becomes 3 extra coordinates of sys.
-/// Returns the term added (its setRestState puts the free nodes at rest in a state).
+/// Returns the term added (its setRestState puts the free nodes at rest in a state; with
+/// AttachBy::Constraint, project the state onto the constraints afterwards).
 std::shared_ptr<const DeformableTerm> addDeformableBody(System& sys, DeformableBody body,
                                                         const std::vector<NodeAttachment>& attach,
-                                                        DeformableTermOptions options = {});
+                                                        DeformableTermOptions options = {},
+                                                        AttachBy attach_by = AttachBy::Jacobian);
 
 }  // namespace redmax

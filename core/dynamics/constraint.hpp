@@ -3,7 +3,8 @@
 // [D Sec. 4.6.4-4.6.5]. A constraint states, at the acceleration level,
 //     G(q) qddot = rhs(q, qdot, t)      (rhs already contains -Gdot qdot and prescribed terms)
 // and reports its position and velocity errors for stabilisation and projection.
-// Maximal-coordinate constraints (G_m) multiply by J_mr themselves, so every G here is in q_r.
+// Maximal-coordinate constraints (G_m) multiply by J_mr themselves, so every G here is in q_r,
+// except for constraints that say they act on the System's extra coordinates.
 #include <string>
 
 #include "core/skeleton/state.hpp"
@@ -25,6 +26,10 @@ class Constraint {
   /// true if the constraint prescribes motion (hybrid dynamics [D Eq. 4.109]): its multipliers
   /// are the torques needed to realise the prescribed motion
   virtual bool isPrescribed() const { return false; }
+  /// true if G has columns for the System's extra coordinates too (e.g. a deformable node tied to
+  /// a body, core/deformable/node_constraint.hpp): calcAcceleration then gets a rows x ndof block
+  /// and the State's q includes the extra coordinates (not combinable with a coordinate map)
+  virtual bool actsOnExtraCoordinates() const { return false; }
 };
 
 }  // namespace redmax

@@ -361,8 +361,9 @@ void System::calcConstraints(const State& s, DynamicsWorkspace& ws) const {
     int row = 0;
     for (const auto& c : constraints_) {
       const int m = c->rows();
-      // constraints act on q_r: the columns of extra coordinates stay zero
-      c->calcAcceleration(model_, s, ws.sk, ws.G.block(row, 0, m, model_.nr()), ws.rhs.segment(row, m));
+      // constraints act on q_r (the columns of extra coordinates stay zero) unless they say otherwise
+      const int cols = c->actsOnExtraCoordinates() ? ndof() : model_.nr();
+      c->calcAcceleration(model_, s, ws.sk, ws.G.block(row, 0, m, cols), ws.rhs.segment(row, m));
       c->calcErrors(model_, s, ws.sk, ws.pos_err.segment(row, m), ws.vel_err.segment(row, m));
       row += m;
     }

@@ -1,7 +1,5 @@
 #include "validation/forward/spline_leg_scene.hpp"
 
-#include <tinyxml2.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "converter/build/functions_to_core.hpp"
+#include "converter/model_edit.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/muscle_force_term.hpp"
 #include "validation/report/plot.hpp"
@@ -68,47 +66,6 @@ void writeText(const std::string& path, const std::string& text) {
 const MuscleForceTerm* muscleForceTerm(const System& sys) {
   for (const auto& t : sys.terms())
     if (const auto* m = dynamic_cast<const MuscleForceTerm*>(t.get())) return m;
-  return nullptr;
-}
-
-// the translation functions of a CustomJoint's x/y/z axes that depend on a coordinate
-struct KneeTranslation {
-  std::array<AxisFunctionPtr, 3> f;
-  Vec3 at(double q) const {
-    VecJ x(1);
-    x[0] = q;
-    Vec3 p = Vec3::Zero();
-    for (int i = 0; i < 3; ++i)
-      if (f[i]) p[i] = f[i]->value(x);
-    return p;
-  }
-};
-
-KneeTranslation kneeTranslation(const std::string& model_path, const std::string& joint) {
-  const osim::ModelDescription d = osim::readOsimModel(model_path);
-  for (const osim::JointDesc& j : d.joints) {
-    if (j.name != joint) continue;
-    if (j.type != "CustomJoint") throw osim::ConvertError(model_path, j.line, "joint '" + joint + "' is not a CustomJoint");
-    KneeTranslation t;
-    for (int i = 0; i < 3; ++i) {
-      const osim::TransformAxisDesc& a = j.spatial_transform[3 + i];
-      if (a.coordinates.size() != 1) continue;
-      // the axes of this scene's knee are the joint frame's x, y, z
-      if ((a.axis - Vec3::Unit(i)).norm() > 1e-12)
-        throw osim::ConvertError(model_path, a.line, "joint '" + joint + "' " + a.name + ": axis is not the frame's");
-      t.f[i] = osim::makeCoreFunction(a.function, 1, model_path, "CustomJoint '" + joint + "' " + a.name);
-    }
-    return t;
-  }
-  throw osim::ConvertError(model_path, 0, "no joint named '" + joint + "'");
-}
-
-tinyxml2::XMLElement* findNamed(tinyxml2::XMLElement* e, const char* tag, const std::string& name) {
-  for (; e; e = e->NextSiblingElement()) {
-    const char* n = e->Attribute("name");
-    if (std::string(e->Name()) == tag && n && name == n) return e;
-    if (auto* c = findNamed(e->FirstChildElement(), tag, name)) return c;
-  }
   return nullptr;
 }
 
@@ -185,35 +142,7 @@ SplineLegRun runOne(const std::string& name, bool spline, bool inertial, const s
 }  // namespace
 
 std::string revoluteKneeModel(const std::string& model_path, const std::string& joint, double angle) {
-  const KneeTranslation t = kneeTranslation(model_path, joint);
-  const Vec3 p = t.at(angle);
-  tinyxml2::XMLDocument doc;
-  if (doc.LoadFile(model_path.c_str()) != tinyxml2::XML_SUCCESS)
-    throw osim::ConvertError(model_path, doc.ErrorLineNum(), std::string("cannot parse: ") + doc.ErrorStr());
-  tinyxml2::XMLElement* j = findNamed(doc.RootElement(), "CustomJoint", joint);
-  if (!j) throw osim::ConvertError(model_path, 0, "no CustomJoint named '" + joint + "'");
-  for (int i = 0; i < 3; ++i) {
-    if (!t.f[i]) continue;
-    const std::string axis = "translation" + std::to_string(i + 1);
-    tinyxml2::XMLElement* a = findNamed(j->FirstChildElement(), "TransformAxis", axis);
-    if (!a) throw osim::ConvertError(model_path, j->GetLineNum(), "joint '" + joint + "' has no " + axis);
-    // the function element is the axis's child named "function"
-    tinyxml2::XMLElement* fn = nullptr;
-    for (auto* c = a->FirstChildElement(); c; c = c->NextSiblingElement())
-      if (c->Attribute("name") && std::string(c->Attribute("name")) == "function") fn = c;
-    if (!fn) throw osim::ConvertError(model_path, a->GetLineNum(), axis + " has no function");
-    tinyxml2::XMLElement* k = doc.NewElement("Constant");
-    k->SetAttribute("name", "function");
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.17g", p[i]);
-    k->InsertNewChildElement("value")->SetText(buf);
-    a->InsertAfterChild(fn, k);
-    a->DeleteChild(fn);
-    if (auto* c = a->FirstChildElement("coordinates")) c->SetText("");
-  }
-  tinyxml2::XMLPrinter pr;
-  doc.Print(&pr);
-  return pr.CStr();
+  return osim::freezeJointTranslations(model_path, joint, angle);
 }
 
 SplineLegResult runSplineLegScene(const SplineLegOptions& o, std::ostream& out) {
@@ -251,7 +180,7 @@ SplineLegResult runSplineLegScene(const SplineLegOptions& o, std::ostream& out) 
     }
   }
   // how far the revolute knee's fixed centre is from where the spline puts the tibia
-  const KneeTranslation t = kneeTranslation(o.model_path, kKnee);
+  const osim::JointTranslation t(o.model_path, kKnee);
   for (const SplineLegRun& r : res.runs)
     if (r.spline)
       for (double q : r.knee) res.knee_centre_offset = std::max(res.knee_centre_offset, (t.at(q) - t.at(q0)).norm());
