@@ -30,6 +30,7 @@ class PointActuatorTerm final : public ForceTerm {
   /// throws ModelError for a body outside the model, a zero or non-finite direction or point
   PointActuatorTerm(const Model& model, std::vector<Actuator> actuators);
   std::string name() const override { return "point_actuators"; }
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   int numControls() const override { return static_cast<int>(actuators_.size()); }
   std::vector<std::string> controlNames() const override;
@@ -55,6 +56,7 @@ class TorqueActuatorTerm final : public ForceTerm {
   /// throws ModelError for a body outside the model, a zero or non-finite axis
   TorqueActuatorTerm(const Model& model, std::vector<Actuator> actuators);
   std::string name() const override { return "torque_actuators"; }
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   int numControls() const override { return static_cast<int>(actuators_.size()); }
   std::vector<std::string> controlNames() const override;

@@ -53,6 +53,7 @@ double externalLoadsPotential(const SkeletonWorkspace& ws, const ExternalLoads& 
 class BodyLoads final : public ForceTerm, public ExternalLoads {
  public:
   std::string name() const override { return "body_loads"; }
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   /// externalLoadsPotential
   double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;

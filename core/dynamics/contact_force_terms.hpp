@@ -54,6 +54,7 @@ struct ContactSummary {
 /// suffices for penetrations).
 class ContactForceTerm : public ForceTerm {
  public:
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const final;
   double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const final;
   void contacts(const SkeletonWorkspace& sk, std::vector<ContactReport>& out) const;

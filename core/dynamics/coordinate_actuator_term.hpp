@@ -19,6 +19,7 @@ class CoordinateActuatorTerm final : public ForceTerm {
   /// throws ModelError for a coordinate index outside the model
   CoordinateActuatorTerm(const Model& model, std::vector<Actuator> actuators);
   std::string name() const override { return "coordinate_actuators"; }
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   int numControls() const override { return static_cast<int>(actuators_.size()); }
   std::vector<std::string> controlNames() const override;

@@ -82,6 +82,10 @@ class ForceTerm {
   virtual std::unique_ptr<TermScratch> makeScratch(const Model&) const { return nullptr; }
   /// add this term's inertia to M (ndof x ndof); needs Stage::Velocity
   virtual void addMass(const Model&, const State&, const TermContext&, MatX& M) const {}
+  /// whether addMass may add anything. False lets System::forwardDynamics solve a system whose
+  /// terms all add no mass by the articulated-body algorithm, without forming M (ForwardRoute).
+  /// Default true, so that a term overriding addMass is never left out; massless terms say false.
+  virtual bool addsMass() const { return true; }
   /// add this term's generalized force (including its quadratic-velocity part) to f (ndof)
   virtual void addForce(const Model&, const State&, const TermContext&, VecX& f) const = 0;
   /// add K = -df/dq and D = -df/dqdot (ndof x ndof); default: explicit term (adds nothing)

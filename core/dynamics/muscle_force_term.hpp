@@ -51,6 +51,7 @@ class MuscleForceTerm final : public ForceTerm {
 
   std::string name() const override { return "muscle_force"; }
   std::unique_ptr<TermScratch> makeScratch(const Model& model) const override;
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
 
   int numStates() const override { return nz_; }

@@ -263,4 +263,11 @@ void takeWrapFallbackCounts(const System& sys, DynamicsWorkspace& ws, WrapFallba
       term->takeWrapFallbackCounts(ws.term_scratch[i].get(), monitor);
 }
 
+bool MuscleTerm::addsMass() const {
+  for (const Muscle& mu : massive_)
+    for (double m : mu.mass_points.mass)
+      if (m != 0.0) return true;
+  return false;
+}
+
 }  // namespace redmax

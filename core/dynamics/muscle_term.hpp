@@ -68,6 +68,9 @@ class MuscleTerm final : public ForceTerm {
   /// a MuscleTermScratch sized for the muscles with mass (null when there are none)
   std::unique_ptr<TermScratch> makeScratch(const Model& model) const override;
   void addMass(const Model& model, const State& s, const TermContext& ctx, MatX& M) const override;
+  /// true when a mass point has non-zero mass (zero-mass points add exactly nothing to M, so
+  /// such a system keeps the massless system's forward route and results)
+  bool addsMass() const override;
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   /// analytic Mdot qdot of the mass points: sum_a m_a (Jdot_ar^T J_ar + J_ar^T Jdot_ar) qdot
   void addMassDotTimesVelocity(const Model& model, const State& s, const TermContext& ctx,

@@ -38,6 +38,7 @@ class CoordinateLimitForceTerm final : public ForceTerm {
   /// transition that is not positive, non-finite values
   CoordinateLimitForceTerm(const Model& model, std::vector<Limit> limits);
   std::string name() const override { return "coordinate_limit_forces"; }
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
   const std::vector<Limit>& limits() const { return limits_; }
@@ -59,6 +60,7 @@ class SpringGeneralizedForceTerm final : public ForceTerm {
   /// throws ModelError for a coordinate outside the model, negative or non-finite parameters
   SpringGeneralizedForceTerm(const Model& model, std::vector<Spring> springs);
   std::string name() const override { return "spring_generalized_forces"; }
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
   const std::vector<Spring>& springs() const { return springs_; }
@@ -79,6 +81,7 @@ class PointToPointSpringTerm final : public ForceTerm {
   /// non-finite parameters
   PointToPointSpringTerm(const Model& model, std::vector<Spring> springs);
   std::string name() const override { return "point_to_point_springs"; }
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
   const std::vector<Spring>& springs() const { return springs_; }
@@ -102,6 +105,7 @@ class BushingForceTerm final : public ForceTerm {
   /// non-finite parameters
   BushingForceTerm(const Model& model, std::vector<Bushing> bushings);
   std::string name() const override { return "bushing_forces"; }
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
   const std::vector<Bushing>& bushings() const { return bushings_; }

@@ -19,6 +19,7 @@ class SampledLoadsTerm final : public ForceTerm {
   explicit SampledLoadsTerm(Sampler sampler, std::string name = "external_loads")
       : sampler_(std::move(sampler)), name_(std::move(name)) {}
   std::string name() const override { return name_; }
+  bool addsMass() const override { return false; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override {
     std::vector<IdLoadSample> samples;
     sampler_(s.t, samples);

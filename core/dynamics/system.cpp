@@ -140,6 +140,28 @@ void System::calcSkeletonKinematics(const State& s, DynamicsWorkspace& ws) const
   bind(ws);
   calcKinematics(model_, s, ws.sk);
   ++ws.evaluation;
+  ws.has_mass = false;  // a new evaluation: M and f are not its own until calcMassAndForce
+}
+
+void System::calcSkeletonMassHere(DynamicsWorkspace& ws, MatX& M) const {
+  if (forward_route == ForwardRoute::Dense)
+    calcSkeletonMass(model_, ws.sk, M);
+  else
+    calcSkeletonMassCrba(model_, ws.sk, ws.fd, M);
+}
+
+ForwardRoute System::plannedForwardRoute() const {
+  if (nc_ > 0 || map_ || n_extra_ > 0) return ForwardRoute::Dense;
+  bool mass_terms = false;
+  for (const auto& t : terms_) mass_terms = mass_terms || t->addsMass();
+  switch (forward_route) {
+    case ForwardRoute::Dense: return ForwardRoute::Dense;
+    case ForwardRoute::TreeSparse: return ForwardRoute::TreeSparse;
+    case ForwardRoute::Articulated: return mass_terms ? ForwardRoute::Dense : ForwardRoute::Articulated;
+    case ForwardRoute::Auto: break;
+  }
+  if (!mass_terms) return ForwardRoute::Articulated;
+  return ndof_ >= kTreeSparseMinDof ? ForwardRoute::TreeSparse : ForwardRoute::Dense;
 }
 
 void System::addConstraint(std::shared_ptr<const Constraint> c) {
@@ -250,13 +272,13 @@ void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
     calcSkeletonKinematics(s, ws);
     calcControls(s, ws);
     if (n_extra_ == 0) {
-      calcSkeletonMass(model_, ws.sk, ws.M);
+      calcSkeletonMassHere(ws, ws.M);
       calcSkeletonForce(model_, s, ws.sk, ws.f);
     } else {
       // the skeleton fills the q_r block; terms own the extra coordinates' mass and force.
       // Assembled through the q_r scratch so M and f keep their size (no reallocation per call).
       const int nr = model_.nr();
-      calcSkeletonMass(model_, ws.sk, ws.M_r);
+      calcSkeletonMassHere(ws, ws.M_r);
       calcSkeletonForce(model_, s, ws.sk, ws.f_r);
       ws.M.setZero(ndof_, ndof_);
       ws.f.setZero(ndof_);
@@ -269,13 +291,14 @@ void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
       terms_[i]->addMass(model_, s, ctx, ws.M);
       terms_[i]->addForce(model_, s, ctx, ws.f);
     }
+    ws.has_mass = true;
     return;
   }
   // skeleton and terms in q_r at the expanded state, then chained through J_rR [D Eq. 4.86]
   expandInto(s, ws);
   calcSkeletonKinematics(ws.s_r, ws);
   calcControls(ws.s_r, ws);
-  calcSkeletonMass(model_, ws.sk, ws.M_r);
+  calcSkeletonMassHere(ws, ws.M_r);
   calcSkeletonForce(model_, ws.s_r, ws.sk, ws.f_r);
   if (!ws.loads.empty()) addExternalLoads(model_, ws.sk, ws.loads, ws.f_r);
   for (size_t i = 0; i < terms_.size(); ++i) {
@@ -287,6 +310,7 @@ void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
   ws.M.noalias() = ws.J_rR.transpose() * MJ;
   const VecX fr = ws.f_r - ws.M_r * (ws.Jdot_rR * s.qdot);
   ws.f.noalias() = ws.J_rR.transpose() * fr;
+  ws.has_mass = true;
 }
 
 namespace {
@@ -416,14 +440,56 @@ VecX System::solveKKT(const MatX& M, const MatX& G, const VecX& a, const VecX& b
   return x.head(n);
 }
 
+bool System::forwardArticulated(const State& s, DynamicsWorkspace& ws, VecX& qddot) const {
+  if (nz_ > 0 && s.z.size() != nz_)
+    throw ModelError("System::forwardDynamics: state has " + std::to_string(s.z.size()) +
+                     " auxiliary states, the system has " + std::to_string(nz_));
+  bind(ws);
+  VecX& tau = ws.fd.tau;
+  tau.setZero(model_.nr());
+  // the terms (none adds mass) and the loads as generalized forces, through J_mr; a bare
+  // skeleton needs no J_mr at all
+  if (!terms_.empty() || !ws.loads.empty() || !controllers_.empty()) {
+    calcSkeletonKinematics(s, ws);
+    calcControls(s, ws);
+    if (!ws.loads.empty()) addExternalLoads(model_, ws.sk, ws.loads, tau);
+    for (size_t i = 0; i < terms_.size(); ++i) terms_[i]->addForce(model_, s, context(ws, i), tau);
+  }
+  ws.has_mass = false;
+  if (!articulatedBodyForward(model_, s, tau, ws.fd, qddot)) return false;
+  if (nz_ > 0) calcStateDerivativesHere(s, ws);
+  return true;
+}
+
 VecX System::forwardDynamics(const State& s, DynamicsWorkspace& ws) const {
+  const ForwardRoute route = plannedForwardRoute();
+  VecX qddot;
+  if (route == ForwardRoute::Articulated) {
+    ws.lambda.resize(0);
+    if (forwardArticulated(s, ws, qddot)) {
+      ws.last_route = ForwardRoute::Articulated;
+      return qddot;
+    }
+  }
   calcMassAndForce(s, ws);
   // the auxiliary states' rates share this evaluation (the terms' scratch holds it)
   if (nz_ > 0) calcStateDerivativesHere(map_ ? ws.s_r : s, ws);
   if (nc_ == 0) {
     ws.lambda.resize(0);
+    // TreeSparse only if the terms kept the tree's pattern and M is positive definite
+    if (route == ForwardRoute::TreeSparse) {
+      coordinateParents(model_, ws.fd.lambda);
+      if (hasTreePattern(ws.M, ws.fd.lambda, ws.fd.stamp) && factorLTDL(ws.M, ws.fd.lambda, ws.fd.LD)) {
+        qddot = ws.f;
+        solveLTDL(ws.fd.LD, ws.fd.lambda, qddot);
+        ws.last_route = ForwardRoute::TreeSparse;
+        return qddot;
+      }
+    }
+    ws.last_route = ForwardRoute::Dense;
     return ws.M.ldlt().solve(ws.f);
   }
+  ws.last_route = ForwardRoute::Dense;
   calcConstraints(s, ws);
   return solveKKT(ws.M, ws.G, ws.f, ws.rhs, &ws.lambda);
 }
@@ -449,6 +515,7 @@ void System::beginInverseDynamics(const State& s, const VecX& qddot, DynamicsWor
     throw ModelError("System::beginInverseDynamics: state has " + std::to_string(s.z.size()) +
                      " auxiliary states, the system has " + std::to_string(nz_));
   recursiveIdForward(model_, s, qddot, ws.rid);
+  ws.has_mass = false;
 }
 
 void System::finishInverseDynamics(const State& s, const VecX& qddot, DynamicsWorkspace& ws, VecX& tau) const {

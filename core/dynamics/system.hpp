@@ -31,6 +31,7 @@
 #include "core/dynamics/coordinate_map.hpp"
 #include "core/dynamics/force_term.hpp"
 #include "core/dynamics/skeleton_dynamics.hpp"
+#include "core/dynamics/structured_forward.hpp"
 #include "core/skeleton/kinematics.hpp"
 
 namespace redmax {
@@ -72,6 +73,13 @@ struct DynamicsWorkspace {
   VecX lambda;     // constraint multipliers           (nc)
   VecX pos_err, vel_err;                            // (nc)
   VecX zdot;       // auxiliary state derivatives (forwardDynamics, calcStateDerivatives) (nz)
+  /// true when M and f hold the last evaluated state's (calcMassAndForce, forwardDynamics on the
+  /// Dense or TreeSparse route); false after forwardDynamics on the Articulated route, which
+  /// forms neither: whoever reads M or f after forwardDynamics calls calcMassAndForce first then
+  bool has_mass = false;
+  /// the route the last forwardDynamics took, after fall-backs (System::forward_route)
+  ForwardRoute last_route = ForwardRoute::Dense;
+  StructuredForwardWorkspace fd;  // scratch of the CRBA, LTDL and ABA routes
 
   // recursive inverse dynamics (System::inverseDynamicsRecursive): poses, twists, rates, wrenches
   RecursiveIdWorkspace rid;
@@ -132,6 +140,14 @@ class System {
   const std::vector<std::shared_ptr<const ForceTerm>>& terms() const { return terms_; }
   const std::vector<std::shared_ptr<const Constraint>>& constraints() const { return constraints_; }
   StabilizationOptions stabilization;
+  /// how forwardDynamics solves for qddot (core/dynamics/structured_forward.hpp, docs/forward.md):
+  /// Auto picks by structure; every route gives the same qddot to round-off. With any route
+  /// other than Dense, calcMassAndForce forms the skeleton's M by CRBA (Dense: J_mr^T M_m J_mr).
+  ForwardRoute forward_route = ForwardRoute::Auto;
+  /// the route forwardDynamics will try for this system (Auto resolved; before the run-time
+  /// fall-backs that ws.last_route records): Dense with constraints, a coordinate map or extra
+  /// coordinates, Articulated only when no term adds mass (ForceTerm::addsMass)
+  ForwardRoute plannedForwardRoute() const;
 
   // auxiliary states and controls
   /// nz: the terms' states, stacked in State::z
@@ -271,6 +287,10 @@ class System {
   int n_extra_ = 0;  // coordinates after q_r that only ForceTerms see
   /// with a map: ws.s_r, ws.J_rR, ws.Jdot_rR from a system state
   void expandInto(const State& s, DynamicsWorkspace& ws) const;
+  // the skeleton's M_r into `M` by the route's method (CRBA unless forward_route is Dense)
+  void calcSkeletonMassHere(DynamicsWorkspace& ws, MatX& M) const;
+  // forwardDynamics by ABA; false (nothing returned) when a pivot fails
+  bool forwardArticulated(const State& s, DynamicsWorkspace& ws, VecX& qddot) const;
 };
 
 }  // namespace redmax

@@ -52,6 +52,8 @@ void Sdirk2::solveStage(const System& sys, double t, const VecX& zq, const VecX&
       const MatX& G = sys.numConstraintRows() > 0 ? ws.G : no_rows;
       VecX dV;
       if (phase == 0) {
+        // the articulated route leaves M unformed (DynamicsWorkspace::has_mass)
+        if (!ws.has_mass) sys.calcMassAndForce(st, ws);
         sys.calcStiffnessDamping(st, ws);
         ++stats_.jacobian_evals;
         const MatX A = ws.M + hg * ws.D + (hg * hg) * ws.K;

@@ -53,8 +53,9 @@ TEST(ContactScenes, WalkerAtRestCarriesItsWeightOnTheFootSpheres) {
   EXPECT_NEAR(mass, 31.0, 1e-12);
   std::printf("walker: sum F_y %.9g N, weight %.9g N, relative %.2g; sum F_x %.2g N; max penetration %.4g m\n", fy,
               weight, std::abs(fy - weight) / weight, fx, r.contacts.max_penetration);
-  // at rest the ground carries the weight: measured 5.6e-16 relative, sum F_x -9.9e-8 N
-  EXPECT_NEAR(fy, weight, 1e-14 * weight) << fy;
+  // at rest the ground carries the weight: measured 1.7e-14 relative (5.6e-16 on the dense forward
+  // route: the settled state differs by round-off between the routes), sum F_x 1.1e-7 N
+  EXPECT_NEAR(fy, weight, 1e-13 * weight) << fy;
   EXPECT_LT(std::abs(fx), 1e-6) << fx;
   EXPECT_LT(r.final_state.qdot.norm(), 1e-3);
 }

@@ -173,7 +173,9 @@ TEST(ForwardTool, Arm26MatchesOpenSimsForwardStandard) {
       {"BIClong.fiber_length", 9.3e-5},   // 6.2e-5
       {"BICshort.activation", 1.7e-6},    // 1.1e-6
       {"BICshort.fiber_length", 9.6e-5},  // 6.4e-5
-      {"BRA.activation", 1.9e-7},         // 1.3e-7
+      // 2.6e-7 on the articulated forward route (Auto), 1.3e-7 on the dense one: rk45 at 1e-5
+      // takes other steps when qddot differs by round-off
+      {"BRA.activation", 3.9e-7},
       {"BRA.fiber_length", 5.1e-5},       // 3.4e-5
   };
   auto bound = [](const std::string& label) {
