@@ -97,7 +97,8 @@ int runLengths(const LengthsFlags& f, const CLI::App& app) {
     std::string description = "musculotendon path lengths (m), wrap " + wrap;
     if (model_lengths && wrap_flags.wrap.width > 0.0)
       description += " (width " + std::to_string(wrap_flags.wrap.width) + " m)";
-    if (wrap == "neural") description += " (network " + f.wrap.network + ")";
+    if (wrap == "neural")
+      description += " (network " + (f.wrap.hasNetwork() ? f.wrap.network : defaultWrapNetworksPath()) + ")";
     osim::writeResultStorage(out_path, res.lengths, f.full_precision, description);
     if (po.wrap_lengths)
       osim::writeResultStorage(f.wrap_lengths, res.wrap_lengths, f.full_precision,

@@ -11,11 +11,19 @@
 #include <memory>
 #include <sstream>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "cli/flags.hpp"
 #include "converter/atomic_file.hpp"
+#include "converter/build/build_core_model.hpp"
+#include "converter/coordinates_file.hpp"
+#include "converter/osim_reader.hpp"
+#include "converter/storage.hpp"
+#include "core/muscles/wrap/network_set.hpp"
+#include "core/muscles/wrap_muscle.hpp"
+#include "tools/wrap_training/model_networks.hpp"
 #include "core/muscles/wrap/network_model.hpp"
 #include "tools/wrap_training/compare.hpp"
 #include "tools/wrap_training/study.hpp"
@@ -86,6 +94,11 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
   std::optional<Mlp> init;
   if (const auto f = optionalFlag(a, "init")) {
     init = Mlp::load(*f);  // a malformed file throws with its line
+    const double C = a.getDouble("compact", 0.0);
+    const auto im = init->meta.find("wrap_map");
+    if ((im == init->meta.end()) != (C == 0.0) || (C > 0.0 && im->second != formatCompactWrapMap(C)))
+      throw UsageError{"--init " + *f + " has " + (im == init->meta.end() ? std::string("the older map") : "wrap_map " + im->second) +
+                       ", --compact asks for " + (C > 0.0 ? formatCompactWrapMap(C) : std::string("the older map"))};
     if (init->meta.count("surface") && init->meta.at("surface") != wrapTypeName(type))
       throw UsageError{"--init " + *f + " is a " + init->meta.at("surface") + " network, not " + wrapTypeName(type)};
     if (init->architecture() != Mlp(wrapInputSize(type), opt.hidden, 3, 0).architecture())
@@ -95,11 +108,20 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
   const std::optional<std::string> report = optionalFlag(a, "report");
   if (report) requireFolder(*report);
 
-  // samples of the exact library over the stated box [D Sec. 5.3.3.1]
-  const WrapInputBox box = makeDefaultWrapBox(type);
+  // samples of the exact library over the stated box [D Sec. 5.3.3.1], or (--compact C) over all of
+  // space through the compact map, displacement outputs (core/muscles/wrap/network_model.hpp)
+  const double compact = a.getDouble("compact", 0.0);
+  if (!(compact >= 0.0 && compact <= 1000.0)) throw UsageError{"--compact must be in [0, 1000] radii (0: the older map)"};
+  if (compact > 0.0 && type != WrapType::Cylinder && type != WrapType::Sphere)
+    throw UsageError{"--compact takes cylinders and spheres (one radius)"};
+  const WrapInputBox box = compact > 0.0 ? makeCompactDefaultWrapBox(type, compact) : makeDefaultWrapBox(type);
   const WrapOracle oracle = makeExactWrapOracle(type);
+  auto makeSet = [&](long n, double thr, unsigned long long seed) {
+    return compact > 0.0 ? makeCompactWrapTrainingSet(type, n, thr, compact, seed, opt.threads)
+                         : makeWrapTrainingSet(box, oracle, n, thr, seed, opt.threads);
+  };
   const auto t_data = Clock::now();
-  const WrapTrainingSet data = makeWrapTrainingSet(box, oracle, samples, threshold, opt.seed, opt.threads);
+  const WrapTrainingSet data = makeSet(samples, threshold, opt.seed);
   std::cerr << "train-wrap: " << wrapTypeName(type) << ", " << samples << " samples kept of " << data.drawn
             << " drawn (" << data.invalid << " with an end inside the surface, " << data.near_contact
             << " with 0 < l/L < " << threshold << " discarded; " << data.wrapped << " kept samples wrap), "
@@ -118,7 +140,7 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
   Mlp net = trainWrapNetwork(data, box, opt, &history);
 
   // error on fresh samples, all of them (also those near the contact change)
-  const WrapTrainingSet test = makeWrapTrainingSet(box, oracle, std::min(samples, 20000L), 0.0, opt.seed + 1000003, opt.threads);
+  const WrapTrainingSet test = makeSet(std::min(samples, 20000L), 0.0, opt.seed + 1000003);
   const WrapErrorStats err = calcWrapNetworkError(net, test);
   if (init)
     for (const char* k : {"command", "adam", "epochs", "final_val_rms_m", "train_seconds", "test_rms_m"})
@@ -128,7 +150,13 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
   net.meta["threshold"] = num(threshold, 6);
   net.meta["test_rms_m"] = num(err.rms, 6);
   net.meta["test_max_m"] = num(err.max, 6);
-  net.meta["box"] = "tools/wrap_training/train.hpp makeDefaultWrapBox (units of the surface size)";
+  if (compact > 0.0) {
+    net.meta["wrap_map"] = formatCompactWrapMap(compact);
+    net.meta["box"] = "all of space: half the pairs in the default box, half with u uniform in the ball |u| < 0.98 C "
+                      "(tools/wrap_training/model_networks.hpp makeCompactWrapTrainingSet; units of the surface size)";
+  } else {
+    net.meta["box"] = "tools/wrap_training/train.hpp makeDefaultWrapBox (units of the surface size)";
+  }
   net.save(*out);
   std::cout << "trained " << net.architecture() << " (" << net.parameterCount() << " parameters) on "
             << wrapTypeName(type) << ": " << history.size() << " epochs, " << history.back().steps << " steps, "
@@ -370,10 +398,217 @@ int runPendulums(const FlagValues& a) {
   return 0;
 }
 
+// ---------------------------------------------------------------------------------------------
+// networks for a model (issue 22): --for MODEL.osim (--coordinates LIST | --ranges default)
+// [--check NETWORKS | --out DIR]. Progress goes to stdout (flushed line by line), so stderr holds
+// only warnings and the error line.
+
+struct ModelPoses {
+  osim::ModelDescription d;
+  osim::BuildResult build;
+  std::vector<VecX> poses;
+  std::string described;  // "238 frames of a.mot" / "500 poses within the coordinate ranges"
+};
+
+ModelPoses readModelPoses(const FlagValues& a) {
+  ModelPoses m;
+  const std::string model_file = a.get("for", "");
+  const bool has_coords = a.has("coordinates"), has_ranges = a.has("ranges");
+  if (has_coords == has_ranges) throw UsageError{"--for needs one of --coordinates Q.mot[,Q2.mot...] or --ranges default"};
+  if (has_ranges && a.get("ranges", "") != "default")
+    throw UsageError{"--ranges takes 'default' (the model's coordinate ranges), got '" + a.get("ranges", "") + "'"};
+  if (a.has("frames") && !has_ranges) throw UsageError{"--frames needs --ranges default"};
+  const long frames = a.getInt("frames", 500);
+  if (frames < 1 || frames > 10000000) throw UsageError{"--frames must be between 1 and 1e7"};
+  m.d = osim::readOsimModel(model_file);  // ConvertError: FILE:LINE: ...
+  osim::BuildOptions opt;
+  opt.constraints = false;  // poses as given, nothing enforced (as `redmax lengths`)
+  m.build = osim::buildCoreModel(m.d, opt);
+  for (const auto& w : m.build.warnings) std::cerr << "warning: " << w << "\n";
+  const int nr = m.build.model.nr();
+  if (has_coords) {
+    const std::vector<std::string> files = splitList(a.get("coordinates", ""));
+    if (files.empty()) throw UsageError{"--coordinates needs at least one file"};
+    for (const auto& f : files) {
+      const osim::Storage st = osim::readStorage(f);
+      const osim::CoordinateRows rows = osim::coordinateRows(st, m.d.coordinates, m.build.coordinate_index, nr, f);
+      if (rows.missing > 0)
+        std::cerr << "warning: " << rows.missing << " coordinate(s) not in " << f << ": held at their default values\n";
+      m.poses.insert(m.poses.end(), rows.q.begin(), rows.q.end());
+    }
+    m.described = std::to_string(m.poses.size()) + " frames of " + a.get("coordinates", "");
+  } else {
+    // uniform within each coordinate's range, seeded
+    std::mt19937_64 rng(static_cast<unsigned long long>(a.getInt("seed", 1)));
+    for (long f = 0; f < frames; ++f) {
+      VecX q = VecX::Zero(nr);
+      for (size_t ci = 0; ci < m.d.coordinates.size(); ++ci) {
+        const int k = m.build.coordinate_index[ci];
+        if (k < 0) continue;
+        const auto& c = m.d.coordinates[ci];
+        const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
+        q[k] = c.locked ? c.default_value : c.range_min + (c.range_max - c.range_min) * u;
+      }
+      m.poses.push_back(std::move(q));
+    }
+    m.described = std::to_string(frames) + " poses drawn within the coordinate ranges (seed " +
+                  std::to_string(a.getInt("seed", 1)) + ")";
+  }
+  if (m.poses.empty()) throw UsageError{"no poses: the coordinates files have no rows"};
+  return m;
+}
+
+std::string safeFileName(const std::string& name) {
+  std::string s;
+  for (char c : name) s += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ? c : '_';
+  return s.empty() ? "wrap" : s;
+}
+
+int runCheckNetworks(const FlagValues& a, const ModelPoses& m, const std::vector<WrapObjectInputs>& inputs) {
+  const std::string path = a.get("check", "");
+  WrapNetworkSet set;
+  try {
+    set = loadWrapNetworks(path);
+  } catch (const NetworkFormatError& e) {
+    throw UsageError{e.what()};  // FILE:LINE: what is wrong
+  } catch (const std::runtime_error& e) {
+    throw UsageError{std::string("--check: ") + e.what()};
+  }
+  WrapMassOptions o;
+  set.applyTo(o);
+  const std::vector<double> alphas{0.1, 0.3, 0.5, 0.7, 0.9};
+  const auto rows = checkWrapNetworks(
+      inputs, [&](const std::string& name, WrapType t) { return o.networkFor(name, wrapTypeName(t)); }, alphas);
+  std::cout << "check " << path << " on " << a.get("for", "") << ", " << m.described
+            << " (position error against the exact library at alpha 0.1..0.9 where the network serves, in radii):\n";
+  std::printf("%-28s %-10s %12s %12s %9s %10s %10s  %s\n", "wrap object", "surface", "evaluations", "fallbacks",
+              "share", "rms", "max", "reasons");
+  long E = 0, F = 0;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    std::string reasons;
+    for (const auto& [why, n] : r.by_reason) reasons += (reasons.empty() ? "" : "; ") + toString(why) + " " + std::to_string(n);
+    std::printf("%-28s %-10s %12ld %12ld %8.2f%% %10.4g %10.4g  %s\n", r.name.c_str(),
+                wrapTypeName(inputs[i].surface.type).c_str(), r.evaluations, r.fallbacks,
+                r.evaluations ? 100.0 * r.fallbacks / r.evaluations : 0.0, r.rms, r.max, reasons.c_str());
+    E += r.evaluations;
+    F += r.fallbacks;
+  }
+  std::printf("total: %ld of %ld wrapped-segment evaluations fell back to the smooth model (%.2f%%)\n", F, E,
+              E ? 100.0 * F / E : 0.0);
+  return 0;
+}
+
+int runForModel(const FlagValues& a, const CLI::App& app) {
+  if (a.has("check") && a.has("out")) throw UsageError{"--check reads networks, --out writes them: give one"};
+  if (!a.has("check") && !a.has("out")) throw UsageError{"--for needs --out DIR (train) or --check NETWORKS"};
+  for (const char* f : {"surface", "hidden", "init", "compare", "study", "pendulums"})
+    if (a.has(f)) throw UsageError{std::string("--") + f + " does not go with --for"};
+  ModelWrapTrainOptions o;
+  TrainOptions& t = o.train;
+  t.hidden = parseHidden(a.get("architecture", "3x32"));
+  o.samples = a.getInt("samples", 8000);
+  t.epochs = static_cast<int>(a.getInt("epochs", 40));
+  t.batch = static_cast<int>(a.getInt("batch", 64));
+  t.learning_rate = a.getDouble("lr", 3e-3);
+  t.seed = static_cast<unsigned long long>(a.getInt("seed", 1));
+  t.threads = static_cast<int>(a.getInt("threads", 1));
+  t.shards = static_cast<int>(a.getInt("shards", t.threads));
+  o.threshold = a.getDouble("threshold", 0.01);
+  o.compact = a.getDouble("compact", 4.0);
+  if (o.samples < 10 || o.samples > 100000000) throw UsageError{"--samples must be between 10 and 1e8"};
+  if (t.epochs < 1 || t.batch < 1) throw UsageError{"--epochs and --batch must be positive"};
+  if (!(t.learning_rate > 0.0 && t.learning_rate < 1.0)) throw UsageError{"--lr must be in (0, 1)"};
+  if (t.threads < 1 || t.threads > 256 || t.shards < 1 || t.shards > 4096)
+    throw UsageError{"--threads must be between 1 and 256, --shards between 1 and 4096"};
+  if (!(o.threshold >= 0.0 && o.threshold < 1.0)) throw UsageError{"--threshold must be in [0, 1)"};
+  if (!(o.compact > 0.0 && o.compact <= 1000.0)) throw UsageError{"--compact must be in (0, 1000] radii"};
+  std::string dir;
+  if (a.has("out")) {
+    dir = a.get("out", "");
+    std::error_code ec;
+    if (dir.empty()) throw UsageError{"--out needs a folder"};
+    if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+      throw UsageError{"--out " + dir + ": exists and is not a folder (--for writes a folder of networks)"};
+  }
+
+  const auto t0 = Clock::now();
+  ModelPoses m;
+  try {
+    m = readModelPoses(a);
+  } catch (const osim::ConvertError& e) {
+    throw UsageError{e.what()};  // FILE:LINE: what is wrong
+  } catch (const ModelError& e) {
+    throw UsageError{a.get("for", "") + ": " + e.what()};
+  }
+  // the wrapping muscles the smooth model (and so the network model) takes; the others keep the exact
+  // model at run time (two wrap objects able to share a segment) and need no network
+  std::vector<Muscle> muscles;
+  for (const Muscle& mu : m.build.model.muscles()) {
+    if (mu.path.wraps.empty()) continue;
+    Muscle probe = mu;
+    probe.wrap = WrapMassOptions{};
+    const std::string why = wrapMassPointsUnsupportedReason(probe);
+    if (why.empty()) muscles.push_back(mu);
+    else std::cout << "train-wrap: muscle '" << mu.name << "' skipped (the wrap models cannot take its path: " << why << ")\n";
+  }
+  const std::vector<WrapObjectInputs> inputs = collectWrapObjectInputs(m.build.model.skeleton(), muscles, m.poses);
+  std::cout << "train-wrap --for " << a.get("for", "") << ": " << m.described << "; " << inputs.size()
+            << " wrap object(s) take wrapped segments\n"
+            << std::flush;
+  if (a.has("check")) return runCheckNetworks(a, m, inputs);
+  if (inputs.empty()) throw UsageError{a.get("for", "") + ": no muscle wraps a surface over these poses: nothing to train"};
+  requireFolder(dir);
+
+  std::string manifest = "redmax-wrap-networks 1\n# written by: " + commandLine(app) +
+                         "\n# one network per wrap object (core/muscles/wrap/network_set.hpp)\n";
+  int trained = 0, k = 0;
+  for (const WrapObjectInputs& in : inputs) {
+    ++k;
+    const std::string head = "train-wrap: [" + std::to_string(k) + "/" + std::to_string(inputs.size()) +
+                             "] wrap object '" + in.name + "' (" + wrapTypeName(in.surface.type) + ", " +
+                             std::to_string(in.muscles.size()) + " muscle(s), " + std::to_string(in.q1.size()) +
+                             " evaluations)";
+    if (in.surface.type != WrapType::Cylinder && in.surface.type != WrapType::Sphere) {
+      std::cout << head << ": skipped, networks take cylinders and spheres; the smooth model serves it\n" << std::flush;
+      continue;
+    }
+    const auto t1 = Clock::now();
+    double last = -1e9;
+    o.train.on_epoch = [&](const TrainEpoch& e) {
+      if (e.elapsed_s - last < 5.0 && e.epoch != o.train.epochs) return;
+      last = e.elapsed_s;
+      std::cout << head << ": epoch " << e.epoch << "/" << o.train.epochs << ", validation rms " << num(e.val_rms_m)
+                << " radii, " << num(e.elapsed_s, 3) << " s\n"
+                << std::flush;
+    };
+    WrapErrorStats err;
+    Mlp net = trainWrapObjectNetwork(in, o, &err);
+    net.meta["command"] = commandLine(app);
+    const std::string file = safeFileName(in.name) + ".txt";
+    net.save((std::filesystem::path(dir) / file).string());
+    manifest += "wrap " + in.name + " " + file + "\n";
+    ++trained;
+    std::cout << head << ": error on fresh samples rms " << num(err.rms) << ", max " << num(err.max) << " radii, "
+              << num(secondsSince(t1), 3) << " s -> " << file << "\n"
+              << std::flush;
+  }
+  if (trained == 0) throw UsageError{"no wrap object is a cylinder or a sphere: nothing to train"};
+  // the manifest last: a run cut short leaves no manifest naming missing files
+  const std::string mpath = (std::filesystem::path(dir) / wrapNetworkManifestName()).string();
+  osim::writeFileAtomic(mpath, manifest);
+  std::cout << "trained " << trained << " network(s) in " << num(secondsSince(t0), 3) << " s; wrote " << mpath
+            << " (use: --wrap neural --wrap-network " << dir << ")\n";
+  return 0;
+}
+
 int runTrainWrap(const CLI::App& app) {
   const FlagValues a(app);
   if (a.has("compare") + a.has("study") + a.has("pendulums") > 1)
     throw UsageError{"--compare, --study and --pendulums exclude each other"};
+  if (a.has("for")) return runForModel(a, app);
+  for (const char* f : {"check", "coordinates", "ranges", "frames", "architecture"})
+    if (a.has(f)) throw UsageError{std::string("--") + f + " needs --for MODEL.osim"};
   if (a.has("pendulums")) return runPendulums(a);
   if (a.has("study")) return runStudy(a);
   return a.has("compare") ? runCompare(a) : runTrain(a, app);
@@ -421,11 +656,39 @@ void declareTrainWrapFlags(CLI::App& app) {
                  "new file's meta as init_*")
       ->type_name("NET.txt")
       ->group(train);
-  app.add_option("--out", "the trained network (required for training)")->type_name("NET.txt")->group(train);
+  app.add_option("--compact",
+                 "the compact input map u = q / (1 + |q| / C) and displacement outputs, over all of\n"
+                 "space (C in radii; cylinder and sphere; --for: default 4); 0 (default without\n"
+                 "--for): the older map over the default box")
+      ->type_name("C")
+      ->check(number())
+      ->group(train);
+  app.add_option("--out", "the trained network (required for training; --for: a folder of networks\nand its manifest wrap_networks.txt)")
+      ->type_name("NET.txt|DIR")
+      ->group(train);
   app.add_option("--report",
                  "training: loss.csv and a loss plot; --compare: speed_error.csv and a plot;\n"
                  "--study: study.csv and a plot; --pendulums: pendulums.csv")
       ->type_name("DIR");
+  const std::string forg = "--for";
+  app.add_option("--for",
+                 "train one network per wrap object the model's muscles use, on the surface-frame\n"
+                 "inputs they see over the poses (compact map), and write DIR/wrap_networks.txt")
+      ->type_name("MODEL.osim")
+      ->group(forg);
+  app.add_option("--coordinates", "--for: the poses, one or more coordinate files (.mot/.sto)")
+      ->type_name("Q.mot,...")
+      ->group(forg);
+  app.add_option("--ranges", "--for: poses drawn uniformly within the model's coordinate ranges")
+      ->type_name("default")
+      ->group(forg);
+  app.add_option("--frames", "--ranges: how many poses (default 500)")->type_name("N")->check(integer())->group(forg);
+  app.add_option("--architecture", "--for: the networks' hidden layers (default 3x32)")->type_name("ARCH")->group(forg);
+  app.add_option("--check",
+                 "--for: instead of training, evaluate these networks (a file, a manifest or a\n"
+                 "folder) on the poses: fallbacks to the smooth model and position error per wrap object")
+      ->type_name("NETWORKS")
+      ->group(forg);
   app.add_flag("--compare")->description("time networks, the smooth model and the exact library per mass point")->group(compare);
   app.add_option("--nets", "trained networks to compare")->type_name("A.txt,B.txt")->group(compare);
   app.add_option("--untrained", "network sizes timed only (default 6x256), or none")
@@ -455,13 +718,16 @@ void declareTrainWrapFlags(CLI::App& app) {
 }
 
 CommandRegistration reg(
-    {"train-wrap", "train the Type III wrap network, or compare wrap models (speed against error)",
+    {"train-wrap", "train Type III wrap networks (one, or all a model needs), or compare wrap models",
      [](CLI::App& app) {
        declareTrainWrapFlags(app);
        app.footer("usage: redmax train-wrap --surface cylinder|sphere|ellipsoid|torus [--hidden 6x256] [--samples N]\n"
      "                         [--epochs E] [--batch B] [--lr 1e-4] [--seed S] [--threshold 0.01]\n"
      "                         [--time-limit SECONDS] [--threads T [--shards S]] [--init NET.txt]\n"
      "                         --out NET.txt [--report DIR]\n"
+     "       redmax train-wrap --for MODEL.osim (--coordinates Q.mot[,...] | --ranges default [--frames N])\n"
+     "                         [--architecture 3x32] [--samples N] [--epochs E] [--compact C] [--seed S]\n"
+     "                         (--out DIR | --check NETWORKS)\n"
      "       redmax train-wrap --compare --surface cylinder|sphere|ellipsoid|torus [--nets A.txt,B.txt]\n"
      "                         [--untrained 6x256,...|none]\n"
      "                         [--muscles M] [--mass-points N] [--width W] [--seed S] --report DIR\n"
@@ -479,6 +745,15 @@ CommandRegistration reg(
      "(default T) summed in order, so the network depends on S and the seed, not on T (S = 1: serial).\n"
      "--init NET.txt continues training from that network (same surface and --hidden; its normalisation is kept,\n"
      "Adam restarts); its command and losses are kept in the new file's meta as init_*.\n"
+     "--compact C: inputs through the compact map u = q / (1 + |q| / C), sampled over all of space, and the\n"
+     "point's displacement from the straight line as output (meta wrap_map; no training box to leave).\n"
+     "--for MODEL.osim: for every wrap object (cylinder or sphere) the model's muscles wrap over the poses\n"
+     "(--coordinates files, or --ranges default: --frames poses, default 500, uniform in the coordinate ranges),\n"
+     "collects the surface-frame end points of its wrapped segments, trains a network on them (jittered, random\n"
+     "alpha; defaults --architecture 3x32, --samples 8000, --epochs 40, --batch 64, --lr 3e-3, --compact 4)\n"
+     "and writes DIR/NAME.txt per wrap object and the manifest DIR/wrap_networks.txt, with progress on stdout.\n"
+     "--check NETWORKS evaluates networks instead: per wrap object the evaluations, fallbacks to the smooth\n"
+     "model by reason, and the position error against the exact library (radii) where the network serves.\n"
      "--compare: M muscles (default 200) x N mass points (default 20) with random end points and velocities;\n"
      "for the exact library (J, Jdot by central differences, wraps shared by a muscle's points), the smooth\n"
      "model (band width W surface sizes, default 0.05) and each network (trained ones from --nets; --untrained\n"

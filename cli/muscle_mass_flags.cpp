@@ -1,13 +1,19 @@
 #include "cli/muscle_mass_flags.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <regex>
 #include <stdexcept>
 
 #include "core/muscles/wrap/network_model.hpp"
+#include "core/muscles/wrap/network_set.hpp"
 #include "validation/simulate/simulate.hpp"
+
+#ifndef REDMAX_SOURCE_DIR
+#define REDMAX_SOURCE_DIR ""
+#endif
 
 namespace redmax::cli {
 
@@ -36,11 +42,14 @@ void addWrapFlags(CLI::App& app, WrapFlags& f, bool with_model, const std::strin
                     ->check(positive("number of metres"))
                     ->group(group);
   f.network_opt = app.add_option("--wrap-network", f.network,
-                                 "neural (required): a network of `redmax train-wrap` (e.g.\n"
-                                 "osim_models/networks/cylinder_3x64.txt); surfaces it was not trained\n"
-                                 "for and inputs outside its training box use the smooth model, with a\n"
-                                 "warning once per muscle and the count in the summary")
-                      ->type_name("FILE")
+                                 "neural: a network of `redmax train-wrap`, a manifest\n"
+                                 "(redmax-wrap-networks 1: one network per wrap object) or a folder\n"
+                                 "holding wrap_networks.txt (`redmax train-wrap --for MODEL.osim --out\n"
+                                 "DIR`); default: the committed osim_models/networks/wrap_networks.txt.\n"
+                                 "Surfaces without a network and inputs outside a network's training box\n"
+                                 "use the smooth model, with a warning once per muscle and the count in\n"
+                                 "the summary")
+                      ->type_name("FILE|MANIFEST|DIR")
                       ->group(group);
 }
 
@@ -99,6 +108,13 @@ void addMuscleMassFlags(CLI::App& app, MuscleMassFlags& f) {
   addWrapFlags(app, f.wrap, true, g);
 }
 
+std::string defaultWrapNetworksPath() {
+  const std::filesystem::path p =
+      std::filesystem::path(REDMAX_SOURCE_DIR) / "osim_models" / "networks" / wrapNetworkManifestName();
+  std::error_code ec;
+  return *REDMAX_SOURCE_DIR && std::filesystem::is_regular_file(p, ec) ? p.string() : "";
+}
+
 void parseWrapFlags(const WrapFlags& f, osim::MuscleMassOptions& o) {
   // smooth by default: the mass matrix stays continuous at contact changes, so energy is conserved
   // to integrator error; exact (finite-difference J) jumps there [D Sec. 5.3.3, 6.2.4]
@@ -111,11 +127,21 @@ void parseWrapFlags(const WrapFlags& f, osim::MuscleMassOptions& o) {
     o.wrap.model = WrapModel::Exact;
   } else if (model == "neural") {
     o.wrap.model = WrapModel::Neural;
-    if (!f.hasNetwork() || f.network.empty())
-      throw UsageError{"--wrap neural needs --wrap-network FILE (a network of `redmax train-wrap`, e.g. "
-                       "osim_models/networks/cylinder_3x64.txt)"};
+    std::string path = f.network;
+    if (!f.hasNetwork()) {
+      // the committed networks (osim_models/networks/wrap_networks.txt), said so
+      path = defaultWrapNetworksPath();
+      if (path.empty())
+        throw UsageError{"--wrap neural needs --wrap-network FILE|MANIFEST|DIR (no committed networks found under " +
+                         std::string(REDMAX_SOURCE_DIR) + "/osim_models/networks)"};
+      std::cerr << "note: --wrap neural without --wrap-network: using the committed networks " << path << "\n";
+    } else if (path.empty()) {
+      throw UsageError{"--wrap-network needs a network file, a manifest or a folder"};
+    }
     try {
-      o.wrap.network = loadWrapNetwork(f.network);
+      loadWrapNetworks(path).applyTo(o.wrap);
+    } catch (const NetworkFormatError& e) {
+      throw UsageError{e.what()};  // FILE:LINE: first
     } catch (const std::exception& e) {
       throw UsageError{std::string("--wrap-network: ") + e.what()};
     }

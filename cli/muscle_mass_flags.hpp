@@ -82,9 +82,13 @@ osim::MuscleMassOptions parseMuscleMassFlags(const MuscleMassFlags& f, bool frac
 /// The wrap flags alone into o.wrap_mass and o.wrap, for a source that gives mass (also `simulate
 /// --muscle-mass-kg`). Not given: wrap_mass on, smooth model, default width. lumped: wrap_mass off.
 /// Throws UsageError for an unknown model, a width given without smooth/neural, --wrap-network
-/// without neural, neural without --wrap-network or with a file loadWrapNetwork refuses. neural
-/// sets o.wrap.network.
+/// without neural, or a --wrap-network that loadWrapNetworks refuses (a network file, a manifest or
+/// a folder). neural sets o.wrap's networks; without --wrap-network it takes the committed
+/// manifest (defaultWrapNetworksPath) and says so on stderr.
 void parseWrapFlags(const WrapFlags& f, osim::MuscleMassOptions& o);
+
+/// REDMAX_SOURCE_DIR/osim_models/networks/wrap_networks.txt when it exists, else "".
+std::string defaultWrapNetworksPath();
 
 /// --wrap neural: a WrapFallbackMonitor that warns on stderr once per muscle (the command sums the
 /// counts of its workspaces into it and prints its summary()); null for the other models.

@@ -17,6 +17,7 @@
 //     potential energy of a uniform line density; no point sits on an attachment, where its mass
 //     would only add to a bone.
 //   - Region::WholePath spreads the points over alpha in [0, 1] in the same way.
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -68,6 +69,17 @@ struct WrapMassOptions {
   double fd_step = 0.0;  ///< Exact: central-difference step on the end points (m); <= 0: 1e-6 size
   /// Neural: the network (loadWrapNetwork); also the fallback's transition width is `width`
   std::shared_ptr<const Mlp> network;
+  /// Neural: networks for single wrap objects (by the WrapObject's name) and for surface types (by
+  /// wrapTypeName), as a manifest lists them (core/muscles/wrap/network_set.hpp); see networkFor
+  std::map<std::string, std::shared_ptr<const Mlp>> wrap_networks, type_networks;
+  /// The network of wrap object `wrap` (a surface of type `type_name`): its own, else its type's,
+  /// else `network` (null when none)
+  const Mlp* networkFor(const std::string& wrap, const std::string& type_name) const {
+    if (auto it = wrap_networks.find(wrap); it != wrap_networks.end()) return it->second.get();
+    if (auto it = type_networks.find(type_name); it != type_networks.end()) return it->second.get();
+    return network.get();
+  }
+  bool hasNetwork() const { return network || !wrap_networks.empty() || !type_networks.empty(); }
   bool network_fd_jdot = false;   ///< Neural: Jdot by the forward difference [D Eq. 5.58], not exactly
   double network_fd_eps = 0.0;    ///< Neural: its time step (s); <= 0: 1e-6
   // fallbacks are counted in the workspace (MuscleKinematics::wrap_counts), not here

@@ -187,7 +187,7 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
   if (muscle.wrap.model == WrapModel::Exact) return "";  // the whole OpenSim path, any surfaces
   if (muscle.wrap.model == WrapModel::Neural)  // a usable network; the smooth model's checks below apply too (fallback)
     for (const PathWrap& w : path.wraps) {
-      const std::string why = w.surface.active ? neuralWrapUnsupportedReason(muscle.wrap.network.get(), w.surface) : "";
+      const std::string why = w.surface.active ? neuralWrapUnsupportedReason(muscle.wrap.networkFor(w.name, wrapTypeName(w.surface.type)), w.surface) : "";
       if (!why.empty()) return "the neural wrap model cannot take wrap object '" + w.name + "': " + why;
     }
   for (size_t k = 0; k < path.wraps.size(); ++k) {
@@ -284,7 +284,8 @@ void calcExactWrapPointsFd(const WrapSurface& surface, const Vec3& p1, const Vec
 NetworkWrapEval calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
                                     const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
                                     const std::vector<double>& alphas, const std::vector<double>& alphadots,
-                                    bool with_alpha, bool velocity, WrapModelPoints& out, NetworkWrapWorkspace& network) {
+                                    bool with_alpha, bool velocity, WrapModelPoints& out, NetworkWrapWorkspace& network,
+                                    const std::string& wrap_name) {
   const int n = static_cast<int>(alphas.size());
   const Vec3 v1 = velocity ? p1dot : Vec3::Zero(), v2 = velocity ? p2dot : Vec3::Zero();
   auto alphadot = [&](int a) { return velocity && !alphadots.empty() ? alphadots[a] : 0.0; };
@@ -308,7 +309,8 @@ NetworkWrapEval calcWrapModelPoints(const WrapMassOptions& options, const WrapSu
     }
     case WrapModel::Neural:  // the network, or the smooth model outside its training box (wrap/network_model.hpp)
       return calcNeuralWrapModelPoints(options, surface, p1, p2, v1, v2, alphas, alphadots, velocity, out, network,
-                                       with_alpha ? &out.x_alpha : nullptr, with_alpha ? &out.x_alphadot : nullptr);
+                                       with_alpha ? &out.x_alpha : nullptr, with_alpha ? &out.x_alphadot : nullptr,
+                                       options.networkFor(wrap_name, wrapTypeName(surface.type)));
     case WrapModel::Exact:
       if (with_alpha || moving_alpha)
         throw std::logic_error("calcWrapModelPoints: the exact model has no derivative along the fraction");
@@ -572,7 +574,7 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
     const SegmentEnds& e = ends[i];
     try {
       const NetworkWrapEval ev = calcWrapModelPoints(muscle.wrap, pw.surface, e.p1, e.p2, e.p1dot, e.p2dot, betas,
-                                                     betadots, moving_beta, vel, wp, mk.network);
+                                                     betadots, moving_beta, vel, wp, mk.network, pw.name);
       if (muscle.wrap.model == WrapModel::Neural) mk.wrap_counts.record(ev, w);  // summed by callers
     } catch (const std::invalid_argument& ex) {
       throw MuscleError(who + ", wrap object '" + pw.name + "': " + ex.what());

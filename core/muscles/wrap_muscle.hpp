@@ -108,12 +108,14 @@ struct WrapModelPoints : WrapMassPoints {
 /// (frame s) by options.model, moving with (p1dot, p2dot) and fraction rates `alphadots` (empty:
 /// all zero). `with_alpha` also fills x_alpha and x_alphadot (the exact model cannot: it has no
 /// alpha derivative; std::logic_error). Without `velocity` Jdot is zero. `network` holds the Neural
-/// model's buffers; returns its outcome (None for the other models). Throws
+/// model's buffers; `wrap_name` (the WrapObject) picks its network (WrapMassOptions::networkFor);
+/// returns its outcome (None for the other models). Throws
 /// std::invalid_argument for an end point inside the surface or an unsupported surface.
 NetworkWrapEval calcWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
                                     const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
                                     const std::vector<double>& alphas, const std::vector<double>& alphadots,
-                                    bool with_alpha, bool velocity, WrapModelPoints& out, NetworkWrapWorkspace& network);
+                                    bool with_alpha, bool velocity, WrapModelPoints& out, NetworkWrapWorkspace& network,
+                                    const std::string& wrap_name = {});
 
 /// The wrap model's length of the wrapped segment p1 -> p2 (frame s) with dL/d(p1, p2) and its time
 /// derivative (the smooth model's; every model that distributes points over several segments uses

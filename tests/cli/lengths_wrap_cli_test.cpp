@@ -297,7 +297,6 @@ TEST_F(LengthsWrapCli, BadWrapValuesExitTwoAndWriteNothing) {
   };
   const std::vector<Case> cases = {
       {"--wrap lumped", "--wrap must be exact, smooth, neural or none"},
-      {"--wrap neural", "--wrap neural needs --wrap-network"},
       {"--wrap neural --wrap-network missing.txt", "--wrap-network"},
       {"--wrap smooth --wrap-width -0.01", "--wrap-width must be a positive number"},
       {"--wrap smooth --wrap-width abc", "wrap-width"},

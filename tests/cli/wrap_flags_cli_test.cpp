@@ -98,7 +98,8 @@ TEST_F(WrapFlagsCli, BadValuesExitTwoWithAClearMessage) {
       {"id" + leg + " --muscle-mass physiological --wrap bogus" + out, "--wrap must be"},
       {"id" + leg + " --wrap smooth" + out, "--wrap needs --muscle-mass physiological or transfer"},
       {"id" + leg + " --muscle-mass physiological --wrap lumped --wrap-width 0.01" + out, "--wrap-width needs --wrap smooth"},
-      {"id" + leg + " --muscle-mass physiological --wrap neural" + out, "--wrap neural needs --wrap-network FILE"},
+      {"id" + leg + " --muscle-mass physiological --wrap neural --wrap-network " + path("absent_dir") + out,
+       "--wrap-network: " + path("absent_dir") + ": no such file or folder"},
       {"validate" + leg + " --report " + path("rep") + " --muscle-mass physiological --wrap bogus",
        "--wrap must be"},
       {"validate" + leg + " --report " + path("rep") + " --wrap exact", "--wrap needs --muscle-mass"},
@@ -115,9 +116,13 @@ TEST_F(WrapFlagsCli, BadValuesExitTwoWithAClearMessage) {
 
 TEST_F(WrapFlagsCli, NeuralTakesANetworkAndFallsBackOutsideItsBox) {
   const std::string sim = kPendulum + " --duration 0.05 --wrap neural";
+  // without --wrap-network: the committed networks (osim_models/networks/wrap_networks.txt), said so
   const CmdResult none = run(sim + " --out " + path("s.sto"));
-  EXPECT_EQ(none.code, 2) << none.err;
-  EXPECT_NE(none.err.find("--wrap neural needs --wrap-network FILE"), std::string::npos) << none.err;
+  EXPECT_EQ(none.code, 0) << none.err;
+  EXPECT_EQ(none.err.rfind("note: --wrap neural without --wrap-network: using the committed networks ", 0), 0u)
+      << none.err;
+  EXPECT_NE(none.err.find("osim_models/networks/wrap_networks.txt"), std::string::npos) << none.err;
+  fs::remove(path("s.sto"));
   std::ofstream(path("bad_net.txt")) << "not a network\n";
   const CmdResult bad = run(sim + " --wrap-network " + path("bad_net.txt") + " --out " + path("s.sto"));
   EXPECT_EQ(bad.code, 2) << bad.err;

@@ -52,9 +52,9 @@ double calcModelPathLength(const Model& model, const Muscle& muscle, const VecX&
         NetworkWrapOptions no;
         no.fallback.width = o.width;
         NetworkWrapEval ev;
-        const double l =
-            calcNetworkWrapPathLength(o.network.get(), w.surface, p1, p2, kNetworkLengthSegments, ws, &ev, no);
-        if (monitor) monitor->record(muscle.name, w.name, ev, o.network.get());
+        const Mlp* net = o.networkFor(w.name, wrapTypeName(w.surface.type));
+        const double l = calcNetworkWrapPathLength(net, w.surface, p1, p2, kNetworkLengthSegments, ws, &ev, no);
+        if (monitor) monitor->record(muscle.name, w.name, ev, net);
         // the fallback is the smooth model: its own length, not a polyline through its points
         length += ev.usedNetwork()
                       ? l

@@ -3,9 +3,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
+#include "core/geometry/constructions.hpp"
+#include "core/geometry/dual.hpp"
 #include "core/muscles/mass_points.hpp"
 #include "core/muscles/path.hpp"
 
@@ -36,6 +39,19 @@ bool quadrantChangesPath(const WrapSurface& s, const Vec3& a, const Vec3& b) {
   return forced || (calcWrapPenetration(s, a, b) > 0.0 && !(sign * near_axis > 0.0));
 }
 
+// Where the cylinder's finite length changes the path the networks learnt (an effectively infinite
+// cylinder): the library and the smooth model give no wrap when both tangent points lie beyond the
+// ends (|z| > L/2), and only then; an end point beyond an end alone changes nothing. Only asked
+// when an end point lies beyond an end (otherwise the tangent points lie within).
+bool finiteLengthChangesPath(const WrapSurface& s, const Vec3& p1, const Vec3& p2) {
+  if (s.type != WrapType::Cylinder) return false;
+  if (std::abs(p1.z()) <= 0.5 * s.length && std::abs(p2.z()) <= 0.5 * s.length) return false;
+  detail::V3<double> r1, r2;
+  bool long_wrap = false;
+  return !detail::cylinderTangentPoints(s.radius, s.length, s.quadrant_axis, s.quadrant_sign,
+                                        detail::constant<double>(p1), detail::constant<double>(p2), r1, r2, long_wrap);
+}
+
 void checkEndPoints(const WrapSurface& s, const Vec3& p1, const Vec3& p2) {
   if (!p1.allFinite() || !p2.allFinite() || p1 == p2)
     throw std::invalid_argument("network wrap: degenerate end points");
@@ -43,6 +59,49 @@ void checkEndPoints(const WrapSurface& s, const Vec3& p1, const Vec3& p2) {
 }
 
 }  // namespace
+
+WrapNetworkMap wrapNetworkMap(const Mlp& net) {
+  WrapNetworkMap m;
+  const auto it = net.meta.find("wrap_map");
+  if (it == net.meta.end()) return m;
+  std::istringstream is(it->second);
+  std::string kind, extra;
+  double C = 0.0;
+  if (!(is >> kind) || kind != "compact" || !(is >> C) || (is >> extra) || !std::isfinite(C) || !(C > 0.0))
+    throw std::invalid_argument("meta wrap_map '" + it->second + "': expected 'compact C' with a number C > 0");
+  m.compact = C;
+  return m;
+}
+
+std::string formatCompactWrapMap(double C) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "compact %.17g", C);
+  return buf;
+}
+
+Vec3 calcCompactWrapInput(const Vec3& q, double C, Mat3* M, const Vec3* qdot, Mat3* Mdot) {
+  const double r = q.norm();
+  const double g = 1.0 / (1.0 + r / C);
+  if (r == 0.0) {  // du/dq = I there (the second derivative has no limit; no end point sits there)
+    if (M) M->setIdentity();
+    if (Mdot) Mdot->setZero();
+    return q;
+  }
+  // M = g I - h q q^T with h = g^2 / (C r)
+  const double h = g * g / (C * r);
+  if (M) *M = g * Mat3::Identity() - h * q * q.transpose();
+  if (Mdot && qdot) {
+    const double rdot = q.dot(*qdot) / r;
+    const double gdot = -g * g * rdot / C;
+    const double hdot = 2.0 * g * gdot / (C * r) - g * g * rdot / (C * r * r);
+    *Mdot = gdot * Mat3::Identity() - hdot * q * q.transpose() - h * (*qdot * q.transpose() + q * qdot->transpose());
+  } else if (Mdot) {
+    Mdot->setZero();
+  }
+  return g * q;
+}
+
+Vec3 calcCompactWrapInputInverse(const Vec3& u, double C) { return u / (1.0 - u.norm() / C); }
 
 int wrapInputSize(WrapType type) {
   switch (type) {
@@ -70,7 +129,7 @@ std::string toString(NetworkWrapFallback why) {
     case NetworkWrapFallback::NoNetwork: return "no network";
     case NetworkWrapFallback::SurfaceType: return "network trained for another surface type";
     case NetworkWrapFallback::Quadrant: return "the quadrant makes the path wrap round the active side";
-    case NetworkWrapFallback::FiniteLength: return "end point beyond the cylinder's length";
+    case NetworkWrapFallback::FiniteLength: return "both tangent points beyond the cylinder's ends";
     case NetworkWrapFallback::OutsideBox: return "outside the training box";
   }
   return "?";
@@ -91,6 +150,11 @@ std::string networkWrapUnsupportedReason(const Mlp& net) {
     return "a wrap network maps 8 inputs (origin, insertion, alpha, radius) to 3 outputs, this one maps " +
            std::to_string(net.inputs()) + " to " + std::to_string(net.outputs());
   if (net.input_min.size() != 8 || net.input_max.size() != 8) return "the network stores no training box";
+  try {
+    wrapNetworkMap(net);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
   return "";
 }
 
@@ -136,14 +200,20 @@ NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface,
     ev.fallback = NetworkWrapFallback::SurfaceType;  // networks take one radius: cylinders and spheres
   } else if (quadrantChangesPath(surface, p1, p2)) {
     ev.fallback = NetworkWrapFallback::Quadrant;
-  } else if (surface.type == WrapType::Cylinder &&
-             (std::abs(p1.z()) > 0.5 * surface.length || std::abs(p2.z()) > 0.5 * surface.length)) {
+  } else if (finiteLengthChangesPath(surface, p1, p2)) {
     ev.fallback = NetworkWrapFallback::FiniteLength;
   } else {
-    // scaled inputs (size units, radius 1) and the box test on each of them
+    // scaled inputs (size units, radius 1; through the compact map when the file declares it) and
+    // the box test on each of them
     const double c = 1.0 / surface.radius;
+    const WrapNetworkMap map = wrapNetworkMap(*net);
+    Vec3 u1 = c * p1, u2 = c * p2;
+    if (map.isCompact()) {
+      u1 = calcCompactWrapInput(c * p1, map.compact);
+      u2 = calcCompactWrapInput(c * p2, map.compact);
+    }
     ws.X.resize(8, n);
-    for (int k = 0; k < n; ++k) ws.X.col(k) << c * p1, c * p2, alphas[k], 1.0;
+    for (int k = 0; k < n; ++k) ws.X.col(k) << u1, u2, alphas[k], 1.0;
     for (int k = 0; k < n && ev.usedNetwork(); ++k)
       for (int i = 0; i < 8; ++i) {
         const double v = ws.X(i, k);
@@ -152,6 +222,46 @@ NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface,
           break;
         }
       }
+  }
+
+  if (ev.usedNetwork() && wrapNetworkMap(*net).isCompact()) {
+    // displacement from the straight line over compact inputs (header)
+    const double R = surface.radius, c = 1.0 / R, C = wrapNetworkMap(*net).compact;
+    const Vec3 q1 = c * p1, q2 = c * p2, q1d = c * p1dot, q2d = c * p2dot;
+    Mat3 M1, M2, M1d, M2d;
+    calcCompactWrapInput(q1, C, &M1, with_jdot ? &q1d : nullptr, &M1d);
+    calcCompactWrapInput(q2, C, &M2, with_jdot ? &q2d : nullptr, &M2d);
+    if (with_jdot) {
+      const Vec3 u1d = M1 * q1d, u2d = M2 * q2d;
+      ws.Xdot.resize(8, n);
+      for (int k = 0; k < n; ++k) ws.Xdot.col(k) << u1d, u2d, alphadot(k), 0.0;
+      if (options.fd_jdot)
+        net->calcJacobianDotFd(ws.X, ws.Xdot, options.fd_eps > 0.0 ? options.fd_eps : 1e-6, ws.Y, ws.J, ws.Jdot, ws.mlp);
+      else
+        net->calcJacobianDot(ws.X, ws.Xdot, ws.Y, ws.J, ws.Jdot, ws.mlp);
+    } else {
+      net->calcJacobian(ws.X, ws.Y, ws.J, ws.mlp);
+    }
+    const Mat3 I = Mat3::Identity();
+    for (int k = 0; k < n; ++k) {
+      const double a = alphas[k], ad = alphadot(k);
+      const auto Jn = ws.J.block<3, 8>(0, 8 * k);
+      out.x[k] = R * (q1 + a * (q2 - q1) + ws.Y.col(k));
+      out.J[k].leftCols<3>() = (1.0 - a) * I + Jn.leftCols<3>() * M1;
+      out.J[k].rightCols<3>() = a * I + Jn.middleCols<3>(3) * M2;
+      if (with_jdot) {
+        const auto Jnd = ws.Jdot.block<3, 8>(0, 8 * k);
+        out.Jdot[k].leftCols<3>() = -ad * I + Jnd.leftCols<3>() * M1 + Jn.leftCols<3>() * M1d;
+        out.Jdot[k].rightCols<3>() = ad * I + Jnd.middleCols<3>(3) * M2 + Jn.middleCols<3>(3) * M2d;
+      } else {
+        out.Jdot[k].setZero();
+      }
+      if (x_alpha) (*x_alpha)[k] = (p2 - p1) + R * Jn.col(6);
+      if (x_alphadot)
+        (*x_alphadot)[k] = with_jdot ? Vec3((p2dot - p1dot) + R * ws.Jdot.col(8 * k + 6)) : Vec3::Zero();
+    }
+    out.used_network = true;
+    return ev;
   }
 
   if (ev.usedNetwork()) {
@@ -228,9 +338,11 @@ void WrapFallbackMonitor::add(const Muscle& muscle, const WrapFallbackCounts& w)
   for (int i = 1; i < WrapFallbackCounts::kReasons; ++i)
     if (w.by_reason[i] > 0) c.by_reason[static_cast<NetworkWrapFallback>(i)] += w.by_reason[i];
   if (before > 0 || w.fallbacks == 0) return;
-  c.first = w.first.describe(muscle.wrap.network.get());
   const auto& wraps = muscle.path.wraps;
   const bool named = w.first_wrap >= 0 && w.first_wrap < static_cast<int>(wraps.size());
+  c.first = w.first.describe(named ? muscle.wrap.networkFor(wraps[w.first_wrap].name,
+                                                            wrapTypeName(wraps[w.first_wrap].surface.type))
+                                   : muscle.wrap.network.get());
   warnFirst(muscle.name, named ? wraps[w.first_wrap].name : std::string("?"), before, c);
 }
 
@@ -277,17 +389,35 @@ NetworkWrapEval calcNeuralWrapModelPoints(const WrapMassOptions& options, const 
                                           const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
                                           const std::vector<double>& alphas, const std::vector<double>& alphadots,
                                           bool velocity, WrapMassPoints& out, NetworkWrapWorkspace& ws,
-                                          std::vector<Vec3>* x_alpha, std::vector<Vec3>* x_alphadot) {
+                                          std::vector<Vec3>* x_alpha, std::vector<Vec3>* x_alphadot, const Mlp* net) {
   NetworkWrapOptions o;
   o.fd_jdot = options.network_fd_jdot;
   o.fd_eps = options.network_fd_eps > 0.0 ? options.network_fd_eps : 1e-6;
   o.fallback.width = options.width;
-  return calcNetworkWrapModel(options.network.get(), surface, p1, p2, p1dot, p2dot, alphas, velocity, out, ws, o,
+  return calcNetworkWrapModel(net ? net : options.network.get(), surface, p1, p2, p1dot, p2dot, alphas, velocity, out, ws, o,
                               alphadots, x_alpha, x_alphadot);
 }
 
 std::shared_ptr<const Mlp> loadWrapNetwork(const std::string& path) {
-  auto net = std::make_shared<Mlp>(Mlp::load(path));
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw std::runtime_error(path + ": cannot open");
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  const std::string text = ss.str();
+  auto net = std::make_shared<Mlp>(Mlp::fromText(text, path));
+  try {
+    wrapNetworkMap(*net);
+  } catch (const std::invalid_argument& e) {
+    // name the meta line, as the format's own errors do
+    std::istringstream in(text);
+    std::string line;
+    int no = 0, at = 0;
+    while (std::getline(in, line) && at == 0) {
+      ++no;
+      if (line.rfind("meta wrap_map", 0) == 0) at = no;
+    }
+    throw NetworkFormatError(path + ":" + std::to_string(at) + ": " + e.what());
+  }
   const std::string why = networkWrapUnsupportedReason(*net);
   if (!why.empty()) throw std::runtime_error(path + ": not a wrap network: " + why);
   return net;

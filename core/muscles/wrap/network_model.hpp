@@ -10,6 +10,16 @@
 // (scale-free), and Jwdot = d/dt (dy/du) along udot = (p1dot / R, p2dot / R): the network's Jdot
 // along the scaled velocities.
 //
+// Input/output map (`meta wrap_map` in the network file). Absent (older files): the network sees
+// q = p / R as above and outputs the point itself (in radii), so its training box bounds how far the
+// end points may be. `compact C` (C > 0; `redmax train-wrap`'s files since issue 22): each end point
+// enters as u = q / (1 + |q| / C), which maps all of space into the ball |u| < C (near end points
+// keep their coordinates, far ones crowd towards the sphere |u| = C), and the output is the
+// point's displacement d from the straight line, x = R (q1 + alpha (q2 - q1) + d(u1, u2, alpha)):
+// d is zero on every straight path and of the order of the radius when the path wraps, however
+// far the ends. Then Jw = d(q1 + alpha (q2 - q1))/dq + (dd/du) (du/dq) and Jwdot adds
+// (d/dt dd/du) du/dq + dd/du d/dt(du/dq) and the alpha rate's -alphadot I, alphadot I.
+//
 // Jdot. Exact (forward tangents through the layers, Mlp::calcJacobianDot) by default, or the
 // dissertation's forward difference of Jacobians [D Eq. 5.58] (Mlp::calcJacobianDotFd) with a time
 // step eps (s) along the scaled velocity; its error is O(eps |udot|^2 |d2J/du2|).
@@ -22,8 +32,10 @@
 //     round the active side although the line passes on the other (a forced wrap, or a contact
 //     whose point nearest the axis lies on the inactive side): networks are trained without a
 //     quadrant; elsewhere the quadrant does not change the path (the smooth model's split);
-//   - an end point of a cylinder lies beyond its finite length (|z| > L/2): networks are trained on
-//     an effectively infinite cylinder; with both |z| <= L/2 the tangent points lie within it;
+//   - the cylinder's finite length changes the path: networks are trained on an effectively
+//     infinite cylinder, and OpenSim's finite one differs from it only where both tangent points
+//     lie beyond its ends (|z| > L/2: no wrap); an end point beyond an end alone changes nothing
+//     (before issue 22 any end point beyond an end fell back);
 //   - any scaled input of any point lies outside the network's training box (input_min/input_max
 //     stored in the network file) [D Sec. 6.2.7].
 // The fallback model is C2 but not equal to the network, so a switch between them moves the
@@ -56,7 +68,7 @@ enum class NetworkWrapFallback {
   NoNetwork,     ///< no network was given
   SurfaceType,   ///< the network was trained for another surface type (meta surface)
   Quadrant,      ///< a cylinder quadrant makes the path wrap round the active side
-  FiniteLength,  ///< an end point lies beyond the cylinder's length
+  FiniteLength,  ///< both tangent points lie beyond the cylinder's ends (no wrap there)
   OutsideBox     ///< a scaled input lies outside the training box
 };
 
@@ -86,6 +98,25 @@ struct NetworkWrapWorkspace {
   MlpWorkspace mlp;
   MatX X, Xdot, Y, J, Jdot;
 };
+
+/// The input/output map of a wrap network (header): compact = 0 for the older files' map (scaled
+/// end points in, absolute points out); compact = C > 0 for `meta wrap_map compact C`.
+struct WrapNetworkMap {
+  double compact = 0.0;
+  bool isCompact() const { return compact > 0.0; }
+};
+
+/// The map a network's `meta wrap_map` declares; std::invalid_argument for a value other than
+/// "compact C" with a finite C > 0.
+WrapNetworkMap wrapNetworkMap(const Mlp& net);
+/// The meta value for a compact map ("compact C", C written with 17 digits).
+std::string formatCompactWrapMap(double C);
+
+/// u = q / (1 + |q| / C) (header), with M = du/dq and, when qdot is given, Mdot = d/dt M along qdot.
+Vec3 calcCompactWrapInput(const Vec3& q, double C, Mat3* M = nullptr, const Vec3* qdot = nullptr,
+                          Mat3* Mdot = nullptr);
+/// The inverse: q = u / (1 - |u| / C) for |u| < C.
+Vec3 calcCompactWrapInputInverse(const Vec3& u, double C);
 
 /// "" when `net` can be a wrap network at all (8 inputs: origin, insertion, alpha, radius; 3
 /// outputs), else why not.
@@ -166,14 +197,14 @@ class WrapFallbackMonitor {
 };
 
 /// The Neural case of the wrap-model dispatch (core/muscles/wrap_muscle.cpp calcWrapModelPoints):
-/// calcNetworkWrapModel with the network and options of `options` (network_fd_jdot,
+/// calcNetworkWrapModel with the network `net` (null: options.network) and the options of `options` (network_fd_jdot,
 /// network_fd_eps, width of the fallback) in the caller's workspace `ws`.
 NetworkWrapEval calcNeuralWrapModelPoints(const WrapMassOptions& options, const WrapSurface& surface, const Vec3& p1,
                                           const Vec3& p2, const Vec3& p1dot, const Vec3& p2dot,
                                           const std::vector<double>& alphas, const std::vector<double>& alphadots,
                                           bool velocity, WrapMassPoints& out, NetworkWrapWorkspace& ws,
                                           std::vector<Vec3>* x_alpha = nullptr,
-                                          std::vector<Vec3>* x_alphadot = nullptr);
+                                          std::vector<Vec3>* x_alphadot = nullptr, const Mlp* net = nullptr);
 
 /// Input layout of the network of a surface type: origin (3), insertion (3), alpha, then the
 /// size parameters: radius (cylinder, sphere), semi-axes a b c (ellipsoid), inner and outer

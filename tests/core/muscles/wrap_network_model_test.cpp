@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <unistd.h>
 #include <random>
 #include <string>
 #include <vector>
@@ -123,6 +125,130 @@ TEST(NetworkWrapModel, JacobiansMatchCentralDifferencesSphere) {
   checkModelAgainstFd(*net, WrapSurface::makeSphere(0.03), 2.8, 5);
 }
 
+// ---------------------------------------------------------------------------------------------
+// the compact input map and displacement output (meta wrap_map compact C, issue 22)
+
+TEST(NetworkWrapModel, CompactMapRoundTripAndDerivatives) {
+  std::mt19937 rng(11);
+  for (const double C : {1.0, 4.0, 10.0})
+    for (int trial = 0; trial < 20; ++trial) {
+      // from near the origin to 1000 radii
+      const Vec3 q = std::pow(10.0, 3.0 * std::uniform_real_distribution<double>(-0.5, 1.0)(rng)) *
+                     test::randomVec(rng, 1.0).normalized();
+      const Vec3 qd = test::randomVec(rng, 1.0);
+      Mat3 M, Md;
+      const Vec3 u = calcCompactWrapInput(q, C, &M, &qd, &Md);
+      EXPECT_LT(u.norm(), C);
+      EXPECT_LE((calcCompactWrapInputInverse(u, C) - q).norm(), 1e-12 * (1.0 + q.norm()) * (1.0 + q.norm() / C));
+      // du/dq and its time derivative along qdot: central differences
+      const double h = 1e-6 * (1.0 + q.norm());
+      Mat3 M_fd, Md_fd;
+      for (int i = 0; i < 3; ++i) {
+        const Vec3 e = h * Vec3::Unit(i);
+        M_fd.col(i) = (calcCompactWrapInput(q + e, C) - calcCompactWrapInput(q - e, C)) / (2 * h);
+      }
+      Mat3 Mp, Mm;
+      calcCompactWrapInput(q + h * qd, C, &Mp);
+      calcCompactWrapInput(q - h * qd, C, &Mm);
+      Md_fd = (Mp - Mm) / (2 * h);
+      EXPECT_TRUE(closeRel(M, M_fd, 1e-7, "du/dq")) << "C " << C << " q " << q.transpose();
+      EXPECT_TRUE(closeRel(Md, Md_fd, 1e-6, "d/dt du/dq")) << "C " << C << " q " << q.transpose();
+    }
+  // near end points keep their coordinates to first order
+  Mat3 M0;
+  EXPECT_EQ(calcCompactWrapInput(Vec3::Zero(), 4.0, &M0), Vec3::Zero());
+  EXPECT_EQ(M0, Mat3::Identity());
+}
+
+// a random network with the compact map and a box of all of space
+Mlp compactNetwork(double C, unsigned seed) {
+  Mlp net(8, {12, 9}, 3, seed);
+  std::mt19937 rng(seed + 7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int l = 0; l < net.layers(); ++l)
+    net.biases(l) = VecX::NullaryExpr(net.biases(l).size(), [&] { return 0.4 * u(rng); });
+  net.output_scale = VecX::Constant(3, 0.3);
+  net.input_min = VecX::Constant(8, -C);
+  net.input_max = VecX::Constant(8, C);
+  net.input_min[6] = 0.0;
+  net.input_max[6] = 1.0;
+  net.meta["surface"] = "cylinder";
+  net.meta["wrap_map"] = formatCompactWrapMap(C);
+  return net;
+}
+
+TEST(NetworkWrapModel, CompactMapJacobiansMatchCentralDifferences) {
+  // J, Jdot, dw/dalpha and its rate through the map and the displacement output
+  checkModelAgainstFd(compactNetwork(4.0, 21), WrapSurface::makeCylinder(0.05, 0.2), 1.8, 23);
+  Mlp sphere = compactNetwork(2.0, 22);
+  sphere.meta["surface"] = "sphere";
+  checkModelAgainstFd(sphere, WrapSurface::makeSphere(0.03), 2.8, 24);
+}
+
+TEST(NetworkWrapModel, CompactMapServesFarEndsAndOutputsTheDisplacement) {
+  // zero output: the straight line exactly, however far the ends (no box to leave)
+  Mlp net = compactNetwork(4.0, 31);
+  net.weights(net.layers() - 1).setZero();
+  net.biases(net.layers() - 1).setZero();
+  net.output_mean.setZero();
+  const WrapSurface s = WrapSurface::makeCylinder(0.02, 100.0);
+  const Vec3 p1(-1.5, 0.9, 0.3), p2(2.0, -1.1, -0.2);  // 75-100 radii from the axis
+  const Vec3 v1(0.1, 0.2, -0.3), v2(-0.2, 0.1, 0.05);
+  const std::vector<double> alphas{0.0, 0.25, 0.5, 1.0}, alphadots{0.1, -0.2, 0.3, 0.0};
+  NetworkWrapWorkspace ws;
+  WrapMassPoints mp;
+  std::vector<Vec3> xa, xad;
+  const NetworkWrapEval ev = calcNetworkWrapModel(&net, s, p1, p2, v1, v2, alphas, true, mp, ws, {}, alphadots, &xa, &xad);
+  ASSERT_TRUE(ev.usedNetwork()) << ev.describe(&net);
+  for (size_t k = 0; k < alphas.size(); ++k) {
+    const double a = alphas[k];
+    EXPECT_LE((mp.x[k] - (p1 + a * (p2 - p1))).norm(), 1e-15) << k;
+    Eigen::Matrix<double, 3, 6> J;
+    J << (1 - a) * Mat3::Identity(), a * Mat3::Identity();
+    EXPECT_LE((mp.J[k] - J).norm(), 1e-15) << k;
+    Eigen::Matrix<double, 3, 6> Jd;
+    Jd << -alphadots[k] * Mat3::Identity(), alphadots[k] * Mat3::Identity();
+    EXPECT_LE((mp.Jdot[k] - Jd).norm(), 1e-15) << k;
+    EXPECT_LE((xa[k] - (p2 - p1)).norm(), 1e-15) << k;
+    EXPECT_LE((xad[k] - (v2 - v1)).norm(), 1e-15) << k;
+  }
+}
+
+TEST(NetworkWrapModel, WrapMapMetaIsCheckedWithItsLine) {
+  Mlp net = compactNetwork(4.0, 41);
+  EXPECT_EQ(wrapNetworkMap(net).compact, 4.0);
+  const auto dir = std::filesystem::temp_directory_path() / ("wrap_map_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  // the file round trip keeps the map bit for bit
+  net.save((dir / "good.txt").string());
+  const auto back = loadWrapNetwork((dir / "good.txt").string());
+  EXPECT_TRUE(back->identical(net));
+  EXPECT_EQ(wrapNetworkMap(*back).compact, 4.0);
+  // older files (no wrap_map) keep the older map
+  net.meta.erase("wrap_map");
+  EXPECT_FALSE(wrapNetworkMap(net).isCompact());
+  for (const std::string bad : {"compact -1", "compact", "compact 4 extra", "affine 2"}) {
+    net.meta["wrap_map"] = bad;
+    const std::string f = (dir / "bad.txt").string();
+    net.save(f);
+    // the meta line's number in the file: after the header lines, meta in key order
+    const std::string text = net.toText();
+    int line = 0, no = 0;
+    for (size_t pos = 0, next; pos < text.size() && line == 0; pos = next + 1) {
+      next = text.find('\n', pos);
+      ++no;
+      if (text.compare(pos, 13, "meta wrap_map") == 0) line = no;
+    }
+    try {
+      loadWrapNetwork(f);
+      ADD_FAILURE() << "accepted wrap_map '" << bad << "'";
+    } catch (const NetworkFormatError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(f + ":" + std::to_string(line) + ": meta wrap_map", 0), 0u) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // the network is trained in units of the surface size: a surface of radius R gets R y(p1 / R,
 // p2 / R, alpha, 1) (positions back in metres)
 TEST(NetworkWrapModel, PositionsAreTheNetworkAtTheSurfaceScale) {
@@ -200,11 +326,22 @@ TEST(NetworkWrapModel, FallbacksGiveTheSmoothModelExactly) {
   ev = calcNetworkWrapModel(sph.get(), s, p1, p2, v1, v2, alphas, true, mp, ws);
   EXPECT_EQ(ev.fallback, NetworkWrapFallback::SurfaceType);
   expectSmooth(s, p1, p2, v1, v2, alphas, mp);
-  // an end point beyond the cylinder's length (|z| = 0.25 > 0.2), inside the box (2.5 radii)
-  const Vec3 high(-0.15, 0.25, 0.25);
-  ev = calcNetworkWrapModel(cyl.get(), s, high, p2, v1, v2, alphas, true, mp, ws);
+  // an end point beyond the cylinder's length (|z| = 0.18 > 0.15) with the tangent points within it
+  // (and inside the box, |z| <= 2 radii): the finite cylinder's path is the infinite one's, so the
+  // network serves (issue 22)
+  const WrapSurface shorter = WrapSurface::makeCylinder(0.1, 0.3);
+  const Vec3 high(-0.25, 0.05, 0.18), low(0.25, 0.02, -0.1);
+  ASSERT_TRUE(calcWrap(shorter, high, low).wraps());
+  ev = calcNetworkWrapModel(cyl.get(), shorter, high, low, v1, v2, alphas, true, mp, ws);
+  EXPECT_TRUE(ev.usedNetwork()) << ev.describe(cyl.get());
+  // both ends (and so both tangent points) beyond the top end (|z| = 0.18, 0.19 > 0.15): the
+  // library gives no wrap although the line passes through the infinite cylinder, so the smooth model
+  const Vec3 high2(0.25, 0.02, 0.19);
+  ASSERT_FALSE(calcWrap(shorter, high, high2).wraps());
+  ASSERT_TRUE(calcWrap(WrapSurface::makeCylinder(0.1, 100.0), high, high2).wraps());
+  ev = calcNetworkWrapModel(cyl.get(), shorter, high, high2, v1, v2, alphas, true, mp, ws);
   EXPECT_EQ(ev.fallback, NetworkWrapFallback::FiniteLength);
-  expectSmooth(s, high, p2, v1, v2, alphas, mp);
+  expectSmooth(shorter, high, high2, v1, v2, alphas, mp);
   // quadrant -x with both ends on +x: OpenSim forces a wrap round -x
   const WrapSurface q = WrapSurface::makeCylinder(0.1, 0.4, 0, -1);
   const Vec3 a(0.05, 0.25, 0.0), b(0.05, -0.25, 0.0);
