@@ -386,6 +386,35 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   return res;
 }
 
+Trajectory simulateTrajectory(const Problem& pr, const VecX& p) {
+  const int nf = static_cast<int>(pr.forces.size());
+  const int ne = static_cast<int>(pr.excitations.size());
+  const int nq0 = static_cast<int>(pr.initial_q.size()), nv0 = static_cast<int>(pr.initial_qdot.size());
+  const VecX sp = p.size() == pr.numParameters() ? VecX(p.tail(pr.num_system_params)) : VecX();
+  const RunSystem rs = makeRunSystem(pr, sp);
+  checkProblem(pr, p, *rs.sys);
+  const int N = numSteps(pr);
+  const double h = pr.duration / N;
+  State s0 = pr.initial;
+  for (int j = 0; j < nq0; ++j) s0.q[pr.initial_q[j]] = p[nf + ne + j];
+  for (int j = 0; j < nv0; ++j) s0.qdot[pr.initial_qdot[j]] = p[nf + ne + nq0 + j];
+  Stepper stepper(pr, *rs.sys);
+  const std::vector<std::string> z_names = rs.sys->numStates() > 0 ? rs.sys->stateNames() : std::vector<std::string>{};
+  Trajectory tr;
+  tr.system = rs.sys;
+  VecX y = Stepper::pack(s0);
+  tr.states.push_back(s0);
+  for (int k = 0; k < N; ++k) {
+    const double t = pr.initial.t + k * h;
+    tr.controls.push_back(controlsAt(pr, rs, p, k, N));
+    y = stepper.step(y, t, h, tr.controls.back());
+    const double t1 = k + 1 == N ? pr.initial.t + pr.duration : t + h;
+    tr.states.push_back(stepper.unpack(y, t1));
+    checkFinite(tr.states.back(), h, pr.integrator.c_str(), &z_names);
+  }
+  return tr;
+}
+
 VecX finiteDifferenceGradient(const Problem& pr, const Objective& obj, const VecX& p) {
   VecX g(p.size());
   auto J = [&](const VecX& x) { return evaluate(pr, obj, x, false).objective; };

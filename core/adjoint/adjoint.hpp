@@ -123,6 +123,16 @@ class AdjointError : public std::runtime_error {
 /// diverges or produces NaN.
 Result evaluate(const Problem& problem, const Objective& objective, const VecX& p, bool with_gradient);
 
+/// The states y_0 .. y_N of the run at p and the controls of each step (the system's own, e.g.
+/// the clamped muscle excitations, then one per driven coordinate), with the system that ran
+/// them: the forward pass of evaluate, for plots and reports.
+struct Trajectory {
+  std::shared_ptr<const System> system;
+  std::vector<State> states;   ///< N + 1
+  std::vector<VecX> controls;  ///< N: step k's
+};
+Trajectory simulateTrajectory(const Problem& problem, const VecX& p);
+
 /// The gradient by central differences of whole simulations: the reference `redmax gradient
 /// --check` compares with. Per parameter, fourth-order differences (at p_i -+ e, -+ 2e) with
 /// e = r max(1, |p_i|) for r = 1e-3, 1e-4, 1e-5, 1e-6 (a mass steps at most a quarter of itself),
