@@ -10,6 +10,7 @@
 
 #include "cli/muscle_mass_flags.hpp"
 #include "converter/osim_reader.hpp"
+#include "core/muscles/hill/muscle_model.hpp"
 #include "validation/gradient/gradient.hpp"
 
 namespace redmax::cli {
@@ -51,6 +52,9 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
   } catch (const SimulationError& e) {
     std::cerr << "error: " << f.model << ": simulation failed: " << e.what() << "\n";
     return 1;
+  } catch (const hill::MuscleModelError& e) {
+    std::cerr << "error: " << f.model << ": simulation failed: " << e.what() << "\n";
+    return 1;
   }
   std::printf("gradient: %s, integrator %s, %ld steps of %.6g s, %d parameters, muscle mass %.4g kg\n",
               g.model.description.name.c_str(), f.integrator.c_str(), res.steps, f.duration / res.steps,
@@ -71,6 +75,9 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
     fd = adjoint::finiteDifferenceGradient(g.problem, g.objective, g.p0);
     fd_s = secondsSince(t0);
   } catch (const SimulationError& e) {
+    std::cerr << "error: " << f.model << ": simulation failed in the finite-difference check: " << e.what() << "\n";
+    return 1;
+  } catch (const hill::MuscleModelError& e) {
     std::cerr << "error: " << f.model << ": simulation failed in the finite-difference check: " << e.what() << "\n";
     return 1;
   }

@@ -151,6 +151,23 @@ TEST(HillGradientTerms, ExcitationsMakeTheMusclesPull) {
   EXPECT_EQ(adjoint::evaluate(e.problem, e.objective, e.p0, false).final.q[0], 0.0);
 }
 
+// excitations are clamped to the muscle's [min_control, max_control]: nodes above max_control
+// drive the run as max_control does, and their derivative is zero (the clamp is flat there)
+TEST(HillGradientTerms, ClampedNodesHaveZeroDerivative) {
+  SimulationModelOptions mo;
+  GradientSetup g = makeGradientSetup(osimModel("tug_of_war_step.osim"), mo, "euler", 0.05, 0.001,
+                                      "excitations:left_muscle@2,right_muscle=0.7", "point:block@0,0,0=0.05,0,0");
+  VecX p = g.p0;
+  p << 1.3, 1.6, 0.7;  // both left nodes above max_control = 1
+  const adjoint::Result r = adjoint::evaluate(g.problem, g.objective, p, true);
+  EXPECT_EQ(r.gradient[0], 0.0);
+  EXPECT_EQ(r.gradient[1], 0.0);
+  EXPECT_NE(r.gradient[2], 0.0);
+  VecX at_max = p;
+  at_max << 1.0, 1.0, 0.7;
+  EXPECT_EQ(adjoint::evaluate(g.problem, g.objective, at_max, false).objective, r.objective);
+}
+
 // zero muscle mass is the massless (lumped) model: the same gradient, bit for bit
 TEST(HillGradientTerms, ZeroMuscleMassReproducesTheMasslessGradient) {
   const std::string params = "excitations:left_muscle@4=0.8,right_muscle@2=0.7;q0:block_x=0.01;qdot0:block_x";

@@ -93,7 +93,11 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
     // computeInitialFiberEquilibrium), activations at their defaults
     DynamicsWorkspace ws(sys);
     ws.controls = pr.controls;
-    sys.equilibrateStates(pr.initial, ws);
+    try {
+      sys.equilibrateStates(pr.initial, ws);
+    } catch (const hill::MuscleModelError& e) {
+      throw ModelError(std::string("the muscles' initial fibre equilibrium: ") + e.what());
+    }
   }
 
   // parameters, collected per kind and then stacked in the problem's order

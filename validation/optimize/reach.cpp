@@ -66,6 +66,12 @@ class Tracker {
       if (result_.simulations == 0) throw;
       failed = true;
       ++result_.failed_simulations;
+    } catch (const hill::MuscleModelError& e) {
+      // excitations whose run drives a muscle model out of its domain (e.g. a damped fibre
+      // velocity that does not converge): the same, a failed run
+      if (result_.simulations == 0) throw SimulationError(e.what(), 0.0, setup_.options.dt);
+      failed = true;
+      ++result_.failed_simulations;
     }
     ReachEvaluation e;
     e.simulations = ++result_.simulations;
