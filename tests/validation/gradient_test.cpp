@@ -168,6 +168,21 @@ TEST(HillGradientTerms, ClampedNodesHaveZeroDerivative) {
   EXPECT_EQ(adjoint::evaluate(g.problem, g.objective, at_max, false).objective, r.objective);
 }
 
+// the cost does not depend on the number of nodes: one difference pair per excited muscle per
+// step, N (1 + 2 n_excited + 2 (2 n + n_z)) step evaluations
+TEST(HillGradientTerms, StepEvaluationsDoNotGrowWithTheNodes) {
+  SimulationModelOptions mo;
+  auto count = [&](const std::string& params) {
+    GradientSetup g = makeGradientSetup(osimModel("tug_of_war_step.osim"), mo, "euler", 0.05, 0.001, params,
+                                        "point:block@0,0,0=0.05,0,0");
+    return adjoint::evaluate(g.problem, g.objective, g.p0, true).step_evaluations;
+  };
+  const long two = count("excitations:left_muscle@2=0.6,right_muscle@2=0.5");
+  const long forty = count("excitations:left_muscle@40=0.6,right_muscle@40=0.5");
+  EXPECT_EQ(two, forty);
+  EXPECT_EQ(two, 50 * (1 + 2 * 2 + 2 * (2 * 1 + 4)));
+}
+
 // zero muscle mass is the massless (lumped) model: the same gradient, bit for bit
 TEST(HillGradientTerms, ZeroMuscleMassReproducesTheMasslessGradient) {
   const std::string params = "excitations:left_muscle@4=0.8,right_muscle@2=0.7;q0:block_x=0.01;qdot0:block_x";
