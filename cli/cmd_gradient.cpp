@@ -10,6 +10,7 @@
 
 #include "cli/muscle_mass_flags.hpp"
 #include "converter/osim_reader.hpp"
+#include "core/muscles/hill/muscle_model.hpp"
 #include "validation/gradient/gradient.hpp"
 
 namespace redmax::cli {
@@ -51,6 +52,9 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
   } catch (const SimulationError& e) {
     std::cerr << "error: " << f.model << ": simulation failed: " << e.what() << "\n";
     return 1;
+  } catch (const hill::MuscleModelError& e) {
+    std::cerr << "error: " << f.model << ": simulation failed: " << e.what() << "\n";
+    return 1;
   }
   std::printf("gradient: %s, integrator %s, %ld steps of %.6g s, %d parameters, muscle mass %.4g kg\n",
               g.model.description.name.c_str(), f.integrator.c_str(), res.steps, f.duration / res.steps,
@@ -71,6 +75,9 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
     fd = adjoint::finiteDifferenceGradient(g.problem, g.objective, g.p0);
     fd_s = secondsSince(t0);
   } catch (const SimulationError& e) {
+    std::cerr << "error: " << f.model << ": simulation failed in the finite-difference check: " << e.what() << "\n";
+    return 1;
+  } catch (const hill::MuscleModelError& e) {
     std::cerr << "error: " << f.model << ": simulation failed in the finite-difference check: " << e.what() << "\n";
     return 1;
   }
@@ -104,6 +111,11 @@ CommandRegistration reg(
                       "the parameters, groups separated by ';':\n"
                       "torques:C[@K][=V],...  constant generalized force on coordinate C in K\n"
                       "                       equal time pieces (default 1), value V (default 0)\n"
+                      "excitations:M[@K][=V],... excitation of muscle M as K nodes of a piecewise-\n"
+                      "                       linear function of time (default 1), value V (default\n"
+                      "                       0.1) within its [min_control, max_control]; the muscles\n"
+                      "                       then pull (Hill-type, activation and fibre states), the\n"
+                      "                       others at their min_control\n"
                       "q0:C[=V],...           initial value of C (default the model's)\n"
                       "qdot0:C[=V],...        initial speed of C\n"
                       "masses:M,...           mass of muscle M (from --muscle-mass-kg M=KG); required")
@@ -113,7 +125,8 @@ CommandRegistration reg(
                       "point:BODY@x,y,z=X,Y,Z W/2 |p - target|^2 at the end, p the point x,y,z of\n"
                       "                       BODY (body frame), target X,Y,Z in ground (m)\n"
                       "speed                  W/2 |qdot|^2 at the end (come to rest)\n"
-                      "effort                 W times the integral of the squared generalized forces;\n"
+                      "effort                 W times the integral of the squared generalized forces\n"
+                      "excitation             W times the integral of the squared excitations;\n"
                       "required")
            ->type_name("SPEC");
        app.add_flag("--check", f->check,
@@ -137,7 +150,8 @@ CommandRegistration reg(
            "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...]\n"
            "                       [--check [--check-tolerance T]]\n"
            "Simulates the model from its default pose with the given parameters (gravity, joint springs\n"
-           "and dampers, constraints, muscle inertia; the muscles pull no force) and prints the objective\n"
+           "and dampers, constraints, muscle inertia; the muscles pull only with excitations: parameters)\n"
+           "and prints the objective\n"
            "and its gradient by the discrete adjoint of the fixed-step integrator (docs/gradients.md).\n"
            "e.g. --params 'torques:r_shoulder_elev,r_elbow_flex' --objective 'point:r_ulna_radius_hand@0,-0.2,0=0.3,0.1,0.4'\n") +
            muscleMassFooter());

@@ -18,8 +18,10 @@ namespace {
 
 struct OptimizeFlags {
   std::string task, model, body = "hand", target, point = "0,0,0", integrator = "euler", method = "lbfgs,bobyqa";
-  std::string coordinates, report, muscle_mass_kg;
+  std::string coordinates, report, muscle_mass_kg, drive = "torques", muscles;
   double duration = 0.0, dt = 0.01, rest = 0.0, tolerance = 1e-3, max_torque = 100.0, initial_step = 1.0;
+  double initial_excitation = 0.1, excitation_weight = 0.0;
+  int nodes = 5;
   long max_simulations = 2000;
   bool quiet = false;
   MuscleMassFlags mm;
@@ -47,6 +49,19 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
   o.tolerance = f.tolerance;
   o.max_torque = f.max_torque;
   o.initial_step = f.initial_step;
+  o.drive = f.drive;
+  if (!f.muscles.empty()) o.muscles = splitList(f.muscles);
+  o.nodes = f.nodes;
+  o.initial_excitation = f.initial_excitation;
+  o.excitation_weight = f.excitation_weight;
+  const bool excite = f.drive == "excitations";
+  if (excite && !given(app, "--initial-step")) o.initial_step = 0.1;  // an excitation, not rad/s^2
+  if (!excite)
+    for (const char* n : {"--excite", "--nodes", "--initial-excitation", "--excitation-weight"})
+      if (given(app, n)) {
+        std::cerr << "error: " << n << ": needs --drive excitations\n";
+        return 2;
+      }
   o.max_simulations = f.max_simulations;
   const std::vector<std::string> methods = splitList(f.method);
   for (const auto& m : methods) {
@@ -64,8 +79,9 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
   if (const int rc = loadOrExit2(f.model, [&] { setup = validation::makeReachSetup(o); })) return rc;
   for (const auto& w : setup.gradient.model.build.warnings) std::cerr << "warning: " << w << "\n";
   if (!f.quiet)
-    std::fprintf(stderr, "reach: %s, %zu torques, hand at (%.4g, %.4g, %.4g) m, target (%.4g, %.4g, %.4g) m, %.4g kg of muscle mass\n",
-                 setup.gradient.model.description.name.c_str(), setup.gradient.param_names.size(), setup.start_point[0],
+    std::fprintf(stderr, "reach: %s, %zu %s, hand at (%.4g, %.4g, %.4g) m, target (%.4g, %.4g, %.4g) m, %.4g kg of muscle mass\n",
+                 setup.gradient.model.description.name.c_str(), setup.gradient.param_names.size(),
+                 excite ? "excitation nodes" : "torques", setup.start_point[0],
                  setup.start_point[1], setup.start_point[2], o.target[0], o.target[1], o.target[2],
                  setup.gradient.model.muscle_mass);
 
@@ -89,7 +105,7 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
     std::printf("%-12s %12ld %16ld %12.4f %14.6e %14.6e %8s  %s\n", r.method.c_str(), r.simulations, r.step_evaluations,
                 r.seconds, r.objective, r.error, r.reached ? "yes" : "no", r.stop.c_str());
   for (const auto& r : results) {
-    std::printf("%s torques (N m):", r.method.c_str());
+    std::printf(excite ? "%s excitations:" : "%s torques (N m):", r.method.c_str());
     for (Eigen::Index i = 0; i < r.torques.size(); ++i) std::printf(" %s=%.8g", setup.gradient.param_names[i].c_str(), r.torques[i]);
     std::printf("\n");
   }
@@ -152,8 +168,31 @@ CommandRegistration reg(
                       "torque divided by its coordinate's diagonal mass-matrix entry at the start; default 1)")
            ->type_name("T")
            ->check(positive());
+       app.add_option("--drive", f->drive,
+                      "what drives the arm: torques (constant generalized forces, default) or\n"
+                      "excitations (the muscles' excitations as piecewise-linear nodes; the Hill-type\n"
+                      "muscles pull, activation and fibre length are states; needs dt of about 0.5 ms)")
+           ->type_name("torques|excitations")
+           ->check(oneOf({"torques", "excitations"}));
+       app.add_option("--excite", f->muscles,
+                      "--drive excitations: the excited muscles (default: all with a Hill-type model;\n"
+                      "the others stay at their min_control)")
+           ->type_name("M,...");
+       app.add_option("--nodes", f->nodes, "--drive excitations: nodes per muscle over the run (default 5)")
+           ->type_name("K")
+           ->check(between(1, 100000, true));
+       app.add_option("--initial-excitation", f->initial_excitation,
+                      "--drive excitations: every node's start value (default 0.1)")
+           ->type_name("E");
+       app.add_option("--excitation-weight", f->excitation_weight,
+                      "--drive excitations: weight W of W times the integral of the squared excitations\n"
+                      "(default 0)")
+           ->type_name("W")
+           ->check(nonNegative());
        app.add_option("--report", f->report,
-                      "write DIR/report.md, DIR/<method>_iterations.csv, DIR/objective.png (gnuplot)")
+                      "write DIR/report.md, DIR/<method>_iterations.csv, DIR/objective.png (gnuplot);\n"
+                      "with --drive excitations also DIR/best_run.csv and DIR/best_run.png (hand path,\n"
+                      "excitations, tendon forces; the lumped replay when the muscles carry mass)")
            ->type_name("DIR");
        app.add_flag("--quiet", f->quiet, "no progress on stderr");
        app.add_option("--muscle-mass-kg", f->muscle_mass_kg,
@@ -165,9 +204,11 @@ CommandRegistration reg(
            "usage: redmax optimize --task reach --model M.osim --target X,Y,Z --duration S\n"
            "                       [--body BODY] [--point x,y,z] [--dt H] [--integrator euler|bdf1|sdirk2]\n"
            "                       [--method lbfgs,nelder-mead,bobyqa] [--rest WEIGHT] [--tolerance T]\n"
+           "                       [--drive excitations [--excite M,...] [--nodes K]]\n"
            "                       [MUSCLE-MASS OPTIONS] [--report DIR]\n"
            "Finds constant generalized forces on the model's coordinates that bring the point to the target\n"
            "at the end of a run from the default pose (gravity, muscle inertia; the muscles pull no force),\n"
+           "or with --drive excitations the muscles' excitation nodes (the muscles pull),\n"
            "[D Sec. 6.2.11]: minimizes 1/2 |p - target|^2 (+ WEIGHT/2 |qdot|^2) with each method from zero\n"
            "and prints simulations, wall time and final error per method (docs/gradients.md §7).\n"
            "e.g. redmax optimize --task reach --model osim_models/reach_arm.osim --point 0,-0.08,0\n"

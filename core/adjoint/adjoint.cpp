@@ -16,23 +16,59 @@ namespace {
 // truncation error (h^2) and the round-off (eps / h) of a central difference meet
 constexpr double kStepFdRel = 6e-6;
 
+// an excitation-driven control: its nodes' parameter indices (into Problem::excitations)
+struct Excited {
+  int control = -1;
+  int nodes = 1;
+  double min = 0.0, max = 1.0;
+  std::vector<int> param;  // per node
+};
+
 // the system of a run: the problem's system plus one CoordinateActuatorTerm (optimal force 1)
-// whose controls are the generalized forces of the driven coordinates
+// whose controls are the generalized forces of the driven coordinates, after the system's own
+// controls (muscle excitations)
 struct RunSystem {
   std::shared_ptr<System> sys;
+  int nu_base = 0;                   // the problem system's own controls
   std::vector<int> driven;           // distinct driven coordinates, in control order
-  std::vector<int> control_of;       // per force parameter: its control index
+  std::vector<int> control_of;       // per force parameter: its control index (after nu_base)
+  std::vector<Excited> excited;      // distinct excitation-driven controls
 };
 
 RunSystem makeRunSystem(const Problem& pr, const VecX& system_params) {
   if (!pr.make_system) throw AdjointError("adjoint: the problem has no system");
   const std::shared_ptr<const System> base = pr.make_system(system_params);
   if (!base) throw AdjointError("adjoint: the system factory returned no system");
-  if (base->numControls() > 0 || !base->controllers().empty())
-    throw AdjointError("adjoint: the system has actuators with controls; only generalized-force parameters drive it");
+  if (!base->controllers().empty())
+    throw AdjointError("adjoint: the system has controllers; only generalized-force and excitation parameters drive it");
   if (base->coordinateMap()) throw AdjointError("adjoint: hyper-reduced coordinates (a coordinate map) are not supported");
   RunSystem rs;
   rs.sys = std::make_shared<System>(*base);
+  rs.nu_base = base->numControls();
+  if (pr.controls.size() != 0 && pr.controls.size() != rs.nu_base)
+    throw AdjointError("adjoint: " + std::to_string(pr.controls.size()) + " constant controls for a system with " +
+                       std::to_string(rs.nu_base));
+  std::map<int, int> ex_index;
+  for (size_t j = 0; j < pr.excitations.size(); ++j) {
+    const ExcitationParameter& ep = pr.excitations[j];
+    if (ep.control < 0 || ep.control >= rs.nu_base)
+      throw AdjointError("adjoint: excitation parameter on control " + std::to_string(ep.control) +
+                         " outside the system's " + std::to_string(rs.nu_base));
+    if (ep.nodes < 1 || ep.node < 0 || ep.node >= ep.nodes || !(ep.min <= ep.max))
+      throw AdjointError("adjoint: excitation parameter node " + std::to_string(ep.node) + " of " +
+                         std::to_string(ep.nodes) + " or bounds [" + std::to_string(ep.min) + ", " +
+                         std::to_string(ep.max) + "]");
+    auto [it, fresh] = ex_index.emplace(ep.control, static_cast<int>(rs.excited.size()));
+    if (fresh) rs.excited.push_back({ep.control, ep.nodes, ep.min, ep.max, std::vector<int>(ep.nodes, -1)});
+    Excited& ex = rs.excited[it->second];
+    if (ex.nodes != ep.nodes || ex.min != ep.min || ex.max != ep.max || ex.param[ep.node] >= 0)
+      throw AdjointError("adjoint: the excitation parameters of control " + std::to_string(ep.control) +
+                         " disagree on their nodes or bounds, or repeat a node");
+    ex.param[ep.node] = static_cast<int>(j);
+  }
+  for (const Excited& ex : rs.excited)
+    for (int i : ex.param)
+      if (i < 0) throw AdjointError("adjoint: control " + std::to_string(ex.control) + " lacks an excitation node");
   const int nr = base->model().nr();
   std::map<int, int> index;
   std::vector<CoordinateActuatorTerm::Actuator> acts;
@@ -48,7 +84,7 @@ RunSystem makeRunSystem(const Problem& pr, const VecX& system_params) {
       rs.driven.push_back(fp.coordinate);
       acts.push_back({"u_" + std::to_string(fp.coordinate), fp.coordinate, 1.0});
     }
-    rs.control_of.push_back(it->second);
+    rs.control_of.push_back(rs.nu_base + it->second);
   }
   if (!acts.empty()) rs.sys->addTerm(std::make_shared<CoordinateActuatorTerm>(base->model(), std::move(acts)));
   return rs;
@@ -61,9 +97,39 @@ int numSteps(const Problem& pr) {
   return static_cast<int>(std::max(1L, static_cast<long>(std::ceil(ratio - 1e-9))));  // as advance()
 }
 
-// the controls (one per driven coordinate) during step k of n
+// the hat-function weights of step k of n on a piecewise-linear excitation with `nodes` nodes
+// over the run: w0 on node i0, w1 on node i0 + 1 (the interpolant at the step's start time)
+void hatWeights(int nodes, int k, int n, int& i0, double& w0, double& w1) {
+  if (nodes == 1) {
+    i0 = 0;
+    w0 = 1.0;
+    w1 = 0.0;
+    return;
+  }
+  const double s = static_cast<double>(k) * (nodes - 1) / n;  // in [0, nodes - 1)
+  i0 = std::min(static_cast<int>(std::floor(s)), nodes - 2);
+  w1 = s - i0;
+  w0 = 1.0 - w1;
+}
+
+// the interpolated excitation of ex at step k of n, before clamping
+double excitationAt(const Excited& ex, const VecX& p, int nf, int k, int n) {
+  int i0 = 0;
+  double w0 = 0.0, w1 = 0.0;
+  hatWeights(ex.nodes, k, n, i0, w0, w1);
+  double e = w0 * p[nf + ex.param[i0]];
+  if (w1 != 0.0) e += w1 * p[nf + ex.param[i0 + 1]];
+  return e;
+}
+
+// the controls during step k of n: the system's own (constant, or the clamped excitations), then
+// one per driven coordinate
 VecX controlsAt(const Problem& pr, const RunSystem& rs, const VecX& p, int k, int n) {
-  VecX u = VecX::Zero(static_cast<Eigen::Index>(rs.driven.size()));
+  VecX u = VecX::Zero(rs.nu_base + static_cast<Eigen::Index>(rs.driven.size()));
+  if (pr.controls.size() != 0) u.head(rs.nu_base) = pr.controls;
+  const int nf = static_cast<int>(pr.forces.size());
+  for (const Excited& ex : rs.excited)
+    u[ex.control] = std::clamp(excitationAt(ex, p, nf, k, n), ex.min, ex.max);
   for (size_t j = 0; j < pr.forces.size(); ++j) {
     const ForceParameter& fp = pr.forces[j];
     if (static_cast<long>(k) * fp.pieces / n == fp.piece) u[rs.control_of[j]] += p[static_cast<Eigen::Index>(j)];
@@ -172,6 +238,7 @@ void checkProblem(const Problem& pr, const VecX& p, const System& sys) {
 
 Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool with_gradient) {
   const int nf = static_cast<int>(pr.forces.size());
+  const int ne = static_cast<int>(pr.excitations.size());
   const int nq0 = static_cast<int>(pr.initial_q.size()), nv0 = static_cast<int>(pr.initial_qdot.size());
   const int ns = pr.num_system_params;
   const VecX sp = p.size() == pr.numParameters() ? VecX(p.tail(ns)) : VecX();
@@ -186,8 +253,9 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
 
   // initial state with its parameters
   State s0 = pr.initial;
-  for (int j = 0; j < nq0; ++j) s0.q[pr.initial_q[j]] = p[nf + j];
-  for (int j = 0; j < nv0; ++j) s0.qdot[pr.initial_qdot[j]] = p[nf + nq0 + j];
+  const int iq0 = nf + ne;  // the first initial-state parameter
+  for (int j = 0; j < nq0; ++j) s0.q[pr.initial_q[j]] = p[iq0 + j];
+  for (int j = 0; j < nv0; ++j) s0.qdot[pr.initial_qdot[j]] = p[iq0 + nq0 + j];
 
   Stepper stepper(pr, sys);
   const int ny = stepper.size();
@@ -195,11 +263,14 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   std::vector<VecX> y(N + 1);
   y[0] = Stepper::pack(s0);
   checkFinite(s0, h, pr.integrator.c_str(), &z_names);
-  double effort = 0.0;
+  double effort = 0.0, excitation_effort = 0.0;
+  const int nub = rs.nu_base;
+  const int nd = static_cast<int>(rs.driven.size());
   const auto forward_start = std::chrono::steady_clock::now();
   for (int k = 0; k < N; ++k) {
     const VecX u = controlsAt(pr, rs, p, k, N);
-    effort += h * u.squaredNorm();
+    effort += h * u.tail(nd).squaredNorm();
+    for (const Excited& ex : rs.excited) excitation_effort += h * u[ex.control] * u[ex.control];
     y[k + 1] = stepper.step(y[k], timeAt(k), h, u);
     checkFinite(stepper.unpack(y[k + 1], timeAt(k + 1)), h, pr.integrator.c_str(), &z_names);
   }
@@ -209,7 +280,8 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   res.final = stepper.unpack(y[N], timeAt(N));
   res.steps = N;
   VecX lambda;
-  res.objective = objectiveValue(sys, obj, res.final, with_gradient ? &lambda : nullptr) + obj.effort_weight * effort;
+  res.objective = objectiveValue(sys, obj, res.final, with_gradient ? &lambda : nullptr) + obj.effort_weight * effort +
+                  obj.excitation_weight * excitation_effort;
   if (!with_gradient) {
     res.step_evaluations = stepper.evaluations;
     return res;
@@ -231,15 +303,14 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
 
   // reverse sweep: lambda_k = (dPhi_k/dy)^T lambda_{k+1}, parameter terms from lambda_{k+1}
   res.gradient = VecX::Zero(pr.numParameters());
-  const int nd = static_cast<int>(rs.driven.size());
   MatX Jy(ny, ny);
-  VecX Ju(nd);
+  VecX Ju(nub + nd);
   for (int k = N - 1; k >= 0; --k) {
     const double t = timeAt(k);
     const VecX u = controlsAt(pr, rs, p, k, N);
     // generalized-force columns: one central difference per driven coordinate (the step is
     // linear in them for euler and bdf1, so this is exact up to round-off there)
-    for (int c = 0; c < nd; ++c) {
+    for (int c = nub; c < nub + nd; ++c) {
       const double e = fdStep(u[c]);
       VecX up = u, um = u;
       up[c] += e;
@@ -250,10 +321,28 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
       const ForceParameter& fp = pr.forces[j];
       if (static_cast<long>(k) * fp.pieces / N == fp.piece) res.gradient[j] += Ju[rs.control_of[j]];
     }
+    // excitation columns: one central difference per excitation-driven control, at the clamped
+    // value the step used; through the clamp (zero outside [min, max]) and the hat weights to the
+    // step's two nodes
+    for (const Excited& ex : rs.excited) {
+      const int c = ex.control;
+      const double e = fdStep(u[c]);
+      VecX up = u, um = u;
+      up[c] += e;
+      um[c] -= e;
+      const double d = lambda.dot(stepper.step(y[k], t, h, up) - stepper.step(y[k], t, h, um)) / (2.0 * e);
+      const double raw = excitationAt(ex, p, nf, k, N);
+      if (raw < ex.min || raw > ex.max) continue;
+      int i0 = 0;
+      double w0 = 0.0, w1 = 0.0;
+      hatWeights(ex.nodes, k, N, i0, w0, w1);
+      res.gradient[nf + ex.param[i0]] += w0 * d;
+      if (w1 != 0.0) res.gradient[nf + ex.param[i0 + 1]] += w1 * d;
+    }
     for (int j = 0; j < ns; ++j) {
       auto phi = [&](int m) { return step_at[4 * j + m]->step(y[k], t, h, u); };
       const VecX d = phi(0) - 8.0 * phi(1) + 8.0 * phi(2) - phi(3);
-      res.gradient[nf + nq0 + nv0 + j] += lambda.dot(d) / (12.0 * pr.system_param_delta[j]);
+      res.gradient[iq0 + nq0 + nv0 + j] += lambda.dot(d) / (12.0 * pr.system_param_delta[j]);
     }
     // state Jacobian of the step, column by column
     for (int i = 0; i < ny; ++i) {
@@ -265,8 +354,8 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     }
     lambda = (Jy.transpose() * lambda).eval();
   }
-  for (int j = 0; j < nq0; ++j) res.gradient[nf + j] += lambda[pr.initial_q[j]];
-  for (int j = 0; j < nv0; ++j) res.gradient[nf + nq0 + j] += lambda[n + pr.initial_qdot[j]];
+  for (int j = 0; j < nq0; ++j) res.gradient[iq0 + j] += lambda[pr.initial_q[j]];
+  for (int j = 0; j < nv0; ++j) res.gradient[iq0 + nq0 + j] += lambda[n + pr.initial_qdot[j]];
   // effort: w sum_k h u_k^2, each step's u the sum of its active force parameters
   if (obj.effort_weight != 0.0) {
     for (int k = 0; k < N; ++k) {
@@ -278,9 +367,52 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
       }
     }
   }
+  // excitation effort: w sum_k h e_k^2 of the clamped excitations
+  if (obj.excitation_weight != 0.0) {
+    for (int k = 0; k < N; ++k)
+      for (const Excited& ex : rs.excited) {
+        const double raw = excitationAt(ex, p, nf, k, N);
+        if (raw < ex.min || raw > ex.max) continue;
+        int i0 = 0;
+        double w0 = 0.0, w1 = 0.0;
+        hatWeights(ex.nodes, k, N, i0, w0, w1);
+        const double g = 2.0 * obj.excitation_weight * h * raw;
+        res.gradient[nf + ex.param[i0]] += w0 * g;
+        if (w1 != 0.0) res.gradient[nf + ex.param[i0 + 1]] += w1 * g;
+      }
+  }
   res.step_evaluations = stepper.evaluations;
   for (const auto& s : step_at) res.step_evaluations += s->evaluations;
   return res;
+}
+
+Trajectory simulateTrajectory(const Problem& pr, const VecX& p) {
+  const int nf = static_cast<int>(pr.forces.size());
+  const int ne = static_cast<int>(pr.excitations.size());
+  const int nq0 = static_cast<int>(pr.initial_q.size()), nv0 = static_cast<int>(pr.initial_qdot.size());
+  const VecX sp = p.size() == pr.numParameters() ? VecX(p.tail(pr.num_system_params)) : VecX();
+  const RunSystem rs = makeRunSystem(pr, sp);
+  checkProblem(pr, p, *rs.sys);
+  const int N = numSteps(pr);
+  const double h = pr.duration / N;
+  State s0 = pr.initial;
+  for (int j = 0; j < nq0; ++j) s0.q[pr.initial_q[j]] = p[nf + ne + j];
+  for (int j = 0; j < nv0; ++j) s0.qdot[pr.initial_qdot[j]] = p[nf + ne + nq0 + j];
+  Stepper stepper(pr, *rs.sys);
+  const std::vector<std::string> z_names = rs.sys->numStates() > 0 ? rs.sys->stateNames() : std::vector<std::string>{};
+  Trajectory tr;
+  tr.system = rs.sys;
+  VecX y = Stepper::pack(s0);
+  tr.states.push_back(s0);
+  for (int k = 0; k < N; ++k) {
+    const double t = pr.initial.t + k * h;
+    tr.controls.push_back(controlsAt(pr, rs, p, k, N));
+    y = stepper.step(y, t, h, tr.controls.back());
+    const double t1 = k + 1 == N ? pr.initial.t + pr.duration : t + h;
+    tr.states.push_back(stepper.unpack(y, t1));
+    checkFinite(tr.states.back(), h, pr.integrator.c_str(), &z_names);
+  }
+  return tr;
 }
 
 VecX finiteDifferenceGradient(const Problem& pr, const Objective& obj, const VecX& p) {

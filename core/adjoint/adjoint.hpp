@@ -13,7 +13,9 @@
 // whole step, so every term the step evaluates (M, f with springs, dampers, muscle inertia of
 // every path type, K and D of bdf1, the KKT rows of constraints, the z update) is in it; the
 // generalized-force columns dPhi_k/du are central differences of the step along each driven
-// coordinate (one pair per coordinate, shared by all of its time pieces); system parameters
+// coordinate (one pair per coordinate, shared by all of its time pieces), and so are the columns
+// of each excitation-driven control (one pair per muscle per step, distributed to its nodes by
+// the hat-function weights at the step's time); system parameters
 // (muscle masses) are fourth-order central differences of the step between systems built at
 // s -+ delta and s -+ 2 delta.
 // The objective's derivatives are analytic. The forward run is the integrator's own step; no
@@ -36,11 +38,25 @@ struct ForceParameter {
   int pieces = 1;
 };
 
+/// One muscle-excitation parameter: node `node` of the `nodes` nodes of a piecewise-linear
+/// excitation in time on the system's control `control` (a MuscleForceTerm's excitation; nodes at
+/// t0 + i duration / (nodes - 1), one node: a constant). The excitation of step k is the
+/// interpolant at the step's start time t_k, clamped to [min, max] (the muscle's min_control and
+/// max_control), constant during the step (docs/gradients.md §2). All nodes of one control must
+/// have the same `nodes`, `min` and `max`.
+struct ExcitationParameter {
+  int control = -1;
+  int node = 0;
+  int nodes = 1;
+  double min = 0.0, max = 1.0;
+};
+
 /// A system that depends on parameters (e.g. muscle masses): built for a value of them.
 using SystemFactory = std::function<std::shared_ptr<const System>(const VecX& system_params)>;
 
 /// What is simulated and which parameters the gradient is taken with respect to. The parameter
-/// vector p is ordered: forces, initial q entries, initial qdot entries, system parameters.
+/// vector p is ordered: forces, excitation nodes, initial q entries, initial qdot entries, system
+/// parameters.
 struct Problem {
   std::string integrator = "euler";  ///< euler, bdf1 or sdirk2
   double dt = 1e-3;
@@ -50,16 +66,22 @@ struct Problem {
   double newton_tol = 1e-12;
   State initial;                     ///< the state the run starts from before p is applied
   std::vector<ForceParameter> forces;
+  std::vector<ExcitationParameter> excitations;
+  /// the system's own controls (e.g. muscle excitations) during the whole run, for those that no
+  /// excitation parameter drives (size numControls(); empty: all zero)
+  VecX controls;
   std::vector<int> initial_q;        ///< coordinates whose initial value is a parameter
   std::vector<int> initial_qdot;     ///< coordinates whose initial speed is a parameter
   /// builds the system for the system parameters (called with an empty vector when there are
-  /// none); the system must have no controls and no coordinate map (checked)
+  /// none); the system must have no controllers and no coordinate map (checked); its controls
+  /// are `controls` and the excitation parameters
   SystemFactory make_system;
   int num_system_params = 0;
   VecX system_param_delta;           ///< step of the central differences per system parameter
                                      ///< (the systems at s - 2 delta must be valid)
   int numParameters() const {
-    return static_cast<int>(forces.size() + initial_q.size() + initial_qdot.size()) + num_system_params;
+    return static_cast<int>(forces.size() + excitations.size() + initial_q.size() + initial_qdot.size()) +
+           num_system_params;
   }
 };
 
@@ -67,6 +89,7 @@ struct Problem {
 ///   point:  w/2 |x(q_N) - target|^2 for a point fixed in a body (x_i in body coordinates)
 ///   speed:  w/2 |qdot_N|^2 (come to rest)
 ///   effort: w sum_steps h |u_k|^2 (the integral of the squared generalized forces)
+///   excitation effort: w sum_steps h |e_k|^2 over the excitation-driven controls (clamped)
 struct Objective {
   struct Point {
     int body = -1;
@@ -77,6 +100,7 @@ struct Objective {
   std::vector<Point> points;
   double speed_weight = 0.0;
   double effort_weight = 0.0;
+  double excitation_weight = 0.0;
 };
 
 struct Result {
@@ -98,6 +122,16 @@ class AdjointError : public std::runtime_error {
 /// `with_gradient`. Throws AdjointError for an invalid problem and SimulationError when the run
 /// diverges or produces NaN.
 Result evaluate(const Problem& problem, const Objective& objective, const VecX& p, bool with_gradient);
+
+/// The states y_0 .. y_N of the run at p and the controls of each step (the system's own, e.g.
+/// the clamped muscle excitations, then one per driven coordinate), with the system that ran
+/// them: the forward pass of evaluate, for plots and reports.
+struct Trajectory {
+  std::shared_ptr<const System> system;
+  std::vector<State> states;   ///< N + 1
+  std::vector<VecX> controls;  ///< N: step k's
+};
+Trajectory simulateTrajectory(const Problem& problem, const VecX& p);
 
 /// The gradient by central differences of whole simulations: the reference `redmax gradient
 /// --check` compares with. Per parameter, fourth-order differences (at p_i -+ e, -+ 2e) with

@@ -76,4 +76,32 @@ TEST_F(OptimizeCli, BadInputExitsTwo) {
   EXPECT_NE(r.err.find("optimize needs --target"), std::string::npos) << r.err;
 }
 
+// --drive excitations: the muscles' excitation nodes drive the block of tug_of_war_step.osim; the
+// report adds the best run (CSV with the excitations and tendon forces, and its plot); the
+// excitation flags without --drive excitations exit 2
+TEST_F(OptimizeCli, ExcitationDriveWritesTheBestRun) {
+  const fs::path report = dir_ / "excite";
+  const CmdResult r = runRedmax(dir_, "optimize --task reach --model " + scene("tug_of_war_step.osim") +
+                                          " --body block --target 0.03,0,0 --duration 0.2 --dt 0.001 --drive "
+                                          "excitations --nodes 3 --initial-excitation 0.5 --method lbfgs "
+                                          "--muscle-mass-kg left_muscle=0.5 --report " + report.string());
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.err.find("6 excitation nodes"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("lbfgs excitations: excitation left_muscle node 1/3="), std::string::npos) << r.out;
+  const std::string csv = slurp(report / "best_run.csv");
+  EXPECT_EQ(csv.rfind("time,hand_x,hand_y,hand_z,lumped_hand_x,lumped_hand_y,lumped_hand_z,excitation_left_muscle,"
+                      "excitation_right_muscle,tendon_force_left_muscle,tendon_force_right_muscle\n", 0), 0u) << csv;
+  long rows = -1;
+  for (char c : csv) rows += c == '\n';
+  EXPECT_EQ(rows, 201);  // t = 0 .. 0.2 s at 1 ms
+  const std::string md = slurp(report / "report.md");
+  EXPECT_NE(md.find("the same excitations on the lumped model"), std::string::npos) << md;
+  if (md.find("plot skipped") == std::string::npos) {
+    EXPECT_TRUE(fs::exists(report / "best_run.png") || fs::exists(report / "best_run.svg")) << md;
+  }
+  const CmdResult bad = run(kReach + " --nodes 3");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("error: --nodes: needs --drive excitations"), std::string::npos) << bad.err;
+}
+
 }  // namespace

@@ -4,6 +4,8 @@
 #include <stdexcept>
 
 #include "converter/osim_reader.hpp"
+#include "core/dynamics/muscle_force_term.hpp"
+#include "core/dynamics/muscle_term.hpp"
 #include "validation/simulate/spec_parse.hpp"
 
 namespace redmax::validation {
@@ -39,33 +41,78 @@ double explicitMass(const SimulationModelOptions& o, const std::string& muscle) 
 
 }  // namespace
 
+std::shared_ptr<System> withMuscleForces(const SimulationModel& m) {
+  const MusculoskeletalModel& model = m.build.model;
+  std::vector<std::shared_ptr<const hill::MuscleModel>> models = model.muscleModels();
+  models.resize(model.muscles().size());
+  auto sys = std::make_shared<System>(*m.system);
+  if (std::none_of(models.begin(), models.end(), [](const auto& x) { return x != nullptr; })) return sys;
+  sys->addTerm(std::make_shared<MuscleForceTerm>(model.skeleton(), model.muscles(), models));
+  // fibre-following mass points read their muscle's states; the notes are about muscles that
+  // cannot (their points stay uniform), which the mass summary already says
+  (void)bindMuscleStates(*sys);
+  return sys;
+}
+
 GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationModelOptions& options,
                                 const std::string& integrator, double duration, double dt,
                                 const std::string& params_spec, const std::string& objective_spec) {
   GradientSetup g;
   const auto description = std::make_shared<const osim::ModelDescription>(osim::readOsimModel(osim_path));
   g.model = makeSimulationModel(*description, options);
+  // with excitation parameters the muscles pull (Hill-type, activation and fibre states in z)
+  const bool hill = params_spec.find("excitations:") != std::string::npos;
+  if (hill) g.model.system = withMuscleForces(g.model);
   adjoint::Problem& pr = g.problem;
   pr.integrator = integrator;
   pr.duration = duration;
   pr.dt = dt;
   pr.initial = defaultInitialState(g.model);
-  const int nz = g.model.system->numStates();
-  pr.initial.z = VecX::Zero(nz);
+  const System& sys = *g.model.system;
+  pr.initial.z = sys.defaultState().z;
+  // the muscles' constant excitations: each one's min_control (the excitation parameters replace
+  // them for the muscles they name); the terms' controls are the muscles' (no controllers here)
+  const MuscleForceTerm* mft = nullptr;
+  int mft_control = 0;
+  if (hill) {
+    int offset = 0;
+    for (const auto& t : sys.terms()) {
+      if (const auto* m = dynamic_cast<const MuscleForceTerm*>(t.get())) {
+        mft = m;
+        mft_control = offset;
+      }
+      offset += t->numControls();
+    }
+    if (!mft) throw std::invalid_argument("--params 'excitations:': the model has no muscle with a Hill-type force model");
+    if (sys.numControls() != mft->numControls())
+      throw std::invalid_argument("--params 'excitations:': the model's system has controls other than its muscles'");
+    pr.controls = VecX::Zero(sys.numControls());
+    for (size_t k = 0; k < mft->actuated().size(); ++k)
+      pr.controls[mft_control + static_cast<Eigen::Index>(k)] = mft->actuated()[k].model->minControl();
+    // fibre lengths in equilibrium with the tendon at the default pose (OpenSim's
+    // computeInitialFiberEquilibrium), activations at their defaults
+    DynamicsWorkspace ws(sys);
+    ws.controls = pr.controls;
+    try {
+      sys.equilibrateStates(pr.initial, ws);
+    } catch (const hill::MuscleModelError& e) {
+      throw ModelError(std::string("the muscles' initial fibre equilibrium: ") + e.what());
+    }
+  }
 
   // parameters, collected per kind and then stacked in the problem's order
   struct Value {
     std::string name;
     double v;
   };
-  std::vector<Value> forces, q0, v0;
+  std::vector<Value> forces, excitations, q0, v0;
   std::vector<std::string> masses;
   const std::string pflag = "--params";
   if (params_spec.empty()) throw std::invalid_argument("--params: no parameters");
   for (const std::string& group : split(params_spec, ';')) {
     const auto colon = group.find(':');
     if (colon == std::string::npos)
-      throw bad(pflag, group, "expected KIND:ITEM,... with KIND torques, q0, qdot0 or masses");
+      throw bad(pflag, group, "expected KIND:ITEM,... with KIND torques, excitations, q0, qdot0 or masses");
     const std::string kind = group.substr(0, colon);
     const std::string list = group.substr(colon + 1);
     if (list.empty()) throw bad(pflag, group, "no items");
@@ -93,6 +140,40 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
                                                            : std::string()),
                             v});
         }
+      } else if (kind == "excitations") {
+        std::string name = nameAndValue(pflag, item_text, item, v, has_value);
+        int nodes = 1;
+        const auto at = name.find('@');
+        if (at != std::string::npos) {
+          double k = 0.0;
+          if (!parseNumber(name.substr(at + 1), k) || k < 1.0 || k != static_cast<int>(k) || k > 100000)
+            throw bad(pflag, item, "the node count after '@' must be a whole number >= 1");
+          nodes = static_cast<int>(k);
+          name = name.substr(0, at);
+        }
+        int found = -1;
+        for (size_t k = 0; k < mft->actuated().size(); ++k)
+          if (mft->actuated()[k].muscle.name == name) found = static_cast<int>(k);
+        if (found < 0) {
+          const bool exists = g.model.build.model.findMuscle(name) >= 0;
+          throw bad(pflag, item, exists ? "muscle '" + name + "' has no Hill-type force model to excite"
+                                        : "no muscle named '" + name + "'");
+        }
+        for (const auto& e : pr.excitations)
+          if (e.control == mft_control + found) throw bad(pflag, item, "muscle '" + name + "' is named twice");
+        const hill::MuscleModel& mm = *mft->actuated()[static_cast<size_t>(found)].model;
+        const double lo = mm.minControl(), hi = mm.maxControl();
+        if (!has_value) v = std::clamp(0.1, lo, hi);
+        if (!(v >= lo && v <= hi))
+          throw bad(pflag, item, "the value must lie in the muscle's [min_control, max_control] = [" +
+                                     std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        for (int k = 0; k < nodes; ++k) {
+          pr.excitations.push_back({mft_control + found, k, nodes, lo, hi});
+          excitations.push_back({"excitation " + name + (nodes > 1 ? " node " + std::to_string(k + 1) + "/" +
+                                                                         std::to_string(nodes)
+                                                                   : std::string()),
+                                 v});
+        }
       } else if (kind == "q0" || kind == "qdot0") {
         const std::string name = nameAndValue(pflag, item_text, item, v, has_value);
         const int c = coordinateIndex(g.model, pflag, item, name);
@@ -110,14 +191,14 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
           throw bad(pflag, item, "needs a positive mass for it in --muscle-mass-kg " + item_text + "=KG");
         masses.push_back(item_text);
       } else {
-        throw bad(pflag, group, "unknown kind '" + kind + "' (torques, q0, qdot0 or masses)");
+        throw bad(pflag, group, "unknown kind '" + kind + "' (torques, excitations, q0, qdot0 or masses)");
       }
     }
   }
-  const int np = static_cast<int>(forces.size() + q0.size() + v0.size() + masses.size());
+  const int np = static_cast<int>(forces.size() + excitations.size() + q0.size() + v0.size() + masses.size());
   g.p0.resize(np);
   int i = 0;
-  for (const auto* list : {&forces, &q0, &v0})
+  for (const auto* list : {&forces, &excitations, &q0, &v0})
     for (const Value& v : *list) {
       g.param_names.push_back(v.name);
       g.p0[i++] = v.v;
@@ -133,13 +214,14 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
   // a mass steps by 1e-3 of itself (fourth-order differences of the step, core/adjoint)
   for (int j = 0; j < pr.num_system_params; ++j) pr.system_param_delta[j] = 1e-3 * g.p0[np - pr.num_system_params + j];
   const std::shared_ptr<const System> base = g.model.system;
-  pr.make_system = [description, options, masses, base](const VecX& sp) -> std::shared_ptr<const System> {
+  pr.make_system = [description, options, masses, base, hill](const VecX& sp) -> std::shared_ptr<const System> {
     if (sp.size() == 0) return base;
     SimulationModelOptions o = options;
     for (size_t j = 0; j < masses.size(); ++j)
       for (auto& [name, kg] : o.explicit_masses)
         if (name == masses[j]) kg = sp[static_cast<Eigen::Index>(j)];
-    return makeSimulationModel(*description, o).system;
+    SimulationModel m = makeSimulationModel(*description, o);
+    return hill ? withMuscleForces(m) : m.system;
   };
 
   // objective
@@ -159,6 +241,9 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
       g.objective.speed_weight += w;
     } else if (term == "effort") {
       g.objective.effort_weight += w;
+    } else if (term == "excitation") {
+      if (pr.excitations.empty()) throw bad(oflag, term_text, "needs excitation parameters (--params 'excitations:...')");
+      g.objective.excitation_weight += w;
     } else if (term.rfind("point:", 0) == 0) {
       const std::string body_spec = term.substr(6);
       const auto at = body_spec.find('@');
@@ -176,7 +261,7 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
       pt.weight = w;
       g.objective.points.push_back(pt);
     } else {
-      throw bad(oflag, term_text, "unknown term (point:BODY@x,y,z=X,Y,Z, speed or effort)");
+      throw bad(oflag, term_text, "unknown term (point:BODY@x,y,z=X,Y,Z, speed, effort or excitation)");
     }
   }
   return g;

@@ -5,6 +5,13 @@
 //   --params    groups separated by ';':
 //                 torques:C[@K][=V],...   a constant generalized force on coordinate C (N m or N),
 //                                         in K equal time pieces (default 1), start value V (0)
+//                 excitations:M[@K][=V],...  the excitation of muscle M as K nodes of a piecewise-
+//                                         linear function of time (default 1: constant), start
+//                                         value V (default 0.1, within the muscle's bounds); with
+//                                         this group the muscles pull (MuscleForceTerm: every
+//                                         muscle with a Hill-type model, its activation and fibre
+//                                         length in z, equilibrated at the start), the others at
+//                                         their min_control
 //                 q0:C[=V],...            the initial value of C (default: the model's)
 //                 qdot0:C[=V],...         the initial speed of C
 //                 masses:M,...            the mass of muscle M (needs --muscle-mass-kg M=KG)
@@ -13,6 +20,8 @@
 //                                         frame, m) against the ground point (X,Y,Z) at the end
 //                 speed                   W/2 |qdot|^2 at the end
 //                 effort                  W * integral of the squared generalized forces
+//                 excitation              W * integral of the squared excitations (of the muscles
+//                                         the excitation parameters drive)
 #include <string>
 #include <vector>
 
@@ -28,6 +37,10 @@ struct GradientSetup {
   std::vector<std::string> param_names;  ///< e.g. "torque elbow_flexion piece 2/10", "mass BIClong"
   SimulationModel model;                 ///< the model at p0's system parameters
 };
+
+/// m's system plus the model's MuscleForceTerm (every muscle with a Hill-type model pulls), as
+/// `redmax forward` builds it, with fibre-following mass points bound to the muscles' states.
+std::shared_ptr<System> withMuscleForces(const SimulationModel& m);
 
 /// Throws std::invalid_argument with a message naming the SPEC item for a bad SPEC (unknown
 /// coordinate, body, muscle, malformed number), osim::ConvertError / ModelError for the model.

@@ -2,6 +2,7 @@
 #include "validation/optimize/reach.hpp"
 
 #include <LBFGS.h>
+#include <LBFGSB.h>
 #include <nlopt.h>
 #include <unistd.h>
 
@@ -15,6 +16,7 @@
 #include <stdexcept>
 
 #include "converter/atomic_file.hpp"
+#include "core/dynamics/muscle_force_term.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "validation/report/plot.hpp"
 
@@ -62,6 +64,12 @@ class Tracker {
       // torques that make the arm spin until the fixed step diverges: an infinite objective, so
       // that line searches step back and simplex methods move away; the start must run
       if (result_.simulations == 0) throw;
+      failed = true;
+      ++result_.failed_simulations;
+    } catch (const hill::MuscleModelError& e) {
+      // excitations whose run drives a muscle model out of its domain (e.g. a damped fibre
+      // velocity that does not converge): the same, a failed run
+      if (result_.simulations == 0) throw SimulationError(e.what(), 0.0, setup_.options.dt);
       failed = true;
       ++result_.failed_simulations;
     }
@@ -142,14 +150,20 @@ void runNlopt(const ReachSetup& setup, nlopt_algorithm algorithm, Tracker& track
   const double box = setup.options.max_torque;
   std::vector<double> lo(n), hi(n), x(n, 0.0);
   for (unsigned i = 0; i < n; ++i) {
-    hi[i] = box / setup.scale[i];
-    lo[i] = -hi[i];
+    x[i] = setup.x0[i];
+    if (setup.bounded) {
+      lo[i] = setup.lower[i];
+      hi[i] = setup.upper[i];
+    } else {
+      hi[i] = box / setup.scale[i];
+      lo[i] = -hi[i];
+    }
   }
   nlopt_set_lower_bounds(opt, lo.data());
   nlopt_set_upper_bounds(opt, hi.data());
   nlopt_set_min_objective(opt, nloptObjective, &data);
   nlopt_set_xtol_rel(opt, 1e-10);
-  nlopt_set_initial_step1(opt, setup.options.initial_step);  // rad/s^2
+  nlopt_set_initial_step1(opt, setup.options.initial_step);  // rad/s^2, or excitation
   double f = 0.0;
   const nlopt_result r = nlopt_optimize(opt, x.data(), &f);
   nlopt_destroy(opt);
@@ -183,14 +197,49 @@ ReachSetup makeReachSetup(const ReachOptions& options) {
   for (const auto& c : coords)
     if (c.empty() || c.find_first_of(",;@=") != std::string::npos)
       throw std::invalid_argument("--coordinates '" + c + "': not a coordinate name");
+  const bool excite = options.drive == "excitations";
+  if (!excite && options.drive != "torques")
+    throw std::invalid_argument("--drive '" + options.drive + "': unknown (torques or excitations)");
+  std::string params = "torques:" + joined(coords, ",");
+  if (excite) {
+    if (options.nodes < 1) throw std::invalid_argument("--nodes: must be at least 1");
+    std::vector<std::string> muscles = options.muscles;
+    if (muscles.empty()) {
+      const SimulationModel m = loadSimulationModel(options.model_path, SimulationModelOptions{});
+      const auto& models = m.build.model.muscleModels();
+      for (size_t k = 0; k < m.build.model.muscles().size(); ++k)
+        if (k < models.size() && models[k]) muscles.push_back(m.build.model.muscles()[k].name);
+      if (muscles.empty()) throw std::invalid_argument(options.model_path + ": no muscle has a Hill-type force model to excite");
+    }
+    std::vector<std::string> items;
+    for (const auto& m : muscles) {
+      if (m.empty() || m.find_first_of(",;@=") != std::string::npos)
+        throw std::invalid_argument("--excite '" + m + "': not a muscle name");
+      std::ostringstream item;
+      item.precision(17);
+      item << m << "@" << options.nodes << "=" << options.initial_excitation;
+      items.push_back(item.str());
+    }
+    params = "excitations:" + joined(items, ",");
+  }
   try {
     s.gradient = makeGradientSetup(options.model_path, options.model_options, options.integrator, options.duration,
-                                   options.dt, "torques:" + joined(coords, ","), "speed");
+                                   options.dt, params, "speed");
   } catch (const std::invalid_argument& e) {
     // "--params 'torques:x': no coordinate named 'x'" in the reach command's words
     std::string what = e.what();
     const std::string p = "--params";
     if (what.rfind(p + " 'torques:", 0) == 0) what = "--coordinates '" + what.substr(p.size() + 10);
+    if (what.rfind(p + " 'excitations:", 0) == 0) {
+      // the item's value is the --initial-excitation, its name a --muscles entry
+      const std::string item = what.substr(p.size() + 14);  // after "--params 'excitations:"
+      const auto end = item.find("': ");
+      const std::string reason = end == std::string::npos ? item : item.substr(end + 3);
+      if (what.find("[min_control, max_control]") != std::string::npos)
+        what = "--initial-excitation: " + reason;
+      else
+        what = "--excite '" + item.substr(0, item.find('@')) + "': " + reason;
+    }
     throw std::invalid_argument(what);
   }
   const Model& model = s.gradient.model.system->model();
@@ -202,10 +251,26 @@ ReachSetup makeReachSetup(const ReachOptions& options) {
   s.gradient.objective = adjoint::Objective{};
   s.gradient.objective.points.push_back(pt);
   s.gradient.objective.speed_weight = options.rest_weight;
+  s.gradient.objective.excitation_weight = excite ? options.excitation_weight : 0.0;
   s.start_point = bodyPoint(model, s.gradient.problem.initial, pt.body, pt.x_i);
   const System& system = *s.gradient.model.system;
   DynamicsWorkspace ws(system);
   system.calcMassAndForce(s.gradient.problem.initial, ws);
+  if (excite) {
+    // excitations are dimensionless and bounded: no scaling, L-BFGS-B within the bounds
+    const auto& ex = s.gradient.problem.excitations;
+    const Eigen::Index n = static_cast<Eigen::Index>(ex.size());
+    s.scale = VecX::Ones(n);
+    s.x0 = s.gradient.p0;
+    s.lower.resize(n);
+    s.upper.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      s.lower[i] = ex[static_cast<size_t>(i)].min;
+      s.upper[i] = ex[static_cast<size_t>(i)].max;
+    }
+    s.bounded = true;
+    return s;
+  }
   const auto& forces = s.gradient.problem.forces;
   s.scale.resize(static_cast<Eigen::Index>(forces.size()));
   for (size_t i = 0; i < forces.size(); ++i) {
@@ -213,6 +278,7 @@ ReachSetup makeReachSetup(const ReachOptions& options) {
     if (!(m > 0.0)) throw std::invalid_argument("--coordinates '" + s.gradient.param_names[i] + "': no inertia to drive");
     s.scale[static_cast<Eigen::Index>(i)] = m;
   }
+  s.x0 = VecX::Zero(s.scale.size());
   return s;
 }
 
@@ -234,13 +300,23 @@ ReachResult optimizeReach(const ReachSetup& setup, const std::string& method, co
     auto f = [&](const VecX& x, VecX& g) { return tracker.evaluate(x, &g); };
     // a failed line search restarts from the best point with an empty memory, as long as the
     // previous attempt improved the objective
-    VecX x = VecX::Zero(setup.gradient.p0.size());
+    VecX x = setup.x0;
     double last_best = std::numeric_limits<double>::infinity();
+    LBFGSpp::LBFGSBParam<double> bparam;
+    bparam.epsilon = 1e-10;
+    bparam.epsilon_rel = 1e-10;
+    bparam.max_iterations = 0;
+    bparam.max_linesearch = 40;
     for (;;) {
-      LBFGSpp::LBFGSSolver<double> solver(param);
       double fx = 0.0;
       try {
-        solver.minimize(f, x, fx);
+        if (setup.bounded) {
+          LBFGSpp::LBFGSBSolver<double> solver(bparam);
+          solver.minimize(f, x, fx, setup.lower, setup.upper);
+        } else {
+          LBFGSpp::LBFGSSolver<double> solver(param);
+          solver.minimize(f, x, fx);
+        }
         res.stop = "gradient below 1e-10";
         break;
       } catch (const Reached&) {
@@ -269,6 +345,69 @@ ReachResult optimizeReach(const ReachSetup& setup, const std::string& method, co
   res.seconds = tracker.seconds();
   res.reached = res.error <= setup.options.tolerance;
   return res;
+}
+
+ReachReplay replayReach(const ReachSetup& setup, const VecX& params) {
+  ReachReplay rp;
+  const GradientSetup& g = setup.gradient;
+  const auto& pt = g.objective.points.front();
+  auto handPath = [&](const adjoint::Trajectory& tr, std::vector<Vec3>& out) {
+    const Model& model = tr.system->model();
+    SkeletonWorkspace sk(model);
+    for (const State& st : tr.states) {
+      calcKinematics(model, st, sk);
+      out.push_back(transformPoint(sk.E_wi[pt.body], pt.x_i));
+    }
+  };
+  const adjoint::Trajectory tr = adjoint::simulateTrajectory(g.problem, params);
+  for (const State& st : tr.states) rp.t.push_back(st.t);
+  handPath(tr, rp.hand);
+  const System& sys = *tr.system;
+  const Model& model = sys.model();
+  const MuscleForceTerm* mft = nullptr;
+  size_t term = 0;
+  for (size_t i = 0; i < sys.terms().size(); ++i)
+    if (const auto* m = dynamic_cast<const MuscleForceTerm*>(sys.terms()[i].get())) {
+      mft = m;
+      term = i;
+    }
+  if (mft) {
+    // the excited muscles, in parameter order
+    std::vector<int> controls;
+    for (const auto& e : g.problem.excitations)
+      if (controls.empty() || controls.back() != e.control) controls.push_back(e.control);
+    SkeletonWorkspace sk(model);
+    rp.excitation.resize(controls.size());
+    rp.tendon_force.resize(controls.size());
+    for (int c : controls) rp.muscles.push_back(mft->actuated()[static_cast<size_t>(c - sys.controlOffset(term))].muscle.name);
+    for (size_t j = 0; j < tr.states.size(); ++j) {
+      const State& st = tr.states[j];
+      calcKinematics(model, st, sk);
+      const VecX& u = tr.controls[std::min(j, tr.controls.size() - 1)];  // the last state: the last step's
+      for (size_t m = 0; m < controls.size(); ++m) {
+        const int k = controls[m] - sys.controlOffset(term);
+        const auto& a = mft->actuated()[static_cast<size_t>(k)];
+        double length = 0.0, speed = 0.0;
+        VecX dl_dq;
+        mft->calcPath(model, st, sk, k, length, speed, dl_dq);
+        hill::MuscleOutput out;
+        VecX zdot(a.model->numStates());
+        a.model->calc(st.z.data() + sys.stateOffset(term) + a.z_offset, {length, speed, u[controls[m]]}, out, zdot.data());
+        rp.excitation[m].push_back(u[controls[m]]);
+        rp.tendon_force[m].push_back(out.tendon_force);
+      }
+    }
+  }
+  if (g.model.muscle_mass > 0.0) {
+    // the same parameters on the model without muscle mass
+    ReachOptions lumped = setup.options;
+    lumped.model_options.muscle_mass = osim::MuscleMassOptions{};
+    lumped.model_options.explicit_masses.clear();
+    const ReachSetup ls = makeReachSetup(lumped);
+    handPath(adjoint::simulateTrajectory(ls.gradient.problem, params), rp.lumped_hand);
+    rp.lumped_error = (rp.lumped_hand.back() - pt.target).norm();
+  }
+  return rp;
 }
 
 namespace {
@@ -338,11 +477,82 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
     }
   }
 
+  // excitation drive: the best run's hand path, excitations and tendon forces (and the lumped replay)
+  const bool excite = o.drive == "excitations";
+  ReachReplay replay;
+  std::string replay_plot, replay_status;
+  const ReachResult* best = nullptr;
+  for (const ReachResult& r : results)
+    if (!best || r.objective < best->objective) best = &r;
+  if (excite && best) {
+    replay = replayReach(setup, best->torques);
+    std::ostringstream c;
+    c.precision(10);
+    c << "time,hand_x,hand_y,hand_z";
+    if (!replay.lumped_hand.empty()) c << ",lumped_hand_x,lumped_hand_y,lumped_hand_z";
+    for (const auto& m : replay.muscles) c << ",excitation_" << m;
+    for (const auto& m : replay.muscles) c << ",tendon_force_" << m;
+    c << "\n";
+    for (size_t j = 0; j < replay.t.size(); ++j) {
+      c << replay.t[j] << "," << replay.hand[j][0] << "," << replay.hand[j][1] << "," << replay.hand[j][2];
+      if (!replay.lumped_hand.empty())
+        c << "," << replay.lumped_hand[j][0] << "," << replay.lumped_hand[j][1] << "," << replay.lumped_hand[j][2];
+      for (const auto& e : replay.excitation) c << "," << e[j];
+      for (const auto& f : replay.tendon_force) c << "," << f[j];
+      c << "\n";
+    }
+    osim::writeFileAtomic((tmp / "best_run.csv").string(), c.str());
+    PlotFigure rf;
+    rf.title = "excitation-driven reach (" + best->method + "): " + setup.gradient.model.description.name;
+    PlotPanel path;
+    path.title = "hand path (ground x-y)";
+    path.xlabel = "x (m)";
+    path.ylabel = "y (m)";
+    auto xy = [](const std::vector<Vec3>& v, int i) {
+      std::vector<double> out;
+      for (const Vec3& p : v) out.push_back(p[i]);
+      return out;
+    };
+    path.lines.push_back(makePlotLine(setup.gradient.model.muscle_mass > 0.0 ? "inertial" : "lumped",
+                                      xy(replay.hand, 0), xy(replay.hand, 1)));
+    if (!replay.lumped_hand.empty())
+      path.lines.push_back(makePlotLine("same excitations, lumped", xy(replay.lumped_hand, 0), xy(replay.lumped_hand, 1)));
+    path.lines.push_back(makePlotLine("target", {o.target[0]}, {o.target[1]}, "points"));
+    PlotPanel ex;
+    ex.title = "excitations";
+    ex.xlabel = "t (s)";
+    ex.ylabel = "u";
+    PlotPanel fo;
+    fo.title = "tendon forces";
+    fo.xlabel = "t (s)";
+    fo.ylabel = "N";
+    for (size_t m = 0; m < replay.muscles.size(); ++m) {
+      ex.lines.push_back(makePlotLine(replay.muscles[m], replay.t, replay.excitation[m]));
+      fo.lines.push_back(makePlotLine(replay.muscles[m], replay.t, replay.tendon_force[m]));
+    }
+    rf.panels = {path, ex, fo};
+    const GnuplotInfo gp2 = findGnuplot();
+    if (!gp2.available) {
+      replay_status = "plot skipped: " + gp2.why_not;
+    } else {
+      const PlotOutcome out = renderPlot(gp2, PlotFormat::Auto, rf, (tmp / "best_run").string());
+      if (out.ok) replay_plot = fs::path(out.file).filename().string();
+      else replay_status = "plot failed: " + out.error;
+    }
+  }
+
   std::ostringstream md;
   md << "# Reaching task: " << setup.gradient.model.description.name << "\n\n";
   md << "Command: `" << command_line << "`\n\n";
-  md << "Constant generalized forces on " << setup.gradient.param_names.size()
-     << " coordinates from zero; objective `1/2 |p - target|^2";
+  if (excite)
+    md << "Muscle excitations, " << o.nodes << " piecewise-linear node(s) per muscle (" << setup.gradient.param_names.size()
+       << " parameters) from " << fmt(o.initial_excitation)
+       << ", within each muscle's [min_control, max_control]; Hill-type muscles with activation and fibre states; "
+          "objective `1/2 |p - target|^2";
+  else
+    md << "Constant generalized forces on " << setup.gradient.param_names.size()
+       << " coordinates from zero; objective `1/2 |p - target|^2";
+  if (excite && o.excitation_weight > 0.0) md << " + " << fmt(o.excitation_weight) << " int |u|^2 dt";
   if (o.rest_weight > 0.0) md << " + " << fmt(o.rest_weight) << "/2 |qdot|^2";
   md << "` at t = " << fmt(o.duration) << " s (" << setup.gradient.problem.integrator << ", dt " << fmt(o.dt)
      << " s, " << setup.gradient.model.muscle_mass << " kg of muscle mass in mass points).\n\n";
@@ -358,7 +568,7 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
        << fmt(r.objective) << " | " << fmt(r.error) << " | " << fmt(r.final_speed) << " | " << (r.reached ? "yes" : "no")
        << " | " << r.stop << " |\n";
   md << "\nOne simulation is one forward run; an L-BFGS evaluation also runs the adjoint sweep, whose cost is in the "
-        "step evaluations (docs/gradients.md §5).\n\n## Converged parameters (N m)\n\n| parameter |";
+        "step evaluations (docs/gradients.md §5).\n\n## Converged parameters" << (excite ? "" : " (N m)") << "\n\n| parameter |";
   for (const ReachResult& r : results) md << " " << r.method << " |";
   md << "\n|---|";
   for (size_t k = 0; k < results.size(); ++k) md << "---|";
@@ -367,6 +577,15 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
     md << "| " << setup.gradient.param_names[i] << " |";
     for (const ReachResult& r : results) md << " " << fmt(r.torques[static_cast<Eigen::Index>(i)], 10) << " |";
     md << "\n";
+  }
+  if (excite && best) {
+    md << "\n## Best run (" << best->method << ")\n\n";
+    md << "- final hand error " << fmt(best->error) << " m";
+    if (replay.lumped_error >= 0.0)
+      md << "; the same excitations on the lumped model (no muscle mass): " << fmt(replay.lumped_error) << " m";
+    md << "\n- [best_run.csv](best_run.csv): time, hand point, excitations and tendon forces per step\n";
+    if (!replay_plot.empty()) md << "\n![hand path, excitations, tendon forces](" << replay_plot << ")\n";
+    else md << "\n(" << replay_status << ")\n";
   }
   md << "\n## Objective per evaluation\n\n";
   for (const ReachResult& r : results) md << "- [" << r.method << "_iterations.csv](" << r.method << "_iterations.csv)\n";

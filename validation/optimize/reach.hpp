@@ -17,6 +17,15 @@
 // fixed step blows up) counts as a simulation with an infinite objective. One "simulation" is one forward run; an L-BFGS evaluation
 // also runs the adjoint sweep, whose cost is counted apart in step evaluations.
 //
+// Driven by muscle excitations instead (drive = "excitations", beyond the dissertation, which
+// names this as what its method could not do): the arm's Hill-type muscles pull (activation and
+// fibre length are states of the run, docs/gradients.md §2) and the parameters are `nodes`
+// piecewise-linear excitation nodes per muscle, from initial_excitation, bounded by each muscle's
+// [min_control, max_control] (L-BFGS-B for lbfgs, NLopt's bounds for the others); the objective
+// adds excitation_weight times the integral of the squared excitations. The report then also
+// plots the hand path, the excitations and the tendon forces of the best run, and replays the
+// best excitations on the lumped model (no muscle mass) when the muscles carry mass.
+//
 // The report (writeReachReport) in DIR: report.md (setup, per method: converged torques,
 // simulations, step evaluations, wall time, final error and speed), <method>_iterations.csv (one
 // row per objective evaluation), objective.png|svg (best objective against simulations, every
@@ -46,6 +55,11 @@ struct ReachOptions {
   double max_torque = 100.0;             ///< N m: the gradient-free methods' box +-max_torque
   double initial_step = 1.0;             ///< rad/s^2: the gradient-free methods' first step (scaled)
   long max_simulations = 2000;
+  std::string drive = "torques";         ///< torques or excitations
+  std::vector<std::string> muscles;      ///< excited muscles; empty: every muscle with a Hill-type model
+  int nodes = 5;                         ///< excitation nodes per muscle over the run
+  double initial_excitation = 0.1;       ///< every node's start value (within each muscle's bounds)
+  double excitation_weight = 0.0;        ///< weight of the integral of the squared excitations
 };
 
 /// The task resolved against the model.
@@ -58,6 +72,9 @@ struct ReachSetup {
   /// The shoulder's long-axis rotation has about a tenth of the flexion's inertia; in torques the
   /// problem is that badly scaled and L-BFGS's first steps fling the arm round.
   VecX scale;
+  VecX x0;            ///< the start, scaled (zero torques, or the initial excitations)
+  VecX lower, upper;  ///< bounds on the scaled parameters (excitations: the muscles' control bounds)
+  bool bounded = false;  ///< lbfgs runs L-BFGS-B within [lower, upper] (the excitations)
 };
 
 /// Throws std::invalid_argument ("--body 'x': ...", "--coordinates 'c': ...", "--target: ...")
@@ -91,12 +108,25 @@ struct ReachResult {
 /// Progress: called after every evaluation.
 using ReachProgress = std::function<void(const std::string& method, const ReachEvaluation&)>;
 
-/// Run one method (lbfgs, nelder-mead, bobyqa) from zero torques. Throws std::invalid_argument
+/// Run one method (lbfgs, nelder-mead, bobyqa) from setup.x0 (zero torques or the initial excitations). Throws std::invalid_argument
 /// for an unknown method and SimulationError when a run diverges.
 ReachResult optimizeReach(const ReachSetup& setup, const std::string& method, const ReachProgress& progress = {});
 
 /// The methods optimizeReach takes.
 const std::vector<std::string>& reachMethods();
+
+/// The best run replayed (for excitation reports): times, the hand point, per excited muscle its
+/// excitation and tendon force per step; `lumped_*` the same excitations on the model without
+/// muscle mass (empty when the muscles carry none).
+struct ReachReplay {
+  std::vector<double> t;
+  std::vector<Vec3> hand;
+  std::vector<std::string> muscles;
+  std::vector<std::vector<double>> excitation, tendon_force;  ///< [muscle][step]
+  std::vector<Vec3> lumped_hand;
+  double lumped_error = -1.0;  ///< m, at the end (< 0: not replayed)
+};
+ReachReplay replayReach(const ReachSetup& setup, const VecX& params);
 
 /// Write the report into dir (see the top of this file); returns the plot's status line. Throws
 /// std::runtime_error "PATH: why" when the folder cannot be written.
