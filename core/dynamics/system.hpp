@@ -30,6 +30,7 @@
 #include "core/dynamics/controller.hpp"
 #include "core/dynamics/coordinate_map.hpp"
 #include "core/dynamics/force_term.hpp"
+#include "core/dynamics/unilateral/unilateral.hpp"
 #include "core/dynamics/skeleton_dynamics.hpp"
 #include "core/skeleton/kinematics.hpp"
 
@@ -132,6 +133,11 @@ class System {
   const std::vector<std::shared_ptr<const ForceTerm>>& terms() const { return terms_; }
   const std::vector<std::shared_ptr<const Constraint>>& constraints() const { return constraints_; }
   StabilizationOptions stabilization;
+  /// Hard unilateral constraints (joint limits, collisions; core/dynamics/unilateral/unilateral.hpp),
+  /// enforced by the integrators that can (bdf1); the others refuse the system. nullptr removes
+  /// them. Throws ModelError with a coordinate map (their rows are built in q_r).
+  void setUnilateral(std::shared_ptr<const UnilateralConstraints> u);
+  const std::shared_ptr<const UnilateralConstraints>& unilateral() const { return unilateral_; }
 
   // auxiliary states and controls
   /// nz: the terms' states, stacked in State::z
@@ -267,6 +273,7 @@ class System {
   int nz_ = 0, nu_ = 0;
   int nc_ = 0;
   std::shared_ptr<const CoordinateMap> map_;
+  std::shared_ptr<const UnilateralConstraints> unilateral_;
   int ndof_ = 0;
   int n_extra_ = 0;  // coordinates after q_r that only ForceTerms see
   /// with a map: ws.s_r, ws.J_rR, ws.Jdot_rR from a system state
