@@ -171,6 +171,12 @@ void System::addConstraint(std::shared_ptr<const Constraint> c) {
   constraints_.push_back(std::move(c));
 }
 
+void System::setUnilateral(std::shared_ptr<const UnilateralConstraints> u) {
+  if (u && map_) throw ModelError("System::setUnilateral: hard unilateral constraints with a coordinate map are not supported");
+  unilateral_ = std::move(u);
+  id_.renew();
+}
+
 int System::addExtraCoordinates(int n) {
   if (n < 0) throw ModelError("System::addExtraCoordinates: negative count");
   if (map_) throw ModelError("System::addExtraCoordinates: not supported together with a coordinate map");
@@ -184,6 +190,8 @@ int System::addExtraCoordinates(int n) {
 void System::setCoordinateMap(std::shared_ptr<const CoordinateMap> map) {
   if (map && n_extra_ > 0)
     throw ModelError("System::setCoordinateMap: not supported together with extra coordinates");
+  if (map && unilateral_)
+    throw ModelError("System::setCoordinateMap: not supported together with hard unilateral constraints");
   if (map && map->nr() != model_.nr())
     throw ModelError("System::setCoordinateMap: map built for " + std::to_string(map->nr()) +
                      " coordinates, model has " + std::to_string(model_.nr()));

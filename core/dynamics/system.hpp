@@ -30,6 +30,7 @@
 #include "core/dynamics/controller.hpp"
 #include "core/dynamics/coordinate_map.hpp"
 #include "core/dynamics/force_term.hpp"
+#include "core/dynamics/unilateral/unilateral.hpp"
 #include "core/dynamics/skeleton_dynamics.hpp"
 #include "core/dynamics/structured_forward.hpp"
 #include "core/skeleton/kinematics.hpp"
@@ -148,6 +149,11 @@ class System {
   /// fall-backs that ws.last_route records): Dense with constraints, a coordinate map or extra
   /// coordinates, Articulated only when no term adds mass (ForceTerm::addsMass)
   ForwardRoute plannedForwardRoute() const;
+  /// Hard unilateral constraints (joint limits, collisions; core/dynamics/unilateral/unilateral.hpp),
+  /// enforced by the integrators that can (bdf1); the others refuse the system. nullptr removes
+  /// them. Throws ModelError with a coordinate map (their rows are built in q_r).
+  void setUnilateral(std::shared_ptr<const UnilateralConstraints> u);
+  const std::shared_ptr<const UnilateralConstraints>& unilateral() const { return unilateral_; }
 
   // auxiliary states and controls
   /// nz: the terms' states, stacked in State::z
@@ -283,6 +289,7 @@ class System {
   int nz_ = 0, nu_ = 0;
   int nc_ = 0;
   std::shared_ptr<const CoordinateMap> map_;
+  std::shared_ptr<const UnilateralConstraints> unilateral_;
   int ndof_ = 0;
   int n_extra_ = 0;  // coordinates after q_r that only ForceTerms see
   /// with a map: ws.s_r, ws.J_rR, ws.Jdot_rR from a system state

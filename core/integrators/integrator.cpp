@@ -95,6 +95,13 @@ void checkAdvanceArguments(const System& sys, const State& s, double t_out, cons
   }
 }
 
+void checkUnilateralSupport(const Integrator& integ, const System& sys) {
+  if (sys.unilateral() && !integ.handlesUnilateral())
+    throw std::invalid_argument("integrator '" + integ.name() +
+                                "' cannot enforce hard unilateral constraints (joint limits, contacts); "
+                                "use bdf1 (docs/contact.md §6)");
+}
+
 DynamicsWorkspace& FixedStepIntegrator::workspace(const System& sys) {
   if (!ws_ || ws_->system_id != sys.id()) ws_ = std::make_unique<DynamicsWorkspace>(sys);
   return *ws_;
@@ -103,6 +110,7 @@ DynamicsWorkspace& FixedStepIntegrator::workspace(const System& sys) {
 void FixedStepIntegrator::advance(const System& sys, State& s, double t_out) {
   const std::string who = name();
   checkAdvanceArguments(sys, s, t_out, who.c_str());
+  checkUnilateralSupport(*this, sys);
   const double span = t_out - s.t;
   if (span <= 0.0) return;
   // ceil(span / dt) equal steps landing on t_out exactly (the 1e-9 slack keeps a round-off

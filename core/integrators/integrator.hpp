@@ -50,6 +50,14 @@ struct IntegratorStats {
   long jacobian_evals = 0;     // implicit methods: Newton/implicit matrix assemblies (K, D or FD Jacobians)
   long reparameterizations = 0;  // joint chart switches applied to the integrated state
   long failed_steps = 0;       // rejected steps (error test or Newton failures)
+  // hard unilateral constraints (bdf1 with System::unilateral(); core/dynamics/unilateral/)
+  long unilateral_steps = 0;   // steps that solved a contact QP (some candidate row present)
+  long qp_iterations = 0;      // active-set changes, all QPs
+  long qp_solves = 0;          // QPs (the friction fixed-point iterations count each)
+  long contact_rows = 0;       // sum over steps of rows with a positive impulse
+  int max_contacts = 0;        // most rows with a positive impulse in one step
+  double max_penetration = 0.0;  // largest penetration at a step's start (m, or rad for limits)
+  long friction_unconverged = 0; // steps whose friction fixed point hit its iteration limit
 };
 
 /// A simulation produced NaN/Inf or diverged: says when, what, and with which step.
@@ -78,6 +86,9 @@ class Integrator {
   /// across calls for the same system: callers that report run-time counts take them from its
   /// term slots (takeWrapFallbackCounts, core/dynamics/muscle_term.hpp)
   virtual DynamicsWorkspace* lastWorkspace() { return nullptr; }
+  /// true if the method enforces System::unilateral() (only bdf1); advance() of the others
+  /// throws std::invalid_argument for a system that has them
+  virtual bool handlesUnilateral() const { return false; }
 
  protected:
   IntegratorStats stats_;
@@ -99,6 +110,8 @@ inline constexpr double kDivergenceLimit = 1e100;
 
 /// Throws std::invalid_argument if the state (q, qdot, z) does not fit the system or t_out < state.t.
 void checkAdvanceArguments(const System& sys, const State& s, double t_out, const char* where);
+/// Throws std::invalid_argument if sys has hard unilateral constraints that integ cannot enforce.
+void checkUnilateralSupport(const Integrator& integ, const System& sys);
 
 /// Shared driver of the fixed-step methods: cuts [state.t, t_out] into ceil(span / dt) equal
 /// steps, calls step() for each, lets the joints switch chart after each step, checks for

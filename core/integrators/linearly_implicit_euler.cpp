@@ -1,5 +1,6 @@
 #include "core/integrators/linearly_implicit_euler.hpp"
 
+#include "core/dynamics/unilateral/qp_solver.hpp"
 #include "core/integrators/implicit_solve.hpp"
 
 namespace redmax {
@@ -13,14 +14,41 @@ void LinearlyImplicitEuler::step(const System& sys, State& s, double h, Dynamics
   const MatX A = ws.M + h * ws.D + (h * h) * ws.K;
   const VecX a = ws.M * s.qdot + h * (ws.f + ws.D * s.qdot);
   static const MatX no_rows;
-  if (sys.numConstraintRows() == 0) {
-    s.qdot = detail::solveImplicit(A, no_rows, a, VecX(), &ws.lambda);
-  } else {
+  static const VecX no_rhs;
+  const bool bilateral = sys.numConstraintRows() > 0;
+  VecX b;
+  if (bilateral) {
     // velocity-level constraint rows, drift removed as in symplectic Euler [D Eq. 4.102, 4.110]
     sys.calcConstraints(s, ws);
-    const VecX b = ws.G * s.qdot + h * ws.rhs - ws.vel_err;
-    s.qdot = detail::solveImplicit(A, ws.G, a, b, &ws.lambda);
+    b = ws.G * s.qdot + h * ws.rhs - ws.vel_err;
   }
+  const MatX& G = bilateral ? ws.G : no_rows;
+  const VecX& bb = bilateral ? b : no_rhs;
+  bool done = false;
+  if (const auto& u = sys.unilateral()) {
+    // hard unilateral constraints: the contact QP on top of this step (docs/contact.md §6);
+    // calcMassAndForce left the kinematics of s at the velocity stage in ws.sk
+    u->detect(sys.model(), s, ws.sk, sys.ndof(), h, rows_);
+    stats_.max_penetration = std::max(stats_.max_penetration, rows_.max_penetration);
+    if (!rows_.c.empty()) {
+      UnilateralStepStats st;
+      try {
+        s.qdot = solveUnilateralStep(A, a, G, bb, rows_, u->options(), &warm_, &ws.lambda, &st);
+      } catch (const QpError& e) {
+        throw SimulationError(std::string("bdf1: contact QP failed: ") + e.what() + " at t = " +
+                                  std::to_string(s.t) + " with step h = " + std::to_string(h),
+                              s.t, h);
+      }
+      stats_.unilateral_steps += st.candidates > 0;
+      stats_.qp_iterations += st.qp_iterations;
+      stats_.qp_solves += st.friction_iterations;
+      stats_.contact_rows += st.contacts;
+      stats_.max_contacts = std::max(stats_.max_contacts, st.contacts);
+      stats_.friction_unconverged += !st.friction_converged;
+      done = true;
+    }
+  }
+  if (!done) s.qdot = detail::solveImplicit(A, G, a, bb, &ws.lambda);
   s.q += h * s.qdot;
   s.t += h;
 }

@@ -12,13 +12,20 @@ namespace redmax {
 /// leaves the damping entirely implicit, which is [D Eq. 4.79-4.80] (there f excludes it).
 /// Gravity and velocity-product terms stay explicit (they are not in K, D). First order;
 /// unconditionally stable for linear springs and dampers. Constraints as in SymplecticEuler:
-/// velocity-level KKT rows with the implicit matrix in place of M.
+/// velocity-level KKT rows with the implicit matrix in place of M. Hard unilateral constraints
+/// (System::unilateral(): joint limits, contacts with friction and restitution) add a QP on the
+/// contact impulses to this step (core/dynamics/unilateral/unilateral.hpp, docs/contact.md §6).
 class LinearlyImplicitEuler final : public FixedStepIntegrator {
  public:
   explicit LinearlyImplicitEuler(const IntegratorOptions& opt) : FixedStepIntegrator(opt) {}
   std::string name() const override { return "bdf1"; }
   /// one step of size h (state.t += h)
   void step(const System& sys, State& state, double h, DynamicsWorkspace& ws) override;
+  bool handlesUnilateral() const override { return true; }
+
+ private:
+  UnilateralRows rows_;        // this step's candidate rows (kept to reuse their storage)
+  UnilateralWarmStart warm_;   // the last step's active contacts
 };
 
 }  // namespace redmax

@@ -390,6 +390,7 @@ CvodeBdf::CvodeBdf(const IntegratorOptions& opt) : SundialsIntegrator(opt) {
 void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
   const std::string who = name();
   checkAdvanceArguments(sys, s, t_out, who.c_str());
+  checkUnilateralSupport(*this, sys);
   if (t_out == s.t) return;
   SundialsSolver& S = *solver_;
   const int n = sys.ndof();

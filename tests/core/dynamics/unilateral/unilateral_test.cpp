@@ -1,0 +1,209 @@
+// Hard unilateral constraints (core/dynamics/unilateral/unilateral.hpp): gaps in closed form,
+// normal rows against finite differences of the gaps, the dual contact step against the primal
+// QP of [D Eq. 3.47], refusals.
+#include "core/dynamics/unilateral/unilateral.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/dynamics/system.hpp"
+#include "core/dynamics/unilateral/qp_solver.hpp"
+#include "core/integrators/integrator.hpp"
+#include "core/joints/basic_joints.hpp"
+#include "core/joints/free_joints.hpp"
+#include "core/spatial/se3.hpp"
+
+namespace redmax {
+namespace {
+
+CollisionGeometry groundPlane() {
+  CollisionGeometry g;
+  g.name = "ground";
+  g.shape = CollisionShape::HalfSpace;
+  g.X_body = makeE(rotationAxisAngle(Vec3::UnitZ(), -M_PI / 2), Vec3::Zero());  // outward normal +y
+  return g;
+}
+
+// a free box (body 0), a free capsule (body 1), a hinged arm with a sphere at its tip (body 2),
+// a free sphere (body 3); ground pairs for all, sphere-sphere between 2 and 3; a limit on the hinge
+struct Scene {
+  std::shared_ptr<System> sys;
+  std::shared_ptr<UnilateralConstraints> u;
+  Scene() {
+    ModelBuilder b("shapes");
+    const Mat3 I = Vec3(0.1, 0.2, 0.3).asDiagonal();
+    b.addBody("box", 1.0, Vec3::Zero(), I, -1, "f0", Free3D{});
+    b.addBody("capsule", 1.0, Vec3::Zero(), I, -1, "f1", Free3D{});
+    b.addBody("arm", 1.0, Vec3(0.5, 0, 0), I, -1, "hinge", Revolute{}, makeTranslation(Vec3(0, 1, 0)));
+    b.addBody("ball", 1.0, Vec3::Zero(), I, -1, "f3", Free3D{});
+    sys = std::make_shared<System>(b.finalize());
+    std::vector<CollisionGeometry> g{groundPlane()};
+    CollisionGeometry box{"box", CollisionShape::Box, 0, makeE(rotationAxisAngle(Vec3::UnitX(), 0.3), Vec3(0, 0.1, 0)),
+                          0.0, 0.0, Vec3(0.1, 0.2, 0.3)};
+    CollisionGeometry cap{"capsule", CollisionShape::Capsule, 1, Mat4::Identity(), 0.05, 0.2, Vec3::Zero()};
+    CollisionGeometry tip{"tip", CollisionShape::Sphere, 2, makeTranslation(Vec3(1, 0, 0)), 0.1, 0, Vec3::Zero()};
+    CollisionGeometry ball{"ball", CollisionShape::Sphere, 3, Mat4::Identity(), 0.15, 0, Vec3::Zero()};
+    g.insert(g.end(), {box, cap, tip, ball});
+    std::vector<CollisionPair> p{{0, 1, 0.5, 0.0}, {0, 2, 0.5, 0.0}, {0, 3, 0.0, 0.0}, {3, 4, 0.3, 0.0}};
+    std::vector<JointLimit> l{{"hinge", 12, -1.0, 1.0, 0.0}};
+    u = std::make_shared<UnilateralConstraints>(sys->model(), g, p, l);
+    sys->setUnilateral(u);
+  }
+};
+
+TEST(Unilateral, GapsInClosedForm) {
+  Scene sc;
+  State s = sc.sys->defaultState();
+  s.q.segment<3>(0) = Vec3(0, 0.5, 0);     // box centre frame
+  s.q.segment<3>(6) = Vec3(0, 0.3, 0);     // capsule, rotated about z by 0.4
+  s.q.segment<3>(9) = Vec3(0, 0, 0.4);
+  s.q[12] = -0.2;                          // hinge
+  s.q.segment<3>(13) = Vec3(1.5, 0.5, 0);  // ball
+  DynamicsWorkspace ws(*sc.sys);
+  sc.sys->kineticEnergy(s, ws);
+  const std::vector<double> g = sc.u->gaps(sc.sys->model(), s, ws.sk);
+  ASSERT_EQ(g.size(), 2u + 8u + 2u + 1u + 1u);
+  EXPECT_NEAR(g[0], -0.2 - (-1.0), 1e-14);
+  EXPECT_NEAR(g[1], 1.0 - (-0.2), 1e-14);
+  // box corners: centre height 0.6, rotated 0.3 about x: heights 0.6 +- 0.2 cos 0.3 +- 0.3 sin 0.3
+  double lowest = 1e9;
+  for (int k = 0; k < 8; ++k) lowest = std::min(lowest, g[2 + k]);
+  EXPECT_NEAR(lowest, 0.6 - 0.2 * std::cos(0.3) - 0.3 * std::sin(0.3), 1e-12);
+  // capsule: cap centres at 0.3 -+ 0.2 sin 0.4, radius 0.05
+  EXPECT_NEAR(std::min(g[10], g[11]), 0.3 - 0.2 * std::sin(0.4) - 0.05, 1e-12);
+  // tip sphere: hinge at (0,1,0), tip at angle -0.2: height 1 - sin 0.2, radius 0.1
+  EXPECT_NEAR(g[12], 1.0 - std::sin(0.2) - 0.1, 1e-12);
+  // sphere-sphere
+  const Vec3 tip(std::cos(0.2), 1.0 - std::sin(0.2), 0.0);
+  EXPECT_NEAR(g[13], (Vec3(1.5, 0.5, 0) - tip).norm() - 0.25, 1e-12);
+}
+
+TEST(Unilateral, NormalRowsAreTheGapRatesByFiniteDifferences) {
+  Scene sc;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  State s = sc.sys->defaultState();
+  for (int k = 0; k < s.q.size(); ++k) s.q[k] = 0.3 * U(rng), s.qdot[k] = U(rng);
+  s.q[1] = 0.3, s.q[7] = 0.2, s.q[13] = 1.0, s.q[14] = 0.6;
+  DynamicsWorkspace ws(*sc.sys);
+  sc.sys->calcMassAndForce(s, ws);
+  UnilateralRows rows;
+  sc.u->detect(sc.sys->model(), s, ws.sk, sc.sys->ndof(), 1e-3, rows);
+  ASSERT_EQ(rows.c.size(), 14u);
+  auto gapsAt = [&](const VecX& q) {
+    State t = s;
+    t.q = q;
+    DynamicsWorkspace w(*sc.sys);
+    sc.sys->kineticEnergy(t, w);
+    return sc.u->gaps(sc.sys->model(), t, w.sk);
+  };
+  const double d = 1e-6;
+  const auto gp = gapsAt(s.q + d * s.qdot), gm = gapsAt(s.q - d * s.qdot);
+  for (size_t i = 0; i < rows.c.size(); ++i) {
+    const double fd = (gp[i] - gm[i]) / (2 * d);
+    EXPECT_NEAR(rows.Jn.row(static_cast<int>(i)).dot(s.qdot), fd, 1e-8 * (1 + std::abs(fd))) << "row " << i;
+    EXPECT_NEAR(rows.c[i].approach, fd, 1e-8 * (1 + std::abs(fd))) << "row " << i;
+  }
+  // the frictional rows' tangents are orthogonal to their normals
+  for (const auto& c : rows.c)
+    if (c.tangent_row >= 0) EXPECT_GT(c.mu, 0.0);
+  EXPECT_EQ(rows.Jt.rows(), 2 * (8 + 2 + 1));
+}
+
+TEST(Unilateral, DualStepEqualsThePrimalQpOfEq347) {
+  // frictionless: min 1/2 v^T A v - a^T v  s.t.  G v = b, J_n v >= target  [D Eq. 3.47], with a
+  // redundant bilateral row, against the dual QP on the impulses
+  std::mt19937 rng(5);
+  std::normal_distribution<double> N(0.0, 1.0);
+  int compared = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const int n = 8, mb = 2, kn = 5;
+    MatX B(n, n), G(mb + 1, n), Jn(kn, n);
+    VecX a(n), target(kn);
+    for (int i = 0; i < n; ++i) {
+      a[i] = N(rng);
+      for (int j = 0; j < n; ++j) B(i, j) = N(rng);
+      for (int r = 0; r < mb; ++r) G(r, i) = N(rng);
+      for (int r = 0; r < kn; ++r) Jn(r, i) = N(rng);
+    }
+    for (int r = 0; r < kn; ++r) target[r] = N(rng);
+    G.row(mb) = G.row(0) + 2 * G.row(1);
+    VecX b(mb + 1);
+    b << N(rng), N(rng), 0.0;
+    b[mb] = b[0] + 2 * b[1];
+    const MatX A = B * B.transpose() + MatX::Identity(n, n);
+    UnilateralRows rows;
+    rows.h = 1.0;
+    rows.Jn = Jn;
+    rows.Jt.resize(0, n);
+    for (int r = 0; r < kn; ++r) {
+      UnilateralRows::Candidate c;
+      c.source = r;
+      c.gap = -1.0;  // all in the QP
+      c.target = target[r];
+      rows.c.push_back(c);
+    }
+    UnilateralOptions opt;
+    opt.regularization = 1e-12;
+    VecX mu;
+    UnilateralStepStats st;
+    const VecX v = solveUnilateralStep(A, a, G, b, rows, opt, nullptr, &mu, &st);
+    QpProblem p;
+    p.H = A;
+    p.g = -a;
+    p.E = G;
+    p.e = b;
+    p.C = Jn;
+    p.d = target;
+    QpResult primal;
+    try {
+      primal = solveQp(p);
+    } catch (const QpError&) {
+      continue;  // random rows can be infeasible
+    }
+    ++compared;
+    EXPECT_LE((v - primal.x).cwiseAbs().maxCoeff(), 1e-7 * (1 + primal.x.norm())) << "trial " << trial;
+    EXPECT_GE((Jn * v - target).minCoeff(), -1e-7);
+    EXPECT_LE((G * v - b).cwiseAbs().maxCoeff(), 1e-9);
+  }
+  EXPECT_GT(compared, 10);
+}
+
+TEST(Unilateral, OnlyBdf1EnforcesThem) {
+  Scene sc;
+  State s = sc.sys->defaultState();
+  s.q[1] = 1.0, s.q[7] = 1.0, s.q[14] = 2.0;
+  IntegratorOptions io;
+  for (const char* name : {"euler", "symplectic", "sdirk2", "rk45", "cvode"}) {
+    auto integ = makeIntegrator(name, io);
+    State t = s;
+    try {
+      integ->advance(*sc.sys, t, 0.01);
+      ADD_FAILURE() << name << " accepted hard unilateral constraints";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("use bdf1"), std::string::npos) << e.what();
+    }
+  }
+  auto bdf1 = makeIntegrator("bdf1", io);
+  State t = s;
+  bdf1->advance(*sc.sys, t, 0.01);
+  EXPECT_TRUE(t.q.allFinite());
+}
+
+TEST(Unilateral, BadInputIsRefused) {
+  Scene sc;
+  const Model& m = sc.sys->model();
+  const auto g = sc.u->geometry();
+  EXPECT_THROW(UnilateralConstraints(m, g, {{1, 2, 0.0, 0.0}}, {}), ModelError);  // box - capsule
+  EXPECT_THROW(UnilateralConstraints(m, g, {{0, 1, -1.0, 0.0}}, {}), ModelError);
+  EXPECT_THROW(UnilateralConstraints(m, g, {{0, 1, 0.0, 1.5}}, {}), ModelError);
+  EXPECT_THROW(UnilateralConstraints(m, g, {}, {{"x", 12, 1.0, -1.0, 0.0}}), ModelError);
+  EXPECT_THROW(UnilateralConstraints(m, g, {}, {{"x", 99, -1.0, 1.0, 0.0}}), ModelError);
+  auto bad = g;
+  bad[3].radius = 0.0;
+  EXPECT_THROW(UnilateralConstraints(m, bad, {}, {}), ModelError);
+}
+
+}  // namespace
+}  // namespace redmax
