@@ -12,7 +12,6 @@
 namespace redmax::adjoint {
 namespace {
 
-
 // an excitation-driven control: its nodes' parameter indices (into Problem::excitations)
 struct Excited {
   int control = -1;
