@@ -154,12 +154,13 @@ CommandRegistration reg(
            "usage: redmax gradient --model M.osim --duration S --params SPEC --objective SPEC\n"
            "                       [--dt H] [--integrator euler|bdf1|sdirk2]\n"
            "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...]\n"
-           "                       [--check [--check-tolerance T]]\n"
+           "                       [--check [--check-tolerance T]] [--jacobian-step REL]\n"
            "Simulates the model from its default pose with the given parameters (gravity, joint springs\n"
-           "and dampers, constraints, muscle inertia; the muscles pull only with excitations: parameters)\n"
-           "and prints the objective\n"
-           "and its gradient by the discrete adjoint of the fixed-step integrator (docs/gradients.md).\n"
-           "e.g. --params 'torques:r_shoulder_elev,r_elbow_flex' --objective 'point:r_ulna_radius_hand@0,-0.2,0=0.3,0.1,0.4'\n") +
+           "and dampers, constraints, muscle inertia; the muscles pull only when --params has an\n"
+           "excitations: group) and prints the objective and its gradient by the discrete adjoint of\n"
+           "the fixed-step integrator (docs/gradients.md).\n"
+           "e.g. --params 'torques:r_shoulder_elev,r_elbow_flex' --objective 'point:r_ulna_radius_hand@0,-0.2,0=0.3,0.1,0.4'\n"
+           "     --params 'excitations:BIClong@10,TRIlong@10' --objective 'point:r_ulna_radius_hand@0,-0.2,0=0.3,0.1,0.4;1e-3*excitation'\n") +
            muscleMassFooter());
        return [f, &app] { return runGradient(*f, app); };
      }});
