@@ -18,7 +18,7 @@ namespace {
 
 struct GradientFlags {
   std::string model, integrator = "euler", params, objective, muscle_mass_kg;
-  double duration = 0.0, dt = 1e-3, check_tolerance = 1e-6;
+  double duration = 0.0, dt = 1e-3, check_tolerance = 1e-6, jacobian_step = 0.0;
   bool check = false;
   MuscleMassFlags mm;
 };
@@ -39,6 +39,7 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
       }))
     return rc;
   for (const auto& w : g.model.build.warnings) std::cerr << "warning: " << w << "\n";
+  if (given(app, "--jacobian-step")) g.problem.jacobian_step = f.jacobian_step;
 
   adjoint::Result res;
   double adjoint_s = 0.0;
@@ -134,6 +135,11 @@ CommandRegistration reg(
                     "steps, 16 runs per parameter) and print the worst relative error\n"
                     "max|adjoint - difference| / max|difference|; exit 1 when it is above\n"
                     "--check-tolerance");
+       app.add_option("--jacobian-step", f->jacobian_step,
+                      "relative step of the step Jacobians' central differences (default 6e-6; 2e-7\n"
+                      "with excited muscles none of which wraps; docs/gradients.md §2)")
+           ->type_name("REL")
+           ->check(between(1e-12, 0.1, false));
        app.add_option("--check-tolerance", f->check_tolerance, "the --check bound (default 1e-6)")
            ->type_name("T")
            ->check(positive());
@@ -148,12 +154,13 @@ CommandRegistration reg(
            "usage: redmax gradient --model M.osim --duration S --params SPEC --objective SPEC\n"
            "                       [--dt H] [--integrator euler|bdf1|sdirk2]\n"
            "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...]\n"
-           "                       [--check [--check-tolerance T]]\n"
+           "                       [--check [--check-tolerance T]] [--jacobian-step REL]\n"
            "Simulates the model from its default pose with the given parameters (gravity, joint springs\n"
-           "and dampers, constraints, muscle inertia; the muscles pull only with excitations: parameters)\n"
-           "and prints the objective\n"
-           "and its gradient by the discrete adjoint of the fixed-step integrator (docs/gradients.md).\n"
-           "e.g. --params 'torques:r_shoulder_elev,r_elbow_flex' --objective 'point:r_ulna_radius_hand@0,-0.2,0=0.3,0.1,0.4'\n") +
+           "and dampers, constraints, muscle inertia; the muscles pull only when --params has an\n"
+           "excitations: group) and prints the objective and its gradient by the discrete adjoint of\n"
+           "the fixed-step integrator (docs/gradients.md).\n"
+           "e.g. --params 'torques:r_shoulder_elev,r_elbow_flex' --objective 'point:r_ulna_radius_hand@0,-0.2,0=0.3,0.1,0.4'\n"
+           "     --params 'excitations:BIClong@10,TRIlong@10' --objective 'point:r_ulna_radius_hand@0,-0.2,0=0.3,0.1,0.4;1e-3*excitation'\n") +
            muscleMassFooter());
        return [f, &app] { return runGradient(*f, app); };
      }});

@@ -12,10 +12,6 @@
 namespace redmax::adjoint {
 namespace {
 
-// relative step of the central differences of one step: about cbrt(machine epsilon), where the
-// truncation error (h^2) and the round-off (eps / h) of a central difference meet
-constexpr double kStepFdRel = 6e-6;
-
 // an excitation-driven control: its nodes' parameter indices (into Problem::excitations)
 struct Excited {
   int control = -1;
@@ -189,7 +185,7 @@ class Stepper {
   int n_ = 0, nz_ = 0;
 };
 
-double fdStep(double x) { return kStepFdRel * std::max(1.0, std::abs(x)); }
+double fdStep(double rel, double x) { return rel * std::max(1.0, std::abs(x)); }
 
 // objective at the final state and its explicit derivatives (dJ/dy_N, dJ/du summed per step)
 double objectiveValue(const System& sys, const Objective& obj, const State& fin, VecX* dJ_dy) {
@@ -230,6 +226,8 @@ void checkProblem(const Problem& pr, const VecX& p, const System& sys) {
     if (c < 0 || c >= n) throw AdjointError("adjoint: initial-q parameter outside the coordinates");
   for (int c : pr.initial_qdot)
     if (c < 0 || c >= n) throw AdjointError("adjoint: initial-qdot parameter outside the coordinates");
+  if (!(pr.jacobian_step > 0.0 && pr.jacobian_step < 1.0))
+    throw AdjointError("adjoint: the step Jacobians' relative difference step must lie in (0, 1)");
   if (pr.num_system_params > 0 && pr.system_param_delta.size() != pr.num_system_params)
     throw AdjointError("adjoint: system_param_delta needs one entry per system parameter");
 }
@@ -311,7 +309,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     // generalized-force columns: one central difference per driven coordinate (the step is
     // linear in them for euler and bdf1, so this is exact up to round-off there)
     for (int c = nub; c < nub + nd; ++c) {
-      const double e = fdStep(u[c]);
+      const double e = fdStep(pr.jacobian_step, u[c]);
       VecX up = u, um = u;
       up[c] += e;
       um[c] -= e;
@@ -326,7 +324,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     // step's two nodes
     for (const Excited& ex : rs.excited) {
       const int c = ex.control;
-      const double e = fdStep(u[c]);
+      const double e = fdStep(pr.jacobian_step, u[c]);
       VecX up = u, um = u;
       up[c] += e;
       um[c] -= e;
@@ -346,7 +344,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     }
     // state Jacobian of the step, column by column
     for (int i = 0; i < ny; ++i) {
-      const double e = fdStep(y[k][i]);
+      const double e = fdStep(pr.jacobian_step, y[k][i]);
       VecX yp = y[k], ym = y[k];
       yp[i] += e;
       ym[i] -= e;

@@ -64,6 +64,11 @@ struct Problem {
   /// sdirk2's Newton tolerance: tighter than a simulation's default (1e-10), since the step
   /// Jacobians difference converged stages and the iteration's error would show in them
   double newton_tol = 1e-12;
+  /// relative step of the central differences of one step (dPhi_k/dy_k, dPhi_k/du): the default
+  /// is about cbrt(machine epsilon), where truncation (e^2) and round-off (eps / e) meet for steps
+  /// whose nonlinearity has the scale of the state; Hill-type tendons near their slack length
+  /// bend on micrometres and want less (docs/gradients.md §2)
+  double jacobian_step = 6e-6;
   State initial;                     ///< the state the run starts from before p is applied
   std::vector<ForceParameter> forces;
   std::vector<ExcitationParameter> excitations;

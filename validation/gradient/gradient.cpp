@@ -6,6 +6,7 @@
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/muscle_force_term.hpp"
 #include "core/dynamics/muscle_term.hpp"
+#include "core/muscles/path.hpp"
 #include "validation/simulate/spec_parse.hpp"
 
 namespace redmax::validation {
@@ -89,6 +90,13 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
     pr.controls = VecX::Zero(sys.numControls());
     for (size_t k = 0; k < mft->actuated().size(); ++k)
       pr.controls[mft_control + static_cast<Eigen::Index>(k)] = mft->actuated()[k].model->minControl();
+    // the step Jacobians' difference step: the tendon's force bends on micrometres, so 6e-6 of a
+    // coordinate gives 5e-6 of the gradient in truncation, 2e-7 gives 5e-10 (measured on
+    // tug_of_war_step.osim, docs/gradients.md §5); a wrapping (Type III) path's dl/dq is itself a central
+    // difference at 1e-7 rad, whose round-off a step that small amplifies, so they keep 6e-6
+    bool wraps = false;
+    for (const auto& a : mft->actuated()) wraps = wraps || pathType(a.muscle.path) == PathType::III;
+    if (!wraps) pr.jacobian_step = 2e-7;
     // fibre lengths in equilibrium with the tendon at the default pose (OpenSim's
     // computeInitialFiberEquilibrium), activations at their defaults
     DynamicsWorkspace ws(sys);
