@@ -35,6 +35,12 @@ TEST(ContactScenes, BallBouncesToERSquaredHeightsAndRestsOnTheGround) {
   o.dt = 1e-4;
   const BallDropResult fine = runBallDrop(o);
   expectApexes(fine, o, 3);
+  // e = 1: every bounce returns to the drop height (no energy lost at the impacts)
+  o.dt = 1e-3;
+  o.restitution = 1.0;
+  o.duration = 2.0;
+  const BallDropResult elastic = runBallDrop(o);
+  expectApexes(elastic, o, 3);
 }
 
 TEST(ContactScenes, BlockSlidesTheCoulombDistance) {
