@@ -257,3 +257,24 @@ TEST_F(ContactCli, HardModesNeedBdf1AndTheirFlags) {
           path("x.sto"));
   EXPECT_EQ(r.code, 2);
 }
+
+TEST_F(ContactCli, HardContactNamesGeometryItCannotUseAndStrictRefuses) {
+  std::string text = slurp(scene("ball_drop.osim"));
+  const std::string anchor = "</ContactSphere>";
+  text.insert(text.find(anchor) + anchor.size(),
+              "\n<ContactMesh name=\"ball_mesh\"><socket_frame>/bodyset/ball</socket_frame><filename>ball.obj</filename></ContactMesh>\n"
+              "<ContactSphere name=\"spare\"><socket_frame>/bodyset/ball</socket_frame><radius>0.05</radius></ContactSphere>\n");
+  const std::string model = write("hard_mesh.osim", text);
+  CmdResult r = run("simulate --model " + model + " --integrator bdf1 --contact hard --duration 0.1 --out " + path("h.sto"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("ContactMesh 'ball_mesh': only ContactSphere and ContactHalfSpace can be hard contacts"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("ContactSphere 'spare': no contact force pairs it"), std::string::npos) << r.err;
+  // the pair the HuntCrossleyForce names is hard; the force itself is not also applied
+  EXPECT_NE(r.out.find("1 contact pairs"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("HuntCrossleyForce"), std::string::npos) << r.err;
+  r = run("simulate --model " + model + " --integrator bdf1 --contact hard --strict --duration 0.1 --out " + path("s.sto"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_FALSE(fs::exists(path("s.sto")));
+}
