@@ -84,7 +84,7 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
     model = validation::loadSimulationModel(model_path, mo);
     if (given(app, "--controls")) {
       // the muscles and actuators as forces, driven by the file (validation/forward/forward_tool.hpp)
-      validation::addActuatorTerms(model, control_warnings, true, &not_applied);
+      validation::addActuatorTerms(model, control_warnings, true, &not_applied, f.hard.contact);
       validation::addControlsFile(*model.system, f.controls, control_warnings);
     } else {
       // the passive forces and contacts; the Simbody engine takes none of them (docs/contact.md)

@@ -92,7 +92,7 @@ bool isActuator(const osim::ForceDesc& f) {
 }  // namespace
 
 void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces,
-                      std::vector<std::string>* not_applied) {
+                      std::vector<std::string>* not_applied, bool hard_contact) {
   std::vector<std::string>& missing = not_applied ? *not_applied : warnings;
   auto sys = std::make_shared<System>(*m.system);
   const MusculoskeletalModel& model = m.build.model;
@@ -116,12 +116,15 @@ void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bo
   }
   if (any) sys->addTerm(std::make_shared<MuscleForceTerm>(model.skeleton(), model.muscles(), models));
   // the actuators, passive forces and contacts (converter/build/force_terms.hpp); other classes are named
-  auto include = [&](const osim::ForceDesc& f) { return f.applies_force && (model_forces || !f.source_file.empty()); };
+  // (hard_contact: the contact forces' geometry becomes hard contacts instead, addHardConstraints)
+  auto include = [&](const osim::ForceDesc& f) {
+    return f.applies_force && (model_forces || !f.source_file.empty()) && !(hard_contact && isContactForce(f));
+  };
   const osim::ForceTermSet terms = osim::buildForceTerms(m.description, m.build, warnings, include);
   for (const auto& t : terms.actuatorTerms()) sys->addTerm(t);
   for (const auto& t : terms.passiveTerms()) sys->addTerm(t);
   listUnmodelledForces(m.description, include, missing);
-  listUnusedContactGeometry(m.description, include, missing);
+  if (!hard_contact) listUnusedContactGeometry(m.description, include, missing);
   // fibre-following mass points read their muscle's states (core/dynamics/muscle_term.hpp)
   for (std::string& note : bindMuscleStates(*sys)) warnings.push_back(std::move(note));
   for (const auto& t : sys->terms())

@@ -50,9 +50,9 @@ void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vect
 /// forces (converter/build/force_terms.hpp, docs/contact.md). model_forces false
 /// (replace_force_set): only the forces that came from force_set_files. Muscles without a force
 /// model, forces whose class is not modelled and contact geometry that nothing applied uses go to
-/// not_applied (one line each; warnings when null).
+/// not_applied (one line each; warnings when null). hard_contact: as addPassiveTerms.
 void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces = true,
-                      std::vector<std::string>* not_applied = nullptr);
+                      std::vector<std::string>* not_applied = nullptr, bool hard_contact = false);
 
 /// Plain `simulate` (no controls): the ForceSet's passive forces and contacts (CoordinateLimitForce,
 /// springs, bushings, HuntCrossleyForce, SmoothSphereHalfSpaceForce) added to m's system. What is
