@@ -1,7 +1,8 @@
 // `redmax scene NAME`: the deformable-body and hybrid-dynamics scenes built in code
-// (docs/deformable.md §4, §6) and the muscle-driven spline-leg scene (docs/forward.md §6); this
-// file only parses and calls validation/scenes/deformable_scenes, validation/scenes/hybrid_scenes
-// and validation/forward/spline_leg_scene.
+// (docs/deformable.md §4, §6), the muscle-driven spline-leg scene (docs/forward.md §6) and the
+// hard-contact scenes (docs/contact.md §6); this file only parses and calls
+// validation/scenes/deformable_scenes, hybrid_scenes, contact_scenes and
+// validation/forward/spline_leg_scene.
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -10,6 +11,7 @@
 
 #include "cli/flags.hpp"
 #include "validation/forward/spline_leg_scene.hpp"
+#include "validation/scenes/contact_scenes.hpp"
 #include "validation/scenes/deformable_scenes.hpp"
 #include "validation/scenes/hybrid_scenes.hpp"
 
@@ -22,6 +24,7 @@ std::vector<std::string> sceneNames() {
   std::vector<std::string> v = scenes::deformableSceneNames();
   for (const auto& n : scenes::hybridSceneNames()) v.push_back(n);
   v.push_back(kSplineLeg);
+  for (const auto& n : scenes::contactSceneNames()) v.push_back(n);
   return v;
 }
 
@@ -31,6 +34,12 @@ std::string bundledModel(const std::string& file) {
   const fs::path here = fs::path("osim_models") / file;
   if (fs::is_regular_file(here)) return here.string();
   return (fs::path(REDMAX_SOURCE_DIR) / "osim_models" / file).string();
+}
+
+bool isContact(const std::string& name) {
+  for (const auto& n : scenes::contactSceneNames())
+    if (n == name) return true;
+  return false;
 }
 
 bool isHybrid(const std::string& name) {
@@ -47,14 +56,15 @@ struct SceneFlags {
 };
 
 constexpr const char* kSummary =
-    "run a deformable-body, hybrid-dynamics or muscle-driven scene (cantilever, strand, soft-pendulum, hand,\n"
-    "starfish, spline-leg)";
+    "run a deformable-body, hybrid-dynamics, muscle-driven or hard-contact scene (cantilever, strand,\n"
+    "soft-pendulum, hand, starfish, spline-leg, ball-drop, block-slide, box-stack, limit-pendulum)";
 
 CommandRegistration reg({"scene", kSummary, [](CLI::App& app) {
                            auto f = std::make_shared<SceneFlags>();
                            app.add_option("name", f->name, "the scene")
                                ->required()
-                               ->type_name("cantilever|strand|soft-pendulum|hand|starfish|spline-leg")
+                               ->type_name("cantilever|strand|soft-pendulum|hand|starfish|spline-leg|ball-drop|block-slide|box-stack|\n"
+                                          "limit-pendulum")
                                ->check(oneOf(sceneNames()));
                            app.add_option("--out", f->out, "output folder (default: ./scene-NAME)")->type_name("DIR");
                            app.add_option("--model", f->model,
@@ -85,7 +95,15 @@ CommandRegistration reg({"scene", kSummary, [](CLI::App& app) {
                                "                 (gastrocnemii constant, soleus and tibialis anterior on an ankle\n"
                                "                 controller, rectus femoris then semimembranosus by hand), lumped\n"
                                "                 against inertial and spline against revolute knee; writes states,\n"
-                               "                 muscle forces, summary.txt and plots (docs/forward.md §6)");
+                               "                 muscle forces, summary.txt and plots (docs/forward.md §6)\n"
+                               "Hard unilateral constraints (bdf1 with the contact QP, docs/contact.md §6); these\n"
+                               "write DIR/states.csv only:\n"
+                               "  ball-drop      a sphere dropped 0.5 m on the ground, restitution 0.5: bounce\n"
+                               "                 apexes against e^2k h and the rest height against the radius\n"
+                               "  block-slide    a box sliding at 2 m/s with mu 0.5: distance against v0^2/(2 mu g)\n"
+                               "  box-stack      three boxes stacked on the ground: drift per second once settled\n"
+                               "  limit-pendulum a rod released horizontally onto a joint limit at -90 deg,\n"
+                               "                 restitution 0.5: kinetic energy after the stop against e^2 before");
                            return [f] {
                              const std::string out = f->out.empty() ? "scene-" + f->name : f->out;
                              if (f->name == kSplineLeg) {
@@ -105,6 +123,11 @@ CommandRegistration reg({"scene", kSummary, [](CLI::App& app) {
                              }
                              if (!f->model.empty() || f->duration > 0)
                                throw UsageError{"--model and --duration are for the spline-leg scene"};
+                             if (isContact(f->name)) {
+                               scenes::runContactScene(f->name, out, std::cout);
+                               std::cout << "wrote " << out << "/states.csv\n";
+                               return 0;
+                             }
                              if (isHybrid(f->name))
                                scenes::runHybridScene(f->name, out, std::cout);
                              else

@@ -38,6 +38,8 @@ struct SimulateFlags {
   bool no_qvv = false, progress = false, quiet = false, full_precision = false, strict = false;
   MuscleMassFlags mm;
   std::string simbody_method, simbody_norm = "rms";
+  std::string joint_limits, contact = "compliant";
+  validation::HardConstraintOptions hard;
 };
 
 int runSimulate(SimulateFlags& f, const CLI::App& app) {
@@ -52,6 +54,18 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   if (prescribing && engine != "core") throw UsageError{"--prescribe needs --engine core"};
   for (const char* n : {"--prescribe-coordinates", "--prescribe-lowpass", "--prescribed-forces"})
     if (given(app, n) && !prescribing) throw UsageError{std::string(n) + " needs --prescribe MOTION"};
+  // hard unilateral constraints: only bdf1 solves the contact QP (docs/contact.md §6)
+  const bool hard = given(app, "--joint-limits") || f.contact == "hard";
+  if (given(app, "--limit-restitution") && !given(app, "--joint-limits"))
+    throw UsageError{"--limit-restitution needs --joint-limits hard|clamped"};
+  for (const char* n : {"--contact-restitution", "--contact-friction"})
+    if (given(app, n) && f.contact != "hard") throw UsageError{std::string(n) + " needs --contact hard"};
+  if (hard && engine != "core") throw UsageError{"--joint-limits and --contact hard need --engine core"};
+  if (hard && f.so.integrator != "bdf1")
+    throw UsageError{"--joint-limits and --contact hard need --integrator bdf1 (the linearly implicit step that "
+                     "solves the contact QP; " + f.so.integrator + " cannot enforce them, docs/contact.md §6)"};
+  f.hard.joint_limits = f.joint_limits;
+  f.hard.contact = f.contact == "hard";
   validation::SimbodyEngineOptions simbody_flags;
   simbody_flags.method = f.simbody_method;
   simbody_flags.infinity_norm = f.simbody_norm == "inf";
@@ -73,15 +87,16 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   validation::MotionPrescription prescription;
   State initial;
   std::vector<std::string> control_warnings, not_applied;
+  validation::HardConstraintSummary hard_made;
   try {
     model = validation::loadSimulationModel(model_path, mo);
     if (given(app, "--controls")) {
       // the muscles and actuators as forces, driven by the file (validation/forward/forward_tool.hpp)
-      validation::addActuatorTerms(model, control_warnings, true, &not_applied);
+      validation::addActuatorTerms(model, control_warnings, true, &not_applied, f.hard.contact);
       validation::addControlsFile(*model.system, f.controls, control_warnings);
     } else {
       // the passive forces and contacts; the Simbody engine takes none of them (docs/contact.md)
-      validation::addPassiveTerms(model, control_warnings, not_applied, engine == "core");
+      validation::addPassiveTerms(model, control_warnings, not_applied, engine == "core", f.hard.contact);
     }
     if (prescribing) {
       // hybrid dynamics: the chosen coordinates follow the motion (validation/simulate/prescribe_motion.hpp)
@@ -91,6 +106,7 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
       prescription = validation::prescribeMotion(model, osim::readStorage(f.prescribe), f.prescribe, po);
       for (const auto& w : prescription.warnings) control_warnings.push_back(w);
     }
+    if (hard) hard_made = validation::addHardConstraints(model, f.hard, not_applied);
     if (given(app, "--initial")) {
       const osim::Storage table = osim::readStorage(f.initial);
       initial = validation::initialStateFromStorage(
@@ -244,6 +260,16 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
                   res.contacts.contacts, res.contacts.active_final, res.contacts.active_max, res.contacts.max_penetration,
                   res.contacts.deepest.empty() ? "none" : res.contacts.deepest.c_str(), res.contacts.deepest_time);
   }
+  if (hard && !quiet)
+    std::printf("unilateral: %d joint limits, %d contact pairs; %ld of %ld steps solved a contact QP, at most %d "
+                "contacts at once (%.3g on average), %ld QP iterations in %ld QPs, largest penetration %.3g "
+                "(m or rad)%s\n",
+                hard_made.limits, hard_made.pairs, res.stats.unilateral_steps, res.stats.steps, res.stats.max_contacts,
+                res.stats.unilateral_steps > 0 ? double(res.stats.contact_rows) / double(res.stats.unilateral_steps) : 0.0,
+                res.stats.qp_iterations, res.stats.qp_solves, res.stats.max_penetration,
+                res.stats.friction_unconverged > 0
+                    ? (", friction fixed point unconverged in " + std::to_string(res.stats.friction_unconverged) + " steps").c_str()
+                    : "");
   // --wrap neural: how often the smooth model stood in for the network (muscle_mass_flags.hpp)
   if (monitor && !quiet) {
     const std::string counts = monitor->summary();
@@ -356,6 +382,31 @@ CommandRegistration reg(
                       "output row (columns <coord>_moment / <coord>_force, as redmax id names them;\n"
                       "with every coordinate prescribed they are the motion's inverse dynamics)")
            ->type_name("FORCES.sto");
+       app.add_option("--joint-limits", f->joint_limits,
+                      "enforce coordinate ranges as hard unilateral constraints: every coordinate's\n"
+                      "range (hard) or those OpenSim marks clamped; locked and prescribed coordinates\n"
+                      "are left out; needs --integrator bdf1 (docs/contact.md §6)")
+           ->type_name("hard|clamped")
+           ->check(oneOf({"hard", "clamped"}));
+       app.add_option("--limit-restitution", f->hard.limit_restitution,
+                      "restitution of the joint limits (default 0: a stop without bounce)")
+           ->type_name("E")
+           ->check(CLI::Range(0.0, 1.0));
+       app.add_option("--contact", f->contact,
+                      "compliant (default): HuntCrossleyForce and SmoothSphereHalfSpaceForce as\n"
+                      "OpenSim computes them; hard: their ContactSphere / ContactHalfSpace pairs as\n"
+                      "hard contacts with Coulomb friction (the forces' dynamic_friction), no\n"
+                      "penetration; needs --integrator bdf1")
+           ->type_name("compliant|hard")
+           ->check(oneOf({"compliant", "hard"}));
+       app.add_option("--contact-restitution", f->hard.contact_restitution,
+                      "with --contact hard: restitution of every pair (default 0)")
+           ->type_name("E")
+           ->check(CLI::Range(0.0, 1.0));
+       app.add_option("--contact-friction", f->hard.contact_friction,
+                      "with --contact hard: Coulomb mu of every pair instead of the model's")
+           ->type_name("MU")
+           ->check(nonNegative());
        app.add_flag("--progress", f->progress, "progress on stderr (otherwise shown once a run takes over 2 s)");
        app.add_flag("--quiet", f->quiet, "no summary and no progress");
        app.add_flag("--strict", f->strict,
@@ -374,6 +425,8 @@ CommandRegistration reg(
            "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
            "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
            "                       [--engine core|simbody [--simbody-method M] [--simbody-norm rms|inf]]\n"
+           "                       [--joint-limits hard|clamped [--limit-restitution E]]\n"
+           "                       [--contact compliant|hard [--contact-restitution E] [--contact-friction MU]]\n"
            "                       [--progress] [--quiet] [--strict] [--full-precision]\n"
            "Integrates the model under gravity from its default pose (each coordinate's default_value and\n"
            "default_speed_value) with its constraints (locked, coupled and prescribed coordinates, welds),\n"
@@ -384,7 +437,8 @@ CommandRegistration reg(
            "kinetic_energy, potential_energy, total_energy (J; gravity potential relative to the origin).\n"
            "A NaN or divergence stops the run: exit 1, the time, coordinate and step are named, and nothing\n"
            "is written. The summary gives steps, rhs evaluations, wall time and the energy drift\n"
-           "max|E(t) - E(0)| relative to max(|E(0)|, max kinetic energy).\n") +
+           "max|E(t) - E(0)| relative to max(|E(0)|, max kinetic energy). With --joint-limits or --contact\n"
+           "hard it adds the contacts, QP iterations and the largest penetration.\n") +
            muscleMassFooter());
        return [f, &app] { return runSimulate(*f, app); };
      }});

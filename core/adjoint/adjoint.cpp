@@ -38,6 +38,9 @@ RunSystem makeRunSystem(const Problem& pr, const VecX& system_params) {
   if (!base->controllers().empty())
     throw AdjointError("adjoint: the system has controllers; only generalized-force and excitation parameters drive it");
   if (base->coordinateMap()) throw AdjointError("adjoint: hyper-reduced coordinates (a coordinate map) are not supported");
+  // the contact QP's active set switches are not differentiated (docs/contact.md §6)
+  if (base->unilateral())
+    throw AdjointError("adjoint: hard unilateral constraints (joint limits, contacts) are not supported");
   RunSystem rs;
   rs.sys = std::make_shared<System>(*base);
   rs.nu_base = base->numControls();

@@ -191,3 +191,90 @@ TEST_F(ContactCli, ForwardToolAppliesContactAndStrictRefusesUnsupported) {
 }
 
 }  // namespace
+
+// hard unilateral constraints (docs/contact.md §6): `simulate --integrator bdf1 --contact hard`
+TEST_F(ContactCli, HardContactBallRestsOnTheFloorWithoutPenetration) {
+  const CmdResult r = run("simulate --model " + scene("ball_drop.osim") +
+                          " --integrator bdf1 --contact hard --contact-restitution 0.5 --duration 2 --full-precision --out " +
+                          path("hard.sto"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("not applied"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("unilateral: 0 joint limits, 1 contact pairs;"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("QP iterations"), std::string::npos) << r.out;
+  const Storage s = readStorage(path("hard.sto"));
+  const int ty = s.findColumn("/jointset/ball_free/ball_ty/value");
+  EXPECT_NEAR(last(s, "/jointset/ball_free/ball_ty/value"), 0.1, 1e-8);  // resting on its radius
+  EXPECT_GT(s.data.col(ty).minCoeff(), 0.1 - 1e-8);                       // never below it
+}
+
+TEST_F(ContactCli, HardContactBlockSlidesTheCoulombDistance) {
+  const CmdResult r = run("simulate --model " + scene("sliding_block.osim") +
+                          " --integrator bdf1 --contact hard --duration 1 --full-precision --out " + path("hb.sto"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Storage s = readStorage(path("hb.sto"));
+  // v0^2 / (2 ud g) with v0 = 2, ud = 0.5 (Coulomb, no transition velocity); first order in dt:
+  // within dt v0 (measured 1.35e-3 m short: dt v0 / 2 and the model's initial overlap pushed out)
+  EXPECT_NEAR(last(s, "/jointset/slide_x/block_x/value"), 4.0 / (2 * 0.5 * kG), 1e-3 * 2.0);
+  EXPECT_LT(std::abs(last(s, "/jointset/slide_x/block_x/speed")), 1e-8);
+}
+
+TEST_F(ContactCli, HardJointLimitHoldsTheClampedCoordinate) {
+  std::string text = slurp(scene("double_pendulum_straight.osim"));
+  // the second coordinate's range [-0.1, 0.6] rad, clamped
+  const auto p = text.find("<range>", text.find("0.523598775598299"));
+  text.replace(p, text.find("</clamped>", p) - p,
+               "<range>-0.1 0.6</range>\n<clamped>true");
+  const std::string model = write("clamped.osim", text);
+  CmdResult r = run("simulate --model " + model + " --integrator bdf1 --joint-limits clamped --duration 2 --out " +
+                    path("lim.sto"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("unilateral: 1 joint limits, 0 contact pairs;"), std::string::npos) << r.out;
+  const Storage s = readStorage(path("lim.sto"));
+  const int dc = s.findColumn("/jointset/pin2/q2/value");
+  ASSERT_GE(dc, 0);
+  EXPECT_LE(s.data.col(dc).maxCoeff(), 0.6 + 1e-8);
+  EXPECT_GE(s.data.col(dc).minCoeff(), -0.1 - 1e-8);
+  // without the limit the coordinate leaves the range (the limit did something)
+  r = run("simulate --model " + model + " --integrator bdf1 --duration 2 --out " + path("free.sto"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Storage f = readStorage(path("free.sto"));
+  EXPECT_TRUE(f.data.col(dc).maxCoeff() > 0.6 + 1e-3 || f.data.col(dc).minCoeff() < -0.1 - 1e-3);
+}
+
+TEST_F(ContactCli, HardModesNeedBdf1AndTheirFlags) {
+  CmdResult r = run("simulate --model " + scene("ball_drop.osim") + " --contact hard --duration 0.1 --out " + path("x.sto"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("need --integrator bdf1"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("x.sto")));
+  r = run("simulate --model " + scene("ball_drop.osim") + " --integrator bdf1 --limit-restitution 0.5 --duration 0.1 --out " +
+          path("x.sto"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--limit-restitution needs --joint-limits"), std::string::npos) << r.err;
+  r = run("simulate --model " + scene("ball_drop.osim") + " --integrator bdf1 --contact-restitution 0.5 --duration 0.1 --out " +
+          path("x.sto"));
+  EXPECT_EQ(r.code, 2);
+  r = run("simulate --model " + scene("ball_drop.osim") + " --engine simbody --integrator bdf1 --contact hard --duration 0.1 --out " +
+          path("x.sto"));
+  EXPECT_EQ(r.code, 2);
+}
+
+TEST_F(ContactCli, HardContactNamesGeometryItCannotUseAndStrictRefuses) {
+  std::string text = slurp(scene("ball_drop.osim"));
+  const std::string anchor = "</ContactSphere>";
+  text.insert(text.find(anchor) + anchor.size(),
+              "\n<ContactMesh name=\"ball_mesh\"><socket_frame>/bodyset/ball</socket_frame><filename>ball.obj</filename></ContactMesh>\n"
+              "<ContactSphere name=\"spare\"><socket_frame>/bodyset/ball</socket_frame><radius>0.05</radius></ContactSphere>\n");
+  const std::string model = write("hard_mesh.osim", text);
+  CmdResult r = run("simulate --model " + model + " --integrator bdf1 --contact hard --duration 0.1 --out " + path("h.sto"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("ContactMesh 'ball_mesh': only ContactSphere and ContactHalfSpace can be hard contacts"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("ContactSphere 'spare': no contact force pairs it"), std::string::npos) << r.err;
+  // the pair the HuntCrossleyForce names is hard; the force itself is not also applied
+  EXPECT_NE(r.out.find("1 contact pairs"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("HuntCrossleyForce"), std::string::npos) << r.err;
+  r = run("simulate --model " + model + " --integrator bdf1 --contact hard --strict --duration 0.1 --out " + path("s.sto"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_FALSE(fs::exists(path("s.sto")));
+}

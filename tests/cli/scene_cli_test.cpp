@@ -117,11 +117,26 @@ TEST_F(SceneCli, HandPrintsItsPrescriptionErrors) {
   EXPECT_TRUE(fs::exists(out / "hand.pvd"));
 }
 
+TEST_F(SceneCli, ContactScenesPrintTheirClosedFormsAndWriteStates) {
+  // the closed-form agreement itself is tested in tests/core/dynamics/unilateral/contact_scenes_test.cpp
+  CmdResult r = runRedmax(dir_, "scene limit-pendulum --out " + (dir_ / "lp").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("after 1.22622 J (e^2 before 1.22622 J)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("QP iterations"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(dir_ / "lp" / "states.csv"));
+  r = runRedmax(dir_, "scene block-slide --out " + (dir_ / "bs").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("v0^2/(2 mu g) 0.407747 m"), std::string::npos) << r.out;
+}
+
 TEST_F(SceneCli, UnknownOrMissingNameIsAUsageError) {
   CmdResult r = runRedmax(dir_, "scene octopus");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("error: "), std::string::npos);
-  EXPECT_NE(r.err.find("cantilever, strand, soft-pendulum, hand, starfish or spline-leg"), std::string::npos);
+  EXPECT_NE(r.err.find("cantilever, strand, soft-pendulum, hand, starfish, spline-leg, ball-drop, block-slide, "
+                       "box-stack or limit-pendulum"),
+            std::string::npos)
+      << r.err;
   r = runRedmax(dir_, "scene");
   EXPECT_EQ(r.code, 2);
   // the spline-leg options are refused for the other scenes; a model that cannot be read is the

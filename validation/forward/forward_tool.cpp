@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -78,6 +79,10 @@ void listUnmodelledForces(const osim::ModelDescription& d, const std::function<b
       not_applied.push_back(f.class_name + " '" + f.name + "' is not modelled in forward simulation; ignored");
 }
 
+bool isContactForce(const osim::ForceDesc& f) {
+  return f.class_name == "HuntCrossleyForce" || f.class_name == "SmoothSphereHalfSpaceForce";
+}
+
 bool isActuator(const osim::ForceDesc& f) {
   return f.class_name == "CoordinateActuator" || f.class_name == "PointActuator" || f.class_name == "TorqueActuator" ||
          f.class_name == "ActivationCoordinateActuator" || f.class_name == "BodyActuator" ||
@@ -87,7 +92,7 @@ bool isActuator(const osim::ForceDesc& f) {
 }  // namespace
 
 void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces,
-                      std::vector<std::string>* not_applied) {
+                      std::vector<std::string>* not_applied, bool hard_contact) {
   std::vector<std::string>& missing = not_applied ? *not_applied : warnings;
   auto sys = std::make_shared<System>(*m.system);
   const MusculoskeletalModel& model = m.build.model;
@@ -111,12 +116,15 @@ void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bo
   }
   if (any) sys->addTerm(std::make_shared<MuscleForceTerm>(model.skeleton(), model.muscles(), models));
   // the actuators, passive forces and contacts (converter/build/force_terms.hpp); other classes are named
-  auto include = [&](const osim::ForceDesc& f) { return f.applies_force && (model_forces || !f.source_file.empty()); };
+  // (hard_contact: the contact forces' geometry becomes hard contacts instead, addHardConstraints)
+  auto include = [&](const osim::ForceDesc& f) {
+    return f.applies_force && (model_forces || !f.source_file.empty()) && !(hard_contact && isContactForce(f));
+  };
   const osim::ForceTermSet terms = osim::buildForceTerms(m.description, m.build, warnings, include);
   for (const auto& t : terms.actuatorTerms()) sys->addTerm(t);
   for (const auto& t : terms.passiveTerms()) sys->addTerm(t);
   listUnmodelledForces(m.description, include, missing);
-  listUnusedContactGeometry(m.description, include, missing);
+  if (!hard_contact) listUnusedContactGeometry(m.description, include, missing);
   // fibre-following mass points read their muscle's states (core/dynamics/muscle_term.hpp)
   for (std::string& note : bindMuscleStates(*sys)) warnings.push_back(std::move(note));
   for (const auto& t : sys->terms())
@@ -133,7 +141,7 @@ std::string strictRefusal(const std::vector<std::string>& not_applied) {
 }
 
 void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std::vector<std::string>& not_applied,
-                     bool apply) {
+                     bool apply, bool hard_contact) {
   const osim::ModelDescription& d = m.description;
   // muscles and actuators need controls: named in one line each, every name given
   auto listNames = [&](const std::vector<std::string>& names, const std::string& what) {
@@ -150,7 +158,9 @@ void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std
   listNames(muscles, apply ? "path forces exert no force without --controls (their mass, if any, stays)"
                            : "path forces exert no force with this engine");
   listNames(actuators, apply ? "actuators apply nothing without --controls" : "actuators apply nothing with this engine");
-  auto passive = [&](const osim::ForceDesc& f) { return f.applies_force && !isActuator(f); };
+  auto passive = [&](const osim::ForceDesc& f) {
+    return f.applies_force && !isActuator(f) && !(hard_contact && isContactForce(f));
+  };
   if (!apply) {
     std::vector<std::string> forces;
     for (const osim::ForceDesc& f : d.forces)
@@ -168,7 +178,96 @@ void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std
     m.system = sys;
   }
   listUnmodelledForces(d, passive, not_applied);
-  listUnusedContactGeometry(d, passive, not_applied);
+  if (!hard_contact) listUnusedContactGeometry(d, passive, not_applied);
+}
+
+HardConstraintSummary addHardConstraints(SimulationModel& m, const HardConstraintOptions& o,
+                                         std::vector<std::string>& not_applied) {
+  const osim::ModelDescription& d = m.description;
+  const Model& core = m.system->model();
+  HardConstraintSummary out;
+  std::vector<JointLimit> limits;
+  if (!o.joint_limits.empty()) {
+    for (const osim::CoordinateDesc& c : d.coordinates) {
+      if (o.joint_limits == "clamped" && !c.clamped) continue;
+      if (c.locked || c.prescribed) continue;
+      const int k = core.findCoordinate(c.name);
+      if (k < 0) {
+        not_applied.push_back(d.source_file + ":" + std::to_string(c.line) + ": coordinate '" + c.name +
+                              "' has no coordinate of its own in the core; its range is not enforced");
+        continue;
+      }
+      limits.push_back({c.name, k, c.range_min, c.range_max, o.limit_restitution});
+      if (!(c.default_value >= c.range_min && c.default_value <= c.range_max))
+        throw ModelError("coordinate " + c.name + ": default value " + std::to_string(c.default_value) +
+                         " lies outside its range [" + std::to_string(c.range_min) + ", " +
+                         std::to_string(c.range_max) + "] that --joint-limits enforces");
+    }
+  }
+  std::vector<CollisionGeometry> geo;
+  std::vector<CollisionPair> pairs;
+  if (o.contact) {
+    std::map<std::string, int> index;  // geometry name -> geo
+    std::set<std::string> used;
+    for (const osim::ContactGeometryDesc& g : d.contact_geometry) {
+      const std::string where = d.source_file + ":" + std::to_string(g.line) + ": " + g.class_name + " '" + g.name + "'";
+      if (g.class_name != "ContactSphere" && g.class_name != "ContactHalfSpace") {
+        not_applied.push_back(where + ": only ContactSphere and ContactHalfSpace can be hard contacts; ignored");
+        continue;
+      }
+      CollisionGeometry c;
+      c.name = g.name;
+      c.shape = g.class_name == "ContactSphere" ? CollisionShape::Sphere : CollisionShape::HalfSpace;
+      c.body = g.body == d.ground_name ? -1 : core.findBody(g.body);
+      if (g.body != d.ground_name && c.body < 0) {
+        not_applied.push_back(where + ": its body '" + g.body + "' is not in the core model; ignored");
+        continue;
+      }
+      c.X_body = g.X_body;
+      c.radius = g.radius;
+      index[g.name] = static_cast<int>(geo.size());
+      geo.push_back(c);
+    }
+    auto harmonic = [](double a, double b) { return a + b > 0.0 ? 2.0 * a * b / (a + b) : 0.0; };
+    auto addPair = [&](int i, int j, double mu) {
+      const CollisionGeometry &a = geo[i], &b = geo[j];
+      const bool hs = (a.shape == CollisionShape::HalfSpace) != (b.shape == CollisionShape::HalfSpace);
+      const bool ss = a.shape == CollisionShape::Sphere && b.shape == CollisionShape::Sphere;
+      if (!(hs || ss) || a.body == b.body) return;
+      pairs.push_back({i, j, o.contact_friction >= 0.0 ? o.contact_friction : mu, o.contact_restitution});
+      used.insert(a.name);
+      used.insert(b.name);
+    };
+    for (const osim::ForceDesc& f : d.forces) {
+      if (!f.applies_force || !isContactForce(f)) continue;
+      if (f.class_name == "SmoothSphereHalfSpaceForce") {
+        auto i = index.find(f.half_space), j = index.find(f.sphere);
+        if (i != index.end() && j != index.end())
+          addPair(i->second, j->second, f.contact_parameters.empty() ? 0.0 : f.contact_parameters[0].dynamic_friction);
+        continue;
+      }
+      std::vector<std::pair<int, double>> members;  // geometry, its dynamic friction
+      for (const osim::ContactParametersDesc& cp : f.contact_parameters)
+        for (const std::string& name : cp.geometry) {
+          auto it = index.find(name);
+          if (it != index.end()) members.emplace_back(it->second, cp.dynamic_friction);
+        }
+      for (size_t a = 0; a < members.size(); ++a)
+        for (size_t b = a + 1; b < members.size(); ++b)
+          addPair(members[a].first, members[b].first, harmonic(members[a].second, members[b].second));
+    }
+    for (const osim::ContactGeometryDesc& g : d.contact_geometry)
+      if (index.count(g.name) && !used.count(g.name))
+        not_applied.push_back(d.source_file + ":" + std::to_string(g.line) + ": " + g.class_name + " '" + g.name +
+                              "': no contact force pairs it with another geometry; it touches nothing");
+  }
+  out.limits = static_cast<int>(limits.size());
+  out.pairs = static_cast<int>(pairs.size());
+  if (limits.empty() && pairs.empty()) return out;
+  auto sys = std::make_shared<System>(*m.system);
+  sys->setUnilateral(std::make_shared<UnilateralConstraints>(core, geo, pairs, limits));
+  m.system = sys;
+  return out;
 }
 
 State forwardInitialState(const SimulationModel& m, const osim::Storage& table, const std::string& file, double time) {

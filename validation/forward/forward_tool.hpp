@@ -50,9 +50,9 @@ void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vect
 /// forces (converter/build/force_terms.hpp, docs/contact.md). model_forces false
 /// (replace_force_set): only the forces that came from force_set_files. Muscles without a force
 /// model, forces whose class is not modelled and contact geometry that nothing applied uses go to
-/// not_applied (one line each; warnings when null).
+/// not_applied (one line each; warnings when null). hard_contact: as addPassiveTerms.
 void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces = true,
-                      std::vector<std::string>* not_applied = nullptr);
+                      std::vector<std::string>* not_applied = nullptr, bool hard_contact = false);
 
 /// Plain `simulate` (no controls): the ForceSet's passive forces and contacts (CoordinateLimitForce,
 /// springs, bushings, HuntCrossleyForce, SmoothSphereHalfSpaceForce) added to m's system. What is
@@ -60,8 +60,31 @@ void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bo
 /// given), forces whose class is not modelled, contact geometry no applied force uses. apply
 /// false (an engine that takes no ForceSet forces): nothing is added and every force and geometry
 /// is listed.
+/// hard_contact: HuntCrossleyForce and SmoothSphereHalfSpaceForce are left out (addHardConstraints
+/// makes their geometry hard contacts) and their geometry is not listed here.
 void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std::vector<std::string>& not_applied,
-                     bool apply = true);
+                     bool apply = true, bool hard_contact = false);
+
+/// `simulate`'s hard modes (docs/contact.md §6).
+struct HardConstraintOptions {
+  std::string joint_limits;        ///< "": none; "hard": every coordinate's range; "clamped": the clamped ones
+  double limit_restitution = 0.0;
+  bool contact = false;            ///< ContactSphere / ContactHalfSpace pairs of the contact forces, hard
+  double contact_restitution = 0.0;
+  double contact_friction = -1.0;  ///< Coulomb mu for every pair; < 0: each force's dynamic_friction
+};
+/// What addHardConstraints made.
+struct HardConstraintSummary {
+  int limits = 0, pairs = 0;
+};
+/// Sets m.system's unilateral constraints (System::setUnilateral) from its description: joint
+/// ranges as limits (not locked or prescribed coordinates), and for the contact forces'
+/// geometry (HuntCrossleyForce: every sphere/half-space or sphere/sphere pair of its contact set
+/// on different bodies, friction 2 u1 u2 / (u1 + u2) of the dynamic coefficients;
+/// SmoothSphereHalfSpaceForce: its pair) hard contacts. Geometry it cannot use is named in
+/// not_applied. Throws ModelError for a coordinate whose default lies outside its hard range.
+HardConstraintSummary addHardConstraints(SimulationModel& m, const HardConstraintOptions& o,
+                                         std::vector<std::string>& not_applied);
 
 /// The message of a --strict refusal: the count, then every item not applied on its own line.
 std::string strictRefusal(const std::vector<std::string>& not_applied);

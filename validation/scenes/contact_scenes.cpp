@@ -117,7 +117,7 @@ BlockSlideResult runBlockSlide(const BlockSlideOptions& o) {
   return r;
 }
 
-BoxStackResult runBoxStack(const BoxStackOptions& o) {
+std::shared_ptr<System> makeBoxStack(const BoxStackOptions& o, State& s) {
   if (o.boxes < 1) throw std::invalid_argument("box-stack: needs at least one box");
   ModelBuilder b("box_stack");
   b.setGravity(Vec3(0, -kG, 0));
@@ -142,10 +142,16 @@ BoxStackResult runBoxStack(const BoxStackOptions& o) {
     geo.push_back(top);
   }
   auto sys = std::make_shared<System>(b.finalize());
-  auto uc = std::make_shared<UnilateralConstraints>(sys->model(), geo, pairs, std::vector<JointLimit>{});
-  sys->setUnilateral(uc);
-  State s = sys->defaultState();
+  sys->setUnilateral(std::make_shared<UnilateralConstraints>(sys->model(), geo, pairs, std::vector<JointLimit>{}));
+  s = sys->defaultState();
   for (int i = 0; i < o.boxes; ++i) s.q[6 * i + 1] = o.half + i * (2 * o.half + o.initial_gap);
+  return sys;
+}
+
+BoxStackResult runBoxStack(const BoxStackOptions& o) {
+  State s;
+  const std::shared_ptr<System> sys = makeBoxStack(o, s);
+  const std::shared_ptr<const UnilateralConstraints> uc = sys->unilateral();
   BoxStackResult r;
   r.run = record(*sys, s, o.dt, o.duration);
   const VecX& last = r.run.rows.back();

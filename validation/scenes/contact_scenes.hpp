@@ -10,6 +10,7 @@
 //                   kinetic energy after the stop against e^2 times the energy before
 // All run bdf1 (the linearly implicit Euler step with the contact QP). Used by `redmax scene`
 // and the tests.
+#include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -65,6 +66,9 @@ struct BoxStackResult {
   double final_max_speed = 0.0;
 };
 BoxStackResult runBoxStack(const BoxStackOptions& o);
+/// the box-stack system (free boxes, each box's corners against the top face of the one below)
+/// and its initial state
+std::shared_ptr<System> makeBoxStack(const BoxStackOptions& o, State& initial);
 
 struct LimitPendulumOptions {
   double length = 1.0, mass = 1.0, restitution = 0.5;

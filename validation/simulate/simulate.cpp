@@ -525,6 +525,13 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
     res.stats.jacobian_evals += st.jacobian_evals;
     res.stats.reparameterizations += st.reparameterizations;
     res.stats.failed_steps += st.failed_steps;
+    res.stats.unilateral_steps += st.unilateral_steps;
+    res.stats.qp_iterations += st.qp_iterations;
+    res.stats.qp_solves += st.qp_solves;
+    res.stats.contact_rows += st.contact_rows;
+    res.stats.max_contacts = std::max(res.stats.max_contacts, st.max_contacts);
+    res.stats.max_penetration = std::max(res.stats.max_penetration, st.max_penetration);
+    res.stats.friction_unconverged += st.friction_unconverged;
   };
 
   // the network wrap model's counts live in the workspaces: the integrator's and the energies'

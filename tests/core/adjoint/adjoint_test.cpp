@@ -213,6 +213,14 @@ TEST(Adjoint, RefusesWhatItCannotDifferentiate) {
   EXPECT_THROW(adjoint::evaluate(pr, Objective{}, VecX::Zero(2), true), adjoint::AdjointError);
   pr.forces = {{5, 0, 1}};
   EXPECT_THROW(adjoint::evaluate(pr, Objective{}, VecX::Zero(1), true), adjoint::AdjointError);
+  // hard unilateral constraints (a joint limit) are refused, not silently dropped
+  auto limited = std::make_shared<System>(*sys);
+  limited->setUnilateral(std::make_shared<UnilateralConstraints>(
+      limited->model(), std::vector<CollisionGeometry>{}, std::vector<CollisionPair>{},
+      std::vector<JointLimit>{{"q0", 0, -1.0, 1.0, 0.0}}));
+  Problem pl = problemFor(limited, "bdf1", 0.1, 0.01);
+  pl.forces = {{0, 0, 1}};
+  EXPECT_THROW(adjoint::evaluate(pl, Objective{}, VecX::Zero(1), true), adjoint::AdjointError);
 }
 
 // ---- excitation parameters (docs/gradients.md §2): a linear first-order "activation" a with

@@ -35,6 +35,30 @@ TEST(ContactScenes, BallBouncesToERSquaredHeightsAndRestsOnTheGround) {
   o.dt = 1e-4;
   const BallDropResult fine = runBallDrop(o);
   expectApexes(fine, o, 3);
+  // e = 1: every bounce returns to the drop height (no energy lost at the impacts)
+  o.dt = 1e-3;
+  o.restitution = 1.0;
+  o.duration = 2.0;
+  const BallDropResult elastic = runBallDrop(o);
+  expectApexes(elastic, o, 3);
+}
+
+TEST(ContactScenes, ContactsAppearingAndVanishingEveryFewSteps) {
+  // an elastic ball bouncing 5 mm high with 10 ms steps: a flight lasts about six steps, so the
+  // contact comes and goes all the time; it must neither sink nor gain height
+  BallDropOptions o;
+  o.restitution = 1.0;
+  o.drop_height = 5e-3;
+  o.dt = 1e-2;
+  o.duration = 2.0;
+  const BallDropResult r = runBallDrop(o);
+  const double v0 = std::sqrt(2 * kG * o.drop_height);
+  ASSERT_GE(r.apexes.size(), 20u);
+  for (double a : r.apexes) EXPECT_LE(a, o.drop_height + o.dt * v0);
+  EXPECT_LE(r.run.stats.max_penetration, 1e-9);
+  // the contact was in the QP in a large share of the steps, and the ball kept bouncing
+  EXPECT_GT(r.run.stats.unilateral_steps, r.run.stats.steps / 4);
+  EXPECT_GT(r.apexes.back(), 0.25 * o.drop_height);
 }
 
 TEST(ContactScenes, BlockSlidesTheCoulombDistance) {
