@@ -152,8 +152,8 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
   net.meta["test_max_m"] = num(err.max, 6);
   if (compact > 0.0) {
     net.meta["wrap_map"] = formatCompactWrapMap(compact);
-    net.meta["box"] = "all of space: half the pairs in the default box, half with u uniform in the ball |u| < 0.98 C "
-                      "(tools/wrap_training/model_networks.hpp makeCompactWrapTrainingSet; units of the surface size)";
+    net.meta["box"] = "the default box's end points through the compact map (tools/wrap_training/model_networks.hpp "
+                      "makeCompactWrapTrainingSet, makeCompactDefaultWrapBox; units of the surface size)";
   } else {
     net.meta["box"] = "tools/wrap_training/train.hpp makeDefaultWrapBox (units of the surface size)";
   }
@@ -657,9 +657,8 @@ void declareTrainWrapFlags(CLI::App& app) {
       ->type_name("NET.txt")
       ->group(train);
   app.add_option("--compact",
-                 "the compact input map u = q / (1 + |q| / C) and displacement outputs, over all of\n"
-                 "space (C in radii; cylinder and sphere; --for: default 4); 0 (default without\n"
-                 "--for): the older map over the default box")
+                 "the compact input map u = q / (1 + |q| / C) and displacement outputs (C in radii;\n"
+                 "cylinder and sphere; --for: default 4); 0 (default without --for): the older map")
       ->type_name("C")
       ->check(number())
       ->group(train);
@@ -745,8 +744,8 @@ CommandRegistration reg(
      "(default T) summed in order, so the network depends on S and the seed, not on T (S = 1: serial).\n"
      "--init NET.txt continues training from that network (same surface and --hidden; its normalisation is kept,\n"
      "Adam restarts); its command and losses are kept in the new file's meta as init_*.\n"
-     "--compact C: inputs through the compact map u = q / (1 + |q| / C), sampled over all of space, and the\n"
-     "point's displacement from the straight line as output (meta wrap_map; no training box to leave).\n"
+     "--compact C: inputs through the compact map u = q / (1 + |q| / C) (same samples, box mapped) and the\n"
+     "point's displacement from the straight line as output (meta wrap_map compact C).\n"
      "--for MODEL.osim: for every wrap object (cylinder or sphere) the model's muscles wrap over the poses\n"
      "(--coordinates files, or --ranges default: --frames poses, default 500, uniform in the coordinate ranges),\n"
      "collects the surface-frame end points of its wrapped segments, trains a network on them (jittered, random\n"
