@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap/network_set.hpp"
 #include "tests/cli/cli_test_util.hpp"
 
@@ -90,6 +91,25 @@ TEST_F(TrainWrapForCli, PendulumNetworksManifestAndCheck) {
     EXPECT_EQ(s.code, 0) << s.err;
     EXPECT_NE(s.err.find("wrap model neural"), std::string::npos) << s.err;
   }
+}
+
+TEST_F(TrainWrapForCli, CompactPlainTrainingRecordsItsMap) {
+  const CmdResult r = run("train-wrap --surface sphere --hidden 2x8 --samples 300 --epochs 3 --batch 32 --lr 1e-3 "
+                          "--compact 4 --out " + path("s.txt"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto net = redmax::loadWrapNetwork(path("s.txt"));
+  EXPECT_EQ(net->meta.at("wrap_map"), redmax::formatCompactWrapMap(4.0));
+  EXPECT_EQ(net->input_names[0], "ori_u");
+  // the box is the default box's image: ori_u within (3 / (1 + 3 / 4) + 0.08) = 1.794 (asserted to 1e-12)
+  EXPECT_NEAR(net->input_max[0], 3.0 / 1.75 + 0.08, 1e-12);
+  EXPECT_EQ(net->input_min[7], 1.0);
+  // --init must match the map
+  const CmdResult bad = run("train-wrap --surface sphere --hidden 2x8 --samples 300 --epochs 1 --init " + path("s.txt") +
+                            " --out " + path("t.txt"));
+  EXPECT_EQ(bad.code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--compact asks for the older map"), std::string::npos) << bad.err;
+  EXPECT_EQ(run("train-wrap --surface torus --compact 4 --out " + path("t.txt")).code, 2);
+  EXPECT_FALSE(fs::exists(path("t.txt")));
 }
 
 TEST_F(TrainWrapForCli, BadInputIsTheFirstErrorLineAndWritesNothing) {
