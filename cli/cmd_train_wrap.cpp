@@ -1,4 +1,6 @@
 // `redmax train-wrap`: train the Type III wrap network on samples of the exact wrapping library
+// (progress on stdout, flushed line by line, in every mode: stderr holds only notes, warnings and the
+// error line)
 // [D Sec. 5.3.3.1], or (--compare) time networks, the smooth model and the exact library per mass
 // point (position + Jacobian + Jdot) against their position error. The work is done by
 // tools/wrap_training/ (train.hpp, compare.hpp, study.hpp); this file parses, calls and prints.
@@ -122,19 +124,19 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
   };
   const auto t_data = Clock::now();
   const WrapTrainingSet data = makeSet(samples, threshold, opt.seed);
-  std::cerr << "train-wrap: " << wrapTypeName(type) << ", " << samples << " samples kept of " << data.drawn
+  std::cout << "train-wrap: " << wrapTypeName(type) << ", " << samples << " samples kept of " << data.drawn
             << " drawn (" << data.invalid << " with an end inside the surface, " << data.near_contact
             << " with 0 < l/L < " << threshold << " discarded; " << data.wrapped << " kept samples wrap), "
-            << num(secondsSince(t_data), 3) << " s\n";
+            << num(secondsSince(t_data), 3) << " s\n" << std::flush;
 
   // progress: a line every 2 s and at the end
   double last_print = -1e9;
   opt.on_epoch = [&](const TrainEpoch& e) {
     if (e.elapsed_s - last_print < 2.0 && e.epoch != opt.epochs) return;
     last_print = e.elapsed_s;
-    std::cerr << "train-wrap: epoch " << e.epoch << "/" << opt.epochs << ", " << e.steps << " steps, train mse "
+    std::cout << "train-wrap: epoch " << e.epoch << "/" << opt.epochs << ", " << e.steps << " steps, train mse "
               << num(e.train_mse) << ", validation mse " << num(e.val_mse) << ", validation rms " << num(e.val_rms_m)
-              << " (size units), " << num(e.elapsed_s, 3) << " s\n";
+              << " (size units), " << num(e.elapsed_s, 3) << " s\n" << std::flush;
   };
   std::vector<TrainEpoch> history;
   Mlp net = trainWrapNetwork(data, box, opt, &history);
@@ -292,8 +294,8 @@ int runStudy(const FlagValues& a) {
   if (opt.epochs < 1 || opt.batch < 1) throw UsageError{"--epochs and --batch must be positive"};
 
   const WrapStudy study = runWrapThresholdStudy(o, [](const WrapStudyCurve& c) {
-    std::cerr << "train-wrap --study: threshold " << c.threshold << ", " << c.architecture << ": validation rms "
-              << c.val_rms << " (size units)\n";
+    std::cout << "train-wrap --study: threshold " << c.threshold << ", " << c.architecture << ": validation rms "
+              << c.val_rms << " (size units)\n" << std::flush;
   });
 
   // CSV: the sweep, the exact library, then x and its derivative per network; a plot per threshold
@@ -366,8 +368,8 @@ int runPendulums(const FlagValues& a) {
   std::vector<scenes::WrapPendulumRun> runs;
   for (size_t i = 0; i < specs.size(); ++i) {
     runs.push_back(scenes::runWrapPendulum(specs[i], wrap, duration, tol));
-    std::cerr << "train-wrap --pendulums: " << i + 1 << "/" << specs.size() << " done, drift "
-              << num(runs.back().max_drift, 3) << " J, " << num(runs.back().wall_s, 3) << " s\n";
+    std::cout << "train-wrap --pendulums: " << i + 1 << "/" << specs.size() << " done, drift "
+              << num(runs.back().max_drift, 3) << " J, " << num(runs.back().wall_s, 3) << " s\n" << std::flush;
   }
   double worst = 0.0;
   long fallbacks = 0, evaluations = 0;
