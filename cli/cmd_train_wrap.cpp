@@ -12,6 +12,7 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <map>
 #include <optional>
 #include <random>
 #include <string>
@@ -20,6 +21,7 @@
 #include "cli/flags.hpp"
 #include "converter/atomic_file.hpp"
 #include "converter/build/build_core_model.hpp"
+#include "converter/build/functions_to_core.hpp"
 #include "converter/coordinates_file.hpp"
 #include "converter/osim_reader.hpp"
 #include "converter/storage.hpp"
@@ -440,7 +442,29 @@ ModelPoses readModelPoses(const FlagValues& a) {
     }
     m.described = std::to_string(m.poses.size()) + " frames of " + a.get("coordinates", "");
   } else {
-    // uniform within each coordinate's range, seeded
+    // uniform within each coordinate's range, seeded; a coordinate a CoordinateCouplerConstraint
+    // makes dependent follows its function (else coupled coordinates, a knee's patella, take poses
+    // the model never reaches)
+    std::map<std::string, int> index;
+    for (size_t ci = 0; ci < m.d.coordinates.size(); ++ci) index[m.d.coordinates[ci].name] = m.build.coordinate_index[ci];
+    struct Coupler {
+      int dependent;
+      std::vector<int> independent;
+      AxisFunctionPtr f;
+      double scale;
+    };
+    std::vector<Coupler> couplers;
+    for (const auto& c : m.d.constraints) {
+      if (c.kind != osim::ConstraintKind::CoordinateCoupler || !c.enforced || !c.function) continue;
+      Coupler cp{index.count(c.dependent_coordinate) ? index[c.dependent_coordinate] : -1, {}, nullptr, c.scale_factor};
+      for (const auto& n : c.independent_coordinates) cp.independent.push_back(index.count(n) ? index[n] : -1);
+      bool ok = cp.dependent >= 0;
+      for (int k : cp.independent) ok = ok && k >= 0;
+      if (!ok) continue;
+      cp.f = osim::makeCoreFunction(*c.function, static_cast<int>(cp.independent.size()), model_file,
+                                    "CoordinateCouplerConstraint '" + c.name + "'");
+      couplers.push_back(std::move(cp));
+    }
     std::mt19937_64 rng(static_cast<unsigned long long>(a.getInt("seed", 1)));
     for (long f = 0; f < frames; ++f) {
       VecX q = VecX::Zero(nr);
@@ -451,10 +475,18 @@ ModelPoses readModelPoses(const FlagValues& a) {
         const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
         q[k] = c.locked ? c.default_value : c.range_min + (c.range_max - c.range_min) * u;
       }
+      for (const Coupler& cp : couplers) {
+        VecJ x(static_cast<Eigen::Index>(cp.independent.size()));
+        for (size_t j = 0; j < cp.independent.size(); ++j) x[static_cast<Eigen::Index>(j)] = q[cp.independent[j]];
+        FunctionValue v;
+        cp.f->evaluate(x, 0, v);
+        q[cp.dependent] = cp.scale * v.value;
+      }
       m.poses.push_back(std::move(q));
     }
     m.described = std::to_string(frames) + " poses drawn within the coordinate ranges (seed " +
-                  std::to_string(a.getInt("seed", 1)) + ")";
+                  std::to_string(a.getInt("seed", 1)) + "; " + std::to_string(couplers.size()) +
+                  " coupled coordinate(s) following their function)";
   }
   if (m.poses.empty()) throw UsageError{"no poses: the coordinates files have no rows"};
   return m;
@@ -680,7 +712,9 @@ void declareTrainWrapFlags(CLI::App& app) {
   app.add_option("--coordinates", "--for: the poses, one or more coordinate files (.mot/.sto)")
       ->type_name("Q.mot,...")
       ->group(forg);
-  app.add_option("--ranges", "--for: poses drawn uniformly within the model's coordinate ranges")
+  app.add_option("--ranges",
+                 "--for: poses drawn uniformly within the model's coordinate ranges (coordinates a\n"
+                 "CoordinateCouplerConstraint makes dependent follow its function)")
       ->type_name("default")
       ->group(forg);
   app.add_option("--frames", "--ranges: how many poses (default 500)")->type_name("N")->check(integer())->group(forg);
@@ -749,7 +783,8 @@ CommandRegistration reg(
      "--compact C: inputs through the compact map u = q / (1 + |q| / C) (same samples, box mapped) and the\n"
      "point's displacement from the straight line as output (meta wrap_map compact C).\n"
      "--for MODEL.osim: for every wrap object (cylinder or sphere) the model's muscles wrap over the poses\n"
-     "(--coordinates files, or --ranges default: --frames poses, default 500, uniform in the coordinate ranges),\n"
+     "(--coordinates files, or --ranges default: --frames poses, default 500, uniform in the coordinate ranges,\n"
+     "coupled coordinates following their CoordinateCouplerConstraint),\n"
      "collects the surface-frame end points of its wrapped segments, trains a network on them (jittered, random\n"
      "alpha; defaults --architecture 3x32, --samples 8000, --epochs 40, --batch 64, --lr 3e-3, --compact 4)\n"
      "and writes DIR/NAME.txt per wrap object and the manifest DIR/wrap_networks.txt, with progress on stdout.\n"

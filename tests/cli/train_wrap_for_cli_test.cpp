@@ -3,7 +3,8 @@
 // bad input gives `error: ...` as the first line of stderr, exit 2, and writes nothing. On
 // subject_walk_armless_18musc (../shared) networks trained on its trial serve every wrapped-segment
 // evaluation of `redmax lengths` over that trial (measured 0 of 2856 fallbacks, 17.6 s of training
-// on the shared 2-core machine; the committed 3x64 network fell back in 1110 of 2856).
+// on the shared 2-core machine; the committed 3x64 network fell back in 1110 of 2856), and so do
+// networks trained on poses within the coordinate ranges (out of sample).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -183,6 +184,27 @@ TEST_F(TrainWrapForCli, SubjectWalkNetworksServeItsTrial) {
   }
   EXPECT_EQ(rows, 10) << c.out;
   std::printf("[ measured ] %s", c.out.c_str());
+  // out of sample: trained on poses within the coordinate ranges (coupled coordinates following their
+  // functions), checked on the trial (measured 0 of 2856, worst RMS 0.011 radii, Gmax2_at_pelvis_l)
+  const CmdResult tr = run("train-wrap --for " + model + " --ranges default --out " + path("swr"));
+  ASSERT_EQ(tr.code, 0) << tr.err;
+  EXPECT_NE(tr.out.find("2 coupled coordinate(s) following their function"), std::string::npos) << tr.out;
+  const CmdResult cr = run("train-wrap --for " + model + " --coordinates " + trial + " --check " + path("swr"));
+  ASSERT_EQ(cr.code, 0) << cr.err;
+  EXPECT_NE(cr.out.find("total: 0 of 2856 wrapped-segment evaluations fell back"), std::string::npos) << cr.out;
+  std::istringstream in2(cr.out);
+  rows = 0;
+  while (std::getline(in2, line)) {
+    std::istringstream ls(line);
+    std::string name, surface, share;
+    long ev = 0, fb = 0;
+    double rms = 0.0, max = 0.0;
+    if (!(ls >> name >> surface >> ev >> fb >> share >> rms >> max) || surface != "cylinder") continue;
+    ++rows;
+    EXPECT_LT(rms, 0.03) << line;
+  }
+  EXPECT_EQ(rows, 10) << cr.out;
+  std::printf("[ measured ] trained on --ranges default: %s", cr.out.c_str());
 }
 
 }  // namespace
