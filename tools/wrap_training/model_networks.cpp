@@ -25,7 +25,7 @@ std::string fmt(double v) {
 
 // the exact library on the unconstrained unit surface (radius 1; cylinder effectively infinite)
 WrapSample label(WrapType type, const Vec3& q1, const Vec3& q2, double alpha) {
-  static thread_local VecX in(8);
+  VecX in(8);
   in << q1, q2, alpha, 1.0;
   return makeExactWrapOracle(type)(in);
 }
