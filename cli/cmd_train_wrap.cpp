@@ -1,4 +1,6 @@
 // `redmax train-wrap`: train the Type III wrap network on samples of the exact wrapping library
+// (progress on stdout, flushed line by line, in every mode: stderr holds only notes, warnings and the
+// error line)
 // [D Sec. 5.3.3.1], or (--compare) time networks, the smooth model and the exact library per mass
 // point (position + Jacobian + Jdot) against their position error. The work is done by
 // tools/wrap_training/ (train.hpp, compare.hpp, study.hpp); this file parses, calls and prints.
@@ -10,6 +12,7 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <map>
 #include <optional>
 #include <random>
 #include <string>
@@ -18,6 +21,7 @@
 #include "cli/flags.hpp"
 #include "converter/atomic_file.hpp"
 #include "converter/build/build_core_model.hpp"
+#include "converter/build/functions_to_core.hpp"
 #include "converter/coordinates_file.hpp"
 #include "converter/osim_reader.hpp"
 #include "converter/storage.hpp"
@@ -122,19 +126,19 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
   };
   const auto t_data = Clock::now();
   const WrapTrainingSet data = makeSet(samples, threshold, opt.seed);
-  std::cerr << "train-wrap: " << wrapTypeName(type) << ", " << samples << " samples kept of " << data.drawn
+  std::cout << "train-wrap: " << wrapTypeName(type) << ", " << samples << " samples kept of " << data.drawn
             << " drawn (" << data.invalid << " with an end inside the surface, " << data.near_contact
             << " with 0 < l/L < " << threshold << " discarded; " << data.wrapped << " kept samples wrap), "
-            << num(secondsSince(t_data), 3) << " s\n";
+            << num(secondsSince(t_data), 3) << " s\n" << std::flush;
 
   // progress: a line every 2 s and at the end
   double last_print = -1e9;
   opt.on_epoch = [&](const TrainEpoch& e) {
     if (e.elapsed_s - last_print < 2.0 && e.epoch != opt.epochs) return;
     last_print = e.elapsed_s;
-    std::cerr << "train-wrap: epoch " << e.epoch << "/" << opt.epochs << ", " << e.steps << " steps, train mse "
+    std::cout << "train-wrap: epoch " << e.epoch << "/" << opt.epochs << ", " << e.steps << " steps, train mse "
               << num(e.train_mse) << ", validation mse " << num(e.val_mse) << ", validation rms " << num(e.val_rms_m)
-              << " (size units), " << num(e.elapsed_s, 3) << " s\n";
+              << " (size units), " << num(e.elapsed_s, 3) << " s\n" << std::flush;
   };
   std::vector<TrainEpoch> history;
   Mlp net = trainWrapNetwork(data, box, opt, &history);
@@ -152,8 +156,8 @@ int runTrain(const FlagValues& a, const CLI::App& app) {
   net.meta["test_max_m"] = num(err.max, 6);
   if (compact > 0.0) {
     net.meta["wrap_map"] = formatCompactWrapMap(compact);
-    net.meta["box"] = "all of space: half the pairs in the default box, half with u uniform in the ball |u| < 0.98 C "
-                      "(tools/wrap_training/model_networks.hpp makeCompactWrapTrainingSet; units of the surface size)";
+    net.meta["box"] = "the default box's end points through the compact map (tools/wrap_training/model_networks.hpp "
+                      "makeCompactWrapTrainingSet, makeCompactDefaultWrapBox; units of the surface size)";
   } else {
     net.meta["box"] = "tools/wrap_training/train.hpp makeDefaultWrapBox (units of the surface size)";
   }
@@ -292,8 +296,8 @@ int runStudy(const FlagValues& a) {
   if (opt.epochs < 1 || opt.batch < 1) throw UsageError{"--epochs and --batch must be positive"};
 
   const WrapStudy study = runWrapThresholdStudy(o, [](const WrapStudyCurve& c) {
-    std::cerr << "train-wrap --study: threshold " << c.threshold << ", " << c.architecture << ": validation rms "
-              << c.val_rms << " (size units)\n";
+    std::cout << "train-wrap --study: threshold " << c.threshold << ", " << c.architecture << ": validation rms "
+              << c.val_rms << " (size units)\n" << std::flush;
   });
 
   // CSV: the sweep, the exact library, then x and its derivative per network; a plot per threshold
@@ -366,8 +370,8 @@ int runPendulums(const FlagValues& a) {
   std::vector<scenes::WrapPendulumRun> runs;
   for (size_t i = 0; i < specs.size(); ++i) {
     runs.push_back(scenes::runWrapPendulum(specs[i], wrap, duration, tol));
-    std::cerr << "train-wrap --pendulums: " << i + 1 << "/" << specs.size() << " done, drift "
-              << num(runs.back().max_drift, 3) << " J, " << num(runs.back().wall_s, 3) << " s\n";
+    std::cout << "train-wrap --pendulums: " << i + 1 << "/" << specs.size() << " done, drift "
+              << num(runs.back().max_drift, 3) << " J, " << num(runs.back().wall_s, 3) << " s\n" << std::flush;
   }
   double worst = 0.0;
   long fallbacks = 0, evaluations = 0;
@@ -438,7 +442,29 @@ ModelPoses readModelPoses(const FlagValues& a) {
     }
     m.described = std::to_string(m.poses.size()) + " frames of " + a.get("coordinates", "");
   } else {
-    // uniform within each coordinate's range, seeded
+    // uniform within each coordinate's range, seeded; a coordinate a CoordinateCouplerConstraint
+    // makes dependent follows its function (else coupled coordinates, a knee's patella, take poses
+    // the model never reaches)
+    std::map<std::string, int> index;
+    for (size_t ci = 0; ci < m.d.coordinates.size(); ++ci) index[m.d.coordinates[ci].name] = m.build.coordinate_index[ci];
+    struct Coupler {
+      int dependent;
+      std::vector<int> independent;
+      AxisFunctionPtr f;
+      double scale;
+    };
+    std::vector<Coupler> couplers;
+    for (const auto& c : m.d.constraints) {
+      if (c.kind != osim::ConstraintKind::CoordinateCoupler || !c.enforced || !c.function) continue;
+      Coupler cp{index.count(c.dependent_coordinate) ? index[c.dependent_coordinate] : -1, {}, nullptr, c.scale_factor};
+      for (const auto& n : c.independent_coordinates) cp.independent.push_back(index.count(n) ? index[n] : -1);
+      bool ok = cp.dependent >= 0;
+      for (int k : cp.independent) ok = ok && k >= 0;
+      if (!ok) continue;
+      cp.f = osim::makeCoreFunction(*c.function, static_cast<int>(cp.independent.size()), model_file,
+                                    "CoordinateCouplerConstraint '" + c.name + "'");
+      couplers.push_back(std::move(cp));
+    }
     std::mt19937_64 rng(static_cast<unsigned long long>(a.getInt("seed", 1)));
     for (long f = 0; f < frames; ++f) {
       VecX q = VecX::Zero(nr);
@@ -449,10 +475,18 @@ ModelPoses readModelPoses(const FlagValues& a) {
         const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
         q[k] = c.locked ? c.default_value : c.range_min + (c.range_max - c.range_min) * u;
       }
+      for (const Coupler& cp : couplers) {
+        VecJ x(static_cast<Eigen::Index>(cp.independent.size()));
+        for (size_t j = 0; j < cp.independent.size(); ++j) x[static_cast<Eigen::Index>(j)] = q[cp.independent[j]];
+        FunctionValue v;
+        cp.f->evaluate(x, 0, v);
+        q[cp.dependent] = cp.scale * v.value;
+      }
       m.poses.push_back(std::move(q));
     }
     m.described = std::to_string(frames) + " poses drawn within the coordinate ranges (seed " +
-                  std::to_string(a.getInt("seed", 1)) + ")";
+                  std::to_string(a.getInt("seed", 1)) + "; " + std::to_string(couplers.size()) +
+                  " coupled coordinate(s) following their function)";
   }
   if (m.poses.empty()) throw UsageError{"no poses: the coordinates files have no rows"};
   return m;
@@ -657,9 +691,8 @@ void declareTrainWrapFlags(CLI::App& app) {
       ->type_name("NET.txt")
       ->group(train);
   app.add_option("--compact",
-                 "the compact input map u = q / (1 + |q| / C) and displacement outputs, over all of\n"
-                 "space (C in radii; cylinder and sphere; --for: default 4); 0 (default without\n"
-                 "--for): the older map over the default box")
+                 "the compact input map u = q / (1 + |q| / C) and displacement outputs (C in radii;\n"
+                 "cylinder and sphere; --for: default 4); 0 (default without --for): the older map")
       ->type_name("C")
       ->check(number())
       ->group(train);
@@ -679,7 +712,9 @@ void declareTrainWrapFlags(CLI::App& app) {
   app.add_option("--coordinates", "--for: the poses, one or more coordinate files (.mot/.sto)")
       ->type_name("Q.mot,...")
       ->group(forg);
-  app.add_option("--ranges", "--for: poses drawn uniformly within the model's coordinate ranges")
+  app.add_option("--ranges",
+                 "--for: poses drawn uniformly within the model's coordinate ranges (coordinates a\n"
+                 "CoordinateCouplerConstraint makes dependent follow its function)")
       ->type_name("default")
       ->group(forg);
   app.add_option("--frames", "--ranges: how many poses (default 500)")->type_name("N")->check(integer())->group(forg);
@@ -745,10 +780,11 @@ CommandRegistration reg(
      "(default T) summed in order, so the network depends on S and the seed, not on T (S = 1: serial).\n"
      "--init NET.txt continues training from that network (same surface and --hidden; its normalisation is kept,\n"
      "Adam restarts); its command and losses are kept in the new file's meta as init_*.\n"
-     "--compact C: inputs through the compact map u = q / (1 + |q| / C), sampled over all of space, and the\n"
-     "point's displacement from the straight line as output (meta wrap_map; no training box to leave).\n"
+     "--compact C: inputs through the compact map u = q / (1 + |q| / C) (same samples, box mapped) and the\n"
+     "point's displacement from the straight line as output (meta wrap_map compact C).\n"
      "--for MODEL.osim: for every wrap object (cylinder or sphere) the model's muscles wrap over the poses\n"
-     "(--coordinates files, or --ranges default: --frames poses, default 500, uniform in the coordinate ranges),\n"
+     "(--coordinates files, or --ranges default: --frames poses, default 500, uniform in the coordinate ranges,\n"
+     "coupled coordinates following their CoordinateCouplerConstraint),\n"
      "collects the surface-frame end points of its wrapped segments, trains a network on them (jittered, random\n"
      "alpha; defaults --architecture 3x32, --samples 8000, --epochs 40, --batch 64, --lr 3e-3, --compact 4)\n"
      "and writes DIR/NAME.txt per wrap object and the manifest DIR/wrap_networks.txt, with progress on stdout.\n"

@@ -52,7 +52,7 @@ TEST_F(TrainWrapCli, TinyTrainingWritesAReproducibleNetworkAndItsLossCurve) {
       "train-wrap --surface cylinder --hidden 2x8 --samples 300 --epochs 3 --batch 32 --seed 2 --out " + net + " --report " + rep;
   CmdResult r = run(args);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("epoch 3/3"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("epoch 3/3"), std::string::npos) << r.out;  // progress on stdout
   const redmax::Mlp m = redmax::Mlp::load(net);
   EXPECT_EQ(m.architecture(), "2x8");
   EXPECT_EQ(m.meta.at("seed"), "2");

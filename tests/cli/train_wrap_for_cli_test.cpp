@@ -3,7 +3,8 @@
 // bad input gives `error: ...` as the first line of stderr, exit 2, and writes nothing. On
 // subject_walk_armless_18musc (../shared) networks trained on its trial serve every wrapped-segment
 // evaluation of `redmax lengths` over that trial (measured 0 of 2856 fallbacks, 17.6 s of training
-// on the shared 2-core machine; the committed 3x64 network fell back in 1110 of 2856).
+// on the shared 2-core machine; the committed 3x64 network fell back in 1110 of 2856), and so do
+// networks trained on poses within the coordinate ranges (out of sample).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -14,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap/network_set.hpp"
 #include "tests/cli/cli_test_util.hpp"
 
@@ -92,6 +94,25 @@ TEST_F(TrainWrapForCli, PendulumNetworksManifestAndCheck) {
   }
 }
 
+TEST_F(TrainWrapForCli, CompactPlainTrainingRecordsItsMap) {
+  const CmdResult r = run("train-wrap --surface sphere --hidden 2x8 --samples 300 --epochs 3 --batch 32 --lr 1e-3 "
+                          "--compact 4 --out " + path("s.txt"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto net = redmax::loadWrapNetwork(path("s.txt"));
+  EXPECT_EQ(net->meta.at("wrap_map"), redmax::formatCompactWrapMap(4.0));
+  EXPECT_EQ(net->input_names[0], "ori_u");
+  // the box is the default box's image: ori_u within (3 / (1 + 3 / 4) + 0.08) = 1.794 (asserted to 1e-12)
+  EXPECT_NEAR(net->input_max[0], 3.0 / 1.75 + 0.08, 1e-12);
+  EXPECT_EQ(net->input_min[7], 1.0);
+  // --init must match the map
+  const CmdResult bad = run("train-wrap --surface sphere --hidden 2x8 --samples 300 --epochs 1 --init " + path("s.txt") +
+                            " --out " + path("t.txt"));
+  EXPECT_EQ(bad.code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--compact asks for the older map"), std::string::npos) << bad.err;
+  EXPECT_EQ(run("train-wrap --surface torus --compact 4 --out " + path("t.txt")).code, 2);
+  EXPECT_FALSE(fs::exists(path("t.txt")));
+}
+
 TEST_F(TrainWrapForCli, BadInputIsTheFirstErrorLineAndWritesNothing) {
   const std::string model = scene("double_pendulum_wrap.osim");
   std::ofstream(path("bad_manifest.txt")) << "redmax-wrap-networks 1\nwrap joint_cylinder\n";
@@ -163,6 +184,27 @@ TEST_F(TrainWrapForCli, SubjectWalkNetworksServeItsTrial) {
   }
   EXPECT_EQ(rows, 10) << c.out;
   std::printf("[ measured ] %s", c.out.c_str());
+  // out of sample: trained on poses within the coordinate ranges (coupled coordinates following their
+  // functions), checked on the trial (measured 0 of 2856, worst RMS 0.011 radii, Gmax2_at_pelvis_l)
+  const CmdResult tr = run("train-wrap --for " + model + " --ranges default --out " + path("swr"));
+  ASSERT_EQ(tr.code, 0) << tr.err;
+  EXPECT_NE(tr.out.find("2 coupled coordinate(s) following their function"), std::string::npos) << tr.out;
+  const CmdResult cr = run("train-wrap --for " + model + " --coordinates " + trial + " --check " + path("swr"));
+  ASSERT_EQ(cr.code, 0) << cr.err;
+  EXPECT_NE(cr.out.find("total: 0 of 2856 wrapped-segment evaluations fell back"), std::string::npos) << cr.out;
+  std::istringstream in2(cr.out);
+  rows = 0;
+  while (std::getline(in2, line)) {
+    std::istringstream ls(line);
+    std::string name, surface, share;
+    long ev = 0, fb = 0;
+    double rms = 0.0, max = 0.0;
+    if (!(ls >> name >> surface >> ev >> fb >> share >> rms >> max) || surface != "cylinder") continue;
+    ++rows;
+    EXPECT_LT(rms, 0.03) << line;
+  }
+  EXPECT_EQ(rows, 10) << cr.out;
+  std::printf("[ measured ] trained on --ranges default: %s", cr.out.c_str());
 }
 
 }  // namespace

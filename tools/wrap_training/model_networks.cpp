@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <stdexcept>
 #include <thread>
@@ -24,10 +25,12 @@ std::string fmt(double v) {
 
 // the exact library on the unconstrained unit surface (radius 1; cylinder effectively infinite)
 WrapSample label(WrapType type, const Vec3& q1, const Vec3& q2, double alpha) {
-  static thread_local VecX in(8);
+  VecX in(8);
   in << q1, q2, alpha, 1.0;
   return makeExactWrapOracle(type)(in);
 }
+
+constexpr double kFarRadii = 1000.0;
 
 // kept samples: X = (u1, u2, alpha, 1), Y = x - straight point (radii)
 struct SetBuilder {
@@ -39,7 +42,10 @@ struct SetBuilder {
   }
   void offer(const WrapSample& s, const Vec3& q1, const Vec3& q2, double alpha, double C, double threshold) {
     ++set.drawn;
-    if (!s.valid || !s.x.allFinite()) {
+    // end points beyond kFarRadii: the library's construction loses its precision there (seen:
+    // displacements of 1e4 radii at 1e5 radii, from splines of moving points extrapolated at poses
+    // drawn within the ranges), and the compact map has crowded them onto |u| = C anyway
+    if (!s.valid || !s.x.allFinite() || q1.norm() > kFarRadii || q2.norm() > kFarRadii) {
       ++set.invalid;
       return;
     }
@@ -170,24 +176,10 @@ WrapInputBox makeCompactWrapBox(const WrapTrainingSet& set, double compact, doub
 
 WrapTrainingSet makeCompactWrapTrainingSet(WrapType type, long n, double threshold, double compact,
                                            unsigned long long seed, int threads) {
-  const double c = 0.98 * compact;
   const WrapInputBox near = makeDefaultWrapBox(type);
   return buildSet(type, n, threshold, compact, seed, threads, [&](std::mt19937_64& rng, Vec3& q1, Vec3& q2, double& alpha) {
-    // half the pairs from the older default box (the near field, where most wraps bend most), half
-    // uniform in the compact ball (all of space)
-    const bool in_box = uniform01(rng) < 0.5;
-    for (int e = 0; e < 2; ++e) {
-      Vec3& q = e == 0 ? q1 : q2;
-      if (in_box) {
-        for (int i = 0; i < 3; ++i) q[i] = near.lo[3 * e + i] + (near.hi[3 * e + i] - near.lo[3 * e + i]) * uniform01(rng);
-        continue;
-      }
-      Vec3 u;
-      do {
-        for (int i = 0; i < 3; ++i) u[i] = c * (2.0 * uniform01(rng) - 1.0);
-      } while (u.norm() >= c);
-      q = calcCompactWrapInputInverse(u, compact);
-    }
+    for (int i = 0; i < 3; ++i) q1[i] = near.lo[i] + (near.hi[i] - near.lo[i]) * uniform01(rng);
+    for (int i = 0; i < 3; ++i) q2[i] = near.lo[3 + i] + (near.hi[3 + i] - near.lo[3 + i]) * uniform01(rng);
     alpha = uniform01(rng);
   });
 }
@@ -195,10 +187,22 @@ WrapTrainingSet makeCompactWrapTrainingSet(WrapType type, long n, double thresho
 WrapInputBox makeCompactDefaultWrapBox(WrapType type, double compact) {
   if (type != WrapType::Cylinder && type != WrapType::Sphere)
     throw std::invalid_argument("the compact map takes cylinders and spheres (one radius)");
+  // the image of the default box's corners bounds each mapped coordinate (|u_i| grows with |q_i|
+  // and shrinks with the other coordinates), widened as makeCompactWrapBox widens
+  const WrapInputBox near = makeDefaultWrapBox(type);
   WrapInputBox b;
   b.names = {"ori_u", "ori_v", "ori_w", "ins_u", "ins_v", "ins_w", "alpha", "radius"};
-  b.lo = VecX::Constant(8, -compact);
-  b.hi = VecX::Constant(8, compact);
+  b.lo = VecX::Zero(8);
+  b.hi = VecX::Zero(8);
+  for (int e = 0; e < 2; ++e)
+    for (int i = 0; i < 3; ++i) {
+      // the largest |u_i| over the box: q_i at its bound, the other coordinates zero
+      Vec3 q = Vec3::Zero();
+      q[i] = near.hi[3 * e + i];
+      const double u = calcCompactWrapInput(q, compact)[i] + 0.02 * compact;
+      b.lo[3 * e + i] = -std::min(u, compact);
+      b.hi[3 * e + i] = std::min(u, compact);
+    }
   b.lo[6] = 0.0;
   b.hi[6] = 1.0;
   b.lo[7] = b.hi[7] = 1.0;

@@ -313,14 +313,19 @@ TEST(NetworkWrapModel, FallbacksGiveTheSmoothModelExactly) {
   EXPECT_TRUE(calcNetworkWrapModel(cyl.get(), s, p1, p2, v1, v2, alphas, true, mp, ws).usedNetwork());
   EXPECT_TRUE(mp.used_network);
   EXPECT_GT((mp.x[1] - calcSmoothWrapPoint(s, p1, p2, 0.5)).norm(), 1e-6);
-  // origin x at 3.5 radii: outside the box [-3, 3], named
+  // origin x at 3.5 radii: outside the box [-3, 3] (compact map: its image), named
   const Vec3 far(-0.35, 0.1, 0.0);
   NetworkWrapEval ev = calcNetworkWrapModel(cyl.get(), s, far, p2, v1, v2, alphas, true, mp, ws);
   EXPECT_EQ(ev.fallback, NetworkWrapFallback::OutsideBox);
   EXPECT_EQ(ev.input, 0);
   EXPECT_EQ(ev.point, 0);
-  EXPECT_NEAR(ev.value, -3.5, 1e-12);
-  EXPECT_NE(ev.describe(cyl.get()).find("ori_x = -3.5"), std::string::npos) << ev.describe(cyl.get());
+  // the value the network sees: the scaled coordinate, through the compact map when the file has one
+  const WrapNetworkMap map = wrapNetworkMap(*cyl);
+  const double seen = map.isCompact() ? calcCompactWrapInput(far / 0.1, map.compact)[0] : -3.5;
+  EXPECT_NEAR(ev.value, seen, 1e-12);
+  EXPECT_NE(ev.describe(cyl.get()).find(cyl->input_names[0] + " = " + (map.isCompact() ? "-1.8" : "-3.5")),
+            std::string::npos)
+      << ev.describe(cyl.get());
   expectSmooth(s, far, p2, v1, v2, alphas, mp);
   // a sphere network on a cylinder
   ev = calcNetworkWrapModel(sph.get(), s, p1, p2, v1, v2, alphas, true, mp, ws);

@@ -191,7 +191,8 @@ TEST(WrapTraining, CommittedNetworksApproximateTheExactLibrary) {
     ASSERT_EQ(net.inputs(), wrapInputSize(type));
     // fresh samples (all of them, also near the contact change): the network must beat the
     // straight path p1 + alpha (p2 - p1), which is exact for every sample that does not wrap
-    // (measured: cylinder straight 0.215, 3x64 0.114, 2x64 0.149; sphere straight 0.122, 3x64 0.103;
+    // (measured, older map: cylinder straight 0.215, 3x64 0.114, 2x64 0.149; sphere straight 0.122, 3x64 0.103;
+    // compact map, radius 1: cylinder straight 0.199, 3x64 0.076, 2x64 0.082; sphere straight 0.101, 3x64 0.047;
     // a 1x32 cylinder network, 0.216, was no better than the straight path and is not kept)
     // Compact-map networks (meta wrap_map, issue 22) take radius-1 inputs through the map and give
     // the displacement from the straight line: the same samples at radius 1, mapped
