@@ -11,8 +11,10 @@
 //     mass, no constraints): O(n), neither M nor J_mr.
 // Conventions as core/dynamics/skeleton_dynamics.hpp: body-frame twists (omega; v), wrenches
 // (torque; force), X_i = Ad of the parent frame in body i, S_i = Ad_ij S the joint's twist map in i.
+#include <optional>
 #include <vector>
 
+#include "core/dynamics/skeleton_dynamics.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "core/skeleton/state.hpp"
 #include "core/skeleton/workspace.hpp"
@@ -58,6 +60,10 @@ struct StructuredForwardWorkspace {
                                      // acceleration                                       (nb)
   std::vector<Mat6> IA;              // articulated inertia                                (nb)
   VecX tau;                          // applied generalized forces (terms, loads)          (nr)
+  // the System's skeleton force by Newton-Euler at zero accelerations (its own, so that it never
+  // disturbs an inverse dynamics begun in DynamicsWorkspace::rid)
+  VecX qddot0;                       // zeros                                              (nr)
+  std::optional<RecursiveIdWorkspace> rid;
   /// size everything but tau for `model` (a no-op when sized)
   void resize(const Model& model);
 };

@@ -150,6 +150,19 @@ void System::calcSkeletonMassHere(DynamicsWorkspace& ws, MatX& M) const {
     calcSkeletonMassCrba(model_, ws.sk, ws.fd, M);
 }
 
+void System::calcSkeletonForceHere(const State& s_sk, DynamicsWorkspace& ws, VecX& f) const {
+  if (forward_route == ForwardRoute::Dense) {
+    calcSkeletonForce(model_, s_sk, ws.sk, f);
+    return;
+  }
+  // f_r = -(M_r 0 - f_r): Newton-Euler at qddot = 0, O(n) where J_mr^T (...) is O(n^2)
+  ws.fd.qddot0.setZero(model_.nr());
+  if (!ws.fd.rid || static_cast<int>(ws.fd.rid->jk.size()) != model_.nb()) ws.fd.rid.emplace(model_);
+  recursiveIdForward(model_, s_sk, ws.fd.qddot0, *ws.fd.rid);
+  recursiveIdBackward(model_, s_sk, *ws.fd.rid, f);
+  f = -f;
+}
+
 ForwardRoute System::plannedForwardRoute() const {
   if (nc_ > 0 || map_ || n_extra_ > 0) return ForwardRoute::Dense;
   bool mass_terms = false;
@@ -281,13 +294,13 @@ void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
     calcControls(s, ws);
     if (n_extra_ == 0) {
       calcSkeletonMassHere(ws, ws.M);
-      calcSkeletonForce(model_, s, ws.sk, ws.f);
+      calcSkeletonForceHere(s, ws, ws.f);
     } else {
       // the skeleton fills the q_r block; terms own the extra coordinates' mass and force.
       // Assembled through the q_r scratch so M and f keep their size (no reallocation per call).
       const int nr = model_.nr();
       calcSkeletonMassHere(ws, ws.M_r);
-      calcSkeletonForce(model_, s, ws.sk, ws.f_r);
+      calcSkeletonForceHere(s, ws, ws.f_r);
       ws.M.setZero(ndof_, ndof_);
       ws.f.setZero(ndof_);
       ws.M.topLeftCorner(nr, nr) = ws.M_r;
@@ -307,7 +320,7 @@ void System::calcMassAndForce(const State& s, DynamicsWorkspace& ws) const {
   calcSkeletonKinematics(ws.s_r, ws);
   calcControls(ws.s_r, ws);
   calcSkeletonMassHere(ws, ws.M_r);
-  calcSkeletonForce(model_, ws.s_r, ws.sk, ws.f_r);
+  calcSkeletonForceHere(ws.s_r, ws, ws.f_r);
   if (!ws.loads.empty()) addExternalLoads(model_, ws.sk, ws.loads, ws.f_r);
   for (size_t i = 0; i < terms_.size(); ++i) {
     const TermContext ctx = context(ws, i);

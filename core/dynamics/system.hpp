@@ -143,7 +143,8 @@ class System {
   StabilizationOptions stabilization;
   /// how forwardDynamics solves for qddot (core/dynamics/structured_forward.hpp, docs/forward.md):
   /// Auto picks by structure; every route gives the same qddot to round-off. With any route
-  /// other than Dense, calcMassAndForce forms the skeleton's M by CRBA (Dense: J_mr^T M_m J_mr).
+  /// other than Dense, calcMassAndForce forms the skeleton's M by CRBA and its f by Newton-Euler
+  /// at qddot = 0 (Dense: J_mr^T M_m J_mr and J_mr^T (f_m - M_m Jdot_mr qdot), the reference).
   ForwardRoute forward_route = ForwardRoute::Auto;
   /// the route forwardDynamics will try for this system (Auto resolved; before the run-time
   /// fall-backs that ws.last_route records): Dense with constraints, a coordinate map or extra
@@ -296,6 +297,9 @@ class System {
   void expandInto(const State& s, DynamicsWorkspace& ws) const;
   // the skeleton's M_r into `M` by the route's method (CRBA unless forward_route is Dense)
   void calcSkeletonMassHere(DynamicsWorkspace& ws, MatX& M) const;
+  // the skeleton's f_r at s_sk (kinematics in ws.sk) into `f`: Newton-Euler at qddot = 0 unless
+  // forward_route is Dense (J_mr^T (f_m - M_m Jdot_mr qdot) + springs and dampers)
+  void calcSkeletonForceHere(const State& s_sk, DynamicsWorkspace& ws, VecX& f) const;
   // forwardDynamics by ABA; false (nothing returned) when a pivot fails
   bool forwardArticulated(const State& s, DynamicsWorkspace& ws, VecX& qddot) const;
 };

@@ -125,7 +125,7 @@ SpeedComparison::SpeedComparison(std::string scene, const Model& model, const Sp
                    I.engine.calcResidualForces(I.udot, I.f_u);
                  },
                  nullptr});
-  ops.push_back({"forward_dynamics", "System::forwardDynamics (M_r, f_r, LDLT)", "realize(Acceleration)",
+  ops.push_back({"forward_dynamics", "System::forwardDynamics (Auto route: ABA on the bare tree)", "realize(Acceleration)",
                  [&I] { I.qddot_out = I.sys.forwardDynamics(I.s0, I.ws_fd); },
                  [&I] {
                    I.engine.invalidatePositions();

@@ -45,7 +45,8 @@ struct SpeedOp {
 /// (calcSkeletonMass vs calcM, kinematics already done), id_redmax (System::inverseDynamics vs
 /// realize(Dynamics) + calcResidualForceIgnoringConstraints), id_recursive
 /// (inverseDynamicsRecursive vs the same Simbody call), forward_dynamics (System::forwardDynamics
-/// vs realize(Acceleration)), and step_<integrator> for each available core integrator:
+/// on its Auto route, ABA on a bare tree, vs realize(Acceleration)), and step_<integrator> for each
+/// available core integrator:
 ///   euler -> SemiExplicitEuler, bdf1 -> SemiExplicitEuler, sdirk2 -> SemiExplicitEuler2 (fixed
 ///   step dt), rk45 -> RungeKuttaMerson, cvode -> CPodes BDF (accuracy = rtol).
 class SpeedComparison {
