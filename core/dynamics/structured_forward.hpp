@@ -1,5 +1,5 @@
 #pragma once
-// Forward dynamics by the tree's structure (issue 18; docs/performance.md §9), beside the dense
+// Forward dynamics by the tree's structure (issue 18; docs/performance.md §10), beside the dense
 // route M qddot = f with M = J_mr^T M_m J_mr and a dense LDLT:
 //   - CRBA: the skeleton's mass matrix by composite rigid bodies [Featherstone, RBDA Sec. 6.2]:
 //     O(n d) for n bodies of depth d, without J_mr^T M_m J_mr; equal to calcSkeletonMass.
@@ -37,7 +37,7 @@ enum class ForwardRoute { Auto, Dense, TreeSparse, Articulated };
 const char* forwardRouteName(ForwardRoute r);
 
 /// Auto takes TreeSparse over Dense from this many coordinates on (with mass terms).
-/// Chosen from validation/bench/forward_structure_bench (docs/performance.md §9, measured).
+/// Chosen from validation/bench/forward_structure_bench (docs/performance.md §10, measured).
 inline constexpr int kTreeSparseMinDof = 16;
 
 /// Scratch of the structured routes (one per DynamicsWorkspace; sized on first use).

@@ -231,19 +231,26 @@ double calcPathLength(const Model& model, const MusclePath& path, const VecX& q,
                       const std::vector<Mat4>& E_wi) {
   // Type III: OpenSim's wrapped path (core/muscles/wrap/wrap_path.hpp)
   if (!path.wraps.empty()) return calcWrappedPath(model, path, q, E_wi).length;
+  std::vector<int> active;
+  std::vector<Vec3> x_w;
+  calcActivePoints(path, q, E_wi, active, x_w);
   double length = 0.0;
-  Vec3 prev = Vec3::Zero();
-  bool first = true;
-  for (const PathPoint& pt : path.points) {
+  for (size_t i = 1; i < x_w.size(); ++i) length += (x_w[i] - x_w[i - 1]).norm();
+  return length;
+}
+
+void calcActivePoints(const MusclePath& path, const VecX& q, const std::vector<Mat4>& E_wi, std::vector<int>& active,
+                      std::vector<Vec3>& x_w) {
+  active.clear();
+  x_w.clear();
+  for (size_t i = 0; i < path.points.size(); ++i) {
+    const PathPoint& pt = path.points[i];
     if (!isPathPointActive(pt, q)) continue;
     Vec3 x_b, dx, ddx;
     calcPointLocation(pt, q, x_b, dx, ddx);
-    const Vec3 x_w = pt.body >= 0 ? transformPoint(E_wi[pt.body], x_b) : x_b;
-    if (!first) length += (x_w - prev).norm();
-    prev = x_w;
-    first = false;
+    active.push_back(static_cast<int>(i));
+    x_w.push_back(pt.body >= 0 ? transformPoint(E_wi[pt.body], x_b) : x_b);
   }
-  return length;
 }
 
 }  // namespace redmax

@@ -34,6 +34,11 @@ void calcPathSegments(MuscleKinematics& mk, bool velocity);
 double calcPathLength(const Model& model, const MusclePath& path, const VecX& q,
                       const std::vector<Mat4>& E_wi);
 
+/// The points of `path` active at q (indices into path.points, conditional points switched as
+/// isPathPointActive says) and their world positions from the body poses E_wi at q.
+void calcActivePoints(const MusclePath& path, const VecX& q, const std::vector<Mat4>& E_wi, std::vector<int>& active,
+                      std::vector<Vec3>& x_w);
+
 /// Location of point p in its body frame at q, with d/dq and d2/dq2 along its coordinate (zero
 /// unless it is a moving point with a coordinate, inside its clamp range).
 void calcPointLocation(const PathPoint& p, const VecX& q, Vec3& x_b, Vec3& dx_b, Vec3& ddx_b);

@@ -10,6 +10,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -169,19 +170,26 @@ TEST_F(TrainWrapForCli, SubjectWalkNetworksServeItsTrial) {
   const CmdResult c = run("train-wrap --for " + model + " --coordinates " + trial + " --check " + path("sw"));
   ASSERT_EQ(c.code, 0) << c.err;
   EXPECT_NE(c.out.find("total: 0 of 2856 wrapped-segment evaluations fell back"), std::string::npos) << c.out;
-  std::istringstream in(c.out);
-  std::string line;
-  int rows = 0;
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string name, surface, share;
-    long ev = 0, fb = 0;
-    double rms = 0.0, max = 0.0;
-    if (!(ls >> name >> surface >> ev >> fb >> share >> rms >> max) || surface != "cylinder") continue;
-    ++rows;
+  // the --check table's cylinder rows: name surface evaluations fallbacks share rms max
+  auto forEachRow = [](const std::string& out, const std::function<void(const std::string&, double, double)>& f) {
+    std::istringstream in(out);
+    std::string line;
+    int rows = 0;
+    while (std::getline(in, line)) {
+      std::istringstream ls(line);
+      std::string name, surface, share;
+      long ev = 0, fb = 0;
+      double rms = 0.0, max = 0.0;
+      if (!(ls >> name >> surface >> ev >> fb >> share >> rms >> max) || surface != "cylinder") continue;
+      ++rows;
+      f(line, rms, max);
+    }
+    return rows;
+  };
+  int rows = forEachRow(c.out, [](const std::string& line, double rms, double max) {
     EXPECT_LT(rms, 0.01) << line;
     EXPECT_LT(max, 0.1) << line;
-  }
+  });
   EXPECT_EQ(rows, 10) << c.out;
   std::printf("[ measured ] %s", c.out.c_str());
   // out of sample: trained on poses within the coordinate ranges (coupled coordinates following their
@@ -192,17 +200,7 @@ TEST_F(TrainWrapForCli, SubjectWalkNetworksServeItsTrial) {
   const CmdResult cr = run("train-wrap --for " + model + " --coordinates " + trial + " --check " + path("swr"));
   ASSERT_EQ(cr.code, 0) << cr.err;
   EXPECT_NE(cr.out.find("total: 0 of 2856 wrapped-segment evaluations fell back"), std::string::npos) << cr.out;
-  std::istringstream in2(cr.out);
-  rows = 0;
-  while (std::getline(in2, line)) {
-    std::istringstream ls(line);
-    std::string name, surface, share;
-    long ev = 0, fb = 0;
-    double rms = 0.0, max = 0.0;
-    if (!(ls >> name >> surface >> ev >> fb >> share >> rms >> max) || surface != "cylinder") continue;
-    ++rows;
-    EXPECT_LT(rms, 0.03) << line;
-  }
+  rows = forEachRow(cr.out, [](const std::string& line, double rms, double) { EXPECT_LT(rms, 0.03) << line; });
   EXPECT_EQ(rows, 10) << cr.out;
   std::printf("[ measured ] trained on --ranges default: %s", cr.out.c_str());
 }

@@ -105,16 +105,7 @@ std::vector<WrapObjectInputs> collectWrapObjectInputs(const Model& model, const 
     for (const Muscle& m : muscles) {
       const MusclePath& path = m.path;
       if (path.wraps.empty()) continue;
-      active.clear();
-      x_w.clear();
-      for (size_t i = 0; i < path.points.size(); ++i) {
-        const PathPoint& pt = path.points[i];
-        if (!isPathPointActive(pt, q)) continue;
-        Vec3 x_b, dx, ddx;
-        calcPointLocation(pt, q, x_b, dx, ddx);
-        active.push_back(static_cast<int>(i));
-        x_w.push_back(pt.body >= 0 ? transformPoint(E_wi[pt.body], x_b) : x_b);
-      }
+      calcActivePoints(path, q, E_wi, active, x_w);
       const std::vector<int> seg_wrap = calcSegmentWraps(m, active, x_w, E_wi);
       for (size_t i = 0; i < seg_wrap.size(); ++i) {
         if (seg_wrap[i] < 0) continue;

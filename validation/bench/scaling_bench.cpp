@@ -3,7 +3,7 @@
 // consecutive links, so each spans two hinges) with 0-5000 mass points in all. Operations:
 //   id_recursive   System::inverseDynamicsRecursive (Newton-Euler, path-wise muscle pass)
 //   id_mass        System::inverseDynamics (tau = M qddot - f: J_mr, M, muscle J_ar)
-//   forward        System::forwardDynamics (Auto route, docs/performance.md §9: ABA without
+//   forward        System::forwardDynamics (Auto route, docs/performance.md §10: ABA without
 //                  muscles, LTDL with them from 16 DoF; the dense LDLT before §9)
 // After the Google Benchmark output: the tables (CPU microseconds per call) and exponents fitted
 // by least squares on log-log data (DoF at 0 points; points at 20 DoF over 500-5000 points).

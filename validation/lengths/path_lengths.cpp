@@ -23,16 +23,7 @@ double calcModelPathLength(const Model& model, const Muscle& muscle, const VecX&
                            NetworkWrapWorkspace& ws, std::vector<int>& active, std::vector<Vec3>& x_w,
                            WrapFallbackMonitor* monitor) {
   const MusclePath& path = muscle.path;
-  active.clear();
-  x_w.clear();
-  for (size_t i = 0; i < path.points.size(); ++i) {
-    const PathPoint& pt = path.points[i];
-    if (!isPathPointActive(pt, q)) continue;
-    Vec3 x_b, dx, ddx;
-    calcPointLocation(pt, q, x_b, dx, ddx);
-    active.push_back(static_cast<int>(i));
-    x_w.push_back(pt.body >= 0 ? transformPoint(E_wi[pt.body], x_b) : x_b);
-  }
+  calcActivePoints(path, q, E_wi, active, x_w);
   const std::vector<int> seg_wrap = calcSegmentWraps(muscle, active, x_w, E_wi);
   const WrapMassOptions& o = muscle.wrap;
   double length = 0.0;

@@ -16,6 +16,16 @@ namespace redmax {
 
 namespace {
 
+// y, dy/dX and (with_jdot) its derivative along ws.Xdot at the inputs ws.X
+void evalNetwork(const Mlp& net, const NetworkWrapOptions& options, bool with_jdot, NetworkWrapWorkspace& ws) {
+  if (!with_jdot)
+    net.calcJacobian(ws.X, ws.Y, ws.J, ws.mlp);
+  else if (options.fd_jdot)
+    net.calcJacobianDotFd(ws.X, ws.Xdot, options.fd_eps > 0.0 ? options.fd_eps : 1e-6, ws.Y, ws.J, ws.Jdot, ws.mlp);
+  else
+    net.calcJacobianDot(ws.X, ws.Xdot, ws.Y, ws.J, ws.Jdot, ws.mlp);
+}
+
 std::string num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", v);
@@ -235,13 +245,8 @@ NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface,
       const Vec3 u1d = M1 * q1d, u2d = M2 * q2d;
       ws.Xdot.resize(8, n);
       for (int k = 0; k < n; ++k) ws.Xdot.col(k) << u1d, u2d, alphadot(k), 0.0;
-      if (options.fd_jdot)
-        net->calcJacobianDotFd(ws.X, ws.Xdot, options.fd_eps > 0.0 ? options.fd_eps : 1e-6, ws.Y, ws.J, ws.Jdot, ws.mlp);
-      else
-        net->calcJacobianDot(ws.X, ws.Xdot, ws.Y, ws.J, ws.Jdot, ws.mlp);
-    } else {
-      net->calcJacobian(ws.X, ws.Y, ws.J, ws.mlp);
     }
+    evalNetwork(*net, options, with_jdot, ws);
     const Mat3 I = Mat3::Identity();
     for (int k = 0; k < n; ++k) {
       const double a = alphas[k], ad = alphadot(k);
@@ -269,13 +274,8 @@ NetworkWrapEval calcNetworkWrapModel(const Mlp* net, const WrapSurface& surface,
     if (with_jdot) {
       ws.Xdot.resize(8, n);
       for (int k = 0; k < n; ++k) ws.Xdot.col(k) << c * p1dot, c * p2dot, alphadot(k), 0.0;
-      if (options.fd_jdot)
-        net->calcJacobianDotFd(ws.X, ws.Xdot, options.fd_eps > 0.0 ? options.fd_eps : 1e-6, ws.Y, ws.J, ws.Jdot, ws.mlp);
-      else
-        net->calcJacobianDot(ws.X, ws.Xdot, ws.Y, ws.J, ws.Jdot, ws.mlp);
-    } else {
-      net->calcJacobian(ws.X, ws.Y, ws.J, ws.mlp);
     }
+    evalNetwork(*net, options, with_jdot, ws);
     for (int k = 0; k < n; ++k) {
       // w = R y(u): Jw = dy/du, Jwdot = its derivative along the scaled velocity; alpha is not
       // scaled, so dw/dalpha = R dy/dalpha (header)
