@@ -36,6 +36,7 @@ MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTe
     if (m.mass_points.size() == 0) continue;
     massive_.push_back(m);
     massive_states_.push_back(states.empty() ? MuscleStateIndex{} : states[k]);
+    for (double mass : m.mass_points.mass) adds_mass_ = adds_mass_ || mass != 0.0;
   }
 }
 
@@ -261,13 +262,6 @@ void takeWrapFallbackCounts(const System& sys, DynamicsWorkspace& ws, WrapFallba
   for (size_t i = 0; i < sys.terms().size() && i < ws.term_scratch.size(); ++i)
     if (const auto* term = dynamic_cast<const MuscleTerm*>(sys.terms()[i].get()))
       term->takeWrapFallbackCounts(ws.term_scratch[i].get(), monitor);
-}
-
-bool MuscleTerm::addsMass() const {
-  for (const Muscle& mu : massive_)
-    for (double m : mu.mass_points.mass)
-      if (m != 0.0) return true;
-  return false;
 }
 
 }  // namespace redmax

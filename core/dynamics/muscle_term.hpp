@@ -70,7 +70,7 @@ class MuscleTerm final : public ForceTerm {
   void addMass(const Model& model, const State& s, const TermContext& ctx, MatX& M) const override;
   /// true when a mass point has non-zero mass (zero-mass points add exactly nothing to M, so
   /// such a system keeps the massless system's forward route and results)
-  bool addsMass() const override;
+  bool addsMass() const override { return adds_mass_; }
   void addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const override;
   /// analytic Mdot qdot of the mass points: sum_a m_a (Jdot_ar^T J_ar + J_ar^T Jdot_ar) qdot
   void addMassDotTimesVelocity(const Model& model, const State& s, const TermContext& ctx,
@@ -103,6 +103,7 @@ class MuscleTerm final : public ForceTerm {
 
   std::vector<Muscle> muscles_;
   std::vector<Muscle> massive_;        // the muscles with at least one mass point
+  bool adds_mass_ = false;             // a mass point of massive_ has non-zero mass (fixed at construction)
   std::vector<MuscleStateIndex> massive_states_;  // their states (fibre-following placement)
   MuscleTermOptions options_;
   int nr_ = 0;

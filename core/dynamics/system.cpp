@@ -48,6 +48,7 @@ void System::addTerm(std::shared_ptr<const ForceTerm> term) {
   u_offset_.push_back(nu_);
   nz_ += term->numStates();
   nu_ += term->numControls();
+  mass_terms_ = mass_terms_ || term->addsMass();
   terms_.push_back(std::move(term));
   id_.renew();
 }
@@ -58,6 +59,8 @@ void System::replaceTerm(size_t i, std::shared_ptr<const ForceTerm> term) {
     throw ModelError("System::replaceTerm: '" + term->name() + "' has other numbers of states or controls than '" +
                      terms_[i]->name() + "'");
   terms_[i] = std::move(term);
+  mass_terms_ = false;
+  for (const auto& t : terms_) mass_terms_ = mass_terms_ || t->addsMass();
   id_.renew();
 }
 
@@ -165,8 +168,7 @@ void System::calcSkeletonForceHere(const State& s_sk, DynamicsWorkspace& ws, Vec
 
 ForwardRoute System::plannedForwardRoute() const {
   if (nc_ > 0 || map_ || n_extra_ > 0) return ForwardRoute::Dense;
-  bool mass_terms = false;
-  for (const auto& t : terms_) mass_terms = mass_terms || t->addsMass();
+  const bool mass_terms = mass_terms_;
   switch (forward_route) {
     case ForwardRoute::Dense: return ForwardRoute::Dense;
     case ForwardRoute::TreeSparse: return ForwardRoute::TreeSparse;

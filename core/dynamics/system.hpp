@@ -288,6 +288,7 @@ class System {
   std::vector<std::shared_ptr<const Controller>> controllers_;
   std::vector<int> z_offset_, u_offset_;  // per term                          (number of terms)
   int nz_ = 0, nu_ = 0;
+  bool mass_terms_ = false;  // a term adds mass (ForceTerm::addsMass), kept by addTerm/replaceTerm
   int nc_ = 0;
   std::shared_ptr<const CoordinateMap> map_;
   std::shared_ptr<const UnilateralConstraints> unilateral_;

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
 
+#include "converter/atomic_file.hpp"
 #include "converter/model_edit.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/muscle_force_term.hpp"
@@ -51,16 +51,6 @@ std::vector<FeedbackRule> ankleController() {
   FeedbackRule sol{"soleus_r", kAnkleCoord, 0.0, -2.0, -0.05, 0.05, 0.01, 1.0};
   FeedbackRule ta{"tib_ant_r", kAnkleCoord, 0.0, 2.0, 0.05, 0.05, 0.01, 1.0};
   return {sol, ta};
-}
-
-void writeText(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << text;
-    if (!f) throw std::runtime_error("cannot write " + path);
-  }
-  fs::rename(tmp, path);
 }
 
 const MuscleForceTerm* muscleForceTerm(const System& sys) {
@@ -161,7 +151,7 @@ SplineLegResult runSplineLegScene(const SplineLegOptions& o, std::ostream& out) 
   const std::string revolute_xml = revoluteKneeModel(o.model_path, kKnee, q0);
   fs::create_directories(o.out_dir);
   const std::string revolute = (fs::path(o.out_dir) / "spline_leg_revolute_knee.osim").string();
-  writeText(revolute, revolute_xml);
+  osim::writeFileAtomic(revolute, revolute_xml);
   res.files.push_back(revolute);
   const std::string model_abs = fs::absolute(o.model_path).string();
   for (const bool spline : {true, false}) {
@@ -170,7 +160,7 @@ SplineLegResult runSplineLegScene(const SplineLegOptions& o, std::ostream& out) 
     res.files.push_back(setup);
     for (const bool inertial : {false, true}) {
       const std::string name = knee + (inertial ? "_inertial" : "_lumped");
-      writeText(setup, setupXml(name, spline ? model_abs : fs::absolute(revolute).string(), o.duration, o.tolerance));
+      osim::writeFileAtomic(setup, setupXml(name, spline ? model_abs : fs::absolute(revolute).string(), o.duration, o.tolerance));
       out << "spline-leg: running " << name << " (" << o.duration << " s, rk45 " << o.tolerance << ")\n" << std::flush;
       res.runs.push_back(runOne(name, spline, inertial, setup, o));
       const SplineLegRun& r = res.runs.back();
@@ -217,7 +207,7 @@ SplineLegResult runSplineLegScene(const SplineLegOptions& o, std::ostream& out) 
     s << line;
   }
   const std::string summary = (fs::path(o.out_dir) / "summary.txt").string();
-  writeText(summary, s.str());
+  osim::writeFileAtomic(summary, s.str());
   res.files.push_back(summary);
   out << s.str();
 
