@@ -1,6 +1,7 @@
 #include "converter/forward_setup.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 
 #include "converter/detail/controller_set.hpp"
@@ -63,6 +64,23 @@ std::vector<ControllerSetupDesc> detail::readControllerSet(const XmlDocument& do
   return out;
 }
 
+std::string detail::readToolControlsFile(const XmlDocument& doc, const XMLElement* tool, const std::string& dir,
+                                         std::vector<std::string>& warnings) {
+  const XMLElement* e = firstChild(tool, "controls_file");
+  const std::string file = childText(tool, "controls_file");
+  if (!e || file.empty()) return "";
+  // OpenSim's XMLDocument: the <OpenSimDocument> Version, 10500 for a document without one
+  int version = 10500;
+  if (std::string(doc.root()->Name()) == "OpenSimDocument")
+    if (const char* v = doc.root()->Attribute("Version")) version = std::atoi(v);
+  if (version < 10904) return resolveRelativeTo(dir, file);
+  warnings.push_back(doc.path() + ":" + std::to_string(lineOf(e)) + ": the tool's own controls_file '" + file +
+                     "' is ignored, as OpenSim ignores it in a document of version " + std::to_string(version) +
+                     " (it reads one only before version 10904): give it to a ControlSetController in the "
+                     "ControllerSet");
+  return "";
+}
+
 ForwardSetup readForwardSetup(const std::string& path) {
   XmlDocument doc(path);
   const XMLElement* root = doc.root();
@@ -110,7 +128,7 @@ ForwardSetup readForwardSetup(const std::string& path) {
   s.minimum_integrator_step_size = positive("minimum_integrator_step_size", 1e-8);
   s.integrator_error_tolerance = positive("integrator_error_tolerance", 1e-5);
   s.controllers = readControllerSet(doc, el, s.directory);
-  s.controls_file = file("controls_file");
+  s.controls_file = readToolControlsFile(doc, el, s.directory, s.warnings);
   s.external_loads_file = file("external_loads_file");
   s.states_file = file("states_file");
   s.use_specified_dt = childBool(doc, el, "use_specified_dt", false);

@@ -98,7 +98,7 @@ AnalyzeSetup readAnalyzeSetup(const std::string& path) {
     doc.fail(firstChild(el, "output_precision"), "output_precision must be in [1, 30]");
 
   s.controllers = readControllerSet(doc, el, s.directory);
-  s.controls_file = file("controls_file");
+  s.controls_file = readToolControlsFile(doc, el, s.directory, s.warnings);
 
   const XMLElement* set = firstChild(el, "AnalysisSet");
   for (const XMLElement* a : childElements(set ? firstChild(set, "objects") : nullptr)) {

@@ -360,8 +360,13 @@ TEST(MuscleAnalysis, ControlsFileDrivesActuatorsAndExcitations) {
   sto << "controls\nversion=1\nnRows=3\nnColumns=3\ninDegrees=no\nendheader\ntime\tsh_reserve\trt.excitation\n"
       << "0\t0.5\t0.1\n0.5\t1.5\t0.7\n1\t0.5\t0.4\n";
   dir.write("c.sto", sto.str());
-  s.setup_file = dir.write("sto.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"
-                                                                    "<controls_file>c.sto</controls_file>"));
+  // OpenSim reads a tool's own controls_file only in documents older than version 10904
+  auto old_document = [](std::string xml) {
+    const std::string v = "Version=\"40000\"";
+    return xml.replace(xml.find(v), v.size(), "Version=\"10900\"");
+  };
+  s.setup_file = dir.write("sto.xml", old_document(setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"
+                                                                                  "<controls_file>c.sto</controls_file>")));
   const AnalyzeTool st(s);
   bool warned_tri = false;
   for (const auto& w : st.warnings()) warned_tri = warned_tri || w.find("no control for actuator 'tri'") != std::string::npos;
@@ -375,12 +380,24 @@ TEST(MuscleAnalysis, ControlsFileDrivesActuatorsAndExcitations) {
     EXPECT_NEAR(out(f, rt).activation, a, 1e-12) << t;
   }
 
+  // the same tool-level controls_file in a version-40000 document: ignored, as OpenSim ignores it,
+  // and named (the controls are then zero)
+  s.setup_file = dir.write("sto40000.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"
+                                                                         "<controls_file>c.sto</controls_file>"));
+  const AnalyzeTool ignored(s);
+  bool named = false;
+  for (const auto& w : ignored.setup().warnings)
+    named = named || (w.find("controls_file 'c.sto' is ignored") != std::string::npos &&
+                      w.find("version 40000") != std::string::npos);
+  EXPECT_TRUE(named);
+  for (const MuscleFrame& f : ignored.runMuscleAnalyses().frames) EXPECT_EQ(f.controls[sr.actuators[2].control], 0.0);
+
   // malformed input: error at the file and line, nothing run
   dir.write("bad.xml", "<?xml version=\"1.0\"?>\n<ControlSet name=\"c\"><objects>\n<ControlLinear name=\"rt\">\n"
                        "<x_nodes><ControlLinearNode><t> 0 </t><value> x </value></ControlLinearNode></x_nodes>\n"
                        "</ControlLinear></objects></ControlSet>\n");
-  s.setup_file = dir.write("bad_setup.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"
-                                                                          "<controls_file>bad.xml</controls_file>"));
+  s.setup_file = dir.write("bad_setup.xml", old_document(setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"
+                                                                                        "<controls_file>bad.xml</controls_file>")));
   try {
     AnalyzeTool bad(s);
     ADD_FAILURE() << "a malformed controls file was accepted";
@@ -418,7 +435,9 @@ TEST(MuscleAnalysis, PointAndTorqueActuatorSpeedsAsOpenSim) {
                      "0\t1\t-1\n1\t1\t-1\n");
   AnalyzeToolSettings s;
   s.setup_file = dir.write("setup.xml", setupXml(muscleAnalysisXml(), "<coordinates_file>q.mot</coordinates_file>"
-                                                                      "<controls_file>c.sto</controls_file>"));
+                                                                      "<ControllerSet><objects><ControlSetController "
+                                                                      "name=\"c\"><controls_file>c.sto</controls_file>"
+                                                                      "</ControlSetController></objects></ControllerSet>"));
   const AnalyzeTool tool(s);
   for (const auto& w : tool.warnings()) EXPECT_EQ(w.find("speed and power nan"), std::string::npos) << w;
   const MuscleAnalysisRun run = tool.runMuscleAnalyses();

@@ -15,6 +15,7 @@
 
 #include "converter/build/build_core_model.hpp"
 #include "converter/osim_reader.hpp"
+#include "core/muscles/wrap/smooth.hpp"
 #include "core/muscles/wrap/wrap_path.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "core/muscles/wrap_muscle.hpp"
@@ -178,7 +179,7 @@ TEST(WrapPathModels, SmoothMusclesAtRandomPosesStayOnOpenSimsPath) {
     const Model& m = r.model;
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
-    int total = 0, errors = 0, on = 0, band = 0, far = 0;
+    int total = 0, errors = 0, on = 0, band = 0, far = 0, end_fade = 0;
     double worst = 0.0;
     for (const Muscle& base : r.model.muscles()) {
       if (pathType(base.path) != redmax::PathType::III) continue;
@@ -198,6 +199,21 @@ TEST(WrapPathModels, SmoothMusclesAtRandomPosesStayOnOpenSimsPath) {
           double dev = 0.0;
           for (int a = 0; a < mu.mass_points.size(); ++a)
             dev = std::max(dev, (mk.x_a[a] - calcWrappedPathPointWorld(mu.path, wp, E_wi, mu.mass_points.alpha[a])).norm());
+          // an end of a wrapped segment within the end-point fade of a surface (smooth.hpp): there the
+          // smooth path turns straight before OpenSim's jumps (an end inside the surface), by as
+          // much as that jump
+          bool at_end = false;
+          for (const PathWrap& pw : mu.path.wraps) {
+            const Mat4 E_ws = pw.body >= 0 ? Mat4(E_wi[pw.body] * pw.E_bs) : pw.E_bs;
+            for (const Vec3& x : mk.x_w) {
+              const Vec3 p = E_ws.topLeftCorner<3, 3>().transpose() * (x - E_ws.topRightCorner<3, 1>());
+              at_end = at_end || calcWrapEndClearance(pw.surface, p) < smoothWrapEndFadeWidth(pw.surface, SmoothWrapOptions{mu.wrap.width});
+            }
+          }
+          if (at_end && dev >= 1e-9) {
+            ++end_fade;
+            continue;
+          }
           worst = std::max(worst, dev);
           (dev < 1e-9 ? on : dev < 1e-3 ? band : far)++;
         } catch (const std::exception& e) {
@@ -207,13 +223,14 @@ TEST(WrapPathModels, SmoothMusclesAtRandomPosesStayOnOpenSimsPath) {
       }
     }
     std::printf("[ measured ] %s: %d smooth muscle-poses, %d on OpenSim's path (< 1e-9 m), %d within 1 mm, %d farther "
-                "(max %.1e m), %d errors\n",
-                rel, total, on, band, far, worst, errors);
+                "(max %.1e m), %d with an end in the end-point fade, %d errors\n",
+                rel, total, on, band, far, worst, end_fade, errors);
     EXPECT_EQ(errors, 0);
     EXPECT_GT(total, 0);
     // measured: 93.8% / 92.3% on the path, none farther than 1 mm, max 7.2e-4 m (both models);
     // 1% of poses used to be allowed arbitrarily far away
     EXPECT_GT(on, 0.9 * total);
+    EXPECT_LE(end_fade, 0.005 * total);  // measured: 2 of 1200 and 0 of 3800
     EXPECT_EQ(far, 0);
     EXPECT_LE(worst, 1e-3);
   }

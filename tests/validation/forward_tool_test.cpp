@@ -73,6 +73,20 @@ TEST(ForwardTool, CoordinateActuatorsAddOptimalForceTimesControl) {
   bare.calcMassAndForce(s0, wb);
   EXPECT_NEAR(f[1] - wb.f[1], 3.0, 1e-12);
   EXPECT_NEAR(f[0] - wb.f[0], 0.0, 1e-12);
+  // the same tool-level controls_file in a version-40000 document: OpenSim 4.6 ignores it (it reads
+  // one only before version 10904; measured with OpenSim 4.6: every control 0), and so does redmax,
+  // naming it
+  s.setup_file = dir.write("setup40000.xml", "<OpenSimDocument Version=\"40000\"><ForwardTool name=\"p\"><model_file>" +
+                                                 model + "</model_file><initial_time>0.4</initial_time>"
+                                                 "<final_time>0.5</final_time><controls_file>c.xml</controls_file>"
+                                                 "<states_file>states.sto</states_file></ForwardTool></OpenSimDocument>");
+  const ForwardTool modern(s);
+  bool named = false;
+  for (const auto& w : modern.setup().warnings) named = named || w.find("controls_file 'c.xml' is ignored") != std::string::npos;
+  EXPECT_TRUE(named);
+  DynamicsWorkspace wm(modern.system());
+  modern.system().calcMassAndForce(modern.initialState(), wm);
+  for (int k = 0; k < wm.controls.size(); ++k) EXPECT_EQ(wm.controls[k], 0.0);
   const ForwardResult r = tool.run();
   ASSERT_FALSE(r.failed) << r.failure;
   EXPECT_EQ(r.states.numRows(), 11);

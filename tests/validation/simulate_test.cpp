@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -265,6 +266,42 @@ TEST(Simulate, ImpulseGivesTheMomentumItCarries) {
   EXPECT_THROW(parseImpulse("link:1,2:0.1"), std::invalid_argument);
   EXPECT_THROW(parseImpulse("link:1,2,3:-1"), std::invalid_argument);
   EXPECT_THROW(parseImpulse(":1,2,3:1"), std::invalid_argument);
+}
+
+// A hard case found on a real model: subject_walk_armless_18musc swinging freely (no controls, no
+// contact: it falls and its joints go far out of range) with physiological mass on glut_max2_* over
+// the smooth wrap model. An end of the wrapped segment reached the pelvis's wrap cylinder, where
+// the tangent construction's derivatives are infinite; rk45 crawled into it and qddot became NaN at
+// t = 0.445 s. With the end-point fade of core/muscles/wrap/smooth.hpp the swing runs to 0.5 s.
+TEST(Simulate, FreeSwingWithWrappingMuscleMassRunsThroughAnEndAtTheSurface) {
+  const std::string model =
+      std::string(REDMAX_SHARED_DIR) + "/opensim/opensim-core/OpenSim/Moco/Test/subject_walk_armless_18musc.osim";
+  if (!fs::exists(model)) GTEST_SKIP() << "shared OpenSim data not found: " << model;
+  SimulationModelOptions mo;
+  mo.muscle_mass.source = osim::MuscleMassOptions::Source::Physiological;
+  mo.muscle_mass.muscles = "glut_max2_.*";
+  mo.muscle_mass.wrap_mass = true;
+  mo.muscle_mass.wrap.model = WrapModel::Smooth;
+  const SimulationModel m = loadSimulationModel(model, mo);
+  ASSERT_GT(m.muscle_mass, 0.1);
+  osim::Storage init;
+  init.labels = {"hip_flexion_r", "hip_flexion_r_u", "hip_flexion_l", "hip_flexion_l_u",
+                 "knee_angle_r",  "knee_angle_r_u",  "knee_angle_l",  "knee_angle_l_u"};
+  init.time = {0.0};
+  init.data.resize(1, 8);
+  init.data << 0.3, -3.0, -0.2, 3.0, -0.6, 6.0, -0.3, -5.0;
+  const State s0 = initialStateFromStorage(m, init, "init");
+  SimulateOptions o;
+  o.integrator = "rk45";
+  o.integrator_options.rtol = 1e-8;
+  o.integrator_options.atol = 1e-8;
+  o.duration = 0.5;
+  const SimulationResult r = simulate(m, s0, o);
+  ASSERT_FALSE(r.failed) << r.failure;
+  EXPECT_NEAR(r.states.time.back(), 0.5, 1e-12);
+  EXPECT_TRUE(r.final_state.q.allFinite() && r.final_state.qdot.allFinite());
+  std::printf("[ measured ] free swing with glut_max2 mass: %ld steps, energy drift %.3e relative\n",
+              static_cast<long>(r.stats.steps), r.energy_drift_rel);
 }
 
 }  // namespace

@@ -567,6 +567,42 @@ struct SmoothSetup {
 };
 
 // the blend's setup over any scalar (the blended point: smoothPoint below)
+// the end-point fade's band, as a fraction of the penetration band's width (default 0.1% of the
+// surface's size): narrow, because models place path points close to their wrap surfaces (with the
+// whole width, 5% of the radius, 11% of Rajagopal2016's wrapping muscle-poses at random poses
+// moved by over 1 mm; with 0.02 of it, 2 of 1200 of subject_walk_armless's, 0 of Rajagopal's)
+constexpr double kEndFadeFraction = 0.02;
+
+// distance of an end point outside the surface (cylinder: from the infinite cylinder, as OpenSim's
+// InsideRadius test; ellipsoid: in units of the smallest semi-axis, as penetration()); a large
+// value for the torus, whose local cylinder is handled in its own frame
+template <class T>
+T endClearance(const WrapSurface& surf, const V3<T>& p) {
+  switch (surf.type) {
+    case WrapType::Cylinder: return dsqrt(p[0] * p[0] + p[1] * p[1]) - surf.radius;
+    case WrapType::Sphere: return norm(p) - surf.radius;
+    case WrapType::Ellipsoid: {
+      const Vec3& a = surf.dimensions;
+      const V3<T> q{p[0] / a[0], p[1] / a[1], p[2] / a[2]};
+      return a.minCoeff() * (norm(q) - 1.0);
+    }
+    case WrapType::Torus: break;
+  }
+  return T(1e300);
+}
+
+// the end-point fade (smooth.hpp): 1 when both ends are at least `width` outside the surface, 0
+// (the straight path, as OpenSim once an end is inside) when one touches it, quintic smoothstep
+// between
+template <class T>
+T endFade(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double width) {
+  const T c1 = endClearance(surf, p1), c2 = endClearance(surf, p2);
+  const T v = (value(c1) < value(c2) ? c1 : c2) / (kEndFadeFraction * width);
+  if (!(value(v) > 1e-6)) return T(0.0);
+  if (value(v) >= 1.0) return T(1.0);
+  return v * v * v * (10.0 + v * (-15.0 + 6.0 * v));
+}
+
 template <class T>
 void smoothSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, double width, SmoothSetup<T>& st) {
   st.torus = false;
@@ -596,6 +632,11 @@ void smoothSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, doub
   const T d = penetration(surf, p1, p2);
   st.d = d;
   st.w = T(0.0);
+  // an end point at the surface: the tangent construction's derivatives are infinite there (the
+  // tangent point runs into the end like sqrt(clearance)); fade to the straight path before it
+  const T fade = endFade(surf, p1, p2, width);
+  if (!(value(fade) > 0.0)) return;
+  const bool faded = value(fade) < 1.0;
   T u_scale = T(1.0);
   if (surf.type == WrapType::Cylinder && surf.quadrant_sign != 0) {
     // the library's quadrant logic: with an end on the active side it wraps when the segment
@@ -616,9 +657,10 @@ void smoothSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, doub
     const T foot = sign * near_axis;
     const double kR = kQuadrantBlend * surf.radius;
     if (forced || (value(d) > 0.0 && !(value(foot) > 0.0))) {
-      st.w = T(1.0);
+      st.w = fade;
       st.ellipsoid = false;
-      if (cylinderSetup(surf, p1, p2, st.arc)) st.mode = SmoothSetup<T>::Mode::Wrapped;
+      if (cylinderSetup(surf, p1, p2, st.arc))
+        st.mode = faded ? SmoothSetup<T>::Mode::Blend : SmoothSetup<T>::Mode::Wrapped;
       return;
     }
     // as the nearest point nears the quadrant plane the band narrows to nothing (u = d kR /
@@ -638,12 +680,12 @@ void smoothSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, doub
                                                      : sphereSetup(surf, p1, p2, st.arc);
   if (!ok) return;  // the library's finite-length cut-off (not smoothed)
   if (value(u) >= 1.0) {
-    st.w = T(1.0);
-    st.mode = SmoothSetup<T>::Mode::Wrapped;
+    st.w = fade;
+    st.mode = faded ? SmoothSetup<T>::Mode::Blend : SmoothSetup<T>::Mode::Wrapped;
     return;
   }
   // quintic smoothstep: C2 at both ends of the band (see the header)
-  st.w = u * u * u * (10.0 + u * (-15.0 + 6.0 * u));
+  st.w = fade * (u * u * u * (10.0 + u * (-15.0 + 6.0 * u)));
   st.mode = SmoothSetup<T>::Mode::Blend;
 }
 
@@ -720,6 +762,14 @@ double calcWrapPenetration(const WrapSurface& surface, const Vec3& p1, const Vec
     return penetration(torusCylinder(surface), f.q1, f.q2);
   }
   return penetration(surface, constant<double>(p1), constant<double>(p2));
+}
+
+double calcWrapEndClearance(const WrapSurface& surface, const Vec3& p) {
+  return endClearance(surface, constant<double>(p));
+}
+
+double smoothWrapEndFadeWidth(const WrapSurface& surface, const SmoothWrapOptions& options) {
+  return kEndFadeFraction * widthOf(surface, options);
 }
 
 Vec3 calcSmoothWrapPoint(const WrapSurface& surface, const Vec3& p1, const Vec3& p2, double alpha,

@@ -22,6 +22,16 @@
 // once per segment and shared by its mass points (calcSmoothWrapPoints). The earlier route
 // (nested duals, one pass per input direction, per point) stays as smooth_reference.
 //
+// End points near the surface. As an end point nears the surface the tangent point runs into it
+// like sqrt(clearance): the wrapped path's derivatives grow without bound and are infinite on the
+// surface, and OpenSim (the exact library) straightens the path once the end is inside
+// (InsideRadius). The weight is therefore multiplied by a second quintic smoothstep of the smaller
+// end clearance over the same width (clearance measured as the InsideRadius test measures it: from
+// the infinite cylinder, from the sphere, from the ellipsoid in units of its smallest semi-axis) over
+// a narrow band, 0.02 of the width (models place path points close to their surfaces: a wide fade
+// would move many real poses off OpenSim's path), so the path turns straight, C2, before an end
+// reaches the surface. Outside both bands the path is the exact one. (The torus uses its own rule:
+// no wrap with an end inside its local cylinder, below.)
 // Supported: Cylinder and Ellipsoid (also with a quadrant), Sphere without a quadrant, and Torus,
 // single wrap (OpenSim's algorithms as the exact library reproduces them).
 // Quadrant cylinders. The library wraps on contact (d > 0) when an end lies on the active side;
@@ -104,6 +114,15 @@ struct SmoothWrapPoint {
   double penetration = 0.0;  ///< d (m); > 0: the exact library wraps
   double weight = 0.0;       ///< blend weight w of the wrapped path
 };
+
+/// Clearance of point p (surface frame, m) outside the surface as the end-point fade measures it:
+/// from the infinite cylinder, from the sphere, from the ellipsoid in units of its smallest semi-axis;
+/// a huge value for the torus.
+double calcWrapEndClearance(const WrapSurface& surface, const Vec3& p);
+
+/// The end-point fade's band (m): the wrapped path fades to the straight one as the smaller end
+/// clearance falls from this to 0 (0.02 of the penetration band's width).
+double smoothWrapEndFadeWidth(const WrapSurface& surface, const SmoothWrapOptions& options = {});
 
 /// "" when the smooth model handles the surface, otherwise why not.
 std::string smoothWrapUnsupportedReason(const WrapSurface& surface);
