@@ -2,8 +2,8 @@
 // Speed of `redmax analyze` on a setup (`redmax bench --analyze-setup`): frames per second of each
 // analysis the setup runs, the tool's construction (reading the model and data, processing the
 // coordinates) timed apart. Static optimization is timed without and with muscle mass
-// (physiological mass in every muscle, as `redmax id --muscle-mass physiological`), so that a user
-// can set the numbers beside OpenSim's AnalyzeTool on the same setup (OpenSim is not run here).
+// (physiological mass in every muscle, as `redmax id --muscle-mass physiological`). OpenSim's
+// AnalyzeTool on the same setups: validation/bench/opensim_side_by_side_bench.cpp.
 #include <string>
 
 #include "converter/analyze/analyze_tool.hpp"

@@ -62,14 +62,43 @@ void MuscleForceTerm::evalPath(const Model& model, const State& s, const Skeleto
   MuscleForceScratch::Entry& e = sc.muscles[k];
   MuscleKinematics& mk = e.mk;
   if (path.wraps.empty()) {
-    // polyline: l = sum_i |x_i+1 - x_i|, dl/dq = sum_i dxbar_i^T (J_x,i+1 - J_x,i)   [D Eq. 5.18-5.19]
+    // polyline: l = sum_i |x_i+1 - x_i|, dl/dq = sum_i dxbar_i^T (J_x,i+1 - J_x,i)   [D Eq. 5.18-5.19],
+    // applied as OpenSim's GeometryPath::produceForces applies the tension: along each segment whose
+    // ends lie on different bodies only (a segment within one body applies nothing, even where a
+    // MovingPathPoint changes its length), and a MovingPathPoint's own term dP/dq . direction taken
+    // at its coordinate's unclamped value (getdPointdQ), while its location is clamped to the
+    // coordinate's range; the lengthening speed likewise (getVelocity, every segment). Inside the
+    // range and without such same-body segments this is -dl/dq exactly (docs/forward.md §3).
     calcPathPoints(model, s, sk, path, mk, true);
     const int kc = static_cast<int>(mk.J_xr.cols());
+    const int P = static_cast<int>(mk.active.size());
+    auto body = [&](int a) { return path.points[mk.active[a]].body; };
     e.dl_dq.setZero(kc);
-    for (int i = 0; i + 1 < static_cast<int>(mk.active.size()); ++i)
-      e.dl_dq.noalias() += (mk.J_xr.middleRows<3>(3 * (i + 1)) - mk.J_xr.middleRows<3>(3 * i)).transpose() * mk.dxbar[i];
+    for (int i = 0; i + 1 < P; ++i)
+      if (body(i) != body(i + 1))
+        e.dl_dq.noalias() += (mk.J_xr.middleRows<3>(3 * (i + 1)) - mk.J_xr.middleRows<3>(3 * i)).transpose() * mk.dxbar[i];
     e.length = mk.length;
     e.speed = mk.lengthening_speed;
+    for (int a = 0; a < P; ++a) {
+      const PathPoint& pt = path.points[mk.active[a]];
+      if (pt.kind != PathPointKind::Moving || !pt.clamp || pt.coordinate < 0) continue;
+      const double qc = s.q[pt.coordinate];
+      if (qc >= pt.clamp_lo && qc <= pt.clamp_hi) continue;  // J_xr holds OpenSim's derivative already
+      Vec3 dw = calcPointLocationDerivativeUnclamped(pt, qc);
+      if (pt.body >= 0) dw = sk.E_wi[pt.body].topLeftCorner<3, 3>() * dw;
+      const int cc = mk.col_of[pt.coordinate];
+      const double v = s.qdot[pt.coordinate];
+      if (a > 0) {
+        const double g = mk.dxbar[a - 1].dot(dw);
+        if (body(a - 1) != pt.body) e.dl_dq[cc] += g;
+        e.speed += g * v;
+      }
+      if (a + 1 < P) {
+        const double g = mk.dxbar[a].dot(dw);
+        if (body(a + 1) != pt.body) e.dl_dq[cc] -= g;
+        e.speed -= g * v;
+      }
+    }
     return;
   }
   // wrapped path: OpenSim's length; the generalized force and the lengthening speed as OpenSim

@@ -3,7 +3,9 @@
 // ForceTerm with its own states and one control (docs/forward.md). At a state, for muscle m:
 //   l, ldot      path length and lengthening speed (core/muscles/path_kinematics.hpp; with wrap
 //                objects OpenSim's wrapped length, core/muscles/wrap/wrap_path.hpp)
-//   dl/dq        Type I/II: sum over segments i of dxbar_i^T (J_x,i+1 - J_x,i) from J_xr (exact);
+//   dl/dq        Type I/II: sum over segments i of dxbar_i^T (J_x,i+1 - J_x,i) from J_xr (exact),
+//                as OpenSim's GeometryPath::produceForces applies it: segments within one body
+//                skipped, a MovingPathPoint's derivative at its coordinate's unclamped value;
 //                Type III: central differences of the wrapped length in each coordinate that can
 //                move the path (h = 1e-7 rad or m), and ldot = dl/dq qdot
 //   F_t, zdot    the model's calc(z_m, {l, ldot, u_m})

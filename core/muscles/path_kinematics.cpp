@@ -117,6 +117,19 @@ void calcPointLocation(const PathPoint& p, const VecX& q, Vec3& x_b, Vec3& dx_b,
   }
 }
 
+Vec3 calcPointLocationDerivativeUnclamped(const PathPoint& p, double q_c) {
+  Vec3 d = Vec3::Zero();
+  if (p.kind != PathPointKind::Moving || p.coordinate < 0) return d;
+  FunctionValue fv;
+  for (int k = 0; k < 3; ++k) {
+    const AxisFunctionPtr& f = p.functions[k];
+    if (!f || f->numArgs() != 1) continue;
+    f->evaluate(VecJ::Constant(1, q_c), 1, fv);
+    d[k] = fv.gradient[0];
+  }
+  return d;
+}
+
 void calcPathPoints(const Model& model, const State& state, const SkeletonWorkspace& sk,
                     const MusclePath& path, MuscleKinematics& mk, bool velocity) {
   if (!columnsCover(model, path, mk)) initMuscleKinematics(model, path, mk);

@@ -43,4 +43,9 @@ void calcActivePoints(const MusclePath& path, const VecX& q, const std::vector<M
 /// unless it is a moving point with a coordinate, inside its clamp range).
 void calcPointLocation(const PathPoint& p, const VecX& q, Vec3& x_b, Vec3& dx_b, Vec3& ddx_b);
 
+/// d(location)/dq of a moving point (body frame) at its coordinate's value q_c as given, not
+/// clamped: OpenSim's MovingPathPoint::getdPointdQ and getVelocity, which differentiate at the
+/// unclamped value while the location is clamped to the range. Zero for other points.
+Vec3 calcPointLocationDerivativeUnclamped(const PathPoint& p, double q_c);
+
 }  // namespace redmax

@@ -6,8 +6,8 @@
 //   gait2354_<mass>   gait2354 (23 DoF, 54 Thelen2003Muscle), every muscle at excitation 0.2 from
 //                     equilibrium, 0.1 s, at 1e-4: cvode lumped and with physiological muscle mass, rk45 lumped
 // Reported as the counter sim_per_wall (simulated s / wall s, higher is faster) beside steps and
-// right-hand sides. OpenSim's ForwardTool is not run here (no OpenSim on this machine): there is
-// no ratio against it. Needs ../shared (REDMAX_SHARED_DIR); not run by ctest.
+// right-hand sides. OpenSim's ForwardTool beside these: opensim_side_by_side_bench (built where
+// OpenSim is installed). Needs ../shared (REDMAX_SHARED_DIR); not run by ctest.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 

@@ -6,6 +6,10 @@
 //   forward/arm26_thelen     the same setup with the model's own Thelen2003Muscle
 //   forward/gait2354         gait2354 (23 DoF, 54 Thelen2003Muscle), every muscle at excitation 0.2
 //                            (a ControlSet file) from equilibrium, 0.1 s, tolerance 1e-4
+//   forward/gait2354_tight   the same at tolerance 1e-8 (both engines converged: their difference
+//                            is the models', not the integrators')
+//   forward/gait10dof18musc_tight  set F's subject01 (planar, 10 DoF, 18 Millard2012EquilibriumMuscle)
+//                            at excitation 0.2 from equilibrium, 0.1 s, tolerance 1e-8
 //   analyze/arm26            OpenSim's arm26 static-optimization test setup (Applications/Analyze/tests),
 //                            read as Thelen2003Muscle_Deprecated as its first standard
 //   analyze/gait2392_E       set E (gait2392, 92 muscles, GRF, 0.4-1.6 s, 6 Hz) with the reserves
@@ -360,9 +364,22 @@ void registerAll() {
     benchmark::RegisterBenchmark(("redmax/analyze/" + name + "_muscle_mass").c_str(), RedmaxAnalyze, name, ac, true)
         ->Unit(benchmark::kMillisecond)->Iterations(1);
   };
+  // the same at 1e-8: how far the two engines' answers are apart once both have converged
+  const ForwardCase gait2354_tight{
+      constantExcitationSetup(shared("opensim-models/Models/Gait2354_Simbody/gait2354_simbody.osim"), "gait2354_tight",
+                              0.1, 0.2, 1e-8),
+      ""};
+  // Millard2012EquilibriumMuscle with elastic tendons, planar gait model of set F
+  const ForwardCase gait10dof{
+      constantExcitationSetup(
+          shared("opensim-models@a26e12c/Pipelines/Gait10dof18musc/OutputReference/subject01.osim"), "gait10dof18musc",
+          0.1, 0.2, 1e-8),
+      ""};
   // the muscles as written first (renameType cannot be undone), then as the standards' class
   forward("arm26_thelen", arm26_own);
   forward("gait2354", gait2354);
+  forward("gait2354_tight", gait2354_tight);
+  forward("gait10dof18musc_tight", gait10dof);
   analyze("gait2392_E", {setE(), ""});
   forward("arm26_standard", arm26_std);
   analyze("arm26", {arm26SO(), deprecated});

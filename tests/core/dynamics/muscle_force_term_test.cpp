@@ -1,6 +1,8 @@
 // MuscleForceTerm and the auxiliary states of a System (docs/forward.md):
 //   - the generalized force is -F_t dl/dq, dl/dq by central differences of the path length
-//     (h = 1e-6, relative 1e-6) on random trees with via and moving points;
+//     (h = 1e-6, relative 1e-6) on random trees with via and moving points; where OpenSim applies
+//     the tension otherwise (a segment within one body, a moving point outside its coordinate's
+//     range) as OpenSim does, in closed form on a slider;
 //   - the power identity f . qdot = -F_t ldot;
 //   - zdot is the model's; states and controls get their offsets and names;
 //   - rk45, cvode and the fixed-step methods integrate z (first-order activation against its
@@ -10,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -219,6 +222,53 @@ TEST(MuscleForceTerm, StateOfTheWrongSizeIsRefused) {
   EXPECT_THROW(integ->advance(sys, s, 0.01), std::invalid_argument);
   DynamicsWorkspace ws(sys);
   EXPECT_THROW(sys.calcMassAndForce(s, ws), ModelError);
+}
+
+// The tension is applied as OpenSim's GeometryPath::produceForces applies it (docs/forward.md §3),
+// in closed form on a slider: ground point P1 = (0, 1, 0); a body on a prismatic joint along x
+// (coordinate q) carries a moving point P2 with x location a clamp(q, -0.1, 0.1) and a fixed point
+// P3 = (0, -0.5, 0). Segment P1-P2 spans two bodies: the tension acts along it, with the moving
+// point's own term at the unclamped q (getdPointdQ): dl/dq applied = d1 (1 + a), inside and outside
+// the range (d1: the x component of the unit vector P1 -> P2). Segment P2-P3 lies in one body: no
+// force, although the moving point changes its length there. The lengthening speed runs over every
+// segment with the unclamped velocity (getVelocity): (d1 (1 + a) - a d2) qdot, d2 the x component of
+// the unit vector P2 -> P3. The length's own gradient differs: d1 (1 + a) - a d2 inside, d1 outside.
+TEST(MuscleForceTerm, AppliesTheTensionAsOpenSimsGeometryPath) {
+  ModelBuilder b("slider");
+  b.addBody("link", 1.0, Vec3::Zero(), Mat3::Identity(), -1, "slide", Prismatic{});
+  const Model m = b.finalize();
+  const double a = 0.5;
+  Muscle mu;
+  mu.name = "m";
+  PathPoint moving = makeMovingPoint(0, 0, {std::make_shared<const LinearFunction>(a, 0.0), nullptr, nullptr});
+  moving.clamp = true;
+  moving.clamp_lo = -0.1;
+  moving.clamp_hi = 0.1;
+  mu.path.points = {makeFixedPoint(-1, Vec3(0.0, 1.0, 0.0)), moving, makeFixedPoint(0, Vec3(0.0, -0.5, 0.0))};
+  const MuscleForceTerm term(m, {mu}, {std::make_shared<test::ToyMuscleModel>()});
+  for (double q : {0.05, 0.25, -0.3}) {
+    State s;
+    s.q = VecX::Constant(1, q);
+    s.qdot = VecX::Constant(1, 0.7);
+    SkeletonWorkspace sk(m);
+    calcKinematics(m, s, sk);
+    double length = 0.0, speed = 0.0;
+    VecX dl_dq;
+    term.calcPath(m, s, sk, 0, length, speed, dl_dq);
+    const double c = std::clamp(q, -0.1, 0.1);
+    const Vec3 p1(0.0, 1.0, 0.0), p2(q + a * c, 0.0, 0.0), p3(q, -0.5, 0.0);
+    const double d1 = (p2 - p1).normalized().x(), d2 = (p3 - p2).normalized().x();
+    EXPECT_NEAR(length, (p2 - p1).norm() + (p3 - p2).norm(), 1e-15) << q;
+    ASSERT_EQ(dl_dq.size(), 1);
+    EXPECT_NEAR(dl_dq[0], d1 * (1.0 + a), 1e-14) << q;
+    EXPECT_NEAR(speed, (d1 * (1.0 + a) - a * d2) * 0.7, 1e-14) << q;
+    // and not the length's gradient, which differs here by a d2 (inside) or a d1 (outside)
+    const double gradient = q > -0.1 && q < 0.1 ? d1 * (1.0 + a) - a * d2 : d1;
+    EXPECT_GT(std::abs(dl_dq[0] - gradient), 0.02) << q;
+    EXPECT_NEAR((pathLengthAt(m, mu, VecX::Constant(1, q + 1e-6)) - pathLengthAt(m, mu, VecX::Constant(1, q - 1e-6))) / 2e-6,
+                gradient, 1e-8)
+        << q;
+  }
 }
 
 }  // namespace
