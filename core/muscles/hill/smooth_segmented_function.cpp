@@ -21,11 +21,6 @@ void checkCurviness(const std::string& property, double c) {
   if (!(c >= 0 && c <= 1)) bad(property, "must be between 0 and 1");
 }
 
-// 5 choose k
-constexpr double kBinom5[6] = {1, 5, 10, 10, 5, 1};
-constexpr double kBinom4[5] = {1, 4, 6, 4, 1};
-constexpr double kBinom3[4] = {1, 3, 3, 1};
-
 }  // namespace
 
 QuinticBezierSegment quinticBezierCorner(double x0, double y0, double dydx0, double x1, double y1,
@@ -49,22 +44,22 @@ QuinticBezierSegment quinticBezierCorner(double x0, double y0, double dydx0, dou
 }
 
 double quinticBezier(double u, const std::array<double, 6>& p, int order) {
+  // Bernstein form of B and of its first two derivatives (differences of the control values), the
+  // powers by products: std::pow here was 80% of a Millard forward run (gait10dof18musc, perf)
   const double v = 1 - u;
-  // Bernstein form of B and of its first two derivatives (differences of the control values)
+  const double u2 = u * u, u3 = u2 * u, v2 = v * v, v3 = v2 * v;
   if (order == 0) {
-    double s = 0;
-    for (int k = 0; k <= 5; ++k) s += kBinom5[k] * std::pow(v, 5 - k) * std::pow(u, k) * p[k];
-    return s;
+    const double u4 = u2 * u2, v4 = v2 * v2;
+    return v4 * v * p[0] + 5 * v4 * u * p[1] + 10 * v3 * u2 * p[2] + 10 * v2 * u3 * p[3] + 5 * v * u4 * p[4] +
+           u4 * u * p[5];
   }
   if (order == 1) {
-    double s = 0;
-    for (int k = 0; k <= 4; ++k) s += kBinom4[k] * std::pow(v, 4 - k) * std::pow(u, k) * (p[k + 1] - p[k]);
-    return 5 * s;
+    const double u4 = u2 * u2, v4 = v2 * v2;
+    return 5 * (v4 * (p[1] - p[0]) + 4 * v3 * u * (p[2] - p[1]) + 6 * v2 * u2 * (p[3] - p[2]) +
+                4 * v * u3 * (p[4] - p[3]) + u4 * (p[5] - p[4]));
   }
-  double s = 0;
-  for (int k = 0; k <= 3; ++k)
-    s += kBinom3[k] * std::pow(v, 3 - k) * std::pow(u, k) * (p[k + 2] - 2 * p[k + 1] + p[k]);
-  return 20 * s;
+  return 20 * (v3 * (p[2] - 2 * p[1] + p[0]) + 3 * v2 * u * (p[3] - 2 * p[2] + p[1]) +
+               3 * v * u2 * (p[4] - 2 * p[3] + p[2]) + u3 * (p[5] - 2 * p[4] + p[3]));
 }
 
 SmoothSegmentedFunction::SmoothSegmentedFunction(std::vector<QuinticBezierSegment> segments, double x0,
