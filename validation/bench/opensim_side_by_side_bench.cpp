@@ -14,6 +14,8 @@
 //                            read as Thelen2003Muscle_Deprecated as its first standard
 //   analyze/gait2392_E       set E (gait2392, 92 muscles, GRF, 0.4-1.6 s, 6 Hz) with the reserves
 //                            `redmax gait-study` generates (converter/analyze/setup_writer.hpp)
+//   analyze/gait10dof18musc_F  set F (Gait10dof18musc subject01, 18 Millard muscles, GRF, 0-2.5 s,
+//                            6 Hz) with the same generated reserves
 //
 // Each engine runs the same setup file: OpenSim's ForwardTool / AnalyzeTool (construction reads the
 // model and inputs; run() integrates or solves every frame and writes its files), redmax's
@@ -256,6 +258,21 @@ std::string setE() {
   return setup;
 }
 
+std::string setF() {
+  static const std::string setup = [] {
+    redmax::osim::IdToolConfig t;
+    const std::string f = "Pipelines/Gait10dof18musc/OutputReference/";
+    t.model_file = shared("opensim-models@a26e12c/" + f + "subject01.osim");
+    t.coordinates_file = shared("opensim-models/" + f + "IK/subject01_walk_IK.mot");
+    t.external_loads_file = shared("opensim-models/" + f + "ExperimentalData/subject01_walk_grf.xml");
+    t.lowpass_cutoff_hz = 6.0;
+    t.t0 = 0.0;
+    t.t1 = 2.5;
+    return redmax::osim::writeStaticOptimizationSetup(t, {}, (scratch() / "gait10dof18musc_F").string()).setup_file;
+  }();
+  return setup;
+}
+
 std::string arm26SO() {
   return shared("opensim-core/Applications/Analyze/tests/resources/arm26_Setup_StaticOptimization.xml");
 }
@@ -381,6 +398,7 @@ void registerAll() {
   forward("gait2354_tight", gait2354_tight);
   forward("gait10dof18musc_tight", gait10dof);
   analyze("gait2392_E", {setE(), ""});
+  analyze("gait10dof18musc_F", {setF(), ""});
   forward("arm26_standard", arm26_std);
   analyze("arm26", {arm26SO(), deprecated});
 }
