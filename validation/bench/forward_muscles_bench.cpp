@@ -3,7 +3,8 @@
 //   arm26_standard    OpenSim's arm26 ForwardTool setup (Applications/Forward/tests), 1 s, rk45 at
 //                     1e-5, read as Thelen2003Muscle_Deprecated (the standard's class)
 //   arm26_thelen      the same setup with the model's own Thelen2003Muscle, rk45 and cvode
-//   gait2354_<mass>   gait2354 (23 DoF, 54 Thelen2003Muscle), every muscle at excitation 0.2 from
+//   gait2354_<mass>   gait2354 (23 DoF, 54 Thelen2003Muscle), every muscle at excitation 0.2 (a
+//                     ControlSet, validation/forward/constant_excitation.hpp) from
 //                     equilibrium, 0.1 s, at 1e-4: cvode lumped and with physiological muscle mass, rk45 lumped
 // Reported as the counter sim_per_wall (simulated s / wall s, higher is faster) beside steps and
 // right-hand sides. OpenSim's ForwardTool beside these: opensim_side_by_side_bench (built where
@@ -13,10 +14,8 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
-#include "converter/osim_reader.hpp"
+#include "validation/forward/constant_excitation.hpp"
 #include "validation/forward/forward_tool.hpp"
 
 namespace {
@@ -29,22 +28,9 @@ using redmax::validation::ForwardToolSettings;
 std::string shared(const std::string& rel) { return std::string(REDMAX_SHARED_DIR) + "/opensim/" + rel; }
 
 std::string constantExcitationSetup(const std::string& model, double t1, double excitation, double tolerance) {
-  const redmax::osim::ModelDescription d = redmax::osim::readOsimModel(model);
-  std::ostringstream f;
-  f << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<OpenSimDocument Version=\"40000\">\n"
-    << "<ForwardTool name=\"run\">\n<model_file>" << model << "</model_file>\n"
-    << "<initial_time>0</initial_time>\n<final_time>" << t1 << "</final_time>\n"
-    << "<solve_for_equilibrium_for_auxiliary_states>true</solve_for_equilibrium_for_auxiliary_states>\n"
-    << "<maximum_number_of_integrator_steps>2000000</maximum_number_of_integrator_steps>\n"
-    << "<integrator_error_tolerance>" << tolerance << "</integrator_error_tolerance>\n"
-    << "<ControllerSet><objects><PrescribedController name=\"constant\">\n<FunctionSet><objects>\n";
-  for (const auto& m : d.muscles)
-    if (m.is_muscle) f << "<Constant name=\"" << m.name << "\"><value>" << excitation << "</value></Constant>\n";
-  f << "</objects></FunctionSet>\n</PrescribedController></objects></ControllerSet>\n</ForwardTool>\n</OpenSimDocument>\n";
-  const fs::path path = fs::temp_directory_path() / ("redmax_forward_bench_" + std::to_string(::getpid()) + "_" +
-                                                     fs::path(model).stem().string() + ".xml");
-  std::ofstream(path) << f.str();
-  return path.string();
+  const fs::path dir = fs::temp_directory_path() / ("redmax_forward_bench_" + std::to_string(::getpid()));
+  return redmax::validation::writeConstantExcitationSetup(model, dir.string(), fs::path(model).stem().string(), t1,
+                                                          excitation, tolerance);
 }
 
 void runTool(benchmark::State& st, const ForwardToolSettings& s) {

@@ -53,6 +53,7 @@
 #include "converter/atomic_file.hpp"
 #include "converter/osim_reader.hpp"
 #include "converter/storage.hpp"
+#include "validation/forward/constant_excitation.hpp"
 #include "validation/forward/forward_tool.hpp"
 
 namespace {
@@ -141,40 +142,10 @@ double coordinateDifference(const redmax::osim::Storage& a, const redmax::osim::
 // ---------------------------------------------------------------------------------------------
 // forward
 
-// a ForwardTool setup: every muscle of `model` at a constant excitation (a ControlSet file of
-// two-node ControlLinears in a ControlSetController: OpenSim 4 ignores a tool-level controls_file),
-// from equilibrium
 std::string constantExcitationSetup(const std::string& model, const std::string& tag, double t1, double excitation,
                                     double tolerance) {
-  const redmax::osim::ModelDescription d = redmax::osim::readOsimModel(model);
-  const fs::path dir = scratch() / tag;
-  fs::create_directories(dir);
-  std::ostringstream c;
-  c << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<OpenSimDocument Version=\"40000\">\n<ControlSet name=\"constant\">\n<objects>\n";
-  for (const auto& m : d.muscles) {
-    if (!m.is_muscle) continue;
-    c << "<ControlLinear name=\"" << m.name << ".excitation\"><is_model_control>true</is_model_control>"
-      << "<use_steps>false</use_steps><x_nodes>";
-    for (double t : {0.0, t1})
-      c << "<ControlLinearNode><t>" << t << "</t><value>" << excitation << "</value></ControlLinearNode>";
-    c << "</x_nodes></ControlLinear>\n";
-  }
-  c << "</objects>\n</ControlSet>\n</OpenSimDocument>\n";
-  redmax::osim::writeFileAtomic((dir / "controls.xml").string(), c.str());
-  std::ostringstream f;
-  f << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<OpenSimDocument Version=\"40000\">\n"
-    << "<ForwardTool name=\"" << tag << "\">\n<model_file>" << model << "</model_file>\n"
-    << "<results_directory>.</results_directory>\n"
-    << "<initial_time>0</initial_time>\n<final_time>" << t1 << "</final_time>\n"
-    << "<solve_for_equilibrium_for_auxiliary_states>true</solve_for_equilibrium_for_auxiliary_states>\n"
-    << "<maximum_number_of_integrator_steps>2000000</maximum_number_of_integrator_steps>\n"
-    << "<integrator_error_tolerance>" << tolerance << "</integrator_error_tolerance>\n"
-    << "<ControllerSet><objects><ControlSetController name=\"constant\">"
-    << "<controls_file>controls.xml</controls_file></ControlSetController></objects></ControllerSet>\n"
-    << "</ForwardTool>\n</OpenSimDocument>\n";
-  const std::string path = (dir / (tag + "_Setup_Forward.xml")).string();
-  redmax::osim::writeFileAtomic(path, f.str());
-  return path;
+  return redmax::validation::writeConstantExcitationSetup(model, (scratch() / tag).string(), tag, t1, excitation,
+                                                          tolerance);
 }
 
 struct ForwardCase {
