@@ -270,24 +270,39 @@ void OsimReader::readModelledForce(const XMLElement* e, ForceDesc& f) {
   if (cls == "CoordinateActuator") {
     coordinate();
   } else if (cls == "PointActuator") {
+    // a document older than 10905 holds the old Force (PointActuator::updateFromXMLNode): body_B,
+    // point_B, direction_A are body, point, direction, the force is global unless the element says
+    // otherwise, and the direction read is negated (OpenSim does so even when the new names are used)
+    const bool old_force = version_ < 10905;
+    auto tag = [&](const char* now, const char* before) {
+      return old_force && !firstChild(e, now) && firstChild(e, before) ? before : now;
+    };
     // body: a BodySet name (PointActuator::extendConnectToModel), never ground
-    const XMLElement* b = firstChild(e, "body");
+    const XMLElement* b = firstChild(e, tag("body", "body_B"));
     f.body1 = textOf(b);
     if (d_.findBody(f.body1) < 0)
       fail(b ? b : e, what + ": body '" + f.body1 + "' is not a body of the model's BodySet");
-    f.point1 = childVec3(doc(), e, "point", Vec3::Zero());
+    f.point1 = childVec3(doc(), e, tag("point", "point_B"), Vec3::Zero());
     f.point_is_global = childBool(doc(), e, "point_is_global", false);
-    f.direction = nonZero("direction", Vec3::UnitX());
-    f.force_is_global = childBool(doc(), e, "force_is_global", false);
+    f.direction = nonZero(tag("direction", "direction_A"), Vec3::UnitX());
+    f.force_is_global = childBool(doc(), e, "force_is_global", old_force);
+    if (old_force) f.direction = -f.direction;
   } else if (cls == "TorqueActuator") {
-    const XMLElement* a = firstChild(e, "bodyA");
-    const XMLElement* b = firstChild(e, "bodyB");
+    // before 10905 (TorqueActuator::updateFromXMLNode): body_A is bodyB, body_B is bodyA, direction_A
+    // is axis, and the axis read is negated (even when the new names are used)
+    const bool old_torque = version_ < 10905;
+    auto tag = [&](const char* now, const char* before) {
+      return old_torque && !firstChild(e, now) && firstChild(e, before) ? before : now;
+    };
+    const XMLElement* a = firstChild(e, tag("bodyA", "body_B"));
+    const XMLElement* b = firstChild(e, tag("bodyB", "body_A"));
     const FrameNode& fa = forceFrame(a ? a : e, textOf(a), what + " bodyA");
     const FrameNode& fb = forceFrame(b ? b : e, textOf(b), what + " bodyB");
     f.body1 = fa.base_body;
     f.body2 = fb.base_body;
     f.force_is_global = childBool(doc(), e, "torque_is_global", true);
-    f.direction = nonZero("axis", Vec3::UnitZ());
+    f.direction = nonZero(tag("axis", "direction_A"), Vec3::UnitZ());
+    if (old_torque) f.direction = -f.direction;
     // an axis in an offset frame of bodyA, re-expressed in its base body
     if (!f.force_is_global) f.direction = fa.X_base.topLeftCorner<3, 3>() * f.direction;
   } else if (cls == "CoordinateLimitForce") {
@@ -662,8 +677,11 @@ void OsimReader::appendForceSetTo(ModelDescription& model) {
   const XMLElement* root = doc_.root();
   if (!root) fail(nullptr, "empty file");
   const XMLElement* set = root;
-  version_ = 40000;
+  // OpenSim's XMLDocument: a file without <OpenSimDocument> is version 10500 (and its objects get
+  // the conversions of older documents, e.g. the PointActuator / TorqueActuator ones below)
+  version_ = 10500;
   if (std::string(root->Name()) == "OpenSimDocument") {
+    version_ = 40000;
     if (const char* v = root->Attribute("Version")) version_ = std::atoi(v);
     set = firstChild(root, "ForceSet");
     if (!set) fail(root, "no <ForceSet> in <OpenSimDocument>: a force_set_files file holds a ForceSet");

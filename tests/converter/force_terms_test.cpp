@@ -124,5 +124,64 @@ TEST(ForceTerms, BadValuesAreErrorsAtTheirLine) {
       "<stiffness>-5", "stiffness must be finite and >= 0");
 }
 
+// A force_set_files file without <OpenSimDocument> is version 10500 to OpenSim, and its
+// PointActuators and TorqueActuators get the conversions of documents older than 10905
+// (PointActuator / TorqueActuator::updateFromXMLNode): direction and axis negated even when the
+// new names are used (OpenSim 4.6 reads gait2354_CMC_Actuators.xml's MX axis 1 0 0 as -1 0 0,
+// measured), the old names body_B, point_B, direction_A (PointActuator) and body_A -> bodyB,
+// body_B -> bodyA, direction_A -> axis (TorqueActuator) read, and a PointActuator's force global
+// unless it says otherwise. The same file in a version-40000 document reads as written.
+TEST(ForceTerms, UnversionedForceSetFilesGetOpenSimsOldActuatorConversions) {
+  test::TempDir dir;
+  const ModelDescription d = readOsimModel(dir.write("m.osim", twoBodies("")));
+  const std::string forces =
+      "<objects>\n"
+      "<PointActuator name=\"p\"><body>b</body><point>0.1 0 0</point><direction>1 0 0</direction>"
+      "<force_is_global>true</force_is_global></PointActuator>\n"
+      "<PointActuator name=\"p_old\"><body_B>a</body_B><point_B>0 0.2 0</point_B><direction_A>0 1 0</direction_A>"
+      "</PointActuator>\n"
+      "<TorqueActuator name=\"t\"><bodyA>a</bodyA><bodyB>ground</bodyB><axis>1 0 0</axis></TorqueActuator>\n"
+      "<Torque name=\"t_old\"><body_A>ground</body_A><body_B>b</body_B><direction_A>0 0 1</direction_A></Torque>\n"
+      "</objects>";
+  ModelDescription old_doc = d;
+  appendForceSetFile(old_doc, dir.write("old.xml", "<ForceSet name=\"f\">" + forces + "</ForceSet>"));
+  ModelDescription new_doc = d;
+  // (the old names are no properties there: a version-40000 file holds the new ones only)
+  const std::string modern =
+      "<objects>\n"
+      "<PointActuator name=\"p\"><body>b</body><point>0.1 0 0</point><direction>1 0 0</direction>"
+      "</PointActuator>\n"
+      "<TorqueActuator name=\"t\"><bodyA>a</bodyA><bodyB>ground</bodyB><axis>1 0 0</axis></TorqueActuator>\n"
+      "</objects>";
+  appendForceSetFile(new_doc, dir.write("new.xml", "<OpenSimDocument Version=\"40000\"><ForceSet name=\"f\">" + modern +
+                                                       "</ForceSet></OpenSimDocument>"));
+  auto find = [](const ModelDescription& m, const std::string& name) -> const ForceDesc& {
+    for (const ForceDesc& f : m.forces)
+      if (f.name == name) return f;
+    ADD_FAILURE() << "no force " << name;
+    return m.forces.front();
+  };
+  // version 10500: negated, old names read
+  EXPECT_EQ(find(old_doc, "p").direction, Vec3(-1, 0, 0));
+  EXPECT_TRUE(find(old_doc, "p").force_is_global);
+  const ForceDesc& po = find(old_doc, "p_old");
+  EXPECT_EQ(po.class_name, "PointActuator");
+  EXPECT_EQ(po.body1, "a");
+  EXPECT_EQ(po.point1, Vec3(0, 0.2, 0));
+  EXPECT_EQ(po.direction, Vec3(0, -1, 0));
+  EXPECT_TRUE(po.force_is_global);
+  EXPECT_EQ(find(old_doc, "t").direction, Vec3(-1, 0, 0));
+  EXPECT_EQ(find(old_doc, "t").body1, "a");
+  const ForceDesc& to = find(old_doc, "t_old");
+  EXPECT_EQ(to.class_name, "TorqueActuator");
+  EXPECT_EQ(to.body1, "b");  // bodyA was body_B
+  EXPECT_EQ(to.body2, d.ground_name);
+  EXPECT_EQ(to.direction, Vec3(0, 0, -1));
+  // version 40000: as written
+  EXPECT_EQ(find(new_doc, "p").direction, Vec3(1, 0, 0));
+  EXPECT_EQ(find(new_doc, "t").direction, Vec3(1, 0, 0));
+  EXPECT_FALSE(find(new_doc, "p").force_is_global);
+}
+
 }  // namespace
 }  // namespace redmax::osim
