@@ -204,6 +204,12 @@ std::vector<ResolvedController> resolveSetupControllers(const std::vector<Contro
   std::vector<ResolvedController> out;
   for (const ControllerSetupDesc& c : controllers) {
     if (c.disabled) continue;
+    if (c.type == "CorrectionController") {
+      // its own actuators and desired states: the forward tool's (validation/forward/forward_tool.cpp)
+      warnings.push_back(setup_file + ":" + std::to_string(c.line) + ": CorrectionController '" + c.name +
+                         "' acts in forward runs only; ignored here");
+      continue;
+    }
     if (c.type == "ControlSetController") {
       if (c.controls_file.empty())
         throw ConvertError(setup_file, c.line, "ControlSetController '" + c.name + "' has no controls_file");

@@ -64,7 +64,7 @@ AxisFunctionPtr makeControlFunction(const ControlLinearDesc& c);
 
 /// One controller of a tool setup's ControllerSet (ForwardTool, AnalyzeTool).
 struct ControllerSetupDesc {
-  std::string type;                 ///< ControlSetController or PrescribedController
+  std::string type;                 ///< ControlSetController, PrescribedController or CorrectionController
   std::string name;
   int line = 0;
   std::vector<std::string> actuator_list;  ///< empty or ALL: every actuator with a control
@@ -72,6 +72,8 @@ struct ControllerSetupDesc {
   std::string controls_file;        ///< ControlSetController (resolved); PrescribedController's optional file
   /// PrescribedController: its FunctionSet, each with the name it was given ("" when unnamed)
   std::vector<std::pair<std::string, FunctionDesc>> functions;
+  /// CorrectionController (forward runs): gains on the errors from the tool's states_file
+  double kp = 100.0, kv = 20.0;
 };
 
 /// A controller resolved against a list of actuator names: control k of the list is driven by

@@ -20,8 +20,14 @@ ControllerSetupDesc readController(const XmlDocument& doc, const XMLElement* e, 
   c.type = e->Name();
   c.name = attribute(e, "name");
   c.line = lineOf(e);
-  if (c.type != "ControlSetController" && c.type != "PrescribedController")
-    doc.fail(e, "unsupported controller class " + c.type + " (ControlSetController and PrescribedController are read)");
+  if (c.type != "ControlSetController" && c.type != "PrescribedController" && c.type != "CorrectionController")
+    doc.fail(e, "unsupported controller class " + c.type +
+                    " (ControlSetController, PrescribedController and CorrectionController are read)");
+  if (c.type == "CorrectionController") {
+    c.kp = childDouble(doc, e, "kp", 100.0);
+    c.kv = childDouble(doc, e, "kv", 20.0);
+    if (!std::isfinite(c.kp) || !std::isfinite(c.kv)) doc.fail(e, "CorrectionController: kp and kv must be finite");
+  }
   c.actuator_list = splitWords(childText(e, "actuator_list"));
   if (const XMLElement* s = firstChild(e, "socket_actuators")) {
     // OpenSim 4.6: a list socket of actuator paths; the last path element names the actuator

@@ -40,6 +40,48 @@ struct TempDir {
   fs::path path;
 };
 
+// OpenSim's CorrectionController (testForward's subject01_Setup_Forward_Controller): a corrector of
+// optimal force 1 on every unconstrained coordinate, -(kp (q - q_d) + kv (u - u_d)) with the desired
+// states the tool's states_file linearly interpolated at t. Closed form at a state between rows.
+TEST(ForwardTool, CorrectionControllerPullsTowardTheStatesFile) {
+  const std::string model = shared("opensim-models/Models/DoublePendulum/double_pendulum.osim");
+  if (!fs::exists(model)) GTEST_SKIP() << "shared OpenSim data not found: " << model;
+  TempDir dir;
+  dir.write("states.sto", "s\nversion=1\nnRows=2\nnColumns=5\ninDegrees=no\nendheader\n"
+                          "time\tq1\tq1_u\tq2\tq2_u\n0\t0.1\t0.5\t0.2\t-0.5\n1\t0.3\t1.5\t-0.2\t0.5\n");
+  ForwardToolSettings s;
+  s.setup_file = dir.write("setup.xml", "<OpenSimDocument Version=\"40000\"><ForwardTool name=\"p\"><model_file>" + model +
+                                            "</model_file><initial_time>0</initial_time><final_time>0.5</final_time>"
+                                            "<ControllerSet><objects><CorrectionController name=\"cc\"><kp>16</kp><kv>8</kv>"
+                                            "</CorrectionController></objects></ControllerSet>"
+                                            "<states_file>states.sto</states_file></ForwardTool></OpenSimDocument>");
+  const ForwardTool tool(s);
+  const System& sys = tool.system();
+  State st = tool.initialState();
+  st.t = 0.25;
+  st.q << 0.4, -0.1;
+  st.qdot << 0.2, 0.3;
+  DynamicsWorkspace ws(sys);
+  sys.calcMassAndForce(st, ws);
+  System bare(sys.model());
+  DynamicsWorkspace wb(bare);
+  bare.calcMassAndForce(st, wb);
+  // desired at t = 0.25: q1 0.15, u1 0.75, q2 0.1, u2 -0.25
+  EXPECT_NEAR(ws.f[0] - wb.f[0], -(16 * (0.4 - 0.15) + 8 * (0.2 - 0.75)), 1e-12);
+  EXPECT_NEAR(ws.f[1] - wb.f[1], -(16 * (-0.1 - 0.1) + 8 * (0.3 + 0.25)), 1e-12);
+  // without a states_file the controller has nothing to correct toward: an error at its line
+  s.setup_file = dir.write("nostates.xml", "<OpenSimDocument Version=\"40000\"><ForwardTool name=\"p\"><model_file>" + model +
+                                               "</model_file>\n<ControllerSet><objects>\n<CorrectionController name=\"cc\"/>"
+                                               "</objects></ControllerSet></ForwardTool></OpenSimDocument>");
+  try {
+    ForwardTool bad(s);
+    ADD_FAILURE() << "a CorrectionController without a states_file was accepted";
+  } catch (const osim::ConvertError& e) {
+    EXPECT_EQ(e.line(), 3) << e.what();
+    EXPECT_NE(std::string(e.what()).find("states_file"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ForwardTool, CoordinateActuatorsAddOptimalForceTimesControl) {
   const std::string model = shared("opensim-models/Models/DoublePendulum/double_pendulum.osim");
   if (!fs::exists(model)) GTEST_SKIP() << "shared OpenSim data not found: " << model;

@@ -12,6 +12,7 @@
 #include "converter/build/force_terms.hpp"
 #include "converter/external_loads.hpp"
 #include "converter/build/functions_to_core.hpp"
+#include "converter/coordinates_file.hpp"
 #include "converter/osim_reader.hpp"
 #include "core/dynamics/sampled_loads.hpp"
 #include "core/dynamics/controller.hpp"
@@ -48,10 +49,99 @@ void addControlsFile(System& sys, const std::string& file, std::vector<std::stri
 }
 
 void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vector<std::string>& warnings) {
+  std::vector<osim::ControllerSetupDesc> controls;  // CorrectionControllers are force terms (below)
+  for (const osim::ControllerSetupDesc& c : setup.controllers)
+    if (c.type != "CorrectionController") controls.push_back(c);
   for (const osim::ResolvedController& r :
-       osim::resolveSetupControllers(setup.controllers, setup.source_file, sys.controlNames(), warnings))
+       osim::resolveSetupControllers(controls, setup.source_file, sys.controlNames(), warnings))
     addResolved(sys, r);
 }
+
+namespace {
+
+// OpenSim's CorrectionController: a CoordinateActuator `<coord>_corrector` of optimal force 1 on every
+// coordinate that is not constrained (locked, prescribed, a coupler's dependent), driven by
+// -(kp (q - q_d(t)) + kv (u - u_d(t))), q_d and u_d the tool's states_file at t as
+// Storage::getDataAtTime gives them (linear between rows and from the last two rows beyond the end;
+// 0 before the first row)
+class CorrectionTerm final : public ForceTerm {
+ public:
+  struct Coordinate {
+    int q = -1;
+    std::vector<double> value, speed;
+  };
+  CorrectionTerm(double kp, double kv, std::vector<double> time, std::vector<Coordinate> coordinates)
+      : kp_(kp), kv_(kv), time_(std::move(time)), coordinates_(std::move(coordinates)) {}
+  std::string name() const override { return "correction_controller"; }
+  bool addsMass() const override { return false; }
+  void addForce(const Model&, const State& s, const TermContext&, VecX& f) const override {
+    const int n = static_cast<int>(time_.size());
+    if (n == 0 || s.t < time_.front()) {
+      for (const Coordinate& c : coordinates_) f[c.q] -= kp_ * s.q[c.q] + kv_ * s.qdot[c.q];
+      return;
+    }
+    int i2 = static_cast<int>(std::upper_bound(time_.begin(), time_.end(), s.t) - time_.begin());
+    if (i2 >= n) i2 = n - 1;
+    const int i1 = std::max(i2 - 1, 0);
+    const double dt = time_[i2] - time_[i1];
+    const double w = dt > 0.0 ? (s.t - time_[i1]) / dt : 0.0;
+    for (const Coordinate& c : coordinates_) {
+      const double qd = c.value[i1] + w * (c.value[i2] - c.value[i1]);
+      const double ud = c.speed[i1] + w * (c.speed[i2] - c.speed[i1]);
+      f[c.q] -= kp_ * (s.q[c.q] - qd) + kv_ * (s.qdot[c.q] - ud);
+    }
+  }
+
+ private:
+  double kp_, kv_;
+  std::vector<double> time_;
+  std::vector<Coordinate> coordinates_;
+};
+
+void addCorrectionControllers(System& sys, const SimulationModel& m, const osim::ForwardSetup& setup,
+                              std::vector<std::string>& warnings) {
+  for (const osim::ControllerSetupDesc& c : setup.controllers) {
+    if (c.type != "CorrectionController" || c.disabled) continue;
+    if (setup.states_file.empty())
+      throw osim::ConvertError(setup.source_file, c.line,
+                               "CorrectionController '" + c.name + "' corrects toward the tool's states_file, "
+                               "and the setup names none");
+    const osim::Storage table = osim::readStorage(setup.states_file);
+    const osim::ModelDescription& d = m.description;
+    std::set<std::string> dependent;  // a coupler's dependent coordinate is constrained
+    for (const osim::ConstraintDesc& k : d.constraints)
+      if (k.kind == osim::ConstraintKind::CoordinateCoupler && k.enforced) dependent.insert(k.dependent_coordinate);
+    std::vector<CorrectionTerm::Coordinate> coords;
+    std::vector<std::string> missing;
+    for (size_t k = 0; k < d.coordinates.size(); ++k) {
+      const osim::CoordinateDesc& cd = d.coordinates[k];
+      const int q = k < m.build.coordinate_index.size() ? m.build.coordinate_index[k] : -1;
+      if (q < 0 || cd.locked || cd.prescribed || dependent.count(cd.name)) continue;
+      const int vc = osim::findCoordinateColumn(table, cd), uc = osim::findSpeedColumn(table, cd);
+      if (vc < 0 || uc < 0) {
+        missing.push_back(cd.name);
+        continue;
+      }
+      const double scale = osim::coordinateScale(table, cd);
+      CorrectionTerm::Coordinate c{q, {}, {}};
+      for (int r = 0; r < table.numRows(); ++r) {
+        c.value.push_back(scale * table.data(r, vc));
+        c.speed.push_back(scale * table.data(r, uc));
+      }
+      coords.push_back(std::move(c));
+    }
+    if (!missing.empty()) {
+      std::string names;
+      for (const std::string& n : missing) names += (names.empty() ? "" : ", ") + n;
+      warnings.push_back(setup.source_file + ":" + std::to_string(c.line) + ": CorrectionController '" + c.name +
+                         "': " + setup.states_file + " has no value or speed column for " + names +
+                         "; those coordinates are not corrected");
+    }
+    sys.addTerm(std::make_shared<CorrectionTerm>(c.kp, c.kv, table.time, std::move(coords)));
+  }
+}
+
+}  // namespace
 
 namespace {
 
@@ -440,6 +530,7 @@ ForwardTool::ForwardTool(ForwardToolSettings settings) : settings_(std::move(set
   }
   System& sys = *model_.system;
   addSetupControllers(sys, setup_, warnings_);
+  addCorrectionControllers(sys, model_, setup_, warnings_);
   if (!setup_.controls_file.empty()) addControlsFile(sys, setup_.controls_file, warnings_);
   if (!settings_.feedback.empty()) addFeedback(sys, model_, settings_.feedback);
   // initial state
