@@ -673,7 +673,7 @@ void OsimReader::readBushing(const XMLElement* e, ForceDesc& f) {
 
 // a force_set_files file: its ForceSet read against `model`'s frames and coordinates, as
 // OpenSim's tools append it (ForceSet(file) then Model::updForceSet().append)
-void OsimReader::appendForceSetTo(ModelDescription& model) {
+void OsimReader::appendForceSetTo(ModelDescription& model, bool model_forces_replaced) {
   const XMLElement* root = doc_.root();
   if (!root) fail(nullptr, "empty file");
   const XMLElement* set = root;
@@ -705,7 +705,34 @@ void OsimReader::appendForceSetTo(ModelDescription& model) {
   for (const BodyDesc& b : d_.bodies) add(FrameNode::Kind::Body, b.name, "/bodyset/" + b.name, b.name, Mat4::Identity());
   for (const FrameDesc& f : d_.frames) add(FrameNode::Kind::Offset, f.name, f.path, f.base_body, f.X_base);
   for (const CoordinateDesc& c : d_.coordinates) coordinate_paths_["/jointset/" + c.joint + "/" + c.name] = c.name;
+  const size_t nf = d_.forces.size(), nm = d_.muscles.size();
   readForceSet(set, doc_.path());
+  // OpenSim's ForceSet::append (AbstractTool::updateModelForces) skips a force whose name the set
+  // already holds: the model's forces (unless replace_force_set emptied the set) and the earlier
+  // files' entries keep their place, the later one is dropped; named here
+  std::set<std::string> held;
+  for (size_t k = 0; k < nf; ++k)
+    if (!model_forces_replaced || !d_.forces[k].source_file.empty()) held.insert(d_.forces[k].name);
+  for (size_t k = 0; k < nm; ++k)
+    if (!model_forces_replaced || !d_.muscles[k].source_file.empty()) held.insert(d_.muscles[k].name);
+  auto dropped = [&](const std::string& name, int line) {
+    if (!held.count(name)) {
+      held.insert(name);
+      return false;
+    }
+    d_.warnings.push_back(doc_.path() + ":" + std::to_string(line) + ": force '" + name +
+                          "' is not appended: the force set already holds a force of that name (OpenSim's "
+                          "ForceSet::append keeps the first)");
+    return true;
+  };
+  std::vector<ForceDesc> forces(d_.forces.begin(), d_.forces.begin() + static_cast<std::ptrdiff_t>(nf));
+  std::vector<PathForceDesc> muscles(d_.muscles.begin(), d_.muscles.begin() + static_cast<std::ptrdiff_t>(nm));
+  for (size_t k = nf; k < d_.forces.size(); ++k)
+    if (!dropped(d_.forces[k].name, d_.forces[k].line)) forces.push_back(d_.forces[k]);
+  for (size_t k = nm; k < d_.muscles.size(); ++k)
+    if (!dropped(d_.muscles[k].name, d_.muscles[k].line)) muscles.push_back(d_.muscles[k]);
+  d_.forces = std::move(forces);
+  d_.muscles = std::move(muscles);
   model = std::move(d_);
 }
 
@@ -784,9 +811,9 @@ PathPointDesc OsimReader::readPathPoint(const XMLElement* e, const std::string& 
 
 namespace redmax::osim {
 
-void appendForceSetFile(ModelDescription& model, const std::string& path) {
+void appendForceSetFile(ModelDescription& model, const std::string& path, bool model_forces_replaced) {
   detail::OsimReader reader(path);
-  reader.appendForceSetTo(model);
+  reader.appendForceSetTo(model, model_forces_replaced);
 }
 
 }  // namespace redmax::osim

@@ -22,8 +22,10 @@ ModelDescription readOsimModel(const std::string& path, const std::string& muscl
 /// to model's forces and muscles, as OpenSim's tools append it; each entry's source_file is
 /// `path`. Bodies, frames and coordinates are the model's; an unknown body or coordinate, a zero
 /// direction, a negative stiffness are errors at their line of that file (ConvertError); the model
-/// is then unchanged.
-void appendForceSetFile(ModelDescription& model, const std::string& path);
+/// is then unchanged. An entry whose name the force set already holds is dropped with a warning
+/// (OpenSim's ForceSet::append keeps the first): the model's forces and muscles count unless
+/// `model_forces_replaced` (the tool's replace_force_set), the earlier files' entries always.
+void appendForceSetFile(ModelDescription& model, const std::string& path, bool model_forces_replaced = false);
 
 /// Build the multibody tree as Simbody's MultibodyGraphMaker does for OpenSim (§3.1): fills
 /// d.tree, appends FreeJoints for unconnected bodies and loop-closure constraints, and reorders

@@ -195,9 +195,25 @@ Storage readStorage(const std::string& path) {
       // the first column is the time, whatever its label (Storage's legacy reader)
       s.labels.assign(labels.begin() + 1, labels.end());
       s.data.resize(rows, ncol - 1);
+      // a row whose time equals the previous row's replaces it (Storage::append's duplicate-time
+      // check, on by default, which Storage(file) reads through)
+      int kept = 0, replaced = 0;
       for (int r = 0; r < rows; ++r) {
-        s.time.push_back(values[static_cast<size_t>(r) * ncol]);
-        for (int c = 1; c < ncol; ++c) s.data(r, c - 1) = values[static_cast<size_t>(r) * ncol + c];
+        const double t = values[static_cast<size_t>(r) * ncol];
+        int at = kept;
+        if (kept > 0 && s.time.back() == t) {
+          at = kept - 1;
+          ++replaced;
+        } else {
+          s.time.push_back(t);
+          ++kept;
+        }
+        for (int c = 1; c < ncol; ++c) s.data(at, c - 1) = values[static_cast<size_t>(r) * ncol + c];
+      }
+      if (replaced > 0) {
+        s.data.conservativeResize(kept, ncol - 1);
+        s.warnings.push_back(std::to_string(replaced) + " row(s) repeat the previous row's time; each replaces that "
+                             "row, as OpenSim's Storage reads them");
       }
     } else {
       // SIMM motion without a time column: uniform times from "range t0 t1", else row numbers

@@ -282,7 +282,11 @@ AnalyzeTool::AnalyzeTool(AnalyzeToolSettings settings) : settings_(std::move(set
   // leaves them out instead of naming them as unmodelled.
   cfg.forces_to_exclude = {"Actuators"};
   ModelDescription with_files = readOsimModel(setup_.model_file, cfg.muscle_class);
-  for (const std::string& file : setup_.force_set_files) appendForceSetFile(with_files, file);
+  const size_t nw = with_files.warnings.size();
+  for (const std::string& file : setup_.force_set_files)
+    appendForceSetFile(with_files, file, setup_.replace_force_set);
+  warnings_.insert(warnings_.end(), with_files.warnings.begin() + static_cast<std::ptrdiff_t>(nw),
+                   with_files.warnings.end());
   for (const ForceDesc& f : with_files.forces)
     if (f.modelled && f.class_name.find("Actuator") == std::string::npos) cfg.forces_to_exclude.push_back(f.name);
   I.id = std::make_unique<InverseDynamicsTool>(cfg);
@@ -675,7 +679,7 @@ void AnalyzeTool::prepareMuscleAnalyses() {
   I.muscle_control.assign(I.geometry.muscles().size(), -1);
   ModelDescription files = d;
   files.forces.clear();
-  for (const std::string& file : setup_.force_set_files) appendForceSetFile(files, file);
+  for (const std::string& file : setup_.force_set_files) appendForceSetFile(files, file, setup_.replace_force_set);
   if (model_forces) {
     for (size_t k = 0; k < d.muscles.size(); ++k) {
       const PathForceDesc& pf = d.muscles[k];

@@ -42,7 +42,7 @@ class OsimReader {
   explicit OsimReader(const std::string& path);
   ModelDescription read();
   /// append the ForceSet of this reader's file (a force_set_files file) to `model`'s forces
-  void appendForceSetTo(ModelDescription& model);
+  void appendForceSetTo(ModelDescription& model, bool model_forces_replaced);
   /// read every muscle as this class (renameType); "" = as written
   void setMuscleClass(std::string cls) { muscle_class_ = std::move(cls); }
 

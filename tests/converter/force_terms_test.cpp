@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "converter/osim_reader.hpp"
@@ -181,6 +182,42 @@ TEST(ForceTerms, UnversionedForceSetFilesGetOpenSimsOldActuatorConversions) {
   EXPECT_EQ(find(new_doc, "p").direction, Vec3(1, 0, 0));
   EXPECT_EQ(find(new_doc, "t").direction, Vec3(1, 0, 0));
   EXPECT_FALSE(find(new_doc, "p").force_is_global);
+}
+
+// OpenSim's ForceSet::append (AbstractTool::updateModelForces) skips an appended force whose name the
+// set already holds (OpenSim's testStaticOptimization passive-force setup appends reserves the
+// model already has: appending them again doubled them, so each carried half); with
+// replace_force_set the model's are gone and the file's count. Earlier files keep their entries.
+TEST(ForceTerms, ForceSetFilesDoNotAppendANameTheSetHolds) {
+  test::TempDir dir;
+  const ModelDescription d = readOsimModel(dir.write(
+      "m.osim", twoBodies("<CoordinateActuator name=\"r\"><coordinate>qa</coordinate><optimal_force>1</optimal_force>"
+                          "</CoordinateActuator>\n")));
+  const std::string file = dir.write(
+      "f.xml", "<OpenSimDocument Version=\"40000\"><ForceSet name=\"f\"><objects>\n"
+               "<CoordinateActuator name=\"r\"><coordinate>qa</coordinate><optimal_force>5</optimal_force>"
+               "</CoordinateActuator>\n"
+               "<CoordinateActuator name=\"s\"><coordinate>xb</coordinate></CoordinateActuator>\n"
+               "</objects></ForceSet></OpenSimDocument>");
+  auto count = [](const ModelDescription& m, const std::string& name) {
+    return std::count_if(m.forces.begin(), m.forces.end(), [&](const ForceDesc& f) { return f.name == name; });
+  };
+  ModelDescription kept = d;
+  appendForceSetFile(kept, file);
+  EXPECT_EQ(count(kept, "r"), 1);
+  EXPECT_EQ(count(kept, "s"), 1);
+  for (const ForceDesc& f : kept.forces)
+    if (f.name == "r") EXPECT_EQ(f.optimal_force, 1.0);  // the model's
+  bool named = false;
+  for (const std::string& w : kept.warnings) named = named || w.find("force 'r' is not appended") != std::string::npos;
+  EXPECT_TRUE(named);
+  appendForceSetFile(kept, file);  // a second file: its entries are all held already
+  EXPECT_EQ(count(kept, "s"), 1);
+  // replace_force_set: the file's r joins (the model's is no longer in the set)
+  ModelDescription replaced = d;
+  appendForceSetFile(replaced, file, true);
+  EXPECT_EQ(count(replaced, "r"), 2);
+  EXPECT_EQ(replaced.forces.back().name, "s");
 }
 
 }  // namespace

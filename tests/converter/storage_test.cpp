@@ -174,6 +174,22 @@ TEST(Storage, LegacyRowsFlowAcrossLinesAndCountsMustAgree) {
   }
 }
 
+// OpenSim's Storage reads rows through append(), whose duplicate-time check (on by default) lets a
+// row with the previous row's time replace it: OpenSim's own walk_subject01_Kinematics_q.sto ends
+// with a repeated row, which would otherwise stop every spline through the times
+TEST(Storage, ARowRepeatingThePreviousTimeReplacesIt) {
+  test::TempDir dir;
+  const Storage s = readStorage(dir.write("dup.sto", header("version=1\nnRows=4\nnColumns=2\n") +
+                                                        "time\ta\n0\t1\n1\t2\n1\t3\n2\t4\n"));
+  ASSERT_EQ(s.numRows(), 3);
+  EXPECT_EQ(s.time, (std::vector<double>{0, 1, 2}));
+  EXPECT_EQ(s.data(1, 0), 3.0);  // the later row
+  EXPECT_EQ(s.data(2, 0), 4.0);
+  bool named = false;
+  for (const std::string& w : s.warnings) named = named || w.find("1 row(s) repeat the previous row's time") != std::string::npos;
+  EXPECT_TRUE(named);
+}
+
 TEST(Storage, HeaderErrors) {
   test::TempDir dir;
   auto expectErr = [&](const std::string& name, const std::string& text, const std::string& what) {

@@ -497,7 +497,10 @@ ForwardTool::ForwardTool(ForwardToolSettings settings) : settings_(std::move(set
   osim::ModelDescription d = osim::readOsimModel(setup_.model_file);
   if (setup_.replace_force_set)
     for (osim::ForceDesc& f : d.forces) f.applies_force = false;
-  for (const std::string& file : setup_.force_set_files) osim::appendForceSetFile(d, file);
+  const size_t nw = d.warnings.size();
+  for (const std::string& file : setup_.force_set_files)
+    osim::appendForceSetFile(d, file, setup_.replace_force_set);
+  warnings_.insert(warnings_.end(), d.warnings.begin() + static_cast<std::ptrdiff_t>(nw), d.warnings.end());
   for (const osim::UnsupportedItem& u : d.unsupported)
     if (u.what.rfind("force ", 0) == 0)  // the model's (force_set_files entries name their file)
       warnings_.push_back(setup_.model_file + ":" + std::to_string(u.line) + ": " + u.what + "; ignored");
