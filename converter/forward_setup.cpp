@@ -75,10 +75,7 @@ std::string detail::readToolControlsFile(const XmlDocument& doc, const XMLElemen
   const XMLElement* e = firstChild(tool, "controls_file");
   const std::string file = childText(tool, "controls_file");
   if (!e || file.empty()) return "";
-  // OpenSim's XMLDocument: the <OpenSimDocument> Version, 10500 for a document without one
-  int version = 10500;
-  if (std::string(doc.root()->Name()) == "OpenSimDocument")
-    if (const char* v = doc.root()->Attribute("Version")) version = std::atoi(v);
+  const int version = documentVersion(doc);
   if (version < 10904) return resolveRelativeTo(dir, file);
   warnings.push_back(doc.path() + ":" + std::to_string(lineOf(e)) + ": the tool's own controls_file '" + file +
                      "' is ignored, as OpenSim ignores it in a document of version " + std::to_string(version) +

@@ -677,12 +677,10 @@ void OsimReader::appendForceSetTo(ModelDescription& model, bool model_forces_rep
   const XMLElement* root = doc_.root();
   if (!root) fail(nullptr, "empty file");
   const XMLElement* set = root;
-  // OpenSim's XMLDocument: a file without <OpenSimDocument> is version 10500 (and its objects get
-  // the conversions of older documents, e.g. the PointActuator / TorqueActuator ones below)
-  version_ = 10500;
+  // a file without <OpenSimDocument> is version 10500, and its objects get the conversions of older
+  // documents (the PointActuator / TorqueActuator ones in readModelledForce)
+  version_ = documentVersion(doc_);
   if (std::string(root->Name()) == "OpenSimDocument") {
-    version_ = 40000;
-    if (const char* v = root->Attribute("Version")) version_ = std::atoi(v);
     set = firstChild(root, "ForceSet");
     if (!set) fail(root, "no <ForceSet> in <OpenSimDocument>: a force_set_files file holds a ForceSet");
   } else if (std::string(root->Name()) != "ForceSet") {

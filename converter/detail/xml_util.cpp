@@ -199,6 +199,13 @@ double roundLikeOstream(double x) {
   return std::strtod(buf, nullptr);
 }
 
+int documentVersion(const XmlDocument& doc) {
+  const XMLElement* root = doc.root();
+  if (!root || std::string(root->Name()) != "OpenSimDocument") return 10500;
+  const char* v = root->Attribute("Version");
+  return v ? std::atoi(v) : 40000;  // OpenSim requires the attribute; a wrapper without one reads as current
+}
+
 const XMLElement* toolRoot(const XmlDocument& doc, const char* tag) {
   const XMLElement* root = doc.root();
   if (std::string(root->Name()) == tag) return root;

@@ -52,6 +52,10 @@ std::string toLower(std::string s);
 /// the tool element of a setup file: <OpenSimDocument><tag> or a bare <tag> root (doc.fail
 /// otherwise)
 const XMLElement* toolRoot(const XmlDocument& doc, const char* tag);
+/// the document's version as OpenSim's XMLDocument takes it: the <OpenSimDocument> Version, 10500
+/// for a document without that root (its objects then get the conversions of old documents);
+/// 40000 for an <OpenSimDocument> without a Version (OpenSim refuses it)
+int documentVersion(const XmlDocument& doc);
 /// the folder of a file path ("." for a bare name)
 std::string folderOf(const std::string& file);
 /// "a, b, c", at most max_names of them, then ", ... (N in all)"

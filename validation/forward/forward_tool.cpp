@@ -98,15 +98,16 @@ class CorrectionTerm final : public ForceTerm {
   std::vector<Coordinate> coordinates_;
 };
 
+// `states`: the tool's states_file, read (absent when the setup names none)
 void addCorrectionControllers(System& sys, const SimulationModel& m, const osim::ForwardSetup& setup,
-                              std::vector<std::string>& warnings) {
+                              const std::optional<osim::Storage>& states, std::vector<std::string>& warnings) {
   for (const osim::ControllerSetupDesc& c : setup.controllers) {
     if (c.type != "CorrectionController" || c.disabled) continue;
-    if (setup.states_file.empty())
+    if (!states)
       throw osim::ConvertError(setup.source_file, c.line,
                                "CorrectionController '" + c.name + "' corrects toward the tool's states_file, "
                                "and the setup names none");
-    const osim::Storage table = osim::readStorage(setup.states_file);
+    const osim::Storage& table = *states;
     const osim::ModelDescription& d = m.description;
     std::set<std::string> dependent;  // a coupler's dependent coordinate is constrained
     for (const osim::ConstraintDesc& k : d.constraints)
@@ -533,17 +534,16 @@ ForwardTool::ForwardTool(ForwardToolSettings settings) : settings_(std::move(set
   }
   System& sys = *model_.system;
   addSetupControllers(sys, setup_, warnings_);
-  addCorrectionControllers(sys, model_, setup_, warnings_);
+  std::optional<osim::Storage> states;
+  if (!setup_.states_file.empty()) states = osim::readStorage(setup_.states_file);
+  addCorrectionControllers(sys, model_, setup_, states, warnings_);
   if (!setup_.controls_file.empty()) addControlsFile(sys, setup_.controls_file, warnings_);
   if (!settings_.feedback.empty()) addFeedback(sys, model_, settings_.feedback);
   // initial state
   initial_ = defaultInitialState(model_);
   initial_.z = sys.defaultState().z;
   initial_.t = setup_.initial_time;
-  if (!setup_.states_file.empty()) {
-    const osim::Storage table = osim::readStorage(setup_.states_file);
-    initial_ = forwardInitialState(model_, table, setup_.states_file, setup_.initial_time);
-  }
+  if (states) initial_ = forwardInitialState(model_, *states, setup_.states_file, setup_.initial_time);
   if (setup_.solve_for_equilibrium) {
     DynamicsWorkspace ws(sys);
     sys.equilibrateStates(initial_, ws);
