@@ -35,6 +35,7 @@ MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTe
     validateMuscle(model, m);
     if (m.mass_points.size() == 0) continue;
     massive_.push_back(m);
+    compact_id_.push_back(needsCompactId(m));
     massive_states_.push_back(states.empty() ? MuscleStateIndex{} : states[k]);
     for (double mass : m.mass_points.mass) adds_mass_ = adds_mass_ || mass != 0.0;
   }
@@ -148,8 +149,8 @@ void MuscleTerm::addMassDotTimesVelocity(const Model& model, const State& s, con
 
 TermIdRoute MuscleTerm::idRoute() const {
   if (!options_.quadratic_velocity) return TermIdRoute::WrenchesWithKinematics;
-  for (const Muscle& m : massive_)
-    if (needsCompactId(m)) return TermIdRoute::WrenchesWithKinematics;
+  for (bool compact : compact_id_)
+    if (compact) return TermIdRoute::WrenchesWithKinematics;
   return TermIdRoute::Wrenches;
 }
 
@@ -165,11 +166,13 @@ void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const Ve
   if (sc.ws.muscles.size() != massive_.size()) sc.ws = MuscleWorkspace(model, massive_);
   sc.id.resize(massive_.size());
   sc.evaluation = 0;  // the muscles' kinematics below are partial: no reuse by addMass & co.
+  calcBodyWorldMotion(motion, sc.bodies);
+  sc.w_world.resize(wrench.size(), Vec6::Zero());
   for (size_t m = 0; m < massive_.size(); ++m) {
     const Muscle& mu = massive_[m];
     MuscleKinematics& mk = sc.ws.muscles[m];
-    if (!needsCompactId(mu) && options_.quadratic_velocity) {
-      addMuscleInverseDynamics(model, s, qddot, motion, model.gravity(), mu, mk, sc.id[m], wrench, tau);
+    if (!compact_id_[m] && options_.quadratic_velocity) {
+      addMuscleInverseDynamics(model, s, qddot, sc.bodies, model.gravity(), mu, mk, sc.id[m], sc.w_world, tau);
       continue;
     }
     // compact J_ar: sum_a J_ar^T m_a (J_ar qddot + Jdot_ar qdot (+ a_z) - g) in the muscle's columns
@@ -187,6 +190,7 @@ void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const Ve
     }
     scatterAddColumns(sc.fc, mk, tau);
   }
+  addWorldWrenches(sc.bodies, sc.w_world, wrench);
 }
 
 double MuscleTerm::kineticEnergy(const Model& model, const State& s, const TermContext& ctx) const {

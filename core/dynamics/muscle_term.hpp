@@ -51,6 +51,8 @@ struct MuscleTermScratch final : TermScratch {
   VecX qdot_c, fc;                  // qdot and force in the muscle's columns              (k)
   // recursive inverse dynamics (addInverseDynamics)
   std::vector<MuscleIdScratch> id;  // path-wise pass of each Type I/II muscle            (n_massive)
+  std::vector<BodyWorldMotion> bodies;  // the bodies' motion in world axes                 (nb)
+  std::vector<Vec6> w_world;        // the muscles' wrenches on the bodies, world axes     (nb)
   VecX qddot_c;                     // qddot in a Type III muscle's columns                (k)
 };
 
@@ -103,6 +105,7 @@ class MuscleTerm final : public ForceTerm {
 
   std::vector<Muscle> muscles_;
   std::vector<Muscle> massive_;        // the muscles with at least one mass point
+  std::vector<bool> compact_id_;       // massive_[m] needs its compact J_ar in inverse dynamics (Type III, fibre)
   bool adds_mass_ = false;             // a mass point of massive_ has non-zero mass (fixed at construction)
   std::vector<MuscleStateIndex> massive_states_;  // their states (fibre-following placement)
   MuscleTermOptions options_;

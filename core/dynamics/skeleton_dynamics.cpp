@@ -81,14 +81,18 @@ RecursiveIdWorkspace::RecursiveIdWorkspace(const Model& model) {
   const int nb = model.nb();
   jk.resize(nb);
   S_i.resize(nb);
-  Ad_ij.resize(nb);
+  R_im.resize(nb);
+  p_im.resize(nb);
   for (int i = 0; i < nb; ++i) {
     const int nq = model.joints()[i].nq;
     jk[i].resize(nq);
     S_i[i].setZero(6, nq);
-    Ad_ij[i] = AdInv(model.joints()[i].E_mi);  // E_im = E_mi^-1
+    const Mat4 E_im = inverseE(model.joints()[i].E_mi);
+    R_im[i] = E_im.topLeftCorner<3, 3>();
+    p_im[i] = E_im.topRightCorner<3, 1>();
   }
-  Ad_ip.assign(nb, Mat6::Identity());
+  R_pi.assign(nb, Mat3::Identity());
+  p_pi.assign(nb, Vec3::Zero());
   E_wi.assign(nb, Mat4::Identity());
   phi.assign(nb, Vec6::Zero());
   phidot.assign(nb, Vec6::Zero());
@@ -99,40 +103,58 @@ void recursiveIdForward(const Model& model, const State& state, const VecX& qddo
   // body acceleration (body coordinates), from phi_i = Ad_ip phi_p + psi_i with
   // dAd_ip/dt = -ad(psi_i) Ad_ip:
   //   phidot_i = Ad_ip phidot_p - ad(psi_i) Ad_ip phi_p + Ad_ij (S qddot + Sdot qdot)
+  // The adjoints act through their rotations and translations (adjointTimes & co.): a 6 x 6
+  // adjoint costs 36 multiplies per product plus its construction, the (R, p) form about 24.
   const int nb = model.nb();
   for (int i = 0; i < nb; ++i) {
     const JointSlot& s = model.joints()[i];
     JointKinematics& jk = ws.jk[i];
     s.joint.calc(state.q.segment(s.q_index, s.nq), state.qdot.segment(s.q_index, s.nq), jk);
-    const Mat4 E_pi = s.E_pf * jk.Q * s.E_mi;
-    const Mat6& Ad_ij = ws.Ad_ij[i];
-    ws.Ad_ip[i] = AdInv(E_pi);
-    ws.S_i[i].noalias() = Ad_ij * jk.S;
+    // E_pi = E_pf Q E_mi as rotation and translation
+    const Mat3 R_fm = s.E_pf.topLeftCorner<3, 3>() * jk.Q.topLeftCorner<3, 3>();
+    const Vec3 p_fm = s.E_pf.topLeftCorner<3, 3>() * jk.Q.topRightCorner<3, 1>() + s.E_pf.topRightCorner<3, 1>();
+    Mat3& R_pi = ws.R_pi[i];
+    Vec3& p_pi = ws.p_pi[i];
+    R_pi.noalias() = R_fm * s.E_mi.topLeftCorner<3, 3>();
+    p_pi.noalias() = R_fm * s.E_mi.topRightCorner<3, 1>();
+    p_pi += p_fm;
+    const Mat3& R_im = ws.R_im[i];
+    const Vec3& p_im = ws.p_im[i];
+    auto& S_i = ws.S_i[i];
+    for (int c = 0; c < s.nq; ++c) S_i.col(c) = adjointTimes(R_im, p_im, jk.S.col(c));
     const auto qd = state.qdot.segment(s.q_index, s.nq);
     const auto qdd = qddot.segment(s.q_index, s.nq);
-    const Vec6 psi = ws.S_i[i] * qd;
-    Vec6 acc = ws.S_i[i] * qdd;
-    acc.noalias() += Ad_ij * (jk.Sdot * qd);
+    Vec6 psi = Vec6::Zero(), acc = Vec6::Zero();
+    if (s.nq > 0) {
+      psi.noalias() = S_i * qd;
+      acc.noalias() = S_i * qdd;
+      acc += adjointTimes(R_im, p_im, jk.Sdot * qd);
+    }
     if (s.parent >= 0) {
       const int p = s.parent;
-      ws.E_wi[i].noalias() = ws.E_wi[p] * E_pi;
-      const Vec6 phi_pi = ws.Ad_ip[i] * ws.phi[p];
+      const auto R_wp = ws.E_wi[p].topLeftCorner<3, 3>();
+      ws.E_wi[i].topLeftCorner<3, 3>().noalias() = R_wp * R_pi;
+      ws.E_wi[i].topRightCorner<3, 1>().noalias() = R_wp * p_pi;
+      ws.E_wi[i].topRightCorner<3, 1>() += ws.E_wi[p].topRightCorner<3, 1>();
+      const Vec6 phi_pi = adjointInvTimes(R_pi, p_pi, ws.phi[p]);
       ws.phi[i] = phi_pi + psi;
-      ws.phidot[i].noalias() = ws.Ad_ip[i] * ws.phidot[p];
-      ws.phidot[i].noalias() -= ad(psi) * phi_pi;
-      ws.phidot[i] += acc;
+      ws.phidot[i] = adjointInvTimes(R_pi, p_pi, ws.phidot[p]) - adTimes(psi, phi_pi) + acc;
     } else {
-      ws.E_wi[i] = E_pi;
+      ws.E_wi[i].topLeftCorner<3, 3>() = R_pi;
+      ws.E_wi[i].topRightCorner<3, 1>() = p_pi;
       ws.phi[i] = psi;
       ws.phidot[i] = acc;
     }
-    // net wrench the body needs minus what gravity and Coriolis give [D Eq. 3.21]
+    // net wrench the body needs minus what gravity and Coriolis give [D Eq. 3.21]:
+    // w = M phidot - ad(phi)^T M phi - Gamma(c)^T R^T m g, Gamma(c)^T f = (c x f; f)
     const Body& b = model.bodies()[i];
     const Vec3 g_i = ws.E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity());
     const Vec6 Mphi = b.M * ws.phi[i];
-    ws.w[i].noalias() = b.M * ws.phidot[i];
-    ws.w[i].noalias() -= ad(ws.phi[i]).transpose() * Mphi;
-    ws.w[i].noalias() -= Gamma(b.com).transpose() * g_i;
+    Vec6& w = ws.w[i];
+    w.noalias() = b.M * ws.phidot[i];
+    w -= adTransposeTimes(ws.phi[i], Mphi);
+    w.head<3>() -= b.com.cross(g_i);
+    w.tail<3>() -= g_i;
   }
 }
 
@@ -142,7 +164,7 @@ void recursiveIdBackward(const Model& model, const State& state, RecursiveIdWork
     const JointSlot& s = model.joints()[i];
     if (s.nq > 0) tau.segment(s.q_index, s.nq).noalias() = ws.S_i[i].transpose() * ws.w[i];
     // transmit to the parent: wrenches map with Ad^T
-    if (s.parent >= 0) ws.w[s.parent].noalias() += ws.Ad_ip[i].transpose() * ws.w[i];
+    if (s.parent >= 0) ws.w[s.parent] += adjointInvTransposeTimes(ws.R_pi[i], ws.p_pi[i], ws.w[i]);
   }
   for (int k = 0; k < model.nr(); ++k) {
     const Coordinate& c = model.coordinates()[k];

@@ -25,8 +25,10 @@ void addJointStiffnessDamping(const Model& model, MatX& K_r, MatX& D_r);
 struct RecursiveIdWorkspace {
   explicit RecursiveIdWorkspace(const Model& model);
   std::vector<JointKinematics> jk;  // per joint Q, S, Sdot                         (nb)
-  std::vector<Mat6> Ad_ij;          // Ad of joint frame M in body i (constant)    (nb)
-  std::vector<Mat6> Ad_ip;          // Ad of the parent body frame in body i        (nb)
+  std::vector<Mat3> R_im;           // joint frame M in body i: rotation (constant) (nb)
+  std::vector<Vec3> p_im;           //   and translation (constant)                 (nb)
+  std::vector<Mat3> R_pi;           // body i in its parent body: rotation          (nb)
+  std::vector<Vec3> p_pi;           //   and translation                            (nb)
   std::vector<Mat6X> S_i;           // Ad_ij S: joint twist map in body i           (nb, 6 x nq)
   std::vector<Mat4> E_wi;           // body poses in world                         (nb)
   std::vector<Vec6> phi, phidot;    // body twists and their rates, body coords    (nb)

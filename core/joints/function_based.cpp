@@ -44,12 +44,33 @@ FunctionBased::FunctionBased(int nq, std::array<TransformAxis, 6> axes, bool com
       throw JointError(where + ax.function->typeName() + " takes " +
                        std::to_string(ax.function->numArgs()) + " arguments but " +
                        std::to_string(m) + " coordinates are listed");
+    kind_[k] = AxisKind::General;
+    if (const auto* c = dynamic_cast<const ConstantFunction*>(ax.function.get())) {
+      kind_[k] = AxisKind::Constant;
+      intercept_[k] = c->constant();
+    } else if (const auto* l = dynamic_cast<const LinearFunction*>(ax.function.get()); l && m == 1) {
+      kind_[k] = AxisKind::Linear1;
+      slope_[k] = l->coefficients()[0];
+      intercept_[k] = l->coefficients()[1];
+    }
   }
 }
 
 void FunctionBased::evalAxis(int k, const VecJ& q, const VecJ& qdot, int order, double& v,
                              VecJ& grad, VecJ& graddot) const {
   const TransformAxis& ax = axes_[k];
+  if (kind_[k] != AxisKind::General) {
+    grad.setZero(nq_);
+    graddot.setZero(nq_);
+    if (kind_[k] == AxisKind::Constant) {
+      v = intercept_[k];
+      return;
+    }
+    const int c = ax.coordinates[0];
+    v = slope_[k] * q[c] + intercept_[k];
+    grad[c] = slope_[k];
+    return;
+  }
   const int m = static_cast<int>(ax.coordinates.size());
   VecJ x(m), xd(m);
   for (int j = 0; j < m; ++j) {
@@ -117,45 +138,52 @@ void FunctionBased::calcSimbody(const VecJ& q, const VecJ& qdot, JointKinematics
     Fqdot.row(k) = gd.transpose();
   }
   const Vec3 a1 = axes_[0].axis, a2 = axes_[1].axis, a3 = axes_[2].axis;
-  const Mat3 R1 = rotationAxisAngle(a1, v[0]), R2 = rotationAxisAngle(a2, v[1]);
-  const Mat3 R = R1 * R2 * rotationAxisAngle(a3, v[2]);
+  const Mat3 R1 = rotationAxisAngle(a1, v[0]);
+  const Mat3 R12 = R1 * rotationAxisAngle(a2, v[1]);
+  const Mat3 R = R12 * rotationAxisAngle(a3, v[2]);
   Mat3 At;
   At << axes_[3].axis, axes_[4].axis, axes_[5].axis;
   out.resize(n);
   out.Q = makeE(R, At * Vec3(v[3], v[4], v[5]));
   if (n == 0) return;
 
-  // W with the true angles, and W for H with Constant angles taken as 0 (Simbody's buildH)
+  // W with the true angles, and W for H with Constant angles taken as 0 (Simbody's buildH); the
+  // two differ only where rotation1 or rotation2 is a nonzero Constant
   Mat3 W;
-  W << a1, R1 * a2, R1 * R2 * a3;
-  auto angleForH = [&](int k) { return axes_[k].coordinates.empty() ? 0.0 : v[k]; };
-  const Mat3 R1h = rotationAxisAngle(a1, angleForH(0));
-  Mat3 Wh;
-  Wh << a1, R1h * a2, R1h * rotationAxisAngle(a2, angleForH(1)) * a3;
+  W << a1, R1 * a2, R12 * a3;
+  Mat3 Wh = W;
+  const bool const1 = axes_[0].coordinates.empty() && v[0] != 0.0;
+  const bool const2 = axes_[1].coordinates.empty() && v[1] != 0.0;
+  if (const1 || const2) {
+    auto angleForH = [&](int k) { return axes_[k].coordinates.empty() ? 0.0 : v[k]; };
+    const Mat3 R1h = rotationAxisAngle(a1, angleForH(0));
+    Wh << a1, R1h * a2, R1h * rotationAxisAngle(a2, angleForH(1)) * a3;
+  }
 
-  const auto Fth = Fq.topRows<3>();
-  const Mat3X Hang = Wh * Fth;  // 3 x n, in F
-  const Mat3X Hlin = At * Fq.bottomRows<3>();
-
+  // column by column in fixed-size 3-vectors (the 3 x n dynamic products were most of the cost)
+  Mat3X Hang = Mat3X::Zero(3, n);  // 3 x n, in F
+  Vec3 Hq = Vec3::Zero();
+  for (int c = 0; c < n; ++c) {
+    Hang.col(c) = Wh * Fq.col(c).head<3>();
+    Hq += Hang.col(c) * qdot[c];
+  }
   // Simbody's Wdot: omega_a from mobility 0 alone, omega_b from all but mobility 2
-  VecJ u1 = VecJ::Zero(n), u2 = qdot;
-  u1[0] = qdot[0];
-  if (n > 2) u2[2] = 0.0;
-  const Vec3 w_a = Hang * u1, w_b = Hang * u2;
+  const Vec3 w_a = Hang.col(0) * qdot[0];
+  const Vec3 w_b = n > 2 ? Vec3(Hq - Hang.col(2) * qdot[2]) : Hq;
   Mat3 Wdot;
   Wdot << Vec3::Zero(), w_a.cross(Vec3(W.col(1))), w_b.cross(Vec3(W.col(2)));
-  const Mat3X Hdang = Wdot * Fth + W * Fqdot.topRows<3>();
-  const Mat3X Hdlin = At * Fqdot.bottomRows<3>();
 
   // to M: S = R^T H; d/dt R^T = -[w] R^T with w = R^T H_ang qdot, the angular velocity Simbody
   // gives the body (V_FM = H u); it differs from the true one only for nonzero Constant rotations
   const Mat3 Rt = R.transpose();
-  const Vec3 w = Rt * (Hang * qdot);
-  const Mat3 Wx = skew(w);
-  out.S.topRows<3>() = Rt * Hang;
-  out.S.bottomRows<3>() = Rt * Hlin;
-  out.Sdot.topRows<3>() = -Wx * out.S.topRows<3>() + Rt * Hdang;
-  out.Sdot.bottomRows<3>() = -Wx * out.S.bottomRows<3>() + Rt * Hdlin;
+  const Vec3 w = Rt * Hq;
+  for (int c = 0; c < n; ++c) {
+    const Vec3 s_ang = Rt * Hang.col(c), s_lin = Rt * (At * Fq.col(c).tail<3>());
+    const Vec3 hd_ang = Wdot * Fq.col(c).head<3>() + W * Fqdot.col(c).head<3>();
+    const Vec3 hd_lin = At * Fqdot.col(c).tail<3>();
+    out.S.col(c) << s_ang, s_lin;
+    out.Sdot.col(c) << Rt * hd_ang - w.cross(s_ang), Rt * hd_lin - w.cross(s_lin);
+  }
 }
 
 }  // namespace redmax

@@ -71,6 +71,11 @@ class FunctionBased {
 
   int nq_ = 0;
   std::array<TransformAxis, 6> axes_;
+  // the functions most axes carry, evaluated without the virtual call and Hessian (per frame, per
+  // axis): a Constant, or a LinearFunction of one coordinate (slope, intercept)
+  enum class AxisKind { General, Constant, Linear1 };
+  std::array<AxisKind, 6> kind_{};
+  std::array<double, 6> slope_{}, intercept_{};
 };
 
 }  // namespace redmax

@@ -1,5 +1,7 @@
 #include "core/muscles/muscle_inverse_dynamics.hpp"
 
+#include <algorithm>
+
 #include "core/muscles/path_kinematics.hpp"
 #include "core/muscles/via_point.hpp"
 
@@ -7,33 +9,73 @@ namespace redmax {
 
 namespace {
 
-// Solves T x = b in place (b becomes x) for the tridiagonal T of size n with sub(r) = T(r, r-1),
-// diag(r) = T(r, r), super(r) = T(r, r+1), by elimination without pivoting: the equal-strain
-// matrix L is diagonally dominant by rows (|sub| + |super| = diag, strictly in the end rows) and
-// so L^T by columns, where elimination without pivoting is stable.
+// The equal-strain matrix L (n x n, tridiagonal: sub(r) = L(r, r-1), diag(r), super(r) = L(r, r+1))
+// factored once as L = B U, B lower bidiagonal (diagonal piv_r, sub-diagonal sub(r)), U unit upper
+// (super-diagonal c_r), by elimination without pivoting: L is diagonally dominant by rows
+// (|sub| + |super| = diag, strictly in the end rows) and so L^T by columns, where elimination
+// without pivoting is stable. The three solves of a muscle (L twice, L^T once) share it.
 template <class Sub, class Diag, class Super>
-void solveTridiagonal(int n, Sub sub, Diag diag, Super super, VecX& b, VecX& c) {
+void factorTridiagonal(int n, Sub sub, Diag diag, Super super, VecX& c, VecX& inv_piv) {
   c.resize(n);
-  double m = diag(0);
-  c[0] = n > 1 ? super(0) / m : 0.0;
-  b[0] /= m;
-  for (int r = 1; r < n; ++r) {
-    m = diag(r) - sub(r) * c[r - 1];
-    c[r] = r + 1 < n ? super(r) / m : 0.0;
-    b[r] = (b[r] - sub(r) * b[r - 1]) / m;
+  inv_piv.resize(n);
+  for (int r = 0; r < n; ++r) {
+    inv_piv[r] = 1.0 / (r == 0 ? diag(0) : diag(r) - sub(r) * c[r - 1]);
+    c[r] = r + 1 < n ? super(r) * inv_piv[r] : 0.0;
   }
+}
+// L x = b in place: B y = b forward, U x = y backward
+template <class Sub>
+void solveFactored(int n, Sub sub, const VecX& c, const VecX& inv_piv, VecX& b) {
+  b[0] *= inv_piv[0];
+  for (int r = 1; r < n; ++r) b[r] = (b[r] - sub(r) * b[r - 1]) * inv_piv[r];
   for (int r = n - 2; r >= 0; --r) b[r] -= c[r] * b[r + 1];
+}
+// L^T x = b in place: U^T y = b forward, B^T x = y backward
+template <class Sub>
+void solveFactoredTransposed(int n, Sub sub, const VecX& c, const VecX& inv_piv, VecX& b) {
+  for (int r = 1; r < n; ++r) b[r] -= c[r - 1] * b[r - 1];
+  b[n - 1] *= inv_piv[n - 1];
+  for (int r = n - 2; r >= 0; --r) b[r] = (b[r] - sub(r + 1) * b[r + 1]) * inv_piv[r];
 }
 
 }  // namespace
 
+void calcBodyWorldMotion(const BodyMotion& motion, std::vector<BodyWorldMotion>& out) {
+  const size_t nb = motion.E_wi.size();
+  out.resize(nb);
+  for (size_t b = 0; b < nb; ++b) {
+    BodyWorldMotion& o = out[b];
+    o.R = motion.E_wi[b].topLeftCorner<3, 3>();
+    o.p = motion.E_wi[b].topRightCorner<3, 1>();
+    o.omega = o.R * motion.phi[b].head<3>();
+    o.nu = o.R * motion.phi[b].tail<3>();
+    o.alpha = o.R * motion.phidot[b].head<3>();
+    o.bias = o.R * motion.phidot[b].tail<3>() + o.omega.cross(o.nu);
+  }
+}
+
+void addWorldWrenches(const std::vector<BodyWorldMotion>& bodies, std::vector<Vec6>& w_world,
+                      std::vector<Vec6>& wrench) {
+  for (size_t b = 0; b < w_world.size(); ++b) {
+    Vec6& w = w_world[b];
+    if (w.isZero(0.0)) continue;
+    wrench[b].head<3>().noalias() += bodies[b].R.transpose() * w.head<3>();
+    wrench[b].tail<3>().noalias() += bodies[b].R.transpose() * w.tail<3>();
+    w.setZero();
+  }
+}
+
 void addMuscleInverseDynamics(const Model& model, const State& state, const VecX& qddot,
-                              const BodyMotion& motion, const Vec3& gravity, const Muscle& muscle,
-                              MuscleKinematics& mk, MuscleIdScratch& sc, std::vector<Vec6>& wrench, VecX& tau) {
+                              const std::vector<BodyWorldMotion>& bodies, const Vec3& gravity,
+                              const Muscle& muscle, MuscleKinematics& mk, MuscleIdScratch& sc,
+                              std::vector<Vec6>& w_world, VecX& tau) {
   const MusclePath& path = muscle.path;
   const MassPoints& mp = muscle.mass_points;
 
-  // 1. active path points: positions, velocities, accelerations [D Eq. 5.8, 5.11]
+  // 1. active path points: positions, velocities, accelerations [D Eq. 5.8, 5.11], in world
+  //    axes from the body's world motion (BodyWorldMotion); a moving point adds its motion on
+  //    the body, rd = R x_b' qdot_k and rdd = R (x_b'' qdot_k^2 + x_b' qddot_k):
+  //    xdot = omega x r + nu + rd,  xddot = alpha x r + omega x (omega x r + 2 rd) + bias + rdd
   activePathPoints(path, state.q, mk.active);
   const int P = static_cast<int>(mk.active.size());
   mk.x_b.resize(P);
@@ -41,30 +83,49 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   mk.xdot_w.resize(P);
   sc.dx_b.resize(P);
   sc.ddx_b.resize(P);
+  sc.r_w.resize(P);
   sc.xddot_w.resize(P);
   for (int a = 0; a < P; ++a) {
     const PathPoint& pt = path.points[mk.active[a]];
+    const int b = pt.body;
+    if (pt.kind != PathPointKind::Moving) {
+      mk.x_b[a] = pt.location;
+      sc.dx_b[a].setZero();
+      sc.ddx_b[a].setZero();
+      if (b < 0) {
+        mk.x_w[a] = pt.location;
+        mk.xdot_w[a].setZero();
+        sc.xddot_w[a].setZero();
+        continue;
+      }
+      const BodyWorldMotion& o = bodies[b];
+      const Vec3 r = o.R * pt.location;
+      const Vec3 wr = o.omega.cross(r);
+      sc.r_w[a] = r;
+      mk.x_w[a] = r + o.p;
+      mk.xdot_w[a] = wr + o.nu;
+      sc.xddot_w[a] = o.alpha.cross(r) + o.omega.cross(wr) + o.bias;
+      continue;
+    }
     calcPointLocation(pt, state.q, mk.x_b[a], sc.dx_b[a], sc.ddx_b[a]);
     const Vec3& x_b = mk.x_b[a];
-    const int c = pt.kind == PathPointKind::Moving ? pt.coordinate : -1;
+    const int c = pt.coordinate;  // none connected: the point is fixed at the functions' values at 0
     const double qd_c = c >= 0 ? state.qdot[c] : 0.0, qdd_c = c >= 0 ? qddot[c] : 0.0;
     const Vec3 xdot_b = sc.dx_b[a] * qd_c;                                // relative to the body
     const Vec3 xddot_b = sc.ddx_b[a] * (qd_c * qd_c) + sc.dx_b[a] * qdd_c;
-    const int b = pt.body;
     if (b < 0) {
       mk.x_w[a] = x_b;
       mk.xdot_w[a] = xdot_b;
       sc.xddot_w[a] = xddot_b;
       continue;
     }
-    const Mat3 R = motion.E_wi[b].topLeftCorner<3, 3>();
-    const Vec6& phi = motion.phi[b];
-    const Vec6& phidot = motion.phidot[b];
-    const Vec3 omega = phi.head<3>();
-    const Vec3 v = omega.cross(x_b) + phi.tail<3>();  // Gamma(x_b) phi
-    mk.x_w[a] = R * x_b + motion.E_wi[b].topRightCorner<3, 1>();
-    mk.xdot_w[a] = R * (v + xdot_b);
-    sc.xddot_w[a] = R * (phidot.head<3>().cross(x_b) + phidot.tail<3>() + omega.cross(v + 2.0 * xdot_b) + xddot_b);
+    const BodyWorldMotion& o = bodies[b];
+    const Vec3 r = o.R * x_b, rd = o.R * xdot_b;
+    const Vec3 v = o.omega.cross(r) + o.nu;
+    sc.r_w[a] = r;
+    mk.x_w[a] = r + o.p;
+    mk.xdot_w[a] = v + rd;
+    sc.xddot_w[a] = o.alpha.cross(r) + o.omega.cross(v - o.nu + 2.0 * rd) + o.bias + o.R * xddot_b;
   }
   calcPathSegments(mk, true);
   if (P < 2) throw std::logic_error("addMuscleInverseDynamics: fewer than two active path points");
@@ -93,7 +154,8 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
     // L sdot = -DeltaS ldot
     sc.rhs.resize(n);
     for (int r = 0; r < n; ++r) sc.rhs[r] = -dS(ld, r);
-    solveTridiagonal(n, Lsub, Ldiag, Lsuper, sc.rhs, sc.tri_c);
+    factorTridiagonal(n, Lsub, Ldiag, Lsuper, sc.tri_c, sc.tri_d);
+    solveFactored(n, Lsub, sc.tri_c, sc.tri_d, sc.rhs);
     mk.sdot.segment(1, n) = sc.rhs;
     // segment length accelerations lddot = dxbar . Delta xddot + dxbardot . Delta xdot [D Eq. 5.28]
     sc.lddot.resize(ns);
@@ -112,7 +174,7 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
       const double dSd_ld = -(sd[r + 2] - sd[r + 1]) * ld[r] + (sd[r + 1] - sd[r]) * ld[r + 1];
       sc.rhs[r] = -(dS(sc.lddot, r) + Ld_sd + dSd_ld);
     }
-    solveTridiagonal(n, Lsub, Ldiag, Lsuper, sc.rhs, sc.tri_c);
+    solveFactored(n, Lsub, sc.tri_c, sc.tri_d, sc.rhs);
     sc.sddot.segment(1, n) = sc.rhs;
   }
 
@@ -120,14 +182,34 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   sc.m0.setZero(ns);
   sc.m1.setZero(ns);
   sc.m2.setZero(ns);
-  for (int a = 0; a < mp.size(); ++a) {
-    const double s_a = mp.alpha[a];
-    int i = 0;
-    while (i < P - 2 && s[i + 1] <= s_a) ++i;
-    const double beta = (s_a - s[i]) / (s[i + 1] - s[i]), m = mp.mass[a];
-    sc.m0[i] += m;
-    sc.m1[i] += m * beta;
-    sc.m2[i] += m * beta * beta;
+  const int N = mp.size();
+  if (std::is_sorted(mp.alpha.begin(), mp.alpha.end())) {
+    // points in increasing alpha (as makeMassPoints places them): each segment's points are one
+    // run [lo, hi), whose moments are vectorised sums (no search per point, no chain of adds)
+    using ArrayMap = Eigen::Map<const Eigen::ArrayXd>;
+    int lo = 0;
+    for (int i = 0; i < ns && lo < N; ++i) {
+      int hi = lo;
+      if (i + 1 == ns) hi = N;
+      else while (hi < N && mp.alpha[hi] < s[i + 1]) ++hi;
+      if (hi == lo) continue;
+      const ArrayMap alpha(mp.alpha.data() + lo, hi - lo), mass(mp.mass.data() + lo, hi - lo);
+      const double inv_ds = 1.0 / (s[i + 1] - s[i]);
+      sc.m0[i] = mass.sum();
+      sc.m1[i] = (mass * (alpha - s[i])).sum() * inv_ds;
+      sc.m2[i] = (mass * (alpha - s[i]).square()).sum() * (inv_ds * inv_ds);
+      lo = hi;
+    }
+  } else {
+    for (int a = 0; a < N; ++a) {
+      const double s_a = mp.alpha[a];
+      int i = 0;
+      while (i < P - 2 && s[i + 1] <= s_a) ++i;
+      const double beta = (s_a - s[i]) / (s[i + 1] - s[i]), m = mp.mass[a];
+      sc.m0[i] += m;
+      sc.m1[i] += m * beta;
+      sc.m2[i] += m * beta * beta;
+    }
   }
   sc.force_x.assign(P, Vec3::Zero());
   sc.force_s.setZero(P);
@@ -155,8 +237,7 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   // 3. Eulerian forces onto the path points: J_sx^T g = -DeltaXbar^T DeltaS^T L^-T g
   if (n > 0) {
     sc.rhs = sc.force_s.segment(1, n);
-    // L^T: sub(r) = L(r-1, r) = -l[r-1], super(r) = L(r+1, r) = -l[r+2]
-    solveTridiagonal(n, [&](int r) { return -l[r - 1]; }, Ldiag, [&](int r) { return -l[r + 2]; }, sc.rhs, sc.tri_c);
+    solveFactoredTransposed(n, Lsub, sc.tri_c, sc.tri_d, sc.rhs);
     for (int i = 0; i < ns; ++i) {
       double k = 0.0;  // (DeltaS^T h)_i
       if (i < n) k -= (s[i + 2] - s[i + 1]) * sc.rhs[i];
@@ -165,7 +246,9 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
       sc.force_x[i + 1] -= k * mk.dxbar[i];
     }
   }
-  // path point forces onto the bodies (Gamma(x_b)^T R^T G) and the moving points' coordinates
+  // path point forces onto the bodies, in world axes (r x G; G) about the body origin (the body
+  // wrench Gamma(x_b)^T R^T G once rotated back, addWorldWrenches), and onto the moving points'
+  // coordinates (R x_b') . G
   for (int a = 0; a < P; ++a) {
     const PathPoint& pt = path.points[mk.active[a]];
     const Vec3& G = sc.force_x[a];
@@ -175,10 +258,9 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
       if (c >= 0) tau[c] += sc.dx_b[a].dot(G);
       continue;
     }
-    const Vec3 g = motion.E_wi[b].topLeftCorner<3, 3>().transpose() * G;
-    wrench[b].head<3>() += mk.x_b[a].cross(g);
-    wrench[b].tail<3>() += g;
-    if (c >= 0) tau[c] += sc.dx_b[a].dot(g);  // (R x_b') . G
+    w_world[b].head<3>() += sc.r_w[a].cross(G);
+    w_world[b].tail<3>() += G;
+    if (c >= 0) tau[c] += (bodies[b].R * sc.dx_b[a]).dot(G);
   }
 }
 

@@ -41,6 +41,7 @@ namespace redmax {
 /// no allocation afterwards unless the active point count grows).
 struct MuscleIdScratch {
   std::vector<Vec3> dx_b, ddx_b;  // moving points: d x_b / dq_k, d2 x_b / dq_k2         (P)
+  std::vector<Vec3> r_w;          // R x_b: path point from its body origin, world axes (P)
   std::vector<Vec3> xddot_w;      // path point accelerations, world                    (P)
   std::vector<Vec3> force_x;      // force on each path point, world                   (P)
   VecX lddot;                     // segment length accelerations                      (P-1)
@@ -49,14 +50,33 @@ struct MuscleIdScratch {
   VecX tri_c, tri_d, rhs;         // tridiagonal solve                                 (P-2)
 };
 
+/// A body's motion in world axes, formed once per pass for all the muscles that attach to it, so
+/// a path point on it costs a rotation and three cross products:
+///   xdot = omega x r + nu,  xddot = alpha x r + omega x (omega x r) + bias   (r = R x_b)
+struct BodyWorldMotion {
+  Mat3 R;       // orientation                                      (E_wi)
+  Vec3 p;       // origin
+  Vec3 omega;   // angular velocity, R omega_i
+  Vec3 nu;      // velocity of the point at the origin, R nu_i
+  Vec3 alpha;   // angular acceleration, R omegadot_i
+  Vec3 bias;    // acceleration of the point at the origin, R nudot_i + omega x nu
+};
+/// out[b] for every body of `motion`
+void calcBodyWorldMotion(const BodyMotion& motion, std::vector<BodyWorldMotion>& out);
+/// wrench[b] += the world-axes wrench w_world[b] (torque about the body origin; force) in body
+/// coordinates, for every body; w_world is zeroed for the next pass
+void addWorldWrenches(const std::vector<BodyWorldMotion>& bodies, std::vector<Vec6>& w_world,
+                      std::vector<Vec6>& wrench);
+
 /// Adds the mass points' share of inverse dynamics of one Type I or II muscle (no wrap objects):
-/// to wrench[b] the wrench body b must supply for them (body coordinates, [D Eq. 3.14]) and to
-/// tau the direct generalized forces of its moving points. `motion` at the state (poses, twists
-/// and their rates for every body); gravity g (world). mk is scratch (path-stage fields are
-/// overwritten; J_xr, J_ar and the other Jacobians are not touched). Throws MuscleError for a
-/// degenerate path, as calcMuscleKinematics does.
+/// to w_world[b] the wrench body b must supply for them (world axes, torque about the body
+/// origin; addWorldWrenches turns it into body coordinates [D Eq. 3.14]) and to tau the direct
+/// generalized forces of its moving points. `bodies` from calcBodyWorldMotion at the state;
+/// gravity g (world). mk is scratch (path-stage fields are overwritten; J_xr, J_ar and the other
+/// Jacobians are not touched). Throws MuscleError for a degenerate path, as calcMuscleKinematics does.
 void addMuscleInverseDynamics(const Model& model, const State& state, const VecX& qddot,
-                              const BodyMotion& motion, const Vec3& gravity, const Muscle& muscle,
-                              MuscleKinematics& mk, MuscleIdScratch& sc, std::vector<Vec6>& wrench, VecX& tau);
+                              const std::vector<BodyWorldMotion>& bodies, const Vec3& gravity,
+                              const Muscle& muscle, MuscleKinematics& mk, MuscleIdScratch& sc,
+                              std::vector<Vec6>& w_world, VecX& tau);
 
 }  // namespace redmax

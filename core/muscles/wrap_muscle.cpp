@@ -555,7 +555,10 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
   std::vector<int> idx;
   std::vector<double> betas, betadots;
   WrapModelPoints wp;
-  MatX stackJ, stackD, cJ, cD;  // sized per segment, reused by its points
+  MatX stackJ, stackD;  // sized per segment, reused by its points
+  // per-point coefficients: at most 3 x 14 and 3 x 25, inline (no heap)
+  Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 14> cJ;
+  Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 25> cD;
   for (int i = 0; i < nseg; ++i) {
     const int w = seg_wrap[i];
     if (w < 0) continue;

@@ -156,7 +156,11 @@ Vec6 logSE3(const Mat4& E) {
   return phi;
 }
 
-Mat3 rotationAxisAngle(const Vec3& unit_axis, double angle) { return expSO3(unit_axis * angle); }
+Mat3 rotationAxisAngle(const Vec3& unit_axis, double angle) {
+  // joints call this per axis per frame, most often with a Constant 0 angle (exactly I either way)
+  if (angle == 0.0) return Mat3::Identity();
+  return expSO3(unit_axis * angle);
+}
 
 Mat6 spatialInertia(double mass, const Vec3& com, const Mat3& inertia_com) {
   const Mat3 C = skew(com);

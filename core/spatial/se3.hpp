@@ -40,6 +40,45 @@ Mat6 ad(const Vec6& phi);
 /// point Jacobian in body coordinates, Gamma(x) = ([x]^T  I) [D Eq. 3.13]
 Mat3x6 Gamma(const Vec3& x);
 
+/// The products above without forming 6 x 6 matrices (the recursions' inner loops; E = (R, p)):
+/// Ad(E) phi = (R w; R v + p x R w)
+inline Vec6 adjointTimes(const Mat3& R, const Vec3& p, const Vec6& phi) {
+  Vec6 out;
+  const Vec3 Rw = R * phi.head<3>();
+  out.head<3>() = Rw;
+  out.tail<3>() = R * phi.tail<3>() + p.cross(Rw);
+  return out;
+}
+/// Ad(E^-1) phi = (R^T w; R^T (v + w x p))
+inline Vec6 adjointInvTimes(const Mat3& R, const Vec3& p, const Vec6& phi) {
+  Vec6 out;
+  out.head<3>() = R.transpose() * phi.head<3>();
+  out.tail<3>() = R.transpose() * (phi.tail<3>() + phi.head<3>().cross(p));
+  return out;
+}
+/// Ad(E^-1)^T w for a wrench w = (tau; f): (R tau + p x R f; R f), a child's wrench in its parent
+inline Vec6 adjointInvTransposeTimes(const Mat3& R, const Vec3& p, const Vec6& w) {
+  Vec6 out;
+  const Vec3 Rf = R * w.tail<3>();
+  out.head<3>() = R * w.head<3>() + p.cross(Rf);
+  out.tail<3>() = Rf;
+  return out;
+}
+/// ad(a) b = (wa x wb; wa x vb + va x wb)
+inline Vec6 adTimes(const Vec6& a, const Vec6& b) {
+  Vec6 out;
+  out.head<3>() = a.head<3>().cross(b.head<3>());
+  out.tail<3>() = a.head<3>().cross(b.tail<3>()) + a.tail<3>().cross(b.head<3>());
+  return out;
+}
+/// ad(a)^T w = -(wa x tau + va x f; wa x f) for a wrench w = (tau; f)
+inline Vec6 adTransposeTimes(const Vec6& a, const Vec6& w) {
+  Vec6 out;
+  out.head<3>() = -(a.head<3>().cross(w.head<3>()) + a.tail<3>().cross(w.tail<3>()));
+  out.tail<3>() = -a.head<3>().cross(w.tail<3>());
+  return out;
+}
+
 /// SO(3) exponential (Rodrigues), accurate for small |w| (Taylor series below 1e-4)
 Mat3 expSO3(const Vec3& w);
 /// SO(3) logarithm, returns w with |w| in [0, pi]; accurate near 0 and near pi

@@ -8,6 +8,7 @@
 // Measured worst differences 2e-16 to 7e-16 of |tau|; bound 5e-15.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <random>
 
@@ -106,6 +107,53 @@ TEST(RecursiveId, MusclesWithMassEqualTheMassMatrixRoute) {
   EXPECT_GT(effect, 1e-2);
   std::printf("[ measured ] Type I/II muscles with mass: recursive vs M route, worst %.2e of |tau| "
               "(muscles' share up to %.1f%% of |tau|)\n", worst, 100 * effect);
+}
+
+TEST(RecursiveId, MassPointsInAnyOrderAndOfUnequalMassEqualTheMassMatrixRoute) {
+  // the path-wise pass sums the moments of a segment's points as one run when alpha increases
+  // (makeMassPoints' order) and point by point otherwise: both against the reference, and the
+  // same points in either order against each other
+  std::mt19937 rng(19);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const Model m = scenes::randomTree(7, 701, scenes::TreeJoints::All);
+  std::vector<double> alpha(17), mass(17);
+  for (size_t a = 0; a < alpha.size(); ++a) {
+    alpha[a] = u01(rng);
+    mass[a] = 0.05 + 0.3 * u01(rng);
+  }
+  alpha[3] = 0.0;  // on the origin, and on the insertion
+  alpha[9] = 1.0;
+  std::vector<size_t> order(alpha.size());
+  for (size_t a = 0; a < order.size(); ++a) order[a] = a;
+  std::sort(order.begin(), order.end(), [&](size_t i, size_t j) { return alpha[i] < alpha[j]; });
+  std::vector<double> alpha_sorted, mass_sorted;
+  for (size_t a : order) {
+    alpha_sorted.push_back(alpha[a]);
+    mass_sorted.push_back(mass[a]);
+  }
+  Muscle shuffled = test::randomViaMuscle(m, rng, 1.0, "shuffled");
+  Muscle sorted = shuffled;
+  shuffled.mass_points = makeMassPoints(alpha, mass);
+  sorted.mass_points = makeMassPoints(alpha_sorted, mass_sorted);
+  ASSERT_FALSE(std::is_sorted(alpha.begin(), alpha.end()));
+  System sys_shuffled(m), sys_sorted(m);
+  sys_shuffled.addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{shuffled}));
+  sys_sorted.addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{sorted}));
+  const double worst = std::max(worstRelative(sys_shuffled, rng, false), worstRelative(sys_sorted, rng, false));
+  EXPECT_LE(worst, 5e-15);
+  DynamicsWorkspace wa(sys_shuffled), wb(sys_sorted);
+  double apart = 0.0;
+  VecX ta, tb;
+  for (int t = 0; t < 4; ++t) {
+    const State s = test::randomState(m.nr(), rng);
+    const VecX qddot = test::randomState(m.nr(), rng).qdot;
+    sys_shuffled.inverseDynamicsRecursive(s, qddot, wa, ta);
+    sys_sorted.inverseDynamicsRecursive(s, qddot, wb, tb);
+    apart = std::max(apart, (ta - tb).lpNorm<Eigen::Infinity>() / std::max(1.0, tb.lpNorm<Eigen::Infinity>()));
+  }
+  EXPECT_LE(apart, 5e-15);
+  std::printf("[ measured ] shuffled, unequal mass points: recursive vs M route worst %.2e, "
+              "shuffled vs sorted %.2e of |tau|\n", worst, apart);
 }
 
 TEST(RecursiveId, WithoutTheQuadraticVelocityVectorTheCompactRouteEqualsTheMassMatrixRoute) {

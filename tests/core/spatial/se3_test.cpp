@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <random>
 
 namespace redmax {
@@ -36,6 +37,35 @@ TEST_F(Se3Test, InverseAndAdjointInverse) {
     EXPECT_TRUE(nearRel(Ad(E) * AdInv(E), Mat6::Identity(), 1e-14));
     EXPECT_TRUE(nearRel(AdInv(E), Ad(inverseE(E)), 1e-14));
   }
+}
+
+TEST_F(Se3Test, RotationTranslationProductsEqualTheSixBySixMatrices) {
+  // adjointTimes & co. (the recursions' inner loops) against Ad, AdInv, ad as matrices
+  for (int k = 0; k < 20; ++k) {
+    const Mat4 E = rpose();
+    const Mat3 R = E.topLeftCorner<3, 3>();
+    const Vec3 p = E.topRightCorner<3, 1>();
+    const Vec6 a = rtwist(), b = rtwist();
+    EXPECT_TRUE(nearRel(adjointTimes(R, p, a), Vec6(Ad(E) * a), 1e-15));
+    EXPECT_TRUE(nearRel(adjointInvTimes(R, p, a), Vec6(AdInv(E) * a), 1e-15));
+    EXPECT_TRUE(nearRel(adjointInvTransposeTimes(R, p, a), Vec6(AdInv(E).transpose() * a), 1e-15));
+    EXPECT_TRUE(nearRel(adTimes(a, b), Vec6(ad(a) * b), 1e-15));
+    EXPECT_TRUE(nearRel(adTransposeTimes(a, b), Vec6(ad(a).transpose() * b), 1e-15));
+  }
+}
+
+TEST_F(Se3Test, RotationAboutAUnitAxisEqualsTheExponential) {
+  // rotationAxisAngle's direct Rodrigues form against expSO3 (its Taylor branch included)
+  double worst = 0.0;
+  for (double angle : {0.0, 1e-9, -3e-5, 2e-4, 0.7, -2.5, 3.14159, 6.0})
+    for (int k = 0; k < 5; ++k) {
+      const Vec3 axis = rvec().normalized();
+      const Mat3 R = rotationAxisAngle(axis, angle);
+      worst = std::max(worst, (R - expSO3(axis * angle)).cwiseAbs().maxCoeff());
+      EXPECT_LE((R * R.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff(), 1e-15);
+    }
+  EXPECT_LE(worst, 1e-15);
+  EXPECT_EQ(rotationAxisAngle(Vec3::UnitX(), 0.0), Mat3::Identity());
 }
 
 TEST_F(Se3Test, AdjointTransformsTwistBracket) {
