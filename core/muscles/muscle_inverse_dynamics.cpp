@@ -9,6 +9,13 @@ namespace redmax {
 
 namespace {
 
+// resize (no-op at the same size) and zero a few entries in place: Eigen's setZero calls memset,
+// whose call costs more than these handful of stores
+void zeroed(VecX& v, int n) {
+  v.resize(n);
+  for (int i = 0; i < n; ++i) v[i] = 0.0;
+}
+
 // The equal-strain matrix L (n x n, tridiagonal: sub(r) = L(r, r-1), diag(r), super(r) = L(r, r+1))
 // factored once as L = B U, B lower bidiagonal (diagonal piv_r, sub-diagonal sub(r)), U unit upper
 // (super-diagonal c_r), by elimination without pivoting: L is diagonally dominant by rows
@@ -78,13 +85,8 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   //    xdot = omega x r + nu + rd,  xddot = alpha x r + omega x (omega x r + 2 rd) + bias + rdd
   activePathPoints(path, state.q, mk.active);
   const int P = static_cast<int>(mk.active.size());
-  mk.x_b.resize(P);
-  mk.x_w.resize(P);
-  mk.xdot_w.resize(P);
-  sc.dx_b.resize(P);
-  sc.ddx_b.resize(P);
-  sc.r_w.resize(P);
-  sc.xddot_w.resize(P);
+  for (std::vector<Vec3>* v : {&mk.x_b, &mk.x_w, &mk.xdot_w, &sc.dx_b, &sc.ddx_b, &sc.r_w, &sc.xddot_w})
+    if (static_cast<int>(v->size()) != P) v->resize(P);  // the call costs even at the same size
   for (int a = 0; a < P; ++a) {
     const PathPoint& pt = path.points[mk.active[a]];
     const int b = pt.body;
@@ -139,8 +141,8 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   mk.s[0] = 0.0;
   for (int i = 1; i < P; ++i) mk.s[i] = mk.s[i - 1] + mk.l[i - 1] / mk.length;
   mk.s[P - 1] = 1.0;
-  mk.sdot.setZero(P);
-  sc.sddot.setZero(P);
+  zeroed(mk.sdot, P);
+  zeroed(sc.sddot, P);
   const VecX& l = mk.l;
   const VecX& ld = mk.ldot;
   const VecX& s = mk.s;
@@ -179,11 +181,12 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   }
 
   // 2. the mass points by segment: three moments each (the rule of calcViaPointMassPoints)
-  sc.m0.setZero(ns);
-  sc.m1.setZero(ns);
-  sc.m2.setZero(ns);
+  zeroed(sc.m0, ns);
+  zeroed(sc.m1, ns);
+  zeroed(sc.m2, ns);
   const int N = mp.size();
-  if (std::is_sorted(mp.alpha.begin(), mp.alpha.end())) {
+  if (sc.alpha_sorted < 0) sc.alpha_sorted = std::is_sorted(mp.alpha.begin(), mp.alpha.end()) ? 1 : 0;
+  if (sc.alpha_sorted == 1) {
     // points in increasing alpha (as makeMassPoints places them): each segment's points are one
     // run [lo, hi), whose moments are vectorised sums (no search per point, no chain of adds)
     using ArrayMap = Eigen::Map<const Eigen::ArrayXd>;
@@ -211,8 +214,9 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
       sc.m2[i] += m * beta * beta;
     }
   }
-  sc.force_x.assign(P, Vec3::Zero());
-  sc.force_s.setZero(P);
+  sc.force_x.resize(P);
+  for (Vec3& f : sc.force_x) f.setZero();
+  zeroed(sc.force_s, P);
   const VecX& sd = mk.sdot;
   const VecX& sdd = sc.sddot;
   for (int i = 0; i < ns; ++i) {

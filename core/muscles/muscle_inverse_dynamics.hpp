@@ -38,7 +38,7 @@
 namespace redmax {
 
 /// Buffers of one muscle's inverse-dynamics pass beyond its MuscleKinematics (sized on first use;
-/// no allocation afterwards unless the active point count grows).
+/// no allocation afterwards unless the active point count grows); one scratch per muscle.
 struct MuscleIdScratch {
   std::vector<Vec3> dx_b, ddx_b;  // moving points: d x_b / dq_k, d2 x_b / dq_k2         (P)
   std::vector<Vec3> r_w;          // R x_b: path point from its body origin, world axes (P)
@@ -48,6 +48,8 @@ struct MuscleIdScratch {
   VecX sddot, force_s;            // Eulerian accelerations and forces (ends unused)   (P)
   VecX m0, m1, m2;                // per segment sum m, sum m beta, sum m beta^2       (P-1)
   VecX tri_c, tri_d, rhs;         // tridiagonal solve                                 (P-2)
+  int alpha_sorted = -1;          // the muscle's mass points come in increasing alpha (1) or not (0);
+                                  // found on the first call: a scratch serves one muscle
 };
 
 /// A body's motion in world axes, formed once per pass for all the muscles that attach to it, so
