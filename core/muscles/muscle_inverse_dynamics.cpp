@@ -90,10 +90,7 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   for (int a = 0; a < P; ++a) {
     const PathPoint& pt = path.points[mk.active[a]];
     const int b = pt.body;
-    if (pt.kind != PathPointKind::Moving) {
-      mk.x_b[a] = pt.location;
-      sc.dx_b[a].setZero();
-      sc.ddx_b[a].setZero();
+    if (pt.kind != PathPointKind::Moving) {  // (x_b, dx_b, ddx_b are read for moving points only)
       if (b < 0) {
         mk.x_w[a] = pt.location;
         mk.xdot_w[a].setZero();

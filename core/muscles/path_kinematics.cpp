@@ -231,7 +231,7 @@ void calcPathSegments(MuscleKinematics& mk, bool velocity) {
   for (int i = 0; i < ns; ++i) {
     const Vec3 dx = mk.x_w[i + 1] - mk.x_w[i];
     mk.l[i] = dx.norm();
-    mk.dxbar[i] = mk.l[i] > 0.0 ? Vec3(dx / mk.l[i]) : Vec3::Zero();
+    mk.dxbar[i] = mk.l[i] > 0.0 ? Vec3(dx * (1.0 / mk.l[i])) : Vec3::Zero();  // one division, not three
     mk.length += mk.l[i];
     if (velocity) {
       mk.ldot[i] = mk.dxbar[i].dot(mk.xdot_w[i + 1] - mk.xdot_w[i]);
