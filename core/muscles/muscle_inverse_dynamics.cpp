@@ -136,7 +136,8 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   const int ns = P - 1, n = P - 2;
   mk.s.resize(P);
   mk.s[0] = 0.0;
-  for (int i = 1; i < P; ++i) mk.s[i] = mk.s[i - 1] + mk.l[i - 1] / mk.length;
+  const double inv_length = 1.0 / mk.length;  // divisions are the slow operations here: one each
+  for (int i = 1; i < P; ++i) mk.s[i] = mk.s[i - 1] + mk.l[i - 1] * inv_length;
   mk.s[P - 1] = 1.0;
   zeroed(mk.sdot, P);
   zeroed(sc.sddot, P);
@@ -161,7 +162,7 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
     for (int i = 0; i < ns; ++i) {
       const Vec3& u = mk.dxbar[i];
       const Vec3 dxd = mk.xdot_w[i + 1] - mk.xdot_w[i];
-      const Vec3 ud = (dxd - u * u.dot(dxd)) / l[i];
+      const Vec3 ud = (dxd - u * u.dot(dxd)) * (1.0 / l[i]);
       sc.lddot[i] = u.dot(sc.xddot_w[i + 1] - sc.xddot_w[i]) + ud.dot(dxd);
     }
     // L sddot = -(DeltaS lddot + Ldot sdot + DeltaSdot ldot)
@@ -218,17 +219,17 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   const VecX& sdd = sc.sddot;
   for (int i = 0; i < ns; ++i) {
     if (sc.m0[i] == 0.0 && sc.m1[i] == 0.0) continue;
-    const double ds = s[i + 1] - s[i];
+    const double inv_ds = 1.0 / (s[i + 1] - s[i]);
     const Vec3 dx = mk.x_w[i + 1] - mk.x_w[i], dxd = mk.xdot_w[i + 1] - mk.xdot_w[i];
     const Vec3 dxdd = sc.xddot_w[i + 1] - sc.xddot_w[i];
     // betadot = b0 + b1 beta, betaddot = e0 + e1 beta (from beta Delta s = s_a - s_i)
-    const double b0 = -sd[i] / ds, b1 = -(sd[i + 1] - sd[i]) / ds;
-    const double e0 = -sdd[i] / ds + 2.0 * b0 * b1, e1 = 2.0 * b1 * b1 - (sdd[i + 1] - sdd[i]) / ds;
+    const double b0 = -sd[i] * inv_ds, b1 = -(sd[i + 1] - sd[i]) * inv_ds;
+    const double e0 = -sdd[i] * inv_ds + 2.0 * b0 * b1, e1 = 2.0 * b1 * b1 - (sdd[i + 1] - sdd[i]) * inv_ds;
     // xddot_a = xddot_i + betaddot Delta x + 2 betadot Delta xdot + beta Delta xddot = c0 + c1 beta
     const Vec3 c0g = sc.xddot_w[i] + e0 * dx + 2.0 * b0 * dxd - gravity;
     const Vec3 c1 = e1 * dx + 2.0 * b1 * dxd + dxdd;
     const Vec3 Fs0 = sc.m0[i] * c0g + sc.m1[i] * c1, Fs1 = sc.m1[i] * c0g + sc.m2[i] * c1;
-    const Vec3 F = dx / ds;
+    const Vec3 F = dx * inv_ds;
     sc.force_x[i] += Fs0 - Fs1;
     sc.force_x[i + 1] += Fs1;
     sc.force_s[i] -= F.dot(Fs0 - Fs1);
