@@ -39,6 +39,8 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
       }))
     return rc;
   for (const auto& w : g.model.build.warnings) std::cerr << "warning: " << w << "\n";
+  for (const auto& w : g.warnings) std::cerr << "warning: " << w << "\n";
+  for (const auto& w : g.not_applied) std::cerr << "warning: not applied: " << w << "\n";
   if (given(app, "--jacobian-step")) g.problem.jacobian_step = f.jacobian_step;
 
   adjoint::Result res;

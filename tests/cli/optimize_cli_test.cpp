@@ -31,7 +31,7 @@ class OptimizeCli : public ::testing::Test {
   fs::path dir_;
 };
 
-const std::string kReach = "--point 0,-0.08,0 --target 0.2,-0.5,0.05 --duration 0.3 --dt 0.01";
+const std::string kReach = "--point 0,-0.08,0 --target 0.25,-0.55,0.05 --duration 0.3 --dt 0.01";
 
 TEST_F(OptimizeCli, WritesTheReport) {
   const fs::path report = dir_ / "reach";

@@ -3,6 +3,7 @@
 // initial-state and muscle-mass parameters, against central differences of whole simulations.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -62,6 +63,34 @@ INSTANTIATE_TEST_SUITE_P(
       std::string n = std::string(info.param.muscle) + "_" + info.param.integrator;
       return n;
     });
+
+// The ForceSet's passive forces are in the gradient's system, as in `redmax simulate`:
+// reach_arm.osim's elbow_limit (CoordinateLimitForce, 1 N m/deg past 0 and 150 deg over a 5 deg
+// transition) stops the elbow driven toward hyperextension, and its force is differentiated with
+// the rest of the step; the muscles (no excitation parameters) are named as not applied.
+TEST(GradientPassiveForces, CoordinateLimitForceActsAndIsDifferentiated) {
+  const std::string file = std::string(REDMAX_SOURCE_DIR) + "/osim_models/reach_arm.osim";
+  GradientSetup g = makeGradientSetup(file, SimulationModelOptions{}, "euler", 0.3, 0.002,
+                                      "torques:elbow_flexion=-2,shoulder_flexion;q0:elbow_flexion=0.1;qdot0:elbow_flexion=-1",
+                                      "point:hand@0,-0.08,0=0.2,-0.6,0;0.1*speed");
+  bool limit = false;
+  for (const auto& t : g.model.system->terms()) limit = limit || t->name() == "coordinate_limit_forces";
+  EXPECT_TRUE(limit);
+  ASSERT_FALSE(g.not_applied.empty());
+  EXPECT_NE(g.not_applied.front().find("6 path forces exert no force without excitation parameters"), std::string::npos)
+      << g.not_applied.front();
+  const adjoint::Result r = adjoint::evaluate(g.problem, g.objective, g.p0, true);
+  const int elbow = g.model.system->model().findCoordinate("elbow_flexion");
+  // -2 N m toward hyperextension from 0.1 rad at -1 rad/s: held within the 5 deg transition
+  // (measured final angle below)
+  EXPECT_GT(r.final.q[elbow], -0.0873);
+  EXPECT_LT(r.final.q[elbow], 0.0);
+  const VecX fd = adjoint::finiteDifferenceGradient(g.problem, g.objective, g.p0);
+  const double err = adjoint::worstRelativeError(r.gradient, fd);
+  EXPECT_LE(err, 2e-7) << "adjoint " << r.gradient.transpose() << "\ndifferences " << fd.transpose();
+  std::printf("[ measured ] elbow_limit in the gradient: final elbow %.4f rad, adjoint vs differences %.2e\n",
+              r.final.q[elbow], err);
+}
 
 TEST(GradientSpec, BadSpecsNameTheItem) {
   const std::string file = std::string(REDMAX_SOURCE_DIR) + "/osim_models/double_pendulum_straight.osim";

@@ -21,7 +21,7 @@ ReachOptions reachOptions() {
   o.model_options.muscle_mass.wrap_mass = true;  // the deltoids and triceps over the smooth wrap model
   o.body = "hand";
   o.point = Vec3(0.0, -0.08, 0.0);
-  o.target = Vec3(0.2, -0.5, 0.05);  // 0.1 m from the hand's start (0.168, -0.607, 0)
+  o.target = Vec3(0.25, -0.55, 0.05);  // 0.11 m from the hand's start (0.168, -0.607, 0), elbow within its limits
   o.duration = 0.3;
   o.dt = 0.01;
   return o;

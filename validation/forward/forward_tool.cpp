@@ -232,7 +232,8 @@ std::string strictRefusal(const std::vector<std::string>& not_applied) {
 }
 
 void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std::vector<std::string>& not_applied,
-                     bool apply, bool hard_contact) {
+                     bool apply, bool hard_contact, const std::string& controls_hint,
+                     const std::vector<std::string>& pulling) {
   const osim::ModelDescription& d = m.description;
   // muscles and actuators need controls: named in one line each, every name given
   auto listNames = [&](const std::vector<std::string>& names, const std::string& what) {
@@ -243,12 +244,13 @@ void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std
   };
   std::vector<std::string> muscles, actuators;
   for (const osim::PathForceDesc& p : d.muscles)
-    if (p.applies_force) muscles.push_back(p.name + " (" + p.class_name + ")");
+    if (p.applies_force && std::find(pulling.begin(), pulling.end(), p.name) == pulling.end())
+      muscles.push_back(p.name + " (" + p.class_name + ")");
   for (const osim::ForceDesc& f : d.forces)
     if (f.applies_force && isActuator(f)) actuators.push_back(f.name + " (" + f.class_name + ")");
-  listNames(muscles, apply ? "path forces exert no force without --controls (their mass, if any, stays)"
+  listNames(muscles, apply ? "path forces exert no force without " + controls_hint + " (their mass, if any, stays)"
                            : "path forces exert no force with this engine");
-  listNames(actuators, apply ? "actuators apply nothing without --controls" : "actuators apply nothing with this engine");
+  listNames(actuators, apply ? "actuators apply nothing without " + controls_hint : "actuators apply nothing with this engine");
   auto passive = [&](const osim::ForceDesc& f) {
     return f.applies_force && !isActuator(f) && !(hard_contact && isContactForce(f));
   };

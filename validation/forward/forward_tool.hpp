@@ -62,8 +62,11 @@ void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bo
 /// is listed.
 /// hard_contact: HuntCrossleyForce and SmoothSphereHalfSpaceForce are left out (addHardConstraints
 /// makes their geometry hard contacts) and their geometry is not listed here.
+/// controls_hint completes "path forces exert no force without ..." (the command's way to drive
+/// them); path forces named in `pulling` are left out of that line (the caller applies them).
 void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std::vector<std::string>& not_applied,
-                     bool apply = true, bool hard_contact = false);
+                     bool apply = true, bool hard_contact = false, const std::string& controls_hint = "--controls",
+                     const std::vector<std::string>& pulling = {});
 
 /// `simulate`'s hard modes (docs/contact.md §6).
 struct HardConstraintOptions {

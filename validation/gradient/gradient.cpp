@@ -7,6 +7,7 @@
 #include "core/dynamics/muscle_force_term.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/muscles/path.hpp"
+#include "validation/forward/forward_tool.hpp"
 #include "validation/simulate/spec_parse.hpp"
 
 namespace redmax::validation {
@@ -55,15 +56,38 @@ std::shared_ptr<System> withMuscleForces(const SimulationModel& m) {
   return sys;
 }
 
+namespace {
+
+// The gradient's model: what `redmax simulate` applies without controls - the ForceSet's passive
+// forces and contacts (CoordinateLimitForce, springs, bushings, HuntCrossleyForce, ...) - and, with
+// excitation parameters, the muscles' Hill-type forces. Actuators (no controllers here) and muscles
+// without excitations are named in not_applied; mass-parameter runs rebuild it the same way.
+SimulationModel makeGradientModel(const osim::ModelDescription& description, const SimulationModelOptions& options,
+                                  bool hill, std::vector<std::string>& warnings,
+                                  std::vector<std::string>& not_applied) {
+  SimulationModel m = makeSimulationModel(description, options);
+  std::vector<std::string> pulling;
+  if (hill) {
+    const MusculoskeletalModel& mm = m.build.model;
+    for (size_t k = 0; k < mm.muscles().size(); ++k)
+      if (k < mm.muscleModels().size() && mm.muscleModels()[k]) pulling.push_back(mm.muscles()[k].name);
+  }
+  addPassiveTerms(m, warnings, not_applied, true, false, "excitation parameters (--params 'excitations:...')",
+                  pulling);
+  if (hill) m.system = withMuscleForces(m);
+  return m;
+}
+
+}  // namespace
+
 GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationModelOptions& options,
                                 const std::string& integrator, double duration, double dt,
                                 const std::string& params_spec, const std::string& objective_spec) {
   GradientSetup g;
   const auto description = std::make_shared<const osim::ModelDescription>(osim::readOsimModel(osim_path));
-  g.model = makeSimulationModel(*description, options);
   // with excitation parameters the muscles pull (Hill-type, activation and fibre states in z)
   const bool hill = params_spec.find("excitations:") != std::string::npos;
-  if (hill) g.model.system = withMuscleForces(g.model);
+  g.model = makeGradientModel(*description, options, hill, g.warnings, g.not_applied);
   adjoint::Problem& pr = g.problem;
   pr.integrator = integrator;
   pr.duration = duration;
@@ -228,8 +252,8 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
     for (size_t j = 0; j < masses.size(); ++j)
       for (auto& [name, kg] : o.explicit_masses)
         if (name == masses[j]) kg = sp[static_cast<Eigen::Index>(j)];
-    SimulationModel m = makeSimulationModel(*description, o);
-    return hill ? withMuscleForces(m) : m.system;
+    std::vector<std::string> warnings, not_applied;  // said once, for p0's model
+    return makeGradientModel(*description, o, hill, warnings, not_applied).system;
   };
 
   // objective

@@ -36,6 +36,8 @@ struct GradientSetup {
   VecX p0;                               ///< the parameter values the SPEC gives
   std::vector<std::string> param_names;  ///< e.g. "torque elbow_flexion piece 2/10", "mass BIClong"
   SimulationModel model;                 ///< the model at p0's system parameters
+  std::vector<std::string> warnings;     ///< building the ForceSet's terms (also in model.build.warnings' style)
+  std::vector<std::string> not_applied;  ///< forces and geometry the gradient's system leaves out, one line each
 };
 
 /// m's system plus the model's MuscleForceTerm (every muscle with a Hill-type model pulls), as
