@@ -78,6 +78,8 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
   validation::ReachSetup setup;
   if (const int rc = loadOrExit2(f.model, [&] { setup = validation::makeReachSetup(o); })) return rc;
   for (const auto& w : setup.gradient.model.build.warnings) std::cerr << "warning: " << w << "\n";
+  for (const auto& w : setup.gradient.warnings) std::cerr << "warning: " << w << "\n";
+  for (const auto& w : setup.gradient.not_applied) std::cerr << "warning: not applied: " << w << "\n";
   if (!f.quiet)
     std::fprintf(stderr, "reach: %s, %zu %s, hand at (%.4g, %.4g, %.4g) m, target (%.4g, %.4g, %.4g) m, %.4g kg of muscle mass\n",
                  setup.gradient.model.description.name.c_str(), setup.gradient.param_names.size(),

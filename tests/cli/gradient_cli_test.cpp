@@ -45,6 +45,18 @@ TEST_F(GradientCli, CheckAgreesWithCentralDifferences) {
   }
 }
 
+TEST_F(GradientCli, WhatTheGradientDoesNotApplyIsNamed) {
+  // reach_arm.osim: elbow_limit is applied (docs/gradients.md §2); its six Thelen muscles pull only
+  // with excitation parameters, and say so
+  const CmdResult r = runRedmax(dir_, "gradient --model " + scene("reach_arm.osim") +
+                                          " --duration 0.02 --params 'torques:elbow_flexion' --objective speed");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: not applied: 6 path forces exert no force without excitation parameters"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("DELT1 (Thelen2003Muscle)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("elbow_limit"), std::string::npos) << r.err;
+}
+
 TEST_F(GradientCli, CheckAboveTheToleranceExitsOne) {
   // no gradient meets differences of whole runs to 1e-15
   const CmdResult r = run(kRun + " --check --check-tolerance 1e-15");
