@@ -167,7 +167,7 @@ void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const Ve
   sc.id.resize(massive_.size());
   sc.evaluation = 0;  // the muscles' kinematics below are partial: no reuse by addMass & co.
   calcBodyWorldMotion(motion, sc.bodies);
-  sc.w_world.resize(wrench.size(), Vec6::Zero());
+  sc.w_world.assign(wrench.size(), Vec6::Zero());  // (zeroed here: a muscle that threw may have left sums)
   for (size_t m = 0; m < massive_.size(); ++m) {
     const Muscle& mu = massive_[m];
     MuscleKinematics& mk = sc.ws.muscles[m];

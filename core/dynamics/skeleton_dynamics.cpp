@@ -99,36 +99,6 @@ RecursiveIdWorkspace::RecursiveIdWorkspace(const Model& model) {
   w.assign(nb, Vec6::Zero());
 }
 
-void recursiveJointStep(const Model& model, int i, const State& state, const Mat3& R_im, const Vec3& p_im,
-                        JointKinematics& jk, Mat3& R_pi, Vec3& p_pi, std::vector<Mat4>& E_wi, Mat6X& S_i,
-                        Vec6& psi, Vec6& sdot_qd) {
-  const JointSlot& s = model.joints()[i];
-  s.joint.calc(state.q.segment(s.q_index, s.nq), state.qdot.segment(s.q_index, s.nq), jk);
-  // E_pi = E_pf Q E_mi as rotation and translation
-  const Mat3 R_fm = s.E_pf.topLeftCorner<3, 3>() * jk.Q.topLeftCorner<3, 3>();
-  const Vec3 p_fm = s.E_pf.topLeftCorner<3, 3>() * jk.Q.topRightCorner<3, 1>() + s.E_pf.topRightCorner<3, 1>();
-  R_pi.noalias() = R_fm * s.E_mi.topLeftCorner<3, 3>();
-  p_pi.noalias() = R_fm * s.E_mi.topRightCorner<3, 1>();
-  p_pi += p_fm;
-  if (s.parent >= 0) {
-    const auto R_wp = E_wi[s.parent].topLeftCorner<3, 3>();
-    E_wi[i].topLeftCorner<3, 3>().noalias() = R_wp * R_pi;
-    E_wi[i].topRightCorner<3, 1>().noalias() = R_wp * p_pi;
-    E_wi[i].topRightCorner<3, 1>() += E_wi[s.parent].topRightCorner<3, 1>();
-  } else {
-    E_wi[i].topLeftCorner<3, 3>() = R_pi;
-    E_wi[i].topRightCorner<3, 1>() = p_pi;
-  }
-  for (int c = 0; c < s.nq; ++c) S_i.col(c) = adjointTimes(R_im, p_im, jk.S.col(c));
-  psi.setZero();
-  sdot_qd.setZero();
-  if (s.nq > 0) {
-    const auto qd = state.qdot.segment(s.q_index, s.nq);
-    psi.noalias() = S_i * qd;
-    sdot_qd = adjointTimes(R_im, p_im, jk.Sdot * qd);
-  }
-}
-
 void recursiveIdForward(const Model& model, const State& state, const VecX& qddot, RecursiveIdWorkspace& ws) {
   // body acceleration (body coordinates), from phi_i = Ad_ip phi_p + psi_i with
   // dAd_ip/dt = -ad(psi_i) Ad_ip:
@@ -136,18 +106,42 @@ void recursiveIdForward(const Model& model, const State& state, const VecX& qddo
   // The adjoints act through their rotations and translations (adjointTimes & co.): a 6 x 6
   // adjoint costs 36 multiplies per product plus its construction, the (R, p) form about 24.
   const int nb = model.nb();
-  Vec6 psi, acc;
   for (int i = 0; i < nb; ++i) {
     const JointSlot& s = model.joints()[i];
-    recursiveJointStep(model, i, state, ws.R_im[i], ws.p_im[i], ws.jk[i], ws.R_pi[i], ws.p_pi[i], ws.E_wi,
-                       ws.S_i[i], psi, acc);
-    if (s.nq > 0) acc.noalias() += ws.S_i[i] * qddot.segment(s.q_index, s.nq);
+    JointKinematics& jk = ws.jk[i];
+    s.joint.calc(state.q.segment(s.q_index, s.nq), state.qdot.segment(s.q_index, s.nq), jk);
+    // E_pi = E_pf Q E_mi as rotation and translation
+    const Mat3 R_fm = s.E_pf.topLeftCorner<3, 3>() * jk.Q.topLeftCorner<3, 3>();
+    const Vec3 p_fm = s.E_pf.topLeftCorner<3, 3>() * jk.Q.topRightCorner<3, 1>() + s.E_pf.topRightCorner<3, 1>();
+    Mat3& R_pi = ws.R_pi[i];
+    Vec3& p_pi = ws.p_pi[i];
+    R_pi.noalias() = R_fm * s.E_mi.topLeftCorner<3, 3>();
+    p_pi.noalias() = R_fm * s.E_mi.topRightCorner<3, 1>();
+    p_pi += p_fm;
+    const Mat3& R_im = ws.R_im[i];
+    const Vec3& p_im = ws.p_im[i];
+    auto& S_i = ws.S_i[i];
+    for (int c = 0; c < s.nq; ++c) S_i.col(c) = adjointTimes(R_im, p_im, jk.S.col(c));
+    const auto qd = state.qdot.segment(s.q_index, s.nq);
+    const auto qdd = qddot.segment(s.q_index, s.nq);
+    Vec6 psi = Vec6::Zero(), acc = Vec6::Zero();
+    if (s.nq > 0) {
+      psi.noalias() = S_i * qd;
+      acc.noalias() = S_i * qdd;
+      acc += adjointTimes(R_im, p_im, jk.Sdot * qd);
+    }
     if (s.parent >= 0) {
       const int p = s.parent;
-      const Vec6 phi_pi = adjointInvTimes(ws.R_pi[i], ws.p_pi[i], ws.phi[p]);
+      const auto R_wp = ws.E_wi[p].topLeftCorner<3, 3>();
+      ws.E_wi[i].topLeftCorner<3, 3>().noalias() = R_wp * R_pi;
+      ws.E_wi[i].topRightCorner<3, 1>().noalias() = R_wp * p_pi;
+      ws.E_wi[i].topRightCorner<3, 1>() += ws.E_wi[p].topRightCorner<3, 1>();
+      const Vec6 phi_pi = adjointInvTimes(R_pi, p_pi, ws.phi[p]);
       ws.phi[i] = phi_pi + psi;
-      ws.phidot[i] = adjointInvTimes(ws.R_pi[i], ws.p_pi[i], ws.phidot[p]) - adTimes(psi, phi_pi) + acc;
+      ws.phidot[i] = adjointInvTimes(R_pi, p_pi, ws.phidot[p]) - adTimes(psi, phi_pi) + acc;
     } else {
+      ws.E_wi[i].topLeftCorner<3, 3>() = R_pi;
+      ws.E_wi[i].topRightCorner<3, 1>() = p_pi;
       ws.phi[i] = psi;
       ws.phidot[i] = acc;
     }

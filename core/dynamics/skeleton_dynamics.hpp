@@ -36,14 +36,6 @@ struct RecursiveIdWorkspace {
   BodyMotion motion() const { return {E_wi, phi, phidot}; }
 };
 
-/// One joint of a root-first recursive pass (Newton-Euler, ABA): joint i's kinematics jk at the
-/// state, the body's pose in its parent (R_pi, p_pi) = E_pf Q E_mi and in the world (E_wi[i] from
-/// E_wi of the parent), the joint's twist map in the body S_i = Ad(E_im) S (E_im = (R_im, p_im),
-/// constant), psi = S_i qdot_i and the velocity-product term sdot_qd = Ad(E_im) Sdot qdot_i.
-void recursiveJointStep(const Model& model, int i, const State& state, const Mat3& R_im, const Vec3& p_im,
-                        JointKinematics& jk, Mat3& R_pi, Vec3& p_pi, std::vector<Mat4>& E_wi, Mat6X& S_i,
-                        Vec6& psi, Vec6& sdot_qd);
-
 /// Forward pass of recursive inverse dynamics: joint kinematics, poses, twists, their rates
 /// phidot = J_mr qddot + Jdot_mr qdot, and each body's net wrench w = M phidot - ad(phi)^T M phi
 /// - gravity [D Eq. 3.21-3.22]. Loads added to ws.w before the backward pass (body coordinates)

@@ -21,8 +21,7 @@ void StructuredForwardWorkspace::resize(const Model& model) {
   if (static_cast<int>(Ic.size()) == nb && static_cast<int>(jk.size()) == nb) return;
   Ic.assign(nb, Mat6::Zero());
   jk.resize(nb);
-  R_im.resize(nb);
-  p_im.resize(nb);
+  Ad_ij.resize(nb);
   S.resize(nb);
   U.resize(nb);
   Dinv.resize(nb);
@@ -30,16 +29,13 @@ void StructuredForwardWorkspace::resize(const Model& model) {
   for (int i = 0; i < nb; ++i) {
     const int nq = model.joints()[i].nq;
     jk[i].resize(nq);
-    const Mat4 E_im = inverseE(model.joints()[i].E_mi);
-    R_im[i] = E_im.topLeftCorner<3, 3>();
-    p_im[i] = E_im.topRightCorner<3, 1>();
+    Ad_ij[i] = AdInv(model.joints()[i].E_mi);  // E_im = E_mi^-1
     S[i].setZero(6, nq);
     U[i].setZero(6, nq);
     Dinv[i].setZero(nq, nq);
     u[i].setZero(nq);
   }
-  R_pi.assign(nb, Mat3::Identity());
-  p_pi.assign(nb, Vec3::Zero());
+  X.assign(nb, Mat6::Identity());
   E_wi.assign(nb, Mat4::Identity());
   phi.assign(nb, Vec6::Zero());
   c.assign(nb, Vec6::Zero());
@@ -145,24 +141,31 @@ bool articulatedBodyForward(const Model& model, const State& s, const VecX& tau,
   // pass 1, root first: poses, twists, velocity-product accelerations c_i and bias forces
   //   phi_i = X_i phi_p + S_i qdot_i,  c_i = -ad(psi_i) X_i phi_p + Ad_ij Sdot qdot_i
   //   pA_i = -ad(phi_i)^T M_i phi_i - Gamma(com)^T R^T m g      (as recursiveIdForward)
-  Vec6 psi;
   for (int i = 0; i < nb; ++i) {
     const JointSlot& sl = model.joints()[i];
-    recursiveJointStep(model, i, s, fw.R_im[i], fw.p_im[i], fw.jk[i], fw.R_pi[i], fw.p_pi[i], fw.E_wi, fw.S[i],
-                       psi, fw.c[i]);
+    JointKinematics& jk = fw.jk[i];
+    sl.joint.calc(s.q.segment(sl.q_index, sl.nq), s.qdot.segment(sl.q_index, sl.nq), jk);
+    const Mat4 E_pi = sl.E_pf * jk.Q * sl.E_mi;
+    fw.X[i] = AdInv(E_pi);
+    fw.S[i].noalias() = fw.Ad_ij[i] * jk.S;
+    const auto qd = s.qdot.segment(sl.q_index, sl.nq);
+    const Vec6 psi = fw.S[i] * qd;
+    fw.c[i].noalias() = fw.Ad_ij[i] * (jk.Sdot * qd);
     if (sl.parent >= 0) {
-      const Vec6 phi_pi = adjointInvTimes(fw.R_pi[i], fw.p_pi[i], fw.phi[sl.parent]);
+      const int p = sl.parent;
+      fw.E_wi[i].noalias() = fw.E_wi[p] * E_pi;
+      const Vec6 phi_pi = fw.X[i] * fw.phi[p];
       fw.phi[i] = phi_pi + psi;
-      fw.c[i] -= adTimes(psi, phi_pi);
+      fw.c[i].noalias() -= ad(psi) * phi_pi;
     } else {
+      fw.E_wi[i] = E_pi;
       fw.phi[i] = psi;
     }
     const Body& b = model.bodies()[i];
     const Vec3 g_i = fw.E_wi[i].topLeftCorner<3, 3>().transpose() * (b.mass * model.gravity());
     fw.IA[i] = b.M;
-    fw.pA[i] = -adTransposeTimes(fw.phi[i], b.M * fw.phi[i]);
-    fw.pA[i].head<3>() -= b.com.cross(g_i);
-    fw.pA[i].tail<3>() -= g_i;
+    fw.pA[i].noalias() = -(ad(fw.phi[i]).transpose() * (b.M * fw.phi[i]));
+    fw.pA[i].noalias() -= Gamma(b.com).transpose() * g_i;
   }
   // pass 2, leaves first: articulated inertias and bias forces handed to the parents
   for (int i = nb - 1; i >= 0; --i) {
@@ -193,17 +196,15 @@ bool articulatedBodyForward(const Model& model, const State& s, const VecX& tau,
     if (sl.parent < 0) continue;
     pa.noalias() += Ia * fw.c[i];
     const int p = sl.parent;
-    // X^T Ia X with X = Ad(E_pi^-1): the 6 x 6 congruence (its (R, p) form is left for later)
-    const Mat6 X = AdInv(makeE(fw.R_pi[i], fw.p_pi[i]));
-    fw.IA[p].noalias() += X.transpose() * (Ia * X);
-    fw.pA[p] += adjointInvTransposeTimes(fw.R_pi[i], fw.p_pi[i], pa);
+    fw.IA[p].noalias() += fw.X[i].transpose() * (Ia * fw.X[i]);
+    fw.pA[p].noalias() += fw.X[i].transpose() * pa;
   }
   // pass 3, root first: accelerations (the world does not accelerate; gravity is a force above)
   qddot.resize(model.nr());
   for (int i = 0; i < nb; ++i) {
     const JointSlot& sl = model.joints()[i];
     Vec6 ap = fw.c[i];
-    if (sl.parent >= 0) ap += adjointInvTimes(fw.R_pi[i], fw.p_pi[i], fw.a[sl.parent]);
+    if (sl.parent >= 0) ap.noalias() += fw.X[i] * fw.a[sl.parent];
     if (sl.nq > 0) {
       auto qdd = qddot.segment(sl.q_index, sl.nq);
       VecJ r = fw.u[i];

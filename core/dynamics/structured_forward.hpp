@@ -50,10 +50,8 @@ struct StructuredForwardWorkspace {
   MatX LD;                           // L (strictly lower) and D (diagonal)               (n x n)
   // ABA
   std::vector<JointKinematics> jk;   // per joint Q, S, Sdot                              (nb)
-  std::vector<Mat3> R_im;            // joint frame M in body i: rotation (constant)      (nb)
-  std::vector<Vec3> p_im;            //   and translation (constant)                      (nb)
-  std::vector<Mat3> R_pi;            // body i in its parent body: rotation                (nb)
-  std::vector<Vec3> p_pi;            //   and translation                                 (nb)
+  std::vector<Mat6> Ad_ij;           // Ad of joint frame M in body i (constant)          (nb)
+  std::vector<Mat6> X;               // Ad of the parent body frame in body i             (nb)
   std::vector<Mat6X> S, U;           // S_i, U_i = IA_i S_i                                (nb, 6 x nq)
   std::vector<MatJ> Dinv;            // (S_i^T IA_i S_i)^-1                                (nb, nq x nq)
   std::vector<VecJ> u;               // tau_i - S_i^T pA_i                                 (nb, nq)

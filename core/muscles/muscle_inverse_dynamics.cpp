@@ -61,14 +61,13 @@ void calcBodyWorldMotion(const BodyMotion& motion, std::vector<BodyWorldMotion>&
   }
 }
 
-void addWorldWrenches(const std::vector<BodyWorldMotion>& bodies, std::vector<Vec6>& w_world,
+void addWorldWrenches(const std::vector<BodyWorldMotion>& bodies, const std::vector<Vec6>& w_world,
                       std::vector<Vec6>& wrench) {
   for (size_t b = 0; b < w_world.size(); ++b) {
-    Vec6& w = w_world[b];
+    const Vec6& w = w_world[b];
     if (w.isZero(0.0)) continue;
     wrench[b].head<3>().noalias() += bodies[b].R.transpose() * w.head<3>();
     wrench[b].tail<3>().noalias() += bodies[b].R.transpose() * w.tail<3>();
-    w.setZero();
   }
 }
 

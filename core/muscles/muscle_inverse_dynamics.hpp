@@ -66,8 +66,8 @@ struct BodyWorldMotion {
 /// out[b] for every body of `motion`
 void calcBodyWorldMotion(const BodyMotion& motion, std::vector<BodyWorldMotion>& out);
 /// wrench[b] += the world-axes wrench w_world[b] (torque about the body origin; force) in body
-/// coordinates, for every body; w_world is zeroed for the next pass
-void addWorldWrenches(const std::vector<BodyWorldMotion>& bodies, std::vector<Vec6>& w_world,
+/// coordinates, for every body
+void addWorldWrenches(const std::vector<BodyWorldMotion>& bodies, const std::vector<Vec6>& w_world,
                       std::vector<Vec6>& wrench);
 
 /// Adds the mass points' share of inverse dynamics of one Type I or II muscle (no wrap objects):
