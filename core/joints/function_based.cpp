@@ -13,17 +13,6 @@ using Mat3X = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 6>;
 const char* kAxisNames[6] = {"rotation1", "rotation2", "rotation3",
                              "translation1", "translation2", "translation3"};
 
-// rotation about a unit axis (the constructor normalises every axis): Rodrigues' c I + s [a] +
-// (1 - c) a a^T directly, without expSO3's norm and W^2 product (three per joint per frame)
-Mat3 unitAxisRotation(const Vec3& a, double angle) {
-  if (angle == 0.0) return Mat3::Identity();
-  const double s = std::sin(angle), c = std::cos(angle), t = 1.0 - c;
-  Mat3 R;
-  R << c + t * a.x() * a.x(), t * a.x() * a.y() - s * a.z(), t * a.x() * a.z() + s * a.y(),
-       t * a.x() * a.y() + s * a.z(), c + t * a.y() * a.y(), t * a.y() * a.z() - s * a.x(),
-       t * a.x() * a.z() - s * a.y(), t * a.y() * a.z() + s * a.x(), c + t * a.z() * a.z();
-  return R;
-}
 }  // namespace
 
 FunctionBased::FunctionBased(int nq, std::array<TransformAxis, 6> axes, bool compat)
@@ -150,9 +139,9 @@ void FunctionBased::calcSimbody(const VecJ& q, const VecJ& qdot, JointKinematics
     Fqdot.row(k) = gd.transpose();
   }
   const Vec3 a1 = axes_[0].axis, a2 = axes_[1].axis, a3 = axes_[2].axis;
-  const Mat3 R1 = unitAxisRotation(a1, v[0]);
-  const Mat3 R12 = R1 * unitAxisRotation(a2, v[1]);
-  const Mat3 R = R12 * unitAxisRotation(a3, v[2]);
+  const Mat3 R1 = rotationUnitAxis(a1, v[0]);
+  const Mat3 R12 = R1 * rotationUnitAxis(a2, v[1]);
+  const Mat3 R = R12 * rotationUnitAxis(a3, v[2]);
   Mat3 At;
   At << axes_[3].axis, axes_[4].axis, axes_[5].axis;
   out.resize(n);
@@ -168,8 +157,8 @@ void FunctionBased::calcSimbody(const VecJ& q, const VecJ& qdot, JointKinematics
   const bool const2 = axes_[1].coordinates.empty() && v[1] != 0.0;
   if (const1 || const2) {
     auto angleForH = [&](int k) { return axes_[k].coordinates.empty() ? 0.0 : v[k]; };
-    const Mat3 R1h = unitAxisRotation(a1, angleForH(0));
-    Wh << a1, R1h * a2, R1h * unitAxisRotation(a2, angleForH(1)) * a3;
+    const Mat3 R1h = rotationUnitAxis(a1, angleForH(0));
+    Wh << a1, R1h * a2, R1h * rotationUnitAxis(a2, angleForH(1)) * a3;
   }
 
   // column by column in fixed-size 3-vectors (the 3 x n dynamic products were most of the cost)

@@ -162,6 +162,16 @@ Mat3 rotationAxisAngle(const Vec3& unit_axis, double angle) {
   return expSO3(unit_axis * angle);
 }
 
+Mat3 rotationUnitAxis(const Vec3& a, double angle) {
+  if (angle == 0.0) return Mat3::Identity();
+  const double s = std::sin(angle), c = std::cos(angle), t = 1.0 - c;
+  Mat3 R;
+  R << c + t * a.x() * a.x(), t * a.x() * a.y() - s * a.z(), t * a.x() * a.z() + s * a.y(),
+       t * a.x() * a.y() + s * a.z(), c + t * a.y() * a.y(), t * a.y() * a.z() - s * a.x(),
+       t * a.x() * a.z() - s * a.y(), t * a.y() * a.z() + s * a.x(), c + t * a.z() * a.z();
+  return R;
+}
+
 Mat6 spatialInertia(double mass, const Vec3& com, const Mat3& inertia_com) {
   const Mat3 C = skew(com);
   Mat6 M;

@@ -92,6 +92,10 @@ Mat3 leftJacobianSO3(const Vec3& w);
 
 /// rotation about a unit axis by angle
 Mat3 rotationAxisAngle(const Vec3& unit_axis, double angle);
+/// the same by Rodrigues' c I + s [a] + (1 - c) a a^T directly (no norm, no W^2 product): equal to
+/// rotationAxisAngle to round-off, but not bit for bit, so only callers whose results may move at
+/// round-off use it (CustomJoint rotations; revolute joints keep expSO3, docs/notes.md)
+Mat3 rotationUnitAxis(const Vec3& unit_axis, double angle);
 
 /// spatial inertia about the body origin from mass, centre of mass c (body frame) and the
 /// 3x3 inertia tensor about the COM in body axes: [[I_c + m[c][c]^T, m[c]], [m[c]^T, m I]]

@@ -55,16 +55,17 @@ TEST_F(Se3Test, RotationTranslationProductsEqualTheSixBySixMatrices) {
 }
 
 TEST_F(Se3Test, RotationAboutAUnitAxisEqualsTheExponential) {
-  // rotationAxisAngle's direct Rodrigues form against expSO3 (its Taylor branch included)
+  // rotationUnitAxis's direct Rodrigues form against expSO3 (its Taylor branch included)
   double worst = 0.0;
   for (double angle : {0.0, 1e-9, -3e-5, 2e-4, 0.7, -2.5, 3.14159, 6.0})
     for (int k = 0; k < 5; ++k) {
       const Vec3 axis = rvec().normalized();
-      const Mat3 R = rotationAxisAngle(axis, angle);
+      const Mat3 R = rotationUnitAxis(axis, angle);
       worst = std::max(worst, (R - expSO3(axis * angle)).cwiseAbs().maxCoeff());
       EXPECT_LE((R * R.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff(), 1e-15);
     }
   EXPECT_LE(worst, 1e-15);
+  EXPECT_EQ(rotationUnitAxis(Vec3::UnitX(), 0.0), Mat3::Identity());
   EXPECT_EQ(rotationAxisAngle(Vec3::UnitX(), 0.0), Mat3::Identity());
 }
 
