@@ -9,7 +9,12 @@
 #include <stdexcept>
 
 #include "core/deformable/deformable_term.hpp"
+#include "core/dynamics/controller.hpp"
+#include "core/dynamics/muscle_force_term.hpp"
+#include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/system.hpp"
+#include "core/muscles/hill/factory.hpp"
+#include "core/skeleton/kinematics.hpp"
 #include "core/integrators/integrator.hpp"
 #include "validation/scenes/scene_io.hpp"
 
@@ -143,13 +148,94 @@ DeformableRun runSoftPendulum(const SoftPendulumOptions& opt) {
   return run;
 }
 
-std::vector<std::string> deformableSceneNames() { return {"cantilever", "strand", "soft-pendulum"}; }
+SoftInsertionRun runSoftInsertion(const SoftInsertionOptions& opt) {
+  if (opt.refinement < 1) throw std::invalid_argument("soft-insertion: refinement must be >= 1");
+  const int k = opt.refinement;
+  System sys(singlePendulum());
+  const Model& model = sys.model();
+  const TetMesh mesh = makeBoxTetMesh(Vec3(0.2, 0.1, 0.1), 2 * k, k, k, Vec3(-0.1, -1.1, -0.05));
+  DeformableBody body = makeFemBody(mesh, opt.E, opt.nu, opt.rho);
+  body.rayleigh_mass = opt.rayleigh_mass;
+  body.rayleigh_stiffness = opt.rayleigh_stiffness;
+  std::vector<NodeAttachment> att;
+  for (int n = 0; n < mesh.numNodes(); ++n)
+    if (opt.rigid || mesh.nodes[n].y() > -1.0 - 1e-12) att.push_back({n, 0});
+  auto term = addDeformableBody(sys, body, att);
+  SoftInsertionRun out;
+  for (int n = 0; n < mesh.numNodes(); ++n)
+    if ((mesh.nodes[n] - Vec3(0.1, -1.1, -0.05)).norm() < 1e-12) out.insertion_node = n;
+  if (out.insertion_node < 0) throw std::logic_error("soft-insertion: no node at the insertion");
+  // the muscle: from a world point up and to the side to the block's far bottom edge
+  Muscle mu;
+  mu.name = "soft_flexor";
+  mu.path.points = {makeFixedPoint(-1, Vec3(0.4, -0.3, 0.0), "origin"),
+                    musclePointAtNode(*term, out.insertion_node, "insertion")};
+  mu.optimal_fiber_length = opt.optimal_fiber_length;
+  mu.tendon_slack_length = opt.tendon_slack_length;
+  MassPointOptions mpo;
+  mpo.count = opt.mass_points;
+  mu.mass_points = makeMassPoints(opt.muscle_mass, opt.optimal_fiber_length, opt.tendon_slack_length, mpo);
+  hill::MuscleParameters par;
+  par.name = mu.name;
+  par.set("max_isometric_force", opt.max_isometric_force);
+  par.set("optimal_fiber_length", opt.optimal_fiber_length);
+  par.set("tendon_slack_length", opt.tendon_slack_length);
+  par.set("pennation_angle_at_optimal", 0.0);
+  const auto hill_model = hill::makeMuscleModel("Thelen2003Muscle", par);
+  sys.addTerm(std::make_shared<MuscleTerm>(model, std::vector<Muscle>{mu}));
+  auto force = std::make_shared<MuscleForceTerm>(model, std::vector<Muscle>{mu},
+                                                 std::vector<std::shared_ptr<const hill::MuscleModel>>{hill_model});
+  sys.addTerm(force);
+  const int force_term = static_cast<int>(sys.terms().size()) - 1;
+  sys.addController(std::make_shared<PrescribedControls>(
+      "excitation", std::vector<PrescribedControls::Entry>{{0, std::make_shared<ConstantFunction>(opt.excitation, 1)}}));
+
+  State s = sys.defaultState();
+  term->setRestState(model, s, 0);
+  DynamicsWorkspace ws(sys);
+  sys.equilibrateStates(s, ws);
+  IntegratorOptions io;
+  io.dt = opt.dt;
+  io.rtol = opt.tolerance;
+  io.atol = 1e-2 * opt.tolerance;
+  auto integ = makeIntegrator(opt.integrator, io);
+  SkeletonWorkspace sk(model);
+  DeformableRun& run = out.run;
+  const Vec3 X_ins = mesh.nodes[out.insertion_node];
+  const int frames = static_cast<int>(std::llround(opt.duration / opt.frame_interval));
+  for (int f = 0; f <= frames; ++f) {
+    if (f > 0) integ->advance(sys, s, f * opt.frame_interval);
+    run.t.push_back(s.t);
+    run.q.push_back(s.q);
+    run.energy.push_back(sys.kineticEnergy(s, ws) + sys.potentialEnergy(s, ws));
+    calcKinematics(model, s, sk);
+    const VecX x = term->nodePositions(model, s, TermContext(sk));
+    run.nodes.push_back(toPoints(x));
+    // where the link would carry the insertion node from its rest position (the link's pose at
+    // the default configuration is the identity)
+    const Vec3 carried = transformPoint(sk.E_wi[0], X_ins);
+    out.insertion_offset.push_back((x.segment<3>(3 * out.insertion_node) - carried).norm());
+    TermContext ctx(sk, nullptr, 0);  // (the tendon force follows the states, not the excitation)
+    ctx.z_offset = sys.stateOffset(force_term);
+    out.tendon_force.push_back(force->calcOutput(model, s, ctx, 0).tendon_force);
+  }
+  run.mesh = mesh;
+  for (int i = 0; i < model.nr(); ++i) run.coordinates.push_back(model.coordinates()[i].name);
+  run.coordinates.resize(sys.ndof());
+  for (size_t n = 0; n < term->nodes().size(); ++n)
+    if (term->nodes()[n].kind == NodeBinding::Kind::Free)
+      for (int c = 0; c < 3; ++c) run.coordinates[term->nodes()[n].index + c] = "node" + std::to_string(n) + "_" + "xyz"[c];
+  return out;
+}
+
+std::vector<std::string> deformableSceneNames() { return {"cantilever", "strand", "soft-pendulum", "soft-insertion"}; }
 
 void runDeformableScene(const std::string& name, const std::string& out_dir, std::ostream& summary) {
   namespace fs = std::filesystem;
   bool known = false;
   for (const auto& n : deformableSceneNames()) known = known || n == name;
-  if (!known) throw std::invalid_argument("unknown scene '" + name + "' (expected cantilever, strand or soft-pendulum)");
+  if (!known)
+    throw std::invalid_argument("unknown scene '" + name + "' (expected cantilever, strand, soft-pendulum or soft-insertion)");
   const fs::path dir(out_dir);
   fs::create_directories(dir);
   summary << std::setprecision(6);
@@ -184,6 +270,28 @@ void runDeformableScene(const std::string& name, const std::string& out_dir, std
             << " J, integrator " << opt.integrator << ", dt " << opt.dt << " s, " << opt.duration << " s\n";
     summary << "energy " << run.energy.front() << " J at t = 0, " << run.energy.back() << " J at t = " << run.t.back()
             << " s, largest change " << worst << " J\n";
+  } else if (name == "soft-insertion") {
+    SoftInsertionOptions opt;
+    const SoftInsertionRun soft = runSoftInsertion(opt);
+    SoftInsertionOptions rigid = opt;
+    rigid.rigid = true;
+    const SoftInsertionRun ref = runSoftInsertion(rigid);
+    run = soft.run;
+    double worst = 0, offset = 0, peak = 0, peak_rigid = 0;
+    for (size_t k = 0; k < run.t.size(); ++k) {
+      worst = std::max(worst, std::abs(run.q[k][0] - ref.run.q[k][0]));
+      offset = std::max(offset, soft.insertion_offset[k]);
+      peak = std::max(peak, soft.tendon_force[k]);
+      peak_rigid = std::max(peak_rigid, ref.tendon_force[k]);
+    }
+    summary << "soft-insertion: Thelen2003 muscle (" << opt.max_isometric_force << " N, " << opt.muscle_mass
+            << " kg on " << opt.mass_points << " mass points) inserting on node " << soft.insertion_node << " of a soft block of "
+            << run.mesh.numNodes() << " nodes, E " << opt.E << " Pa, excitation " << opt.excitation << ", integrator "
+            << opt.integrator << ", dt " << opt.dt << " s, " << opt.duration << " s\n";
+    summary << "link angle " << run.q.back()[0] << " rad at t = " << run.t.back() << " s, rigid insertion "
+            << ref.run.q.back()[0] << " rad, largest difference " << worst << " rad\n";
+    summary << "largest tendon force " << peak << " N (rigid insertion " << peak_rigid
+            << " N), largest insertion displacement from the link's carry " << offset << " m\n";
   } else {
     SoftPendulumOptions opt;
     run = runSoftPendulum(opt);

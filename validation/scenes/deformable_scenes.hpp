@@ -72,6 +72,33 @@ struct SoftPendulumOptions {
 };
 DeformableRun runSoftPendulum(const SoftPendulumOptions& opt);
 
+/// A muscle inserting on soft tissue (issue 24): singlePendulum() with a soft block on its tip (as
+/// SoftPendulumOptions), and a Thelen2003 muscle from a point fixed in the world to a free node at
+/// the block's far bottom corner, with inertial mass points (Type I chain through the node's
+/// coordinates, musclePointAtNode). From rest, constant excitation: the muscle pulls the soft
+/// tissue, which deforms and swings the link. `rigid` attaches every node to the link (the
+/// insertion is then a point of the link): the rigid limit of the same masses.
+struct SoftInsertionOptions {
+  double E = 2e5, nu = 0.3, rho = 1000.0;
+  double rayleigh_mass = 1.0, rayleigh_stiffness = 0.0;
+  int refinement = 2;
+  bool rigid = false;
+  double excitation = 0.5;
+  double max_isometric_force = 300.0, optimal_fiber_length = 0.3, tendon_slack_length = 0.5;  // N, m, m
+  double muscle_mass = 0.2;  // kg, spread over the fibre's share of the path
+  int mass_points = 10;
+  double dt = 1e-3, duration = 0.6, frame_interval = 0.02;
+  std::string integrator = "bdf1";
+  double tolerance = 1e-8;  // rtol of adaptive integrators (atol 1e-2 of it)
+};
+struct SoftInsertionRun {
+  DeformableRun run;
+  std::vector<double> tendon_force;      // N, at each output
+  std::vector<double> insertion_offset;  // m: the insertion node's distance from where the link would carry it
+  int insertion_node = -1;
+};
+SoftInsertionRun runSoftInsertion(const SoftInsertionOptions& opt);
+
 /// the names `redmax scene` accepts
 std::vector<std::string> deformableSceneNames();
 
