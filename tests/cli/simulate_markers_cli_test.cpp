@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -182,6 +183,14 @@ TEST_F(SimulateMarkersCli, BadInputExitsTwoWithAClearMessageAndWritesNothing) {
   // out of reach: 2 m below the pin of a 1 m pendulum, 1 m from the nearest reachable point
   std::ofstream(path("far.trc")) << trcText("tip", grid(0.01, 100), [](double) { return redmax::Vec3(0, -2, 0); });
   std::ofstream(path("bad.trc")) << "PathFileType\t4\t(X/Y/Z)\tbad.trc\nDataRate\n";
+  // a marker on ground: a model error, named at the marker's line of the .osim
+  std::string grounded = pendulumOsim(1);
+  const std::string on_link = "<socket_parent_frame>/bodyset/link1</socket_parent_frame><location>0 -0.5 0";
+  grounded.replace(grounded.find(on_link), on_link.size(), "<socket_parent_frame>/ground</socket_parent_frame><location>0 -0.5 0");
+  std::ofstream(path("grounded.osim")) << grounded;
+  const std::string mid_line =
+      std::to_string(1 + std::count(grounded.begin(), grounded.begin() + grounded.find("<Marker name=\"mid\""), '\n'));
+  std::ofstream(path("mid.trc")) << trcText("mid", grid(0.01, 100), [](double) { return redmax::Vec3(0, -0.5, 0); });
   const std::string model = "--model " + path("p1.osim");
   const std::string out = " --out " + path("never.sto") + " --prescribed-forces " + path("never_f.sto");
   const std::string hold = " --prescribe-markers " + path("hold.trc");
@@ -195,6 +204,8 @@ TEST_F(SimulateMarkersCli, BadInputExitsTwoWithAClearMessageAndWritesNothing) {
       {model + hold + " --duration 1.5" + out, "the run spans [0, 1.5] s, outside the marker file's [0, 1] s"},
       {model + " --prescribe-markers " + path("bad.trc") + " --duration 1" + out, path("bad.trc") + ":2: "},
       {model + " --prescribe-markers " + path("missing.trc") + " --duration 1" + out, "missing.trc"},
+      {"--model " + path("grounded.osim") + " --prescribe-markers " + path("mid.trc") + " --duration 1" + out,
+       "grounded.osim:" + mid_line + ": marker 'mid' is on 'ground', which has no moving body in the core model"},
       {model + hold + " --duration 1 --engine simbody" + out, "--prescribe-markers needs --engine core"},
       {model + " --duration 1 --prescribe-marker-names tip" + out, "--prescribe-marker-names needs --prescribe-markers"},
       {model + hold + " --prescribe " + path("q.mot") + " --duration 1" + out, "cannot be combined"},

@@ -88,7 +88,10 @@ MarkerPrescription prescribeMarkers(SimulationModel& m, const osim::MarkerTable&
     const osim::MarkerDesc& mk = d.markers[k];
     const int db = d.findBody(mk.body);
     const int body = db >= 0 && db < static_cast<int>(m.build.body_index.size()) ? m.build.body_index[db] : -1;
-    if (body < 0) fail(mk.line, "marker '" + mk.name + "' is on '" + mk.body + "', which does not move (ground)");
+    if (body < 0)  // a model error: named at the marker's line of the .osim
+      throw osim::ConvertError(d.source_file, mk.line,
+                               "marker '" + mk.name + "' is on '" + mk.body +
+                                   "', which has no moving body in the core model (ground, or a loop's split body)");
     // no gap where the run needs the marker; then as many gap-free rows around it as the file has
     for (int r = lo; r <= hi; ++r)
       if (!trc.present(r, c))
