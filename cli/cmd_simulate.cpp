@@ -19,6 +19,8 @@
 #include "core/muscles/wrap/network_model.hpp"
 #include "validation/forward/forward_tool.hpp"
 #include "validation/report/progress.hpp"
+#include "converter/trc_file.hpp"
+#include "validation/simulate/prescribe_markers.hpp"
 #include "validation/simulate/prescribe_motion.hpp"
 #include "validation/simulate/simulate.hpp"
 #include "validation/simulate/simulate_simbody.hpp"
@@ -31,7 +33,7 @@ const std::vector<std::string> kIntegrators = {"euler", "symplectic", "bdf1", "s
 
 struct SimulateFlags {
   std::string model, out, initial, muscle_mass_kg, impulse, engine = "core", controls;
-  std::string prescribe, prescribe_coordinates, prescribed_forces;
+  std::string prescribe, prescribe_coordinates, prescribed_forces, prescribe_markers, prescribe_marker_names;
   double prescribe_lowpass = -1.0;
   validation::SimulateOptions so;
   double initial_time = 0.0;
@@ -51,9 +53,18 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
     if (given(app, n) && engine != "simbody") throw UsageError{std::string(n) + " needs --engine simbody"};
   if (given(app, "--controls") && engine != "core") throw UsageError{"--controls needs --engine core"};
   const bool prescribing = given(app, "--prescribe");
+  const bool markers = given(app, "--prescribe-markers");
   if (prescribing && engine != "core") throw UsageError{"--prescribe needs --engine core"};
-  for (const char* n : {"--prescribe-coordinates", "--prescribe-lowpass", "--prescribed-forces"})
-    if (given(app, n) && !prescribing) throw UsageError{std::string(n) + " needs --prescribe MOTION"};
+  if (markers && engine != "core") throw UsageError{"--prescribe-markers needs --engine core"};
+  if (prescribing && markers)
+    throw UsageError{"--prescribe and --prescribe-markers cannot be combined yet (docs/deformable.md §7)"};
+  if (given(app, "--prescribe-coordinates") && !prescribing)
+    throw UsageError{"--prescribe-coordinates needs --prescribe MOTION"};
+  if (given(app, "--prescribe-marker-names") && !markers)
+    throw UsageError{"--prescribe-marker-names needs --prescribe-markers TRIAL.trc"};
+  for (const char* n : {"--prescribe-lowpass", "--prescribed-forces"})
+    if (given(app, n) && !prescribing && !markers)
+      throw UsageError{std::string(n) + " needs --prescribe MOTION or --prescribe-markers TRIAL.trc"};
   // hard unilateral constraints: only bdf1 solves the contact QP (docs/contact.md §6)
   const bool hard = given(app, "--joint-limits") || f.contact == "hard";
   if (given(app, "--limit-restitution") && !given(app, "--joint-limits"))
@@ -85,6 +96,8 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   // model and initial state: every problem here is the user's input (exit 2)
   validation::SimulationModel model;
   validation::MotionPrescription prescription;
+  validation::MarkerPrescription marker_prescription;
+  validation::MarkerStart marker_start;
   State initial;
   std::vector<std::string> control_warnings, not_applied;
   validation::HardConstraintSummary hard_made;
@@ -133,6 +146,29 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
         throw osim::ConvertError(f.prescribe, 0, os.str());
       }
       validation::applyPrescription(model, prescription, initial);
+    }
+    if (markers) {
+      // markers follow the file (validation/simulate/prescribe_markers.hpp): the window is known now
+      const osim::MarkerTable trc = osim::readTrc(f.prescribe_markers);
+      if (!given(app, "--initial") && !trc.time.empty()) initial.t = trc.time.front();
+      validation::MarkerPrescriptionOptions po;
+      if (given(app, "--prescribe-marker-names")) po.markers = splitList(f.prescribe_marker_names, ",");
+      po.lowpass_cutoff_hz = f.prescribe_lowpass;
+      po.t_begin = initial.t;
+      po.t_end = initial.t + so.duration;
+      marker_prescription = validation::prescribeMarkers(model, trc, f.prescribe_markers, po);
+      for (const auto& w : marker_prescription.warnings) control_warnings.push_back(w);
+      marker_start = validation::applyMarkerPrescription(model, marker_prescription, f.prescribe_markers, initial);
+      const validation::MarkerPrescription& mp = marker_prescription;
+      if (mp.rows > marker_start.independent_rows || mp.rows > mp.free_coordinates) {
+        std::ostringstream os;
+        os << f.prescribe_markers << ": " << mp.rows << " marker rows on " << mp.free_coordinates
+           << " free coordinates, " << marker_start.independent_rows
+           << " of the rows independent at the start: the others are met with the minimum-norm forces (only the "
+              "components the coordinates feel) and a path the model cannot follow in the least-squares sense "
+              "(the summary gives the largest distance)";
+        control_warnings.push_back(os.str());
+      }
     }
   } catch (const osim::ConvertError& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -188,6 +224,9 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   if (prescribing) {
     prescribed_forces = std::make_unique<validation::PrescribedForceRecorder>(model, prescription);
     so.check = prescribed_forces->check(so.check);
+  } else if (markers) {
+    prescribed_forces = std::make_unique<validation::PrescribedForceRecorder>(model, marker_prescription);
+    so.check = prescribed_forces->check(so.check);
   }
   const std::clock_t cpu_start = std::clock();
   validation::SimulationResult res;
@@ -230,8 +269,12 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
          << "\n";
     if (prescribed_forces && given(app, "--prescribed-forces")) {
       std::ostringstream pd;
-      pd << "redmax simulate: generalized forces of the coordinates prescribed by " << f.prescribe << " ("
-         << model_path << ")\n";
+      if (markers)
+        pd << "redmax simulate: world forces (N) at the markers prescribed by " << f.prescribe_markers
+           << ", then the generalized forces they take (" << model_path << ")\n";
+      else
+        pd << "redmax simulate: generalized forces of the coordinates prescribed by " << f.prescribe << " ("
+           << model_path << ")\n";
       osim::writeResultStorage(f.prescribed_forces, prescribed_forces->table(), f.full_precision, pd.str());
     }
     osim::writeResultStorage(out_path, res.states, f.full_precision, desc.str());
@@ -245,7 +288,15 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
                 so.duration, (simbody_flags.method.empty() ? so.integrator : simbody_flags.method).c_str(), engine.c_str(), res.stats.steps, res.stats.rhs_evals,
                 res.stats.failed_steps, res.wall_s, cpu_s, res.energy_initial, res.energy_final, res.energy_drift_rel, res.energy_drift_abs,
                 out_path.c_str());
-    if (prescribed_forces) {
+    if (prescribed_forces && markers) {
+      // per marker: the largest force it took and how far it got from its trajectory (output rows)
+      const validation::MarkerPrescription& mp = marker_prescription;
+      std::printf("prescribed from %s: %zu markers", f.prescribe_markers.c_str(), mp.markers.size());
+      for (size_t k = 0; k < mp.markers.size(); ++k)
+        std::printf("%s %s max |F| %.4g N, max distance %.3g m", k == 0 ? ";" : ",", mp.markers[k].c_str(),
+                    prescribed_forces->markerPeakForce()[k], prescribed_forces->markerPeakDistance()[k]);
+      std::printf("%s\n", given(app, "--prescribed-forces") ? (" -> " + f.prescribed_forces).c_str() : "");
+    } else if (prescribed_forces) {
       // the largest generalized force each prescription took
       std::printf("prescribed from %s: %zu coordinates", f.prescribe.c_str(), prescription.coordinates.size());
       const osim::Storage& t = prescribed_forces->table();
@@ -373,14 +424,29 @@ CommandRegistration reg(
                       "with --prescribe: only these coordinates (default: every free coordinate the\n"
                       "motion has a column for)")
            ->type_name("C1,C2,...");
+       app.add_option("--prescribe-markers", f->prescribe_markers,
+                      "maximal inverse dynamics: markers of the model's MarkerSet follow this\n"
+                      "OpenSim marker file (.trc, mm or m) exactly, each a natural quintic spline of\n"
+                      "its samples; the coordinates start solved onto the markers (refused if a\n"
+                      "marker stays over 1e-6 m off), then move forward; a gap in the run's window is\n"
+                      "refused; the run starts at the file's first time (or --initial's) and may not\n"
+                      "run past its last; not with --prescribe")
+           ->type_name("TRIAL.trc");
+       app.add_option("--prescribe-marker-names", f->prescribe_marker_names,
+                      "with --prescribe-markers: only these markers (default: every marker of the\n"
+                      "model the file has)")
+           ->type_name("A,B,...");
        app.add_option("--prescribe-lowpass", f->prescribe_lowpass,
-                      "with --prescribe: low-pass cutoff (Hz) before the splines, as the ID tool's\n"
-                      "lowpass_cutoff_frequency_for_coordinates (default: none)")
+                      "with --prescribe or --prescribe-markers: low-pass cutoff (Hz) before the\n"
+                      "splines, as the ID tool's lowpass_cutoff_frequency_for_coordinates (default:\n"
+                      "none)")
            ->type_name("HZ");
        app.add_option("--prescribed-forces", f->prescribed_forces,
                       "with --prescribe: write the generalized force each prescription takes at every\n"
                       "output row (columns <coord>_moment / <coord>_force, as redmax id names them;\n"
-                      "with every coordinate prescribed they are the motion's inverse dynamics)")
+                      "with every coordinate prescribed they are the motion's inverse dynamics); with\n"
+                      "--prescribe-markers: each marker's world force (<marker>_fx/_fy/_fz, N), then\n"
+                      "the generalized force the markers take on every coordinate")
            ->type_name("FORCES.sto");
        app.add_option("--joint-limits", f->joint_limits,
                       "enforce coordinate ranges as hard unilateral constraints: every coordinate's\n"
@@ -422,6 +488,8 @@ CommandRegistration reg(
            "                       [--initial STATE.sto [--initial-time T]] [--controls FILE]\n"
            "                       [--prescribe MOTION [--prescribe-coordinates LIST] [--prescribe-lowpass HZ]\n"
            "                        [--prescribed-forces FORCES.sto]]\n"
+           "                       [--prescribe-markers TRIAL.trc [--prescribe-marker-names A,B,...]\n"
+           "                        [--prescribe-lowpass HZ] [--prescribed-forces FORCES.sto]]\n"
            "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...] [--no-qvv]\n"
            "                       [--impulse TARGET:FX,FY,FZ:DURATION]\n"
            "                       [--engine core|simbody [--simbody-method M] [--simbody-norm rms|inf]]\n"

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "converter/coordinates_file.hpp"
 #include "converter/error.hpp"
 #include "converter/signal/coordinate_pipeline.hpp"
 #include "core/dynamics/constraints/constraint_function.hpp"
 #include "core/dynamics/constraints/prescribed_coordinate.hpp"
+#include "validation/simulate/prescribe_markers.hpp"
 
 namespace redmax::validation {
 
@@ -116,23 +118,62 @@ void applyPrescription(const SimulationModel& m, const MotionPrescription& p, St
 }
 
 PrescribedForceRecorder::PrescribedForceRecorder(const SimulationModel& m, const MotionPrescription& p)
-    : m_(m), p_(p), ws_(std::make_shared<DynamicsWorkspace>(*m.system)) {
+    : m_(m), q_index_(p.q_index), ws_(std::make_shared<DynamicsWorkspace>(*m.system)) {
   table_.name = "Prescribed generalized forces";
   table_.version = 1;
   table_.labels = p.labels;
   table_.data.resize(0, static_cast<Eigen::Index>(p.labels.size()));
 }
 
+PrescribedForceRecorder::PrescribedForceRecorder(const SimulationModel& m, const MarkerPrescription& p)
+    : m_(m), ws_(std::make_shared<DynamicsWorkspace>(*m.system)) {
+  table_.name = "Prescribed marker forces";
+  table_.version = 1;
+  table_.labels = p.labels;
+  table_.data.resize(0, static_cast<Eigen::Index>(p.labels.size()));
+  // each marker's rows in the stacked constraints (the System keeps them in the order added)
+  marker_row_.assign(p.constraints.size(), -1);
+  int row = 0;
+  for (const auto& c : m.system->constraints()) {
+    for (size_t k = 0; k < p.constraints.size(); ++k)
+      if (c.get() == p.constraints[k].get()) marker_row_[k] = row;
+    row += c->rows();
+  }
+  for (int r : marker_row_)
+    if (r < 0) throw std::logic_error("PrescribedForceRecorder: a marker's constraint is not in the system");
+  peak_force_.assign(p.constraints.size(), 0.0);
+  peak_distance_.assign(p.constraints.size(), 0.0);
+}
+
+void PrescribedForceRecorder::record(const State& s) {
+  m_.system->forwardDynamics(s, *ws_);
+  const DynamicsWorkspace& ws = *ws_;
+  const Eigen::Index r = table_.data.rows();
+  table_.data.conservativeResize(r + 1, Eigen::NoChange);
+  if (marker_row_.empty()) {
+    const VecX tau = m_.system->prescribedForces(ws);
+    for (size_t c = 0; c < q_index_.size(); ++c) table_.data(r, static_cast<Eigen::Index>(c)) = tau[q_index_[c]];
+  } else {
+    // lambda is the world force at the marker (prescribed_point.hpp); -G^T lambda its generalized force
+    VecX tau = VecX::Zero(ws.G.cols());
+    Eigen::Index col = 0;
+    for (size_t k = 0; k < marker_row_.size(); ++k) {
+      const Vec3 force = ws.lambda.segment<3>(marker_row_[k]);
+      table_.data.block<1, 3>(r, col) = force.transpose();
+      col += 3;
+      tau.noalias() -= ws.G.middleRows(marker_row_[k], 3).transpose() * force;
+      peak_force_[k] = std::max(peak_force_[k], force.norm());
+      peak_distance_[k] = std::max(peak_distance_[k], ws.pos_err.segment<3>(marker_row_[k]).norm());
+    }
+    table_.data.block(r, col, 1, tau.size()) = tau.transpose();
+  }
+  table_.time.push_back(s.t);
+}
+
 std::function<std::string(const State&, double, double)> PrescribedForceRecorder::check(
     std::function<std::string(const State&, double, double)> previous) {
   return [this, previous](const State& s, double K, double V) -> std::string {
-    m_.system->forwardDynamics(s, *ws_);
-    const VecX tau = m_.system->prescribedForces(*ws_);
-    const Eigen::Index r = table_.data.rows();
-    table_.data.conservativeResize(r + 1, Eigen::NoChange);
-    for (size_t c = 0; c < p_.q_index.size(); ++c)
-      table_.data(r, static_cast<Eigen::Index>(c)) = tau[p_.q_index[c]];
-    table_.time.push_back(s.t);
+    record(s);
     return previous ? previous(s, K, V) : std::string();
   };
 }

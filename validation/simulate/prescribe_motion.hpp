@@ -52,20 +52,34 @@ MotionPrescription prescribeMotion(SimulationModel& m, const osim::Storage& moti
 /// all constraints of m (positions, then velocities)
 void applyPrescription(const SimulationModel& m, const MotionPrescription& p, State& s);
 
-/// Records the generalized force of every prescription at each output row of a run: install it as
-/// SimulateOptions::check (it chains to a check already there). `table()` then holds time and one
-/// column per prescribed coordinate (N m or N), named as `redmax id` names its columns.
+struct MarkerPrescription;  // validation/simulate/prescribe_markers.hpp
+
+/// Records the forces of the prescriptions at each output row of a run: install it as
+/// SimulateOptions::check (it chains to a check already there). `table()` then holds time and
+/// - for a MotionPrescription: one column per prescribed coordinate (N m or N), named as `redmax id`
+///   names its columns;
+/// - for a MarkerPrescription: each marker's world force at the marker (<marker>_fx/_fy/_fz, N),
+///   then the generalized force the markers take together, J^T lambda, on every coordinate
+///   (<coord>_moment / <coord>_force, as above).
 class PrescribedForceRecorder {
  public:
   PrescribedForceRecorder(const SimulationModel& m, const MotionPrescription& p);
+  PrescribedForceRecorder(const SimulationModel& m, const MarkerPrescription& p);
   /// wraps `previous` (may be empty) into a check that records and then calls it
   std::function<std::string(const State&, double, double)> check(
       std::function<std::string(const State&, double, double)> previous = {});
   const osim::Storage& table() const { return table_; }
+  /// markers only: per marker, the largest |force| (N) and the largest distance between the marker
+  /// and its trajectory (m) over the recorded rows
+  const std::vector<double>& markerPeakForce() const { return peak_force_; }
+  const std::vector<double>& markerPeakDistance() const { return peak_distance_; }
 
  private:
+  void record(const State& s);
   const SimulationModel& m_;
-  const MotionPrescription& p_;
+  std::vector<int> q_index_;      // motion: the prescribed coordinates, one column each
+  std::vector<int> marker_row_;   // markers: the first constraint row of each
+  std::vector<double> peak_force_, peak_distance_;
   std::shared_ptr<DynamicsWorkspace> ws_;
   osim::Storage table_;
 };
