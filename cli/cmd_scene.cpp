@@ -57,14 +57,15 @@ struct SceneFlags {
 
 constexpr const char* kSummary =
     "run a deformable-body, hybrid-dynamics, muscle-driven or hard-contact scene (cantilever, strand,\n"
-    "soft-pendulum, hand, starfish, spline-leg, ball-drop, block-slide, box-stack, limit-pendulum)";
+    "soft-pendulum, soft-insertion, hand, starfish, spline-leg, ball-drop, block-slide, box-stack,\n"
+    "limit-pendulum)";
 
 CommandRegistration reg({"scene", kSummary, [](CLI::App& app) {
                            auto f = std::make_shared<SceneFlags>();
                            app.add_option("name", f->name, "the scene")
                                ->required()
-                               ->type_name("cantilever|strand|soft-pendulum|hand|starfish|spline-leg|ball-drop|block-slide|box-stack|\n"
-                                          "limit-pendulum")
+                               ->type_name("cantilever|strand|soft-pendulum|soft-insertion|hand|starfish|spline-leg|ball-drop|\n"
+                                          "block-slide|box-stack|limit-pendulum")
                                ->check(oneOf(sceneNames()));
                            app.add_option("--out", f->out, "output folder (default: ./scene-NAME)")->type_name("DIR");
                            app.add_option("--model", f->model,
@@ -82,6 +83,10 @@ CommandRegistration reg({"scene", kSummary, [](CLI::App& app) {
                                "                 symplectic Euler; prints its energy change\n"
                                "  soft-pendulum  soft FEM block on a swinging rigid link (bdf1, fully implicit\n"
                                "                 coupling) against the same block held rigid\n"
+                               "  soft-insertion a Thelen muscle with mass points inserting on a free node of a soft\n"
+                               "                 block on a hinged link, constant excitation (bdf1), against the\n"
+                               "                 same muscle inserting on the link; prints the angle difference,\n"
+                               "                 the tendon forces and the insertion's displacement\n"
                                "  hand           arm, elbow and four fingers with DIP = 0.5 PIP (hyper-reduced\n"
                                "                 coordinates), fingertips prescribed on circles (maximal\n"
                                "                 inverse dynamics), elbow angle prescribed; prints the largest\n"

@@ -318,4 +318,18 @@ std::shared_ptr<const DeformableTerm> addDeformableBody(System& sys, DeformableB
   return term;
 }
 
+PathPoint musclePointAtNode(const DeformableTerm& term, int node, std::string name) {
+  const auto& nodes = term.nodes();
+  if (node < 0 || node >= static_cast<int>(nodes.size()))
+    throw ModelError("musclePointAtNode: node " + std::to_string(node) + " of a body with " +
+                     std::to_string(nodes.size()) + " nodes");
+  const NodeBinding& b = nodes[static_cast<size_t>(node)];
+  switch (b.kind) {
+    case NodeBinding::Kind::Free: return makeNodePoint(b.index, std::move(name));
+    case NodeBinding::Kind::Body: return makeFixedPoint(b.index, b.point, std::move(name));
+    case NodeBinding::Kind::World: break;
+  }
+  return makeFixedPoint(-1, b.point, std::move(name));
+}
+
 }  // namespace redmax

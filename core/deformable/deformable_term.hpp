@@ -25,6 +25,7 @@
 
 #include "core/deformable/deformable_body.hpp"
 #include "core/dynamics/force_term.hpp"
+#include "core/muscles/path.hpp"
 
 namespace redmax {
 
@@ -100,6 +101,13 @@ class DeformableTerm final : public ForceTerm {
   DeformableTermOptions options_;
   bool has_body_nodes_ = false;
 };
+
+/// A muscle path point at node `node` of `term`'s body, for a muscle that inserts on (or runs
+/// through) soft tissue: a Node point on the node's three coordinates when it is free, the body
+/// point it is fixed to when carried by a body through J_am, a world point when fixed in the world
+/// (core/muscles/path.hpp). The muscle's mass points and force then reach the node's coordinates
+/// through the same chain J_ar = J_ax J_xr as on bones. ModelError for a node out of range.
+PathPoint musclePointAtNode(const DeformableTerm& term, int node, std::string name = "");
 
 /// Which nodes of a deformable body are attached, and to what: body index, or -1 for the world.
 struct NodeAttachment {

@@ -72,7 +72,11 @@ void MuscleForceTerm::evalPath(const Model& model, const State& s, const Skeleto
     calcPathPoints(model, s, sk, path, mk, true);
     const int kc = static_cast<int>(mk.J_xr.cols());
     const int P = static_cast<int>(mk.active.size());
-    auto body = [&](int a) { return path.points[mk.active[a]].body; };
+    // what carries point a: its body (-1 the world), or for a deformable node the node itself
+    auto body = [&](int a) {
+      const PathPoint& pt = path.points[mk.active[a]];
+      return pt.kind == PathPointKind::Node ? -2 - pt.coordinate : pt.body;
+    };
     e.dl_dq.setZero(kc);
     for (int i = 0; i + 1 < P; ++i)
       if (body(i) != body(i + 1))
@@ -90,12 +94,12 @@ void MuscleForceTerm::evalPath(const Model& model, const State& s, const Skeleto
       const double v = s.qdot[pt.coordinate];
       if (a > 0) {
         const double g = mk.dxbar[a - 1].dot(dw);
-        if (body(a - 1) != pt.body) e.dl_dq[cc] += g;
+        if (body(a - 1) != body(a)) e.dl_dq[cc] += g;
         e.speed += g * v;
       }
       if (a + 1 < P) {
         const double g = mk.dxbar[a].dot(dw);
-        if (body(a + 1) != pt.body) e.dl_dq[cc] -= g;
+        if (body(a + 1) != body(a)) e.dl_dq[cc] -= g;
         e.speed -= g * v;
       }
     }
@@ -249,7 +253,7 @@ void MuscleForceTerm::calcPath(const Model& model, const State& s, const Skeleto
   const MuscleForceScratch::Entry& e = sc.muscles[k];
   length = e.length;
   speed = e.speed;
-  dl_dq = VecX::Zero(model.nr());
+  dl_dq = VecX::Zero(std::max<int>(model.nr(), static_cast<int>(s.q.size())));  // with extra coordinates: all of q
   for (int j = 0; j < e.dl_dq.size(); ++j) dl_dq[e.mk.cols[j]] = e.dl_dq[j];
 }
 

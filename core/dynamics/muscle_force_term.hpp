@@ -76,7 +76,8 @@ class MuscleForceTerm final : public ForceTerm {
   const std::vector<Actuated>& actuated() const { return actuated_; }
   /// the outputs of actuated muscle k at s (an evaluation without scratch), e.g. for reports
   hill::MuscleOutput calcOutput(const Model& model, const State& s, const TermContext& ctx, int k) const;
-  /// path length, speed and dl/dq (nr) of actuated muscle k at s (Stage::Velocity)
+  /// path length, speed and dl/dq (nr, or all of s.q with extra coordinates) of actuated muscle k
+  /// at s (Stage::Velocity)
   void calcPath(const Model& model, const State& s, const SkeletonWorkspace& sk, int k, double& length,
                 double& speed, VecX& dl_dq) const;
 

@@ -11,8 +11,11 @@ namespace redmax {
 namespace {
 
 // no path-wise inverse dynamics for Type III paths, nor for fibre-following points (their placement
-// moves with the fibre): those take the compact J_ar route with a_z
-bool needsCompactId(const Muscle& m) { return pathType(m.path) == PathType::III || m.fibre.enabled(); }
+// moves with the fibre), nor for paths through deformable nodes (no body wrench carries a node's
+// force): those take the compact J_ar route (with a_z)
+bool needsCompactId(const Muscle& m) {
+  return pathType(m.path) == PathType::III || m.fibre.enabled() || hasNodePoints(m.path);
+}
 
 // fibre-following points: the fibre's own motion adds the bias acceleration a_z to each point
 bool hasFibreBias(const Muscle& m, const MuscleKinematics& mk) {

@@ -90,6 +90,9 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
     const PathPoint& pt = path.points[mk.active[a]];
     const int b = pt.body;
     if (pt.kind != PathPointKind::Moving) {  // (x_b, dx_b, ddx_b are read for moving points only)
+      if (pt.kind == PathPointKind::Node)
+        throw std::logic_error("addMuscleInverseDynamics: muscle '" + muscle.name +
+                               "' has a deformable node point (MuscleTerm takes its compact J_ar route)");
       if (b < 0) {
         mk.x_w[a] = pt.location;
         mk.xdot_w[a].setZero();

@@ -25,7 +25,8 @@
 //      coordinate. The bodies' wrenches go through the skeleton's backward pass (J_mr^T).
 // Work per muscle: O(P) path points plus a few flops per mass point, independent of the number of
 // coordinates the muscle spans; Types I (P = 2: s = (0, 1) fixed, beta = alpha) and II alike.
-// Type III (wrapping) paths are not handled here (MuscleTerm forms their compact J_ar instead).
+// Type III (wrapping) paths and paths with deformable node points are not handled here (MuscleTerm
+// forms their compact J_ar instead).
 // The result equals the mass-matrix route sum_a J_ar^T m_a (...) to round-off (same segment rule
 // as calcViaPointMassPoints; tests/core/dynamics/recursive_id_test.cpp).
 #include <string>

@@ -26,7 +26,8 @@ namespace redmax {
 struct MuscleKinematics {
   // columns (model- and path-dependent only): initMuscleKinematics
   std::vector<int> cols;            // reduced coordinates that can move the path, ascending  (k)
-  std::vector<int> col_of;          // compact column of each coordinate, -1 if not in cols  (nr)
+  std::vector<int> col_of;          // compact column of each coordinate, -1 if not in cols  (nr, or up
+                                    // to the last node coordinate with Node points, path.hpp)
 
   // path stage, position: calcPathPoints
   std::vector<int> active;          // indices into path.points of the active points, in order (P)

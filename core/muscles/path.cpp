@@ -41,6 +41,28 @@ PathPoint makeMovingPoint(int body, int coordinate, std::array<AxisFunctionPtr, 
   return p;
 }
 
+PathPoint makeNodePoint(int coordinate, std::string name) {
+  PathPoint p = makeFixedPoint(-1, Vec3::Zero(), std::move(name));
+  p.kind = PathPointKind::Node;
+  p.coordinate = coordinate;
+  return p;
+}
+
+bool hasNodePoints(const MusclePath& path) {
+  for (const PathPoint& p : path.points)
+    if (p.kind == PathPointKind::Node) return true;
+  return false;
+}
+
+Vec3 nodeOrWorldPosition(const PathPoint& p, const VecX& q) {
+  if (p.kind != PathPointKind::Node) return p.location;
+  if (p.coordinate < 0 || p.coordinate + 3 > q.size())
+    throw ModelError("path point '" + p.name + "': node coordinates " + std::to_string(p.coordinate) + ".." +
+                     std::to_string(p.coordinate + 2) + " are not in the state (" + std::to_string(q.size()) +
+                     " coordinates)");
+  return q.segment<3>(p.coordinate);
+}
+
 bool isPathPointActive(const PathPoint& p, const VecX& q) {
   if (p.kind != PathPointKind::Conditional) return true;
   if (p.coordinate < 0) return false;  // OpenSim: an unconnected coordinate is never active
@@ -99,6 +121,15 @@ void validatePath(const Model& model, const MusclePath& path, const std::string&
       throw ModelError(where + "body index " + std::to_string(p.body) + " is not a body of model '" +
                        model.name() + "' (" + std::to_string(model.nb()) + " bodies; -1 = world)");
     if (!p.location.allFinite()) throw ModelError(where + "non-finite location");
+    if (p.kind == PathPointKind::Node) {
+      // the node's coordinates follow q_r (System::addExtraCoordinates); the model cannot bound them
+      if (p.coordinate < model.nr() || p.body != -1)
+        throw ModelError(where + "a node point needs its first coordinate after the model's " +
+                         std::to_string(model.nr()) + " (got " + std::to_string(p.coordinate) + ") and no body");
+      if (path.num_wraps > 0 || !path.wraps.empty())
+        throw ModelError(where + "node points on a path with wrap objects are not supported (the wrap "
+                         "constructions take end points in a body frame)");
+    }
     const bool needs_coord = p.kind == PathPointKind::Conditional || p.kind == PathPointKind::Moving;
     if (needs_coord && (p.coordinate < -1 || p.coordinate >= model.nr()))
       throw ModelError(where + "coordinate index " + std::to_string(p.coordinate) + " out of range (" +

@@ -11,6 +11,11 @@
 //   Moving       each location component is a function of one coordinate, x_b = f(q_k), in the
 //                body frame; a component without a function keeps `location`'s value. Its velocity
 //                gains a term through q_k, so J_xr gets a column that does not go through J_mr.
+//   Node         a free node of a deformable body (core/deformable/, a muscle inserting on soft
+//                tissue): its world position is the three System coordinates q[coordinate ..
+//                coordinate + 2] (extra coordinates after q_r, System::addExtraCoordinates), so
+//                J_xr is the identity in those three columns and Jdot_xr = 0 [D Eq. 4.92]; no J_xm
+//                block (no body). Not combined with wrap objects (validatePath refuses).
 // Path types (docs/design.md §2): I = two fixed points, III = any wrap object, II = everything else.
 // Wrap objects: `wraps` lists the path's PathWraps (surface, body, pose, range) in OpenSim's
 // order; core/muscles/wrap/wrap_path.hpp computes the wrapped path. `num_wraps` marks Type III
@@ -39,18 +44,19 @@
 
 namespace redmax {
 
-enum class PathPointKind { Fixed, Conditional, Moving };
+enum class PathPointKind { Fixed, Conditional, Moving, Node };
 
 /// One path point. Frames: `location` and the moving functions are in the frame of body `body`
 /// (the OpenSim body frame), or in the world when body = -1.
 struct PathPoint {
   std::string name;
   PathPointKind kind = PathPointKind::Fixed;
-  int body = -1;                      // body index, -1 = world
+  int body = -1;                      // body index, -1 = world (and for Node points)
   Vec3 location = Vec3::Zero();       // body frame; Moving: used for components without a function
 
   // Conditional: the tested coordinate (reduced index into q, -1 = none: never active) and range.
   // Moving: the driving coordinate (-1 = none: functions evaluated at 0).
+  // Node: the first of the node's three coordinates in the System's q (>= the model's nr).
   int coordinate = -1;
   double range_lo = 0.0;              // Conditional only, radians or metres
   double range_hi = 0.0;
@@ -74,6 +80,13 @@ PathPoint makeConditionalPoint(int body, const Vec3& location, int coordinate, d
 /// A moving point whose x, y, z components are f(q[coordinate]); null functions keep `location`.
 PathPoint makeMovingPoint(int body, int coordinate, std::array<AxisFunctionPtr, 3> functions,
                           const Vec3& location = Vec3::Zero(), std::string name = "");
+
+/// A free deformable node whose world position is q[coordinate .. coordinate + 2] (coordinate: the
+/// first of its three extra coordinates in the System; DeformableTerm::nodes() gives it).
+PathPoint makeNodePoint(int coordinate, std::string name = "");
+/// The point's position in the world when it does not depend on a body: a Node point's three
+/// coordinates of q (ModelError naming the point when q is too short), else its location.
+Vec3 nodeOrWorldPosition(const PathPoint& p, const VecX& q);
 
 /// OpenSim's activity tolerance of conditional path points (docs/opensim_compatibility.md §6)
 inline constexpr double kConditionalTolerance = 1e-5;
@@ -101,6 +114,9 @@ struct MusclePath {
   std::vector<PathWrap> wraps;        // the wrap objects themselves, in PathWrapSet order
 };
 
+/// true when some point of `path` is a Node point (the path then moves with extra coordinates)
+bool hasNodePoints(const MusclePath& path);
+
 enum class PathType { I, II, III };
 /// I: exactly two fixed points and no wraps; III: any wrap; II otherwise
 PathType pathType(const MusclePath& path);
@@ -114,7 +130,8 @@ void activePathPoints(const MusclePath& path, const VecX& q, std::vector<int>& a
 /// Throws ModelError, naming `muscle_name` and the point, when the path does not fit `model`: fewer
 /// than two points, a body or coordinate index out of range, a conditional origin or insertion
 /// (the path could lose its ends), a conditional range with lo > hi, non-finite locations, a
-/// moving-point function of more than one argument.
+/// moving-point function of more than one argument, a Node point whose coordinate is not after the
+/// model's nr, a Node point on a path with wrap objects.
 void validatePath(const Model& model, const MusclePath& path, const std::string& muscle_name);
 
 }  // namespace redmax

@@ -6,18 +6,22 @@
 namespace redmax {
 
 void initMuscleKinematics(const Model& model, const MusclePath& path, MuscleKinematics& mk) {
-  const int nr = model.nr();
-  // coordinates of every joint above any path body, and those driving moving points
-  std::vector<char> used(nr, 0);
+  // coordinates of every joint above any path body, those driving moving points, and the three of
+  // each node point (extra coordinates after q_r: col_of then reaches past nr)
+  int n = model.nr();
+  for (const PathPoint& pt : path.points)
+    if (pt.kind == PathPointKind::Node && pt.coordinate >= 0) n = std::max(n, pt.coordinate + 3);
+  std::vector<char> used(n, 0);
   for (const PathPoint& pt : path.points) {
     if (pt.body >= 0)
       for (int j : model.ancestors(pt.body))
         for (int c = 0; c < model.joints()[j].nq; ++c) used[model.joints()[j].q_index + c] = 1;
     if (pt.kind == PathPointKind::Moving && pt.coordinate >= 0) used[pt.coordinate] = 1;
+    if (pt.kind == PathPointKind::Node && pt.coordinate >= 0) used[pt.coordinate] = used[pt.coordinate + 1] = used[pt.coordinate + 2] = 1;
   }
   mk.cols.clear();
-  mk.col_of.assign(nr, -1);
-  for (int c = 0; c < nr; ++c)
+  mk.col_of.assign(n, -1);
+  for (int c = 0; c < n; ++c)
     if (used[c]) {
       mk.col_of[c] = static_cast<int>(mk.cols.size());
       mk.cols.push_back(c);
@@ -53,7 +57,7 @@ MuscleWorkspace::MuscleWorkspace(const Model& model, const std::vector<Muscle>& 
 }
 
 MatX expandColumns(const MatX& J, const MuscleKinematics& mk, int nr) {
-  MatX full = MatX::Zero(J.rows(), nr);
+  MatX full = MatX::Zero(J.rows(), std::max<int>(nr, static_cast<int>(mk.col_of.size())));
   for (int j = 0; j < static_cast<int>(mk.cols.size()); ++j) full.col(mk.cols[j]) = J.col(j);
   return full;
 }
@@ -76,8 +80,11 @@ void scatterAddColumns(const VecX& compact, const MuscleKinematics& mk, VecX& fu
 namespace {
 // true if mk's columns cover every coordinate that can move `path`
 bool columnsCover(const Model& model, const MusclePath& path, const MuscleKinematics& mk) {
-  if (static_cast<int>(mk.col_of.size()) != model.nr()) return false;
+  if (static_cast<int>(mk.col_of.size()) < model.nr()) return false;
   for (const PathPoint& pt : path.points) {
+    if (pt.kind == PathPointKind::Node &&
+        (pt.coordinate + 3 > static_cast<int>(mk.col_of.size()) || mk.col_of[pt.coordinate] < 0))
+      return false;
     if (pt.body >= 0)
       for (int j : model.ancestors(pt.body))
         if (model.joints()[j].nq > 0 && mk.col_of[model.joints()[j].q_index] < 0) return false;
@@ -156,6 +163,18 @@ void calcPathPoints(const Model& model, const State& state, const SkeletonWorksp
 
   for (int a = 0; a < P; ++a) {
     const PathPoint& pt = path.points[mk.active[a]];
+    if (pt.kind == PathPointKind::Node) {
+      // a free deformable node: its own three coordinates, J_xr = I there, Jdot_xr = 0
+      mk.x_w[a] = mk.x_b[a] = nodeOrWorldPosition(pt, state.q);
+      mk.J_xm[a].setZero();
+      const int cc = mk.col_of[pt.coordinate];
+      mk.J_xr.block<3, 3>(3 * a, cc).setIdentity();
+      if (velocity) {
+        mk.xdot_w[a] = state.qdot.segment<3>(pt.coordinate);
+        mk.Jdot_xm[a].setZero();
+      }
+      continue;
+    }
     Vec3 dx_b, ddx_b;
     calcPointLocation(pt, state.q, mk.x_b[a], dx_b, ddx_b);
     const Vec3& x_b = mk.x_b[a];
@@ -262,7 +281,7 @@ void calcActivePoints(const MusclePath& path, const VecX& q, const std::vector<M
     Vec3 x_b, dx, ddx;
     calcPointLocation(pt, q, x_b, dx, ddx);
     active.push_back(static_cast<int>(i));
-    x_w.push_back(pt.body >= 0 ? transformPoint(E_wi[pt.body], x_b) : x_b);
+    x_w.push_back(pt.body >= 0 ? transformPoint(E_wi[pt.body], x_b) : nodeOrWorldPosition(pt, q));
   }
 }
 

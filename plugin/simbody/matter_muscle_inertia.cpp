@@ -19,6 +19,8 @@ std::string simbodyWrapShapeUnsupportedReason(const Muscle& mu) {
   if (mu.fibre.enabled())
     return "muscle '" + mu.name + "': fibre-following mass placement is computed by the core only (--engine core, "
            "or --mass-placement uniform)";
+  if (hasNodePoints(mu.path))
+    return "muscle '" + mu.name + "': a path through deformable nodes is the core's only (Simbody has no such nodes)";
   return "";
 }
 

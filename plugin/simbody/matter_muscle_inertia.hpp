@@ -48,7 +48,8 @@
 namespace redmax::simbody {
 
 /// "" when a muscle with mass points can be carried by the Simbody side, else why not: every path
-/// the core takes, with mass points at fixed arc fractions (not fibre-following placement).
+/// the core takes, with mass points at fixed arc fractions (not fibre-following placement), and no
+/// deformable node points.
 std::string simbodyWrapShapeUnsupportedReason(const Muscle& muscle);
 
 /// Where a core model's bodies and coordinates are in a Simbody system.

@@ -55,7 +55,7 @@ TEST_F(SceneCli, CantileverPrintsTipDeflectionAgainstBeamTheory) {
 }
 
 TEST_F(SceneCli, DynamicScenesWriteStatesAndAVtkSeries) {
-  for (const std::string name : {"strand", "soft-pendulum"}) {
+  for (const std::string name : {"strand", "soft-pendulum", "soft-insertion"}) {
     const fs::path out = dir_ / name;
     const CmdResult r = runRedmax(dir_, "scene " + name + " --out " + out.string());
     ASSERT_EQ(r.code, 0) << r.err;
@@ -63,7 +63,7 @@ TEST_F(SceneCli, DynamicScenesWriteStatesAndAVtkSeries) {
     EXPECT_EQ(states.rfind("time,", 0), 0u);
     int rows = 0;
     for (char c : states) rows += c == '\n';
-    EXPECT_EQ(rows, 1 + (name == "strand" ? 101 : 51));  // header + frames every 0.02 s
+    EXPECT_EQ(rows, 1 + (name == "strand" ? 101 : name == "soft-pendulum" ? 51 : 31));  // header + frames every 0.02 s
     const std::string pvd = slurp(out / (name + ".pvd"));
     int frames = 0;
     for (size_t at = pvd.find("<DataSet"); at != std::string::npos; at = pvd.find("<DataSet", at + 1)) ++frames;
@@ -73,6 +73,11 @@ TEST_F(SceneCli, DynamicScenesWriteStatesAndAVtkSeries) {
       const redmax::TetMesh last = redmax::readVtkTetMesh((out / "soft-pendulum_0050.vtk").string());
       EXPECT_EQ(last.numNodes(), 45);
       EXPECT_NE(r.out.find("rigid block"), std::string::npos);
+    } else if (name == "soft-insertion") {
+      // the node's columns are in the states, and the summary compares with the rigid insertion
+      EXPECT_NE(states.find("node"), std::string::npos);
+      EXPECT_NE(r.out.find("rigid insertion"), std::string::npos);
+      EXPECT_NE(r.out.find("largest tendon force"), std::string::npos);
     } else {
       EXPECT_NE(r.out.find("largest change"), std::string::npos);
     }
@@ -133,7 +138,7 @@ TEST_F(SceneCli, UnknownOrMissingNameIsAUsageError) {
   CmdResult r = runRedmax(dir_, "scene octopus");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("error: "), std::string::npos);
-  EXPECT_NE(r.err.find("cantilever, strand, soft-pendulum, hand, starfish, spline-leg, ball-drop, block-slide, "
+  EXPECT_NE(r.err.find("cantilever, strand, soft-pendulum, soft-insertion, hand, starfish, spline-leg, ball-drop, block-slide, "
                        "box-stack or limit-pendulum"),
             std::string::npos)
       << r.err;
