@@ -122,6 +122,37 @@ void DeformableTerm::mapMatrix(const SparseMat& A, MatX& out, const DeformableSc
   }
 }
 
+void DeformableTerm::mapMatrix(const SparseMat& A, Triplets& out, const DeformableScratch& sc, int nr) const {
+  using Kind = NodeBinding::Kind;
+  MatX rr = MatX::Zero(nr, nr);  // attached-attached pairs all land in the q_r block
+  for (int col = 0; col < A.outerSize(); ++col) {
+    const int nj = col / 3, cj = col % 3;
+    const NodeBinding& bj = nodes_[nj];
+    if (bj.kind == Kind::World) continue;
+    for (SparseMat::InnerIterator it(A, col); it; ++it) {
+      const int ni = static_cast<int>(it.row()) / 3, ci = static_cast<int>(it.row()) % 3;
+      const NodeBinding& bi = nodes_[ni];
+      const double a = it.value();
+      if (bi.kind == Kind::World) continue;
+      if (bi.kind == Kind::Free && bj.kind == Kind::Free) {
+        out.emplace_back(bi.index + ci, bj.index + cj, a);
+      } else if (bi.kind == Kind::Free) {
+        for (int k = 0; k < nr; ++k)
+          if (sc.J[nj](cj, k) != 0.0) out.emplace_back(bi.index + ci, k, a * sc.J[nj](cj, k));
+      } else if (bj.kind == Kind::Free) {
+        for (int k = 0; k < nr; ++k)
+          if (sc.J[ni](ci, k) != 0.0) out.emplace_back(k, bj.index + cj, a * sc.J[ni](ci, k));
+      } else {
+        rr.noalias() += a * sc.J[ni].row(ci).transpose() * sc.J[nj].row(cj);
+      }
+    }
+  }
+  if (!has_body_nodes_) return;
+  for (int j = 0; j < nr; ++j)
+    for (int i = 0; i < nr; ++i)
+      if (rr(i, j) != 0.0) out.emplace_back(i, j, rr(i, j));
+}
+
 SparseMat DeformableTerm::dampingMatrix(const DeformableScratch& sc) const {
   const int n3 = 3 * body_.numNodes();
   SparseMat D(n3, n3);
@@ -162,18 +193,28 @@ void DeformableTerm::addStiffnessDamping(const Model& model, const State& s, con
   mapMatrix(sc.el.K, K, sc, nr);
   const SparseMat Dx = dampingMatrix(sc);
   mapMatrix(Dx, D, sc, nr);
+  forEachAttachedStiffnessColumn(model, s, ctx, sc, Dx, static_cast<int>(K.rows()),
+                                 [&](int k, const VecX& col) { K.col(k) += col; });
+}
+
+template <class Add>
+void DeformableTerm::forEachAttachedStiffnessColumn(const Model& model, const State& s, const TermContext& ctx,
+                                                    const DeformableScratch& sc, const SparseMat& Dx, int ndof,
+                                                    Add&& add) const {
   if (!has_body_nodes_) return;
   // dJ_a/dq_k: the kinematics at (q, qdot = e_k) give Jdot_mr = dJ_mr/dq_k, and dR/dq_k = R [omega_k]
+  const int nr = model.nr();
   const int N = body_.numNodes();
   SkeletonWorkspace tmp(model);
   State sk_state;
   sk_state.q = s.q.head(nr);
   const VecX qdot_r = s.qdot.head(nr);
-  VecX dv(3 * N), col(K.rows());
+  VecX dv(3 * N), col(ndof);
   for (int k = 0; k < nr; ++k) {
     sk_state.qdot = VecX::Unit(nr, k);
     calcKinematics(model, sk_state, tmp);
     dv.setZero();
+    col.setZero();
     bool any = false;
     for (int n = 0; n < N; ++n) {
       const NodeBinding& b = nodes_[n];
@@ -187,16 +228,32 @@ void DeformableTerm::addStiffnessDamping(const Model& model, const State& s, con
       const Mat3x6 G = Gamma(b.point);
       const MatX dJ = R * (skew(omega_k) * (G * Ji) + G * tmp.Jdot_mr.middleRows<6>(6 * b.index));
       // geometric stiffness of the node's force: K(:, k) -= dJ^T f_a
-      K.col(k).head(nr).noalias() -= dJ.transpose() * sc.F.segment<3>(3 * n);
+      col.head(nr).noalias() -= dJ.transpose() * sc.F.segment<3>(3 * n);
       dv.segment<3>(3 * n) = dJ * qdot_r;
       any = true;
     }
-    if (!any || Dx.nonZeros() == 0) continue;
+    if (!any) continue;
     // the damping force -D_x v through v's dependence on q: K(:, k) += J_MR^T D_x dv
-    col.setZero();
-    mapForce(Dx * dv, col, sc, nr);
-    K.col(k) += col;
+    if (Dx.nonZeros() != 0) mapForce(Dx * dv, col, sc, nr);
+    add(k, col);
   }
+}
+
+bool DeformableTerm::addSparseMatrices(const Model& model, const State& s, const TermContext& ctx, bool stiffness,
+                                       Triplets& M, Triplets& K, Triplets& D) const {
+  DeformableScratch local;
+  const DeformableScratch& sc = evaluate(model, s, ctx, stiffness, local);
+  const int nr = model.nr();
+  mapMatrix(Mx_, M, sc, nr);
+  if (!stiffness) return true;
+  mapMatrix(sc.el.K, K, sc, nr);
+  const SparseMat Dx = dampingMatrix(sc);
+  mapMatrix(Dx, D, sc, nr);
+  forEachAttachedStiffnessColumn(model, s, ctx, sc, Dx, static_cast<int>(s.q.size()), [&](int k, const VecX& col) {
+    for (int i = 0; i < col.size(); ++i)
+      if (col[i] != 0.0) K.emplace_back(i, k, col[i]);
+  });
+  return true;
 }
 
 void DeformableTerm::addMassDotTimesVelocity(const Model& model, const State& s, const TermContext& ctx,

@@ -71,6 +71,11 @@ class DeformableTerm final : public ForceTerm {
   /// elastic energy plus -sum m g . x (world origin reference)
   double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
 
+  /// free nodes are extra coordinates: M, K, D reach them (addSparseMatrices gives them sparse)
+  bool matricesOnSkeletonOnly() const override { return false; }
+  /// the same M, K, D as addMass and addStiffnessDamping, as triplets (System::calcSparseMatrices)
+  bool addSparseMatrices(const Model& model, const State& s, const TermContext& ctx, bool stiffness, Triplets& M,
+                         Triplets& K, Triplets& D) const override;
   const DeformableBody& body() const { return body_; }
   const std::vector<NodeBinding>& nodes() const { return nodes_; }
   const DeformableTermOptions& options() const { return options_; }
@@ -89,6 +94,13 @@ class DeformableTerm final : public ForceTerm {
   void mapForce(const VecX& F, Eigen::Ref<VecX> f, const DeformableScratch& sc, int nr) const;
   // add J_MR^T A J_MR (A: 3N x 3N) to out (ndof x ndof)
   void mapMatrix(const SparseMat& A, MatX& out, const DeformableScratch& sc, int nr) const;
+  // the same as triplets (the q_r block summed densely first)
+  void mapMatrix(const SparseMat& A, Triplets& out, const DeformableScratch& sc, int nr) const;
+  // the attached nodes' part of K (geometric stiffness and the damping's q-dependence): column k
+  // (< nr) of it, over all coordinates, handed to `add(k, column)` for each coordinate that moves one
+  template <class Add>
+  void forEachAttachedStiffnessColumn(const Model& model, const State& s, const TermContext& ctx,
+                                      const DeformableScratch& sc, const SparseMat& Dx, int ndof, Add&& add) const;
   // D_x = alpha M_x + beta K_x (needs sc.el.K)
   SparseMat dampingMatrix(const DeformableScratch& sc) const;
 

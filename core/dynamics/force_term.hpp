@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/SparseCore>
+
 #include "core/skeleton/kinematics.hpp"
 #include "core/skeleton/state.hpp"
 #include "core/skeleton/workspace.hpp"
@@ -145,6 +147,21 @@ class ForceTerm {
   /// their names (numControls): the actuator names, as OpenSim's controls files name them
   virtual std::vector<std::string> controlNames() const { return {}; }
   virtual double potentialEnergy(const Model&, const State&, const TermContext&) const { return 0.0; }
+
+  // Sparse assembly, for systems with many extra coordinates (System::calcSparseMatrices, the
+  // sparse route of bdf1, docs/deformable.md §5). A term whose M, K or D reach extra coordinates
+  // says so (matricesOnSkeletonOnly() false) and adds them as triplets over all coordinates in
+  // addSparseMatrices; every other term keeps its dense addMass / addStiffnessDamping, which the
+  // System then calls on matrices of the q_r block only (nr x nr).
+  using Triplets = std::vector<Eigen::Triplet<double>>;
+  /// false when addMass or addStiffnessDamping may write outside the q_r block
+  virtual bool matricesOnSkeletonOnly() const { return true; }
+  /// add M, and with `stiffness` also K and D, as (row, column, value) triplets over all
+  /// coordinates (duplicates are summed); false: no sparse form (the System uses the dense one)
+  virtual bool addSparseMatrices(const Model&, const State&, const TermContext&, bool /*stiffness*/,
+                                 Triplets& /*M*/, Triplets& /*K*/, Triplets& /*D*/) const {
+    return false;
+  }
 };
 
 }  // namespace redmax

@@ -41,6 +41,7 @@ MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTe
     compact_id_.push_back(needsCompactId(m));
     massive_states_.push_back(states.empty() ? MuscleStateIndex{} : states[k]);
     for (double mass : m.mass_points.mass) adds_mass_ = adds_mass_ || mass != 0.0;
+    node_points_ = node_points_ || hasNodePoints(m.path);
   }
 }
 
@@ -86,13 +87,13 @@ MuscleTermScratch& MuscleTerm::evaluate(const Model& model, const State& s, cons
   return sc;
 }
 
-void MuscleTerm::addMass(const Model& model, const State& s, const TermContext& ctx, MatX& M) const {
-  if (massive_.empty()) return;
+template <class Add>
+void MuscleTerm::forEachMuscleMass(const Model& model, const State& s, const TermContext& ctx, Add&& add) const {
   MuscleTermScratch local;
   MuscleTermScratch& sc = evaluate(model, s, ctx, local);
   // J_ar^T M_a J_ar, M_a diagonal [D Eq. 5.7b]
   // one product per muscle on sqrt(m_a)-scaled rows, (W^1/2 J)^T (W^1/2 J) = J^T W J, in the
-  // muscle's compact columns, then scattered into M
+  // muscle's compact columns
   for (size_t m = 0; m < massive_.size(); ++m) {
     const MassPoints& mp = massive_[m].mass_points;
     const MuscleKinematics& mk = sc.ws.muscles[m];
@@ -100,10 +101,28 @@ void MuscleTerm::addMass(const Model& model, const State& s, const TermContext& 
     sc.scaled_J.resize(J.rows(), J.cols());
     for (int a = 0; a < mp.size(); ++a) sc.scaled_J.middleRows<3>(3 * a) = std::sqrt(mp.mass[a]) * J.middleRows<3>(3 * a);
     sc.Mc.noalias() = sc.scaled_J.transpose() * sc.scaled_J;
-    const int k = static_cast<int>(mk.cols.size());
-    for (int j = 0; j < k; ++j)
-      for (int i = 0; i < k; ++i) M(mk.cols[i], mk.cols[j]) += sc.Mc(i, j);
+    add(mk.cols, sc.Mc);
   }
+}
+
+void MuscleTerm::addMass(const Model& model, const State& s, const TermContext& ctx, MatX& M) const {
+  if (massive_.empty()) return;
+  forEachMuscleMass(model, s, ctx, [&M](const std::vector<int>& cols, const MatX& Mc) {
+    const int k = static_cast<int>(cols.size());
+    for (int j = 0; j < k; ++j)
+      for (int i = 0; i < k; ++i) M(cols[i], cols[j]) += Mc(i, j);
+  });
+}
+
+bool MuscleTerm::addSparseMatrices(const Model& model, const State& s, const TermContext& ctx, bool, Triplets& M,
+                                   Triplets&, Triplets&) const {
+  if (!node_points_) return false;  // the q_r block: the dense addMass
+  forEachMuscleMass(model, s, ctx, [&M](const std::vector<int>& cols, const MatX& Mc) {
+    const int k = static_cast<int>(cols.size());
+    for (int j = 0; j < k; ++j)
+      for (int i = 0; i < k; ++i) M.emplace_back(cols[i], cols[j], Mc(i, j));
+  });
+  return true;
 }
 
 void MuscleTerm::addForce(const Model& model, const State& s, const TermContext& ctx, VecX& f) const {

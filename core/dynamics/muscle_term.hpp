@@ -85,6 +85,11 @@ class MuscleTerm final : public ForceTerm {
   void addInverseDynamics(const Model& model, const State& s, const VecX& qddot, const TermContext& ctx,
                           const BodyMotion& motion, std::vector<Vec6>& wrench, VecX& tau) const override;
   double potentialEnergy(const Model& model, const State& s, const TermContext& ctx) const override;
+  /// false when a muscle with mass runs through a deformable node (its M reaches extra coordinates)
+  bool matricesOnSkeletonOnly() const override { return !node_points_; }
+  /// M as triplets when a muscle with mass runs through a node (false otherwise: the dense q_r form)
+  bool addSparseMatrices(const Model& model, const State& s, const TermContext& ctx, bool stiffness, Triplets& M,
+                         Triplets& K, Triplets& D) const override;
 
   const std::vector<Muscle>& muscles() const { return muscles_; }
   const MuscleTermOptions& options() const { return options_; }
@@ -99,6 +104,9 @@ class MuscleTerm final : public ForceTerm {
   // already holds this evaluation, or (direct calls without a slot) `local`, evaluated now
   MuscleTermScratch& evaluate(const Model& model, const State& s, const TermContext& ctx,
                               MuscleTermScratch& local) const;
+  // J_ar^T M_a J_ar of each muscle with mass in its compact columns: add(mk.cols, Mc)
+  template <class Add>
+  void forEachMuscleMass(const Model& model, const State& s, const TermContext& ctx, Add&& add) const;
   /// massive_[m]'s kinematics at s: fibre-following muscles read their states (or equilibrium)
   void kinematicsOf(size_t m, const Model& model, const State& s, const TermContext& ctx,
                     MuscleKinematics& mk) const;
@@ -107,6 +115,7 @@ class MuscleTerm final : public ForceTerm {
   std::vector<Muscle> massive_;        // the muscles with at least one mass point
   std::vector<bool> compact_id_;       // massive_[m] needs its compact J_ar in inverse dynamics (Type III, fibre)
   bool adds_mass_ = false;             // a mass point of massive_ has non-zero mass (fixed at construction)
+  bool node_points_ = false;           // a muscle of massive_ runs through a deformable node
   std::vector<MuscleStateIndex> massive_states_;  // their states (fibre-following placement)
   MuscleTermOptions options_;
   int nr_ = 0;

@@ -375,6 +375,54 @@ void System::calcMassDotTimesVelocity(const State& s, DynamicsWorkspace& ws, Vec
   Mdot_v.noalias() += ws.Jdot_rR.transpose() * (ws.M_r * ws.s_r.qdot);
 }
 
+void System::calcSparseMatrices(const State& s, DynamicsWorkspace& ws, bool stiffness,
+                                Eigen::SparseMatrix<double>& M, Eigen::SparseMatrix<double>& K,
+                                Eigen::SparseMatrix<double>& D) const {
+  if (map_) throw ModelError("System::calcSparseMatrices: not with a coordinate map");
+  if (nz_ > 0 && s.z.size() != nz_)
+    throw ModelError("System::calcSparseMatrices: state has " + std::to_string(s.z.size()) +
+                     " auxiliary states, the system has " + std::to_string(nz_));
+  const int nr = model_.nr();
+  calcSkeletonKinematics(s, ws);
+  calcControls(s, ws);
+  calcSkeletonMassHere(ws, ws.M_r);
+  calcSkeletonForceHere(s, ws, ws.f_r);
+  ws.f.setZero(ndof_);
+  ws.f.head(nr) = ws.f_r;
+  if (!ws.loads.empty()) addExternalLoads(model_, ws.sk, ws.loads, ws.f);
+  // the q_r block: the skeleton, joint springs and dampers, and every term whose matrices stay there
+  ws.K_r.setZero(nr, nr);
+  ws.D_r.setZero(nr, nr);
+  if (stiffness) addJointStiffnessDamping(model_, ws.K_r, ws.D_r);
+  ForceTerm::Triplets tM, tK, tD;
+  for (size_t i = 0; i < terms_.size(); ++i) {
+    const TermContext ctx = context(ws, i);
+    terms_[i]->addForce(model_, s, ctx, ws.f);
+    if (terms_[i]->addSparseMatrices(model_, s, ctx, stiffness, tM, tK, tD)) continue;
+    if (!terms_[i]->matricesOnSkeletonOnly())
+      throw std::logic_error("System::calcSparseMatrices: term '" + terms_[i]->name() +
+                             "' reaches extra coordinates but has no sparse form");
+    terms_[i]->addMass(model_, s, ctx, ws.M_r);
+    if (stiffness) terms_[i]->addStiffnessDamping(model_, s, ctx, ws.K_r, ws.D_r);
+  }
+  auto dense = [nr](const MatX& A, ForceTerm::Triplets& t) {
+    for (int j = 0; j < nr; ++j)
+      for (int i = 0; i < nr; ++i)
+        if (A(i, j) != 0.0) t.emplace_back(i, j, A(i, j));
+  };
+  dense(ws.M_r, tM);
+  ws.has_mass = false;  // (ws.M is not this state's)
+  M.resize(ndof_, ndof_);
+  M.setFromTriplets(tM.begin(), tM.end());
+  if (!stiffness) return;
+  dense(ws.K_r, tK);
+  dense(ws.D_r, tD);
+  K.resize(ndof_, ndof_);
+  K.setFromTriplets(tK.begin(), tK.end());
+  D.resize(ndof_, ndof_);
+  D.setFromTriplets(tD.begin(), tD.end());
+}
+
 void System::calcStiffnessDamping(const State& s, DynamicsWorkspace& ws) const {
   if (!map_) {
     ws.K.setZero(ndof(), ndof());

@@ -196,6 +196,16 @@ class System {
   /// otherwise jump the dependents). Returns the number of joints switched.
   int reparameterize(State& s) const;
 
+  /// The implicit step's matrices without forming dense ndof x ndof ones (bdf1's sparse route,
+  /// for many extra coordinates): ws.f as calcMassAndForce gives it, and M, K = -df/dq, D = -df/dqdot
+  /// (K and D only with `stiffness`) as sparse matrices over all coordinates: the skeleton's and the
+  /// q_r-only terms' blocks dense inside, the terms with extra coordinates by their
+  /// addSparseMatrices. Equal to calcMassAndForce + calcStiffnessDamping to round-off. Throws
+  /// ModelError with a coordinate map, std::logic_error for a term that reaches extra coordinates
+  /// without a sparse form.
+  void calcSparseMatrices(const State& s, DynamicsWorkspace& ws, bool stiffness, Eigen::SparseMatrix<double>& M,
+                          Eigen::SparseMatrix<double>& K, Eigen::SparseMatrix<double>& D) const;
+
   /// Position projection onto the constraint manifold: mass-weighted Newton steps
   ///   [M G^T; G 0] [dq; mu] = [0; -C]
   /// until max |C| <= tol or max_iter steps; redundant rows are handled as in solveKKT.

@@ -10,4 +10,12 @@ namespace redmax::detail {
 /// is bypassed for a pivoted LU of the full matrix.
 VecX solveImplicit(const MatX& A, const MatX& G, const VecX& a, const VecX& b, VecX* lambda);
 
+/// The same with a sparse A (bdf1's sparse route): A factored once (simplicial LDL^T with AMD
+/// ordering when A is symmetric and the factorisation succeeds, else sparse LU with COLAMD), the
+/// constraints by the Schur complement G A^-1 G^T (nc solves) with a complete orthogonal
+/// decomposition, so redundant rows get the minimum-norm multiplier as in System::solveKKT.
+/// Throws std::runtime_error when A is singular.
+VecX solveImplicitSparse(const Eigen::SparseMatrix<double>& A, const MatX& G, const VecX& a, const VecX& b,
+                         VecX* lambda);
+
 }  // namespace redmax::detail

@@ -41,6 +41,11 @@ struct IntegratorOptions {
   long max_steps = 10'000'000;  // per advance() call
   double newton_tol = 1e-10;    // sdirk2: converged when |dV| <= newton_tol (1 + |V|)
   int newton_max_iter = 12;     // sdirk2: iterations per Newton phase (approximate, then FD Jacobian)
+  // bdf1 with extra coordinates (deformable nodes): "dense" forms M, K, D over all coordinates,
+  // "sparse" assembles them sparse (System::calcSparseMatrices) and factors sparse; "auto" takes
+  // sparse from kSparseStepFrom coordinates on (measured crossover, docs/deformable.md §5) unless
+  // the system has hard unilateral constraints or a coordinate map (dense only)
+  std::string linear_solver = "auto";
 };
 
 /// Counters accumulated over the lifetime of one Integrator (all advance() calls).

@@ -3,9 +3,52 @@
 #include "core/dynamics/unilateral/qp_solver.hpp"
 #include "core/integrators/implicit_solve.hpp"
 
+#include <stdexcept>
+
 namespace redmax {
 
+LinearlyImplicitEuler::LinearlyImplicitEuler(const IntegratorOptions& opt) : FixedStepIntegrator(opt) {
+  if (opt.linear_solver != "auto" && opt.linear_solver != "dense" && opt.linear_solver != "sparse")
+    throw std::invalid_argument("bdf1: linear_solver must be auto, dense or sparse, not '" + opt.linear_solver + "'");
+}
+
+bool LinearlyImplicitEuler::sparseRoute(const System& sys) const {
+  const std::string& how = options().linear_solver;
+  if (how == "dense") return false;
+  const bool possible = !sys.coordinateMap() && !sys.unilateral();
+  if (how == "sparse") {
+    if (!possible)
+      throw ModelError("bdf1: the sparse linear solver takes no coordinate map and no hard unilateral constraints");
+    return true;
+  }
+  return possible && sys.numExtraCoordinates() > 0 && sys.ndof() >= kSparseStepFrom;
+}
+
 void LinearlyImplicitEuler::step(const System& sys, State& s, double h, DynamicsWorkspace& ws) {
+  if (sparseRoute(sys)) {
+    // the same step over sparse matrices: (M + h D + h^2 K) qdot+ = M qdot + h (f + D qdot)
+    sys.calcSparseMatrices(s, ws, true, M_, K_, D_);
+    ++stats_.rhs_evals;
+    ++stats_.jacobian_evals;
+    const VecX a = M_ * s.qdot + h * (ws.f + D_ * s.qdot);
+    const Eigen::SparseMatrix<double> A = M_ + h * D_ + (h * h) * K_;
+    static const MatX no_rows;
+    static const VecX no_rhs;
+    VecX b;
+    if (sys.numConstraintRows() > 0) {
+      sys.calcConstraints(s, ws);
+      b = ws.G * s.qdot + h * ws.rhs - ws.vel_err;
+    }
+    try {
+      s.qdot = detail::solveImplicitSparse(A, sys.numConstraintRows() > 0 ? ws.G : no_rows,
+                                           a, sys.numConstraintRows() > 0 ? b : no_rhs, &ws.lambda);
+    } catch (const std::runtime_error& e) {
+      throw SimulationError(std::string("bdf1: ") + e.what() + " at t = " + std::to_string(s.t), s.t, h);
+    }
+    s.q += h * s.qdot;
+    s.t += h;
+    return;
+  }
   sys.calcMassAndForce(s, ws);
   sys.calcStiffnessDamping(s, ws);
   ++stats_.rhs_evals;

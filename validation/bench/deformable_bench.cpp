@@ -6,7 +6,11 @@
 //   sparse     assemble + Eigen SimplicialLDLT (AMD ordering) of A
 //   cholmod    assemble + CHOLMOD's Cholesky of A (when built with SuiteSparse)
 //   dense      assemble + Eigen's dense LDLT of A (up to 1,225 vertices: O(n^3))
-// After Google Benchmark's output: a table (CPU milliseconds per step) and the exponents fitted
+// Second study, the coupled System (bdf1 over skeleton and nodes in one system [D Eq. 4.95]): a
+// 3-link chain holding a soft block (4k x k x k cubes) by one face, one bdf1 step with the dense
+// route (M, K, D over all coordinates, dense KKT) against the sparse route (System::
+// calcSparseMatrices + detail::solveImplicitSparse); this sets kSparseStepFrom.
+// After Google Benchmark's output: tables (CPU milliseconds per step) and the exponents fitted
 // by least squares on log-log data. Not run by ctest; timing only.
 #include <benchmark/benchmark.h>
 
@@ -23,7 +27,10 @@
 #include <Eigen/CholmodSupport>
 #endif
 
+#include "core/deformable/deformable_term.hpp"
 #include "core/deformable/node_solver.hpp"
+#include "core/integrators/linearly_implicit_euler.hpp"
+#include "validation/scenes/scenes.hpp"
 #include "validation/bench/cpu_reporter.hpp"
 #include "validation/bench/fit.hpp"
 
@@ -57,6 +64,32 @@ struct Scene {
 };
 
 using bench::fittedExponent;
+
+// the coupled study's system: chain + block, at a deformed moving state
+struct Coupled {
+  System sys{scenes::revoluteChain(3)};
+  State s;
+  explicit Coupled(int k) {
+    const TetMesh mesh = makeBoxTetMesh(Vec3(0.4, 0.1, 0.1), 4 * k, k, k, Vec3(0.0, -1.25, -0.05));
+    DeformableBody fem = makeFemBody(mesh, 1e6, 0.3, 1000.0);
+    fem.rayleigh_mass = 0.1;
+    fem.rayleigh_stiffness = 1e-3;
+    std::vector<NodeAttachment> att;
+    for (int n = 0; n < mesh.numNodes(); ++n)
+      if (mesh.nodes[n].x() < 1e-12) att.push_back({n, 2});
+    auto term = addDeformableBody(sys, fem, att);
+    s = sys.defaultState();
+    term->setRestState(s);
+    std::mt19937 rng(k);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int i = 0; i < s.q.size(); ++i) {
+      s.q[i] += i < 3 ? 0.5 * u(rng) : 1e-3 * u(rng);
+      s.qdot[i] = i < 3 ? u(rng) : 0.05 * u(rng);
+    }
+    vertices = mesh.numNodes();
+  }
+  int vertices = 0;
+};
 
 }  // namespace
 
@@ -112,6 +145,30 @@ int main(int argc, char** argv) {
       })->Unit(benchmark::kMillisecond);
   }
 
+  // the coupled System: dense against sparse bdf1 steps
+  const std::vector<int> kc{1, 2, 3, 4, 6, 8};
+  const int coupled_dense_max_k = 4;
+  std::map<int, std::unique_ptr<Coupled>> coupled;
+  auto ckey = [](int V, const std::string& op) { return "coupled" + std::to_string(V) + "/" + op; };
+  for (int k : kc) {
+    coupled[k] = std::make_unique<Coupled>(k);
+    Coupled* c = coupled[k].get();
+    for (const std::string op : {"dense", "sparse"}) {
+      if (op == "dense" && k > coupled_dense_max_k) continue;
+      benchmark::RegisterBenchmark(ckey(c->vertices, op).c_str(), [c, op](benchmark::State& st) {
+        IntegratorOptions io;
+        io.linear_solver = op;
+        LinearlyImplicitEuler euler(io);
+        DynamicsWorkspace ws(c->sys);
+        for (auto _ : st) {
+          State x = c->s;
+          euler.step(c->sys, x, kStep, ws);
+          benchmark::DoNotOptimize(x.qdot.data());
+        }
+      })->Unit(benchmark::kMillisecond);
+    }
+  }
+
   redmax::bench::CpuReporter rep;
   benchmark::RunSpecifiedBenchmarks(&rep);
   std::printf("\nCPU milliseconds per implicit step, 1 thread (co-rotated FEM beam, h = %g s)\n\n| vertices |", kStep);
@@ -142,5 +199,22 @@ int main(int argc, char** argv) {
     else std::printf(" - |");
   }
   std::printf("\n");
+
+  std::printf("\nCoupled System (3-link chain + block), CPU milliseconds per bdf1 step\n\n"
+              "| vertices | coordinates | dense | sparse | dense / sparse |\n|---|---|---|---|---|\n");
+  std::vector<double> xs, yd, ys, xd;
+  for (int k : kc) {
+    const Coupled& c = *coupled[k];
+    const auto d = rep.us.find(ckey(c.vertices, "dense")), sp = rep.us.find(ckey(c.vertices, "sparse"));
+    std::printf("| %d | %d |", c.vertices, c.sys.ndof());
+    if (d != rep.us.end()) std::printf(" %.3f |", d->second / 1e3), xd.push_back(c.vertices), yd.push_back(d->second);
+    else std::printf(" - |");
+    if (sp != rep.us.end()) std::printf(" %.3f |", sp->second / 1e3), xs.push_back(c.vertices), ys.push_back(sp->second);
+    else std::printf(" - |");
+    if (d != rep.us.end() && sp != rep.us.end()) std::printf(" %.2f |\n", d->second / sp->second);
+    else std::printf(" - |\n");
+  }
+  if (xd.size() >= 2 && xs.size() >= 2)
+    std::printf("| fitted exponent | | %.2f | %.2f | |\n", fittedExponent(xd, yd), fittedExponent(xs, ys));
   return 0;
 }
