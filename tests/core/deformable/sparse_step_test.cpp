@@ -111,7 +111,9 @@ TEST(SparseStep, SolverEqualsTheDenseSolveSymmetricOrNotWithRedundantRows) {
     EXPECT_LE((G * xs - b).cwiseAbs().maxCoeff(), 1e-15);
     // the multipliers that act, G^T lambda, agree (lambda itself splits over the repeated rows)
     EXPECT_LE(relDiff(G.transpose() * ls, G.transpose() * ld), 1e-13);
-    if (symmetric) EXPECT_LE(relDiff(ls, ld), 1e-13);  // both minimum-norm
+    if (symmetric) {
+      EXPECT_LE(relDiff(ls, ld), 1e-13);  // both minimum-norm
+    }
   }
   // a singular A is an error, not a NaN
   MatX Z = MatX::Zero(3, 3);

@@ -107,7 +107,9 @@ TEST(Unilateral, NormalRowsAreTheGapRatesByFiniteDifferences) {
   }
   // the frictional rows' tangents are orthogonal to their normals
   for (const auto& c : rows.c)
-    if (c.tangent_row >= 0) EXPECT_GT(c.mu, 0.0);
+    if (c.tangent_row >= 0) {
+      EXPECT_GT(c.mu, 0.0);
+    }
   EXPECT_EQ(rows.Jt.rows(), 2 * (8 + 2 + 1));
 }
 
