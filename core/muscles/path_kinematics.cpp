@@ -281,7 +281,9 @@ void calcActivePoints(const MusclePath& path, const VecX& q, const std::vector<M
     Vec3 x_b, dx, ddx;
     calcPointLocation(pt, q, x_b, dx, ddx);
     active.push_back(static_cast<int>(i));
-    x_w.push_back(pt.body >= 0 ? transformPoint(E_wi[pt.body], x_b) : nodeOrWorldPosition(pt, q));
+    x_w.push_back(pt.body >= 0                      ? transformPoint(E_wi[pt.body], x_b)
+                  : pt.kind == PathPointKind::Node ? nodeOrWorldPosition(pt, q)
+                                                   : x_b);
   }
 }
 

@@ -47,6 +47,10 @@ TEST(NodeMuscle, JacobiansAndLengthDerivativeMatchDifferences) {
     calcKinematics(model, s, sk);
     MuscleKinematics mk;
     calcMuscleKinematics(model, s, sk, sc.muscle, mk, true);
+    // the pose-only length (reports, fibre placement) reads the node from q as the workspace does
+    std::vector<Mat4> E;
+    calcBodyPoses(model, s.q, E);
+    EXPECT_NEAR(calcPathLength(model, sc.muscle.path, s.q, E), mk.length, 1e-15 * mk.length);
     const MatX J = expandColumns(mk.J_ar, mk, nq), Jdot = expandColumns(mk.Jdot_ar, mk, nq);
     ASSERT_EQ(J.cols(), nq);
     // the insertion's three node columns are in the Jacobian
