@@ -108,8 +108,11 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
       validation::addActuatorTerms(model, control_warnings, true, &not_applied, f.hard.contact);
       validation::addControlsFile(*model.system, f.controls, control_warnings);
     } else {
-      // the passive forces and contacts; the Simbody engine takes none of them (docs/contact.md)
-      validation::addPassiveTerms(model, control_warnings, not_applied, engine == "core", f.hard.contact);
+      // the passive forces and contacts; the Simbody engine takes the contact forces only, as
+      // Simbody's own force elements (docs/contact.md)
+      validation::addPassiveTerms(model, control_warnings, not_applied,
+                                  engine == "core" ? validation::PassiveForces::All : validation::PassiveForces::ContactOnly,
+                                  f.hard.contact);
     }
     if (prescribing) {
       // hybrid dynamics: the chosen coordinates follow the motion (validation/simulate/prescribe_motion.hpp)

@@ -3,6 +3,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "plugin/simbody/contact_forces.hpp"
 #include "plugin/simbody/model_to_simbody.hpp"
 #include "plugin/simbody/particle_muscles.hpp"
 
@@ -12,6 +13,7 @@ struct ParticleSimulation::Impl {
   Model model;
   std::unique_ptr<SimbodyModel> sm;
   std::unique_ptr<ParticleMuscles> particles;
+  SimbodyContacts contacts;  // (before the integrator: Simbody's contact forces refer to it)
   std::unique_ptr<SimTK::Integrator> integ;
   std::unique_ptr<SimTK::TimeStepper> stepper;
   State state;
@@ -32,6 +34,7 @@ ParticleSimulation::ParticleSimulation(const MusculoskeletalModel& mm, const Sta
   m.model = model;
   m.sm = makeSimbodyModel(model);
   m.particles = std::make_unique<ParticleMuscles>(*m.sm, model, mm.muscles());
+  m.contacts = addSimbodyContacts(*m.sm, model, ContactForces{options.hunt_crossley, options.smooth_contacts});
   SimTK::State st = m.sm->default_state;
   setSimbodyState(*m.sm, model, initial, st);
   m.particles->placeParticles(st);

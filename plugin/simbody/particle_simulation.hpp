@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/dynamics/contact_force_terms.hpp"
 #include "core/model/musculoskeletal_model.hpp"
 #include "core/skeleton/model.hpp"
 #include "core/skeleton/state.hpp"
@@ -28,6 +29,9 @@ struct ParticleSimulationOptions {
   /// The finger (FDP, FDS 0.2 kg over 5 points each, 1 s) reaches 1e-6 rad against the core with
   /// the least CPU as feldberg, infinity_norm, accuracy 3e-12, constraint_tolerance 3e-13.
   bool infinity_norm = false;
+  /// compliant contact as Simbody's own force elements (plugin/simbody/contact_forces.hpp)
+  std::vector<HuntCrossleyForceTerm::Force> hunt_crossley;
+  std::vector<SmoothSphereHalfSpaceForceTerm::Contact> smooth_contacts;
 };
 
 /// Simbody's integrator counters (Integrator::getNum*), summed over the run.

@@ -232,8 +232,9 @@ std::string strictRefusal(const std::vector<std::string>& not_applied) {
 }
 
 void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std::vector<std::string>& not_applied,
-                     bool apply, bool hard_contact, const std::string& controls_hint,
+                     PassiveForces which, bool hard_contact, const std::string& controls_hint,
                      const std::vector<std::string>& pulling) {
+  const bool apply = which != PassiveForces::None;
   const osim::ModelDescription& d = m.description;
   // muscles and actuators need controls: named in one line each, every name given
   auto listNames = [&](const std::vector<std::string>& names, const std::string& what) {
@@ -252,8 +253,16 @@ void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std
                            : "path forces exert no force with this engine");
   listNames(actuators, apply ? "actuators apply nothing without " + controls_hint : "actuators apply nothing with this engine");
   auto passive = [&](const osim::ForceDesc& f) {
-    return f.applies_force && !isActuator(f) && !(hard_contact && isContactForce(f));
+    return f.applies_force && !isActuator(f) && !(hard_contact && isContactForce(f)) &&
+           (which != PassiveForces::ContactOnly || isContactForce(f));
   };
+  if (which == PassiveForces::ContactOnly) {
+    // the forces the engine leaves out, named
+    std::vector<std::string> forces;
+    for (const osim::ForceDesc& f : d.forces)
+      if (f.applies_force && !isActuator(f) && !isContactForce(f)) forces.push_back(f.name + " (" + f.class_name + ")");
+    listNames(forces, "forces are not applied with this engine (it applies the contact forces only)");
+  }
   if (!apply) {
     std::vector<std::string> forces;
     for (const osim::ForceDesc& f : d.forces)

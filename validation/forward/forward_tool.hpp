@@ -54,19 +54,22 @@ void addSetupControllers(System& sys, const osim::ForwardSetup& setup, std::vect
 void addActuatorTerms(SimulationModel& m, std::vector<std::string>& warnings, bool model_forces = true,
                       std::vector<std::string>* not_applied = nullptr, bool hard_contact = false);
 
+/// Which of the ForceSet's passive forces an engine applies: all (the core), the contact forces
+/// only (the Simbody engine: its own HuntCrossleyForce and SmoothSphereHalfSpaceForce), none.
+enum class PassiveForces { All, ContactOnly, None };
+
 /// Plain `simulate` (no controls): the ForceSet's passive forces and contacts (CoordinateLimitForce,
 /// springs, bushings, HuntCrossleyForce, SmoothSphereHalfSpaceForce) added to m's system. What is
 /// not applied goes to not_applied: the path forces and the actuators (one line each, every name
-/// given), forces whose class is not modelled, contact geometry no applied force uses. apply
-/// false (an engine that takes no ForceSet forces): nothing is added and every force and geometry
-/// is listed.
+/// given), forces whose class is not modelled, contact geometry no applied force uses, and with
+/// `which` other than All the forces the engine does not take (listed, with None every geometry).
 /// hard_contact: HuntCrossleyForce and SmoothSphereHalfSpaceForce are left out (addHardConstraints
 /// makes their geometry hard contacts) and their geometry is not listed here.
 /// controls_hint completes "path forces exert no force without ..." (the command's way to drive
 /// them); path forces named in `pulling` are left out of that line (the caller applies them).
 void addPassiveTerms(SimulationModel& m, std::vector<std::string>& warnings, std::vector<std::string>& not_applied,
-                     bool apply = true, bool hard_contact = false, const std::string& controls_hint = "--controls",
-                     const std::vector<std::string>& pulling = {});
+                     PassiveForces which = PassiveForces::All, bool hard_contact = false,
+                     const std::string& controls_hint = "--controls", const std::vector<std::string>& pulling = {});
 
 /// `simulate`'s hard modes (docs/contact.md §6).
 struct HardConstraintOptions {

@@ -72,7 +72,7 @@ SimulationModel makeGradientModel(const osim::ModelDescription& description, con
     for (size_t k = 0; k < mm.muscles().size(); ++k)
       if (k < mm.muscleModels().size() && mm.muscleModels()[k]) pulling.push_back(mm.muscles()[k].name);
   }
-  addPassiveTerms(m, warnings, not_applied, true, false, "excitation parameters (--params 'excitations:...')",
+  addPassiveTerms(m, warnings, not_applied, PassiveForces::All, false, "excitation parameters (--params 'excitations:...')",
                   pulling);
   if (hill) m.system = withMuscleForces(m);
   return m;

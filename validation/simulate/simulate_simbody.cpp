@@ -20,6 +20,8 @@ std::string simbodyEngineUnsupportedReason(const SimulationModel& m, const Simul
            std::to_string(m.system->numConstraintRows()) +
            " rows: locked, coupled or prescribed coordinates, welds); use --engine core";
   if (m.impulses) return "--engine simbody does not apply --impulse loads; use --engine core";
+  if (m.system->unilateral())
+    return "--engine simbody has no hard unilateral constraints (--joint-limits, --contact hard); use --engine core";
   for (const Muscle& mu : m.build.model.muscles())
     if (mu.fibre.enabled() && mu.mass_points.size() > 0)
       return "--engine simbody moves mass points at fixed arc fractions only; --mass-placement fibre needs --engine core";
@@ -46,6 +48,13 @@ SimulationResult simulateSimbody(const SimulationModel& m, const State& initial,
   po.max_step = so.integrator_options.max_step;
   if (!engine.method.empty()) po.integrator = engine.method;
   po.infinity_norm = engine.infinity_norm;
+  // the model's compliant contact, as Simbody's own force elements (plugin/simbody/contact_forces.hpp)
+  for (const auto& t : m.system->terms()) {
+    if (const auto* hc = dynamic_cast<const HuntCrossleyForceTerm*>(t.get()))
+      po.hunt_crossley.insert(po.hunt_crossley.end(), hc->forces().begin(), hc->forces().end());
+    if (const auto* ss = dynamic_cast<const SmoothSphereHalfSpaceForceTerm*>(t.get()))
+      po.smooth_contacts.insert(po.smooth_contacts.end(), ss->contactList().begin(), ss->contactList().end());
+  }
 
   // the core driver's output times (adaptive methods): t0 + k h_out, the last one t0 + duration
   const double h_out = so.output_dt > 0.0 ? so.output_dt : 0.01;

@@ -8,8 +8,11 @@
 // Integrators: rk45 -> SimTK::RungeKuttaMersonIntegrator, cvode -> SimTK::CPodesIntegrator (BDF,
 // Newton); --simbody-method picks another (feldberg, rk3, verlet) and --simbody-norm Simbody's
 // error norm. rtol is Simbody's accuracy and atol its constraint tolerance (the particles' path
-// constraints, m and m/s). What Simbody cannot take (core constraints, impulses, --no-qvv, other
-// integrators) is refused by simbodyEngineUnsupportedReason before anything runs.
+// constraints, m and m/s). What Simbody cannot take (core constraints, impulses, hard unilateral
+// constraints, --no-qvv, other integrators) is refused by simbodyEngineUnsupportedReason before
+// anything runs. Of the ForceSet it applies the compliant contact forces (HuntCrossleyForce,
+// SmoothSphereHalfSpaceForce) as Simbody's own force elements (plugin/simbody/contact_forces.hpp);
+// the other passive forces are named as not applied by the caller (validation::PassiveForces).
 //
 // The finger (osim_models/finger.osim, FDP and FDS 0.2 kg each) is sensitive: a 1e-10 rad change of
 // q0 grows to 1.6e-6 rad in 1 s, so agreeing with the core to 1e-6 there needs local errors near
