@@ -15,12 +15,20 @@ Mat4 worldPose(const SkeletonWorkspace& sk, const CollisionGeometry& g) {
   return g.body < 0 ? g.X_body : Mat4(sk.E_wi[g.body] * g.X_body);
 }
 
-// the sphere centres (radius r) or corner points (radius 0) a shape offers to a half-space, world
-void shapePoints(const CollisionGeometry& g, const Mat4& X, std::vector<Vec3>& pts, double& r) {
+// the sphere centres (radius r) or surface points (radius 0) a shape offers to a half-space of
+// outward normal n, world
+void shapePoints(const CollisionGeometry& g, const Mat4& X, const Vec3& n, std::vector<Vec3>& pts, double& r) {
   pts.clear();
   const Vec3 o = X.topRightCorner<3, 1>();
   const Mat3 R = X.topLeftCorner<3, 3>();
   switch (g.shape) {
+    case CollisionShape::Ellipsoid: {
+      // the support point along -n: x = o + R A u with |u| = 1 minimising n . x, u = -A R^T n / |A R^T n|
+      const Vec3 An = g.half_extents.cwiseProduct(R.transpose() * n);
+      pts.push_back(o - R * (g.half_extents.cwiseProduct(An) / An.norm()));
+      r = 0.0;
+      break;
+    }
     case CollisionShape::Sphere:
       pts.push_back(o);
       r = g.radius;
@@ -52,8 +60,38 @@ const char* shapeName(CollisionShape s) {
     case CollisionShape::Capsule: return "capsule";
     case CollisionShape::Box: return "box";
     case CollisionShape::HalfSpace: return "half-space";
+    case CollisionShape::Ellipsoid: return "ellipsoid";
   }
   return "?";
+}
+
+// the contact points of a pair (a: half-space, sphere or capsule; b: the other) at world poses
+// Xa, Xb: (point, gap) with the normal n from a into b
+void pairContacts(const CollisionGeometry& ga, const CollisionGeometry& gb, const Mat4& Xa, const Mat4& Xb,
+                  std::vector<std::pair<Vec3, double>>& contacts, Vec3& n, std::vector<Vec3>& pts) {
+  contacts.clear();
+  if (ga.shape == CollisionShape::HalfSpace) {
+    n = -Xa.topLeftCorner<3, 3>().col(0);
+    const Vec3 o_a = Xa.topRightCorner<3, 1>();
+    double r = 0.0;
+    shapePoints(gb, Xb, n, pts, r);
+    for (const Vec3& c : pts) contacts.emplace_back(c - r * n, n.dot(c - o_a) - r);
+    return;
+  }
+  // sphere or capsule a against sphere b: a's nearest point to b's centre (the capsule's axis
+  // segment clamped), then two spheres
+  Vec3 ca = Xa.topRightCorner<3, 1>();
+  const Vec3 cb = Xb.topRightCorner<3, 1>();
+  if (ga.shape == CollisionShape::Capsule) {
+    const Vec3 axis = Xa.topLeftCorner<3, 3>().col(0);
+    const double t = std::clamp(axis.dot(cb - ca), -ga.half_length, ga.half_length);
+    ca += t * axis;
+  }
+  const Vec3 dlt = cb - ca;
+  const double dist = dlt.norm();
+  n = dist > 1e-12 ? Vec3(dlt / dist) : Vec3::UnitY();
+  const double gap = dist - ga.radius - gb.radius;
+  contacts.emplace_back(ca + (ga.radius + 0.5 * gap) * n, gap);
 }
 
 }  // namespace
@@ -69,19 +107,26 @@ UnilateralConstraints::UnilateralConstraints(const Model& model, std::vector<Col
       throw ModelError("collision geometry " + g.name + ": negative or non-finite size or frame");
     if ((g.shape == CollisionShape::Sphere || g.shape == CollisionShape::Capsule) && !(g.radius > 0.0))
       throw ModelError("collision geometry " + g.name + ": radius must be positive");
+    if (g.shape == CollisionShape::Ellipsoid && !(g.half_extents.minCoeff() > 0.0))
+      throw ModelError("collision geometry " + g.name + ": the ellipsoid's semi-axes must be positive");
   }
   const int ng = static_cast<int>(geometry_.size());
   for (auto& p : pairs_) {
     if (p.first < 0 || p.first >= ng || p.second < 0 || p.second >= ng)
       throw ModelError("collision pair: geometry index out of range");
-    if (geometry_[p.second].shape == CollisionShape::HalfSpace) std::swap(p.first, p.second);
+    // the half-space first, a capsule before a sphere
+    if (geometry_[p.second].shape == CollisionShape::HalfSpace ||
+        (geometry_[p.second].shape == CollisionShape::Capsule && geometry_[p.first].shape == CollisionShape::Sphere))
+      std::swap(p.first, p.second);
     const CollisionGeometry &a = geometry_[p.first], &b = geometry_[p.second];
     const std::string what = "collision pair " + a.name + " - " + b.name;
     const bool ok = (a.shape == CollisionShape::HalfSpace && b.shape != CollisionShape::HalfSpace) ||
-                    (a.shape == CollisionShape::Sphere && b.shape == CollisionShape::Sphere);
+                    (a.shape == CollisionShape::Sphere && b.shape == CollisionShape::Sphere) ||
+                    (a.shape == CollisionShape::Capsule && b.shape == CollisionShape::Sphere);
     if (!ok)
       throw ModelError(what + ": " + shapeName(a.shape) + " against " + shapeName(b.shape) +
-                       " is not supported (half-space with sphere, capsule or box; sphere with sphere)");
+                       " is not supported (half-space with sphere, capsule, box or ellipsoid; sphere with sphere or "
+                       "capsule)");
     if (a.body == b.body) throw ModelError(what + ": both on one body");
     if (!(p.friction >= 0.0) || !std::isfinite(p.friction)) throw ModelError(what + ": friction must be >= 0");
     if (!(p.restitution >= 0.0 && p.restitution <= 1.0)) throw ModelError(what + ": restitution must be in [0, 1]");
@@ -150,22 +195,9 @@ void UnilateralConstraints::detect(const Model& model, const State& s, const Ske
     const CollisionPair& p = pairs_[i];
     const CollisionGeometry &ga = geometry_[p.first], &gb = geometry_[p.second];
     const Mat4 Xa = worldPose(sk, ga), Xb = worldPose(sk, gb);
-    double r = 0.0;
-    std::vector<std::pair<Vec3, double>> contacts;  // (point on the surface of b side, gap) with normal
+    std::vector<std::pair<Vec3, double>> contacts;  // (contact point, gap) with the normal n
     Vec3 n;
-    if (ga.shape == CollisionShape::HalfSpace) {
-      n = -Xa.topLeftCorner<3, 3>().col(0);
-      const Vec3 o_a = Xa.topRightCorner<3, 1>();
-      shapePoints(gb, Xb, pts, r);
-      for (const Vec3& c : pts) contacts.emplace_back(c - r * n, n.dot(c - o_a) - r);
-    } else {
-      const Vec3 ca = Xa.topRightCorner<3, 1>(), cb = Xb.topRightCorner<3, 1>();
-      const Vec3 dlt = cb - ca;
-      const double dist = dlt.norm();
-      n = dist > 1e-12 ? Vec3(dlt / dist) : Vec3::UnitY();
-      const double gap = dist - ga.radius - gb.radius;
-      contacts.emplace_back(ca + (ga.radius + 0.5 * gap) * n, gap);
-    }
+    pairContacts(ga, gb, Xa, Xb, contacts, n, pts);
     // tangents: world x projected on the plane (z if x is nearly normal), and n x t1
     Vec3 t1 = Vec3::UnitX() - n.x() * n;
     if (t1.norm() < 0.1) t1 = Vec3::UnitZ() - n.z() * n;
@@ -208,17 +240,12 @@ std::vector<double> UnilateralConstraints::gaps(const Model& model, const State&
     out.push_back(l.upper - s.q[l.coordinate]);
   }
   std::vector<Vec3> pts;
+  std::vector<std::pair<Vec3, double>> contacts;
+  Vec3 n;
   for (const auto& p : pairs_) {
     const CollisionGeometry &ga = geometry_[p.first], &gb = geometry_[p.second];
-    const Mat4 Xa = worldPose(sk, ga), Xb = worldPose(sk, gb);
-    if (ga.shape == CollisionShape::HalfSpace) {
-      double r = 0.0;
-      shapePoints(gb, Xb, pts, r);
-      const Vec3 n = -Xa.topLeftCorner<3, 3>().col(0);
-      for (const Vec3& c : pts) out.push_back(n.dot(c - Xa.topRightCorner<3, 1>()) - r);
-    } else {
-      out.push_back((Xb.topRightCorner<3, 1>() - Xa.topRightCorner<3, 1>()).norm() - ga.radius - gb.radius);
-    }
+    pairContacts(ga, gb, worldPose(sk, ga), worldPose(sk, gb), contacts, n, pts);
+    for (const auto& c : contacts) out.push_back(c.second);
   }
   return out;
 }

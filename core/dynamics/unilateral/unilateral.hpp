@@ -33,10 +33,11 @@
 
 namespace redmax {
 
-enum class CollisionShape { Sphere, Capsule, Box, HalfSpace };
+enum class CollisionShape { Sphere, Capsule, Box, HalfSpace, Ellipsoid };
 
 /// A collision shape fixed in a body (-1: the ground). The half-space fills x > 0 of its frame
-/// (OpenSim's ContactHalfSpace; outward normal -x); the capsule's axis is the frame's x axis.
+/// (OpenSim's ContactHalfSpace; outward normal -x); the capsule's axis is the frame's x axis; the
+/// ellipsoid's semi-axes lie along the frame's axes.
 struct CollisionGeometry {
   std::string name;
   CollisionShape shape = CollisionShape::Sphere;
@@ -44,11 +45,15 @@ struct CollisionGeometry {
   Mat4 X_body = Mat4::Identity();     ///< geometry frame in the body frame
   double radius = 0.0;                ///< Sphere, Capsule
   double half_length = 0.0;           ///< Capsule: half the distance between the cap centres
-  Vec3 half_extents = Vec3::Zero();   ///< Box
+  Vec3 half_extents = Vec3::Zero();   ///< Box: half extents; Ellipsoid: semi-axes
 };
 
-/// Two geometries that may touch: a half-space with a sphere, capsule (its two cap spheres) or
-/// box (its eight corners), or two spheres.
+/// Two geometries that may touch: a half-space with a sphere, capsule (its two cap spheres), box
+/// (its eight corners) or ellipsoid (its deepest point: the support point along the inward
+/// normal, o - R A^2 R^T n / |A R^T n| for semi-axes A), two spheres, or a capsule and a sphere
+/// (the sphere against the nearest point of the capsule's axis segment, a sphere-sphere contact
+/// of radii r_capsule and r_sphere there). One contact point per sphere, cap, corner or ellipsoid,
+/// its rows the point's velocity on each body along the normal (and two tangents).
 struct CollisionPair {
   int first = -1, second = -1;  ///< indices into the geometry list
   double friction = 0.0;        ///< Coulomb coefficient mu (>= 0)
