@@ -40,6 +40,10 @@ int runFlick(FlickFlags& f, const CLI::App& app) {
   for (const auto& n : integrators)
     if (n != "euler" && n != "symplectic" && n != "bdf1" && n != "sdirk2" && n != "rk45" && n != "cvode")
       throw UsageError{"--integrators: unknown integrator '" + n + "'"};
+  if (!o.joint_limits.empty())
+    for (const auto& n : integrators)
+      if (n != "bdf1") throw UsageError{"--joint-limits needs --integrators bdf1 (the step with the contact QP), got '" + n + "'"};
+  if (given(app, "--limit-restitution") && o.joint_limits.empty()) throw UsageError{"--limit-restitution needs --joint-limits"};
   std::vector<bool> gravity;
   if (f.gravity == "on") gravity = {true};
   else if (f.gravity == "off") gravity = {false};
@@ -47,8 +51,10 @@ int runFlick(FlickFlags& f, const CLI::App& app) {
 
   const auto rows = validation::runFlickStudy(o, integrators, gravity, f.mass, dts);
   std::printf("finger flick: force on '%s' along +y for %g s, then %g s of fixed steps; inertial = %g kg in each of "
-              "FDP and FDS\n%s",
-              o.target.c_str(), o.impulse_time, o.duration, f.mass, validation::formatFlickTable(rows).c_str());
+              "FDP and FDS; joint ranges %s\n%s",
+              o.target.c_str(), o.impulse_time, o.duration, f.mass,
+              o.joint_limits.empty() ? "free (not enforced)" : ("enforced (--joint-limits " + o.joint_limits + ")").c_str(),
+              validation::formatFlickTable(rows).c_str());
   if (given(app, "--csv")) osim::writeFileAtomic(f.csv, validation::formatFlickCsv(rows));
   return 0;
 }
@@ -90,10 +96,18 @@ CommandRegistration reg(
            ->type_name("F")
            ->check(positive());
        app.add_option("--csv", f->csv, "also write the table as CSV (atomically)")->type_name("OUT.csv");
+       app.add_option("--joint-limits", f->o.joint_limits,
+                      "hard: every coordinate's range, clamped: the clamped ones, as hard limits (bdf1 only)")
+           ->type_name("hard|clamped")
+           ->check(oneOf({"hard", "clamped"}));
+       app.add_option("--limit-restitution", f->o.limit_restitution, "restitution at the limits (default 0)")
+           ->type_name("E")
+           ->check(CLI::Range(0.0, 1.0));
        app.footer(
            "usage: redmax flick --model finger.osim [--integrators euler,symplectic] [--gravity on|off|both]\n"
            "                    [--mass KG] [--dt S | --dts S1,S2,...] [--duration S] [--impulse-time S]\n"
            "                    [--target MARKER] [--energy-growth F] [--csv OUT.csv]\n"
+           "                    [--joint-limits hard|clamped [--limit-restitution E]]\n"
            "The study of the dissertation's 6.2.5: a force along +y (ground frame) on the fingertip for the\n"
            "first --impulse-time seconds, then --duration s of fixed steps --dt. Variants: lumped (the model\n"
            "as is) and inertial (--mass kg in each of FDP and FDS, added). A run fails on a NaN/divergence\n"

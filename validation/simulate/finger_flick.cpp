@@ -1,8 +1,12 @@
 #include "validation/simulate/finger_flick.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <limits>
 #include <sstream>
+
+#include "validation/forward/forward_tool.hpp"
 
 namespace redmax::validation {
 
@@ -16,8 +20,22 @@ FlickRun runFlick(const FlickOptions& options, double force) {
   imp.duration = options.impulse_time;
   mo.impulses = {imp};
   if (!options.gravity) mo.gravity = Vec3::Zero();
-  const SimulationModel m = loadSimulationModel(options.model_path, mo);
+  SimulationModel m = loadSimulationModel(options.model_path, mo);
+  if (!options.joint_limits.empty()) {
+    HardConstraintOptions ho;
+    ho.joint_limits = options.joint_limits;
+    ho.limit_restitution = options.limit_restitution;
+    std::vector<std::string> not_applied;  // (the finger's coordinates all have their own columns)
+    addHardConstraints(m, ho, not_applied);
+  }
   const State s0 = defaultInitialState(m);
+  // the coordinates' ranges, to measure excursions through the bone
+  std::vector<std::pair<int, std::pair<double, double>>> ranges;
+  for (const osim::CoordinateDesc& c : m.description.coordinates) {
+    const int k = m.system->model().findCoordinate(c.name);
+    if (k >= 0 && !c.locked && !c.prescribed && c.range_min < c.range_max) ranges.push_back({k, {c.range_min, c.range_max}});
+  }
+  double excursion = 0.0;
 
   SimulateOptions so;
   so.integrator = options.integrator;
@@ -27,6 +45,7 @@ FlickRun runFlick(const FlickOptions& options, double force) {
   double E_flick = std::numeric_limits<double>::quiet_NaN(), K_max = 0.0;
   so.check = [&](const State& s, double K, double V) -> std::string {
     K_max = std::max(K_max, K);
+    for (const auto& [k, r] : ranges) excursion = std::max({excursion, r.first - s.q[k], s.q[k] - r.second});
     if (s.t < options.impulse_time - 1e-12) return "";
     if (std::isnan(E_flick)) E_flick = K + V;  // the first row after the flick
     if (K + V - E_flick > options.energy_growth * K_max) {
@@ -37,7 +56,7 @@ FlickRun runFlick(const FlickOptions& options, double force) {
     return "";
   };
   const SimulationResult r = simulate(m, s0, so);
-  return {force, !r.failed, r.failure};
+  return {force, !r.failed, r.failure, excursion};
 }
 
 FlickSearch findLargestSurvivedFlick(const FlickOptions& options, double lo, double hi, double step,
@@ -54,6 +73,7 @@ FlickSearch findLargestSurvivedFlick(const FlickOptions& options, double lo, dou
       break;
     }
     pass = f;
+    out.excursion = r.max_excursion;
   }
   if (pass > 0.0 && std::isfinite(fail)) {
     while (fail / pass > 1.0 + rel_tol) {
@@ -62,6 +82,7 @@ FlickSearch findLargestSurvivedFlick(const FlickOptions& options, double lo, dou
       out.runs.push_back(r);
       if (r.survived) {
         pass = mid;
+        out.excursion = r.max_excursion;
       } else {
         fail = mid;
         out.first_failure = r.why;
@@ -119,12 +140,14 @@ std::string fmt(double x) {
 std::string formatFlickTable(const std::vector<FlickStudyRow>& rows) {
   std::ostringstream os;
   os << "| integrator | dt (ms) | gravity | variant | largest force, no energy artifact (first failing) | "
-        "largest force, no divergence (first failing) |\n|---|---|---|---|---|---|\n";
+        "largest force, no divergence (first failing) | excursion beyond a range there (rad) |\n"
+        "|---|---|---|---|---|---|---|\n";
   for (const auto& r : rows)
     os << "| " << r.integrator << " | " << r.dt * 1e3 << " | " << (r.gravity ? "on" : "off") << " | " << r.variant
        << " | "
        << fmt(r.artifact.largest_survived) << " N (" << fmt(r.artifact.smallest_failed) << ") | "
-       << fmt(r.divergence.largest_survived) << " N (" << fmt(r.divergence.smallest_failed) << ") |\n";
+       << fmt(r.divergence.largest_survived) << " N (" << fmt(r.divergence.smallest_failed) << ") | "
+       << fmt(r.divergence.excursion) << " |\n";
   return os.str();
 }
 
@@ -132,11 +155,12 @@ std::string formatFlickCsv(const std::vector<FlickStudyRow>& rows) {
   std::ostringstream os;
   os.precision(10);
   os << "integrator,dt_s,gravity,variant,artifact_survived_N,artifact_failed_N,divergence_survived_N,"
-        "divergence_failed_N,artifact_runs,divergence_runs\n";
+        "divergence_failed_N,artifact_runs,divergence_runs,artifact_excursion,divergence_excursion\n";
   for (const auto& r : rows)
     os << r.integrator << "," << r.dt << "," << (r.gravity ? 1 : 0) << "," << r.variant << "," << r.artifact.largest_survived << ","
        << r.artifact.smallest_failed << "," << r.divergence.largest_survived << "," << r.divergence.smallest_failed
-       << "," << r.artifact.runs.size() << "," << r.divergence.runs.size() << "\n";
+       << "," << r.artifact.runs.size() << "," << r.divergence.runs.size() << "," << r.artifact.excursion << ","
+       << r.divergence.excursion << "\n";
   return os.str();
 }
 

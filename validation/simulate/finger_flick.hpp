@@ -5,8 +5,10 @@
 // survives when it ends without a NaN/divergence and without gaining energy after the flick: the
 // finger (under gravity or not) is conservative once the flick ends, so a gain is numerical; the
 // total energy may not exceed its value at the end of the flick by more than `energy_growth` times
-// the largest kinetic energy seen so far. (The model has no joint limits, so a joint may turn
-// freely: excursions are no sign of instability here and are not checked.)
+// the largest kinetic energy seen so far. Without joint limits a joint may turn freely, through
+// the bone (every run records the largest excursion beyond a coordinate's range; it is no sign of
+// instability there); with `joint_limits` the ranges are hard unilateral constraints of the bdf1
+// step (docs/contact.md §6), so the finger stops at its ranges.
 // The largest force survived is found by a geometric scan followed by bisection.
 #include <string>
 #include <vector>
@@ -28,12 +30,17 @@ struct FlickOptions {
   /// muscle name -> kg of mass points (empty: lumped)
   std::vector<std::pair<std::string, double>> muscle_masses;
   int mass_points = 20;
+  /// "": no limits; "hard" (every coordinate's range) or "clamped" (the clamped ones) as hard
+  /// unilateral constraints (bdf1 only), with this restitution
+  std::string joint_limits;
+  double limit_restitution = 0.0;
 };
 
 struct FlickRun {
   double force = 0.0;   ///< N
   bool survived = false;
   std::string why;      ///< failure reason ("" when it survived)
+  double max_excursion = 0.0;  ///< rad (m): the largest excursion of a coordinate beyond its range
 };
 
 /// One run with a force of magnitude `force` (N) along options.direction.
@@ -42,6 +49,7 @@ FlickRun runFlick(const FlickOptions& options, double force);
 struct FlickSearch {
   double largest_survived = 0.0;  ///< N; 0 if even `lo` failed
   double smallest_failed = 0.0;   ///< N; +inf if even `hi` survived
+  double excursion = 0.0;         ///< max_excursion of the run at largest_survived
   std::string first_failure;      ///< why the run at smallest_failed failed
   std::vector<FlickRun> runs;     ///< every run, in the order made
 };

@@ -268,11 +268,17 @@ VecX solveUnilateralStep(const MatX& A, const VecX& a, const MatX& G, const VecX
     vf.noalias() -= AiGt * Lf;
   }
   // the rows that can close within the step, at the start's or the free step's velocity
-  UnilateralRows rows;
   const VecX wf_all = all.Jn * vf;
   std::vector<int> keep;
   for (int i = 0; i < static_cast<int>(all.c.size()); ++i)
     if (all.c[i].gap + all.h * std::min({0.0, all.c[i].approach, wf_all[i]}) < opt.margin) keep.push_back(i);
+  // Rows left out can still close: the impulses of the others move their coordinates (a limit's
+  // impulse throws a neighbouring joint into its own limit). After each solve the rows the
+  // result would close join the set and it is solved again (at most once per row).
+  std::vector<char> in_set(all.c.size(), 0);
+  for (int i : keep) in_set[i] = 1;
+  int rounds_qp = 0, rounds_friction = 0;
+  for (;;) {
   const int kn = static_cast<int>(keep.size());
   if (kn == 0) {
     if (mu_bilateral) *mu_bilateral = mb > 0 ? Lf : VecX();
@@ -280,6 +286,7 @@ VecX solveUnilateralStep(const MatX& A, const VecX& a, const MatX& G, const VecX
     if (warm) warm->active_keys.clear();
     return vf;
   }
+  UnilateralRows rows;
   int kt = 0;
   for (int i : keep) kt += all.c[i].tangent_row >= 0 ? 2 : 0;
   rows.c.reserve(kn);
@@ -401,6 +408,25 @@ VecX solveUnilateralStep(const MatX& A, const VecX& a, const MatX& G, const VecX
       }
     }
   }
+  const VecX v = vf + X * p;
+  {
+    const VecX w_all = all.Jn * v;
+    bool added = false;
+    for (int i = 0; i < static_cast<int>(all.c.size()); ++i)
+      if (!in_set[i] && all.c[i].gap + all.h * std::min({0.0, all.c[i].approach, w_all[i]}) < opt.margin) {
+        keep.push_back(i);
+        in_set[i] = 1;
+        added = true;
+      }
+    rounds_qp += st.qp_iterations;
+    rounds_friction += st.friction_iterations;
+    if (added) {
+      std::sort(keep.begin(), keep.end());
+      continue;
+    }
+  }
+  st.qp_iterations = rounds_qp;
+  st.friction_iterations = rounds_friction;
   for (int i = 0; i < kn; ++i) st.contacts += p[i] > 0.0;
   if (warm) {
     warm->active_keys.clear();
@@ -411,7 +437,8 @@ VecX solveUnilateralStep(const MatX& A, const VecX& a, const MatX& G, const VecX
     else mu_bilateral->resize(0);
   }
   if (stats) *stats = st;
-  return vf + X * p;
+  return v;
+  }
 }
 
 }  // namespace redmax
