@@ -45,6 +45,27 @@ TEST(FingerFlick, InertialFingerSurvivesAForceThatBreaksTheLumpedOne) {
   }
 }
 
+TEST(FingerFlick, WithItsJointRangesEnforcedTheFingerStopsAtTheBone) {
+  // without limits the lumped finger (bdf1 = euler here) fails at 6.7 N with its joints spinning
+  // through the bone; with the ranges as hard limits (bdf1's contact QP) lumped and inertial alike
+  // survive 1 kN and never leave their ranges
+  FlickOptions free_joints = finger();
+  free_joints.integrator = "bdf1";
+  const FlickRun spun = runFlick(free_joints, 10.0);
+  EXPECT_FALSE(spun.survived);
+  EXPECT_GT(spun.max_excursion, 1.0);  // measured: tens of rad through the bone
+  FlickOptions limited = free_joints;
+  limited.joint_limits = "hard";
+  for (bool inertial : {false, true}) {
+    if (inertial) limited.muscle_masses = {{"FDP", 0.2}, {"FDS", 0.2}};
+    for (double force : {10.0, 1000.0}) {
+      const FlickRun r = runFlick(limited, force);
+      EXPECT_TRUE(r.survived) << force << " N, " << (inertial ? "inertial" : "lumped") << ": " << r.why;
+      EXPECT_LT(r.max_excursion, 1e-6) << force << " N";  // measured at most 3.9e-7 rad (1 kN)
+    }
+  }
+}
+
 TEST(FingerFlick, NoFlickNoFailureAndNoMotionWithoutGravity) {
   // without gravity and without a force the finger stays at rest, whatever its muscles weigh
   FlickOptions o = finger();
