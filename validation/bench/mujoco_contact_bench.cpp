@@ -34,14 +34,6 @@ using peers::MjContactParams;
 
 constexpr double kG = 9.81;
 
-// the bouncy variant: a linear spring-damper with restitution e has damping ratio
-// z = -ln e / sqrt(pi^2 + ln^2 e); stiffness 1e5 /s^2 (contact about 10 steps long)
-MjContactParams bouncy(double e) {
-  const double k = 1e5, z = -std::log(e) / std::sqrt(M_PI * M_PI + std::log(e) * std::log(e));
-  MjContactParams p;
-  p.solref = "-" + std::to_string(k) + " -" + std::to_string(2 * z * std::sqrt(k));
-  return p;
-}
 MjContactParams elliptic() {
   MjContactParams p;
   p.elliptic_cone = true;
@@ -70,7 +62,7 @@ int main(int argc, char** argv) {
   const long nb = std::lround(bo.duration / bo.dt), ns = std::lround(so.duration / so.dt),
              nx = std::lround(xo.duration / xo.dt);
   // models loaded once (mj_loadXML compiles; not part of a step)
-  peers::MujocoModel mb(peers::ballDropMjcf(bo, {})), mbb(peers::ballDropMjcf(bo, bouncy(bo.restitution))),
+  peers::MujocoModel mb(peers::ballDropMjcf(bo, {})), mbb(peers::ballDropMjcf(bo, peers::bouncyContact(bo.restitution))),
       ms(peers::blockSlideMjcf(so, {})), mse(peers::blockSlideMjcf(so, elliptic())), mx(peers::boxStackMjcf(xo, {})),
       mxe(peers::boxStackMjcf(xo, elliptic()));
 
@@ -132,15 +124,15 @@ int main(int argc, char** argv) {
   };
   std::printf("\nball-drop: r %g m from %g m, redmax e %g; first impact against sqrt(2h/g) = %.5f s\n\n",
               bo.radius, bo.drop_height, bo.restitution, std::sqrt(2 * bo.drop_height / kG));
-  std::printf("| | first impact (s) | apexes (m) | rest height (m) | largest penetration (m) | max |height - redmax's| (m) |\n"
-              "|---|---|---|---|---|---|\n");
-  std::printf("| redmax (e %g) | %.3f | %s | %.9f | %.2e | - |\n", bo.restitution, r_impact, apexes(rb.apexes).c_str(),
-              rb.rest_height, r_pen);
-  std::printf("| MuJoCo default | %.3f | %s | %.9f | %.2e | %.3g |\n", jb.first_impact, apexes(jb.apexes).c_str(),
-              jb.rest_height, jb.max_penetration, maxDiff(rh, jb.height.y));
-  std::printf("| MuJoCo bouncy (solref %s) | %.3f | %s | %.9f | %.2e | %.3g |\n", bouncy(bo.restitution).solref.c_str(),
-              jbb.first_impact, apexes(jbb.apexes).c_str(), jbb.rest_height, jbb.max_penetration,
-              maxDiff(rh, jbb.height.y));
+  std::printf("| | first impact (s) | apexes (m) | rest height (m) | penetration at rest (m) | largest penetration (m) | max |height - redmax's| (m) |\n"
+              "|---|---|---|---|---|---|---|\n");
+  std::printf("| redmax (e %g) | %.3f | %s | %.9f | %.2e | %.2e | - |\n", bo.restitution, r_impact,
+              apexes(rb.apexes).c_str(), rb.rest_height, std::max(0.0, bo.radius - rb.rest_height), r_pen);
+  std::printf("| MuJoCo default | %.3f | %s | %.9f | %.2e | %.2e | %.3g |\n", jb.first_impact, apexes(jb.apexes).c_str(),
+              jb.rest_height, bo.radius - jb.rest_height, jb.max_penetration, maxDiff(rh, jb.height.y));
+  std::printf("| MuJoCo bouncy (solref %s) | %.3f | %s | %.9f | %.2e | %.2e | %.3g |\n",
+              peers::bouncyContact(bo.restitution).solref.c_str(), jbb.first_impact, apexes(jbb.apexes).c_str(), jbb.rest_height,
+              bo.radius - jbb.rest_height, jbb.max_penetration, maxDiff(rh, jbb.height.y));
   // free fall alone: the samples before either side's first impact
   const size_t ff = static_cast<size_t>(std::lround(std::min(r_impact, jb.first_impact) / bo.dt)) - 1;
   std::printf("free fall before the first impact (%zu steps): max |height difference| %.3g m\n", ff,

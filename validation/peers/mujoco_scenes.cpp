@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -52,6 +53,15 @@ void throwOnWarnings(const mjData* d) {
 }
 
 }  // namespace
+
+MjContactParams bouncyContact(double e, double stiffness) {
+  const double l = std::log(e), z = -l / std::sqrt(M_PI * M_PI + l * l);
+  std::array<char, 64> buf{};
+  std::snprintf(buf.data(), buf.size(), "-%.0f -%.1f", stiffness, 2 * z * std::sqrt(stiffness));
+  MjContactParams p;
+  p.solref = buf.data();
+  return p;
+}
 
 struct MujocoModel::Impl {
   mjModel* m = nullptr;

@@ -23,6 +23,11 @@ struct MjContactParams {
   bool elliptic_cone = false;
 };
 
+/// a bouncing contact: solref in the direct format (-stiffness, -damping) with the damping of a
+/// linear spring-damper whose restitution is `e` (ratio z = -ln e / sqrt(pi^2 + ln^2 e), damping
+/// 2 z sqrt(k)). MuJoCo's impedance (solimp) scales both, so the bounce is near e, not e.
+MjContactParams bouncyContact(double e, double stiffness = 1e5);
+
 /// one loaded MuJoCo model and its data; not copyable
 class MujocoModel {
  public:
