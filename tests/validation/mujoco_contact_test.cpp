@@ -57,12 +57,12 @@ TEST(MujocoContact, BouncySolrefBouncesNearTheRestitution) {
   const scenes::BallDropOptions o;  // e 0.5: apexes e^(2k) h0 = 0.125, 0.03125, 0.0078 m
   peers::MujocoModel m(peers::ballDropMjcf(o, peers::bouncyContact(o.restitution)));
   const peers::MjBallDropResult j = peers::runBallDrop(m, o);
-  // measured 0.1332, 0.0441, 0.0122 m: MuJoCo's impedance makes it livelier than the linear
+  // measured 0.1331, 0.0450, 0.0126 m: MuJoCo's impedance makes it livelier than the linear
   // spring-damper the damping was chosen from, more so on slower impacts
   ASSERT_GE(j.apexes.size(), 3u);
   EXPECT_NEAR(j.apexes[0], 0.125, 0.0125);
   EXPECT_GT(j.apexes[1], 0.03125);
-  EXPECT_LT(j.apexes[1], 0.05);
+  EXPECT_LT(j.apexes[1], 0.055);
   EXPECT_LT(j.apexes[2], j.apexes[1]);
   EXPECT_NEAR(j.rest_height, o.radius, 5e-5);  // measured 0.0999891 m: stiffer than the default
 }
