@@ -11,7 +11,7 @@
 //   validation/ -> core, converter, plugin, view;  cli/ -> anything
 // External libraries: tinyxml2 only in converter/; Simbody only in plugin/, validation/ and
 // tests; SUNDIALS only in core/integrators/*.cpp (never a header); LBFGSpp and NLopt only in
-// validation/optimize/*.cpp.
+// validation/optimize/*.cpp; MuJoCo (the contact comparison) only in validation/peers/*.cpp.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -144,6 +144,12 @@ TEST(Layering, IncludesPointDownOnly) {
         EXPECT_TRUE(inc.file.rfind("validation/optimize/", 0) == 0 && inc.file.size() > 4 &&
                     inc.file.substr(inc.file.size() - 4) == ".cpp")
             << where << " (LBFGSpp and NLopt only in validation/optimize/*.cpp)";
+      }
+      if (inc.target.rfind("mujoco/", 0) == 0) {
+        // a peer for comparison (docs/contact.md §6.4a), optional: never in a header or the core
+        EXPECT_TRUE(inc.file.rfind("validation/peers/", 0) == 0 && inc.file.size() > 4 &&
+                    inc.file.substr(inc.file.size() - 4) == ".cpp")
+            << where << " (MuJoCo only in validation/peers/*.cpp)";
       }
       if (isSundials(inc.target)) {
         EXPECT_TRUE(dir == "core/integrators" && inc.file.size() > 4 &&
