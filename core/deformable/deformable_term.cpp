@@ -98,7 +98,12 @@ void DeformableTerm::mapForce(const VecX& F, Eigen::Ref<VecX> f, const Deformabl
   }
 }
 
-void DeformableTerm::mapMatrix(const SparseMat& A, MatX& out, const DeformableScratch& sc, int nr) const {
+// J_MR^T A J_MR entry by entry: each non-zero a of A between node coordinates (i, j) lands on the
+// coordinates the two nodes' rows map to: free-free one entry, free-attached a row or column of
+// J_a over q_r, attached-attached the q_r block (world nodes nothing)
+template <class FreeFree, class FreeBody, class BodyFree, class BodyBody>
+void DeformableTerm::forEachMappedEntry(const SparseMat& A, const DeformableScratch& sc, FreeFree&& ff, FreeBody&& fb,
+                                        BodyFree&& bf, BodyBody&& bb) const {
   using Kind = NodeBinding::Kind;
   for (int col = 0; col < A.outerSize(); ++col) {
     const int nj = col / 3, cj = col % 3;
@@ -109,44 +114,35 @@ void DeformableTerm::mapMatrix(const SparseMat& A, MatX& out, const DeformableSc
       const NodeBinding& bi = nodes_[ni];
       const double a = it.value();
       if (bi.kind == Kind::World) continue;
-      if (bi.kind == Kind::Free && bj.kind == Kind::Free) {
-        out(bi.index + ci, bj.index + cj) += a;
-      } else if (bi.kind == Kind::Free) {
-        out.row(bi.index + ci).head(nr) += a * sc.J[nj].row(cj);
-      } else if (bj.kind == Kind::Free) {
-        out.col(bj.index + cj).head(nr) += a * sc.J[ni].row(ci).transpose();
-      } else {
-        out.topLeftCorner(nr, nr).noalias() += a * sc.J[ni].row(ci).transpose() * sc.J[nj].row(cj);
-      }
+      if (bi.kind == Kind::Free && bj.kind == Kind::Free) ff(bi.index + ci, bj.index + cj, a);
+      else if (bi.kind == Kind::Free) fb(bi.index + ci, sc.J[nj].row(cj), a);
+      else if (bj.kind == Kind::Free) bf(sc.J[ni].row(ci), bj.index + cj, a);
+      else bb(sc.J[ni].row(ci), sc.J[nj].row(cj), a);
     }
   }
 }
 
+void DeformableTerm::mapMatrix(const SparseMat& A, MatX& out, const DeformableScratch& sc, int nr) const {
+  forEachMappedEntry(
+      A, sc, [&](int i, int j, double a) { out(i, j) += a; },
+      [&](int i, const auto& Jj, double a) { out.row(i).head(nr) += a * Jj; },
+      [&](const auto& Ji, int j, double a) { out.col(j).head(nr) += a * Ji.transpose(); },
+      [&](const auto& Ji, const auto& Jj, double a) { out.topLeftCorner(nr, nr).noalias() += a * Ji.transpose() * Jj; });
+}
+
 void DeformableTerm::mapMatrix(const SparseMat& A, Triplets& out, const DeformableScratch& sc, int nr) const {
-  using Kind = NodeBinding::Kind;
   MatX rr = MatX::Zero(nr, nr);  // attached-attached pairs all land in the q_r block
-  for (int col = 0; col < A.outerSize(); ++col) {
-    const int nj = col / 3, cj = col % 3;
-    const NodeBinding& bj = nodes_[nj];
-    if (bj.kind == Kind::World) continue;
-    for (SparseMat::InnerIterator it(A, col); it; ++it) {
-      const int ni = static_cast<int>(it.row()) / 3, ci = static_cast<int>(it.row()) % 3;
-      const NodeBinding& bi = nodes_[ni];
-      const double a = it.value();
-      if (bi.kind == Kind::World) continue;
-      if (bi.kind == Kind::Free && bj.kind == Kind::Free) {
-        out.emplace_back(bi.index + ci, bj.index + cj, a);
-      } else if (bi.kind == Kind::Free) {
+  forEachMappedEntry(
+      A, sc, [&](int i, int j, double a) { out.emplace_back(i, j, a); },
+      [&](int i, const auto& Jj, double a) {
         for (int k = 0; k < nr; ++k)
-          if (sc.J[nj](cj, k) != 0.0) out.emplace_back(bi.index + ci, k, a * sc.J[nj](cj, k));
-      } else if (bj.kind == Kind::Free) {
+          if (Jj[k] != 0.0) out.emplace_back(i, k, a * Jj[k]);
+      },
+      [&](const auto& Ji, int j, double a) {
         for (int k = 0; k < nr; ++k)
-          if (sc.J[ni](ci, k) != 0.0) out.emplace_back(k, bj.index + cj, a * sc.J[ni](ci, k));
-      } else {
-        rr.noalias() += a * sc.J[ni].row(ci).transpose() * sc.J[nj].row(cj);
-      }
-    }
-  }
+          if (Ji[k] != 0.0) out.emplace_back(k, j, a * Ji[k]);
+      },
+      [&](const auto& Ji, const auto& Jj, double a) { rr.noalias() += a * Ji.transpose() * Jj; });
   if (!has_body_nodes_) return;
   for (int j = 0; j < nr; ++j)
     for (int i = 0; i < nr; ++i)

@@ -96,6 +96,10 @@ class DeformableTerm final : public ForceTerm {
   void mapMatrix(const SparseMat& A, MatX& out, const DeformableScratch& sc, int nr) const;
   // the same as triplets (the q_r block summed densely first)
   void mapMatrix(const SparseMat& A, Triplets& out, const DeformableScratch& sc, int nr) const;
+  // the walk both mapMatrix forms share: one callback per kind of node pair
+  template <class FreeFree, class FreeBody, class BodyFree, class BodyBody>
+  void forEachMappedEntry(const SparseMat& A, const DeformableScratch& sc, FreeFree&& ff, FreeBody&& fb,
+                          BodyFree&& bf, BodyBody&& bb) const;
   // the attached nodes' part of K (geometric stiffness and the damping's q-dependence): column k
   // (< nr) of it, over all coordinates, handed to `add(k, column)` for each coordinate that moves one
   template <class Add>

@@ -128,18 +128,31 @@ DeformableRun runStrand(const StrandOptions& opt) {
   return run;
 }
 
-DeformableRun runSoftPendulum(const SoftPendulumOptions& opt) {
-  if (opt.refinement < 1) throw std::invalid_argument("soft-pendulum: refinement must be >= 1");
-  const int k = opt.refinement;
-  System sys(singlePendulum());
-  const TetMesh mesh = makeBoxTetMesh(Vec3(0.2, 0.1, 0.1), 2 * k, k, k, Vec3(-0.1, -1.1, -0.05));
-  DeformableBody body = makeFemBody(mesh, opt.E, opt.nu, opt.rho);
-  body.rayleigh_mass = opt.rayleigh_mass;
-  body.rayleigh_stiffness = opt.rayleigh_stiffness;
+namespace {
+
+// singlePendulum()'s link with a soft block (0.2 x 0.1 x 0.1 m, 2k x k x k cubes) on its tip, its
+// top face attached (every node when `rigid`): the soft-pendulum and soft-insertion scenes
+std::shared_ptr<const DeformableTerm> addBlockOnLink(System& sys, int k, double E, double nu, double rho,
+                                                     double rayleigh_mass, double rayleigh_stiffness, bool rigid,
+                                                     TetMesh& mesh) {
+  mesh = makeBoxTetMesh(Vec3(0.2, 0.1, 0.1), 2 * k, k, k, Vec3(-0.1, -1.1, -0.05));
+  DeformableBody body = makeFemBody(mesh, E, nu, rho);
+  body.rayleigh_mass = rayleigh_mass;
+  body.rayleigh_stiffness = rayleigh_stiffness;
   std::vector<NodeAttachment> att;
   for (int n = 0; n < mesh.numNodes(); ++n)
-    if (opt.rigid || mesh.nodes[n].y() > -1.0 - 1e-12) att.push_back({n, 0});
-  auto term = addDeformableBody(sys, body, att);
+    if (rigid || mesh.nodes[n].y() > -1.0 - 1e-12) att.push_back({n, 0});
+  return addDeformableBody(sys, body, att);
+}
+
+}  // namespace
+
+DeformableRun runSoftPendulum(const SoftPendulumOptions& opt) {
+  if (opt.refinement < 1) throw std::invalid_argument("soft-pendulum: refinement must be >= 1");
+  System sys(singlePendulum());
+  TetMesh mesh;
+  auto term = addBlockOnLink(sys, opt.refinement, opt.E, opt.nu, opt.rho, opt.rayleigh_mass, opt.rayleigh_stiffness,
+                             opt.rigid, mesh);
   State s = sys.defaultState();
   s.q[0] = opt.q0;
   term->setRestState(sys.model(), s, 0);
@@ -150,17 +163,11 @@ DeformableRun runSoftPendulum(const SoftPendulumOptions& opt) {
 
 SoftInsertionRun runSoftInsertion(const SoftInsertionOptions& opt) {
   if (opt.refinement < 1) throw std::invalid_argument("soft-insertion: refinement must be >= 1");
-  const int k = opt.refinement;
   System sys(singlePendulum());
   const Model& model = sys.model();
-  const TetMesh mesh = makeBoxTetMesh(Vec3(0.2, 0.1, 0.1), 2 * k, k, k, Vec3(-0.1, -1.1, -0.05));
-  DeformableBody body = makeFemBody(mesh, opt.E, opt.nu, opt.rho);
-  body.rayleigh_mass = opt.rayleigh_mass;
-  body.rayleigh_stiffness = opt.rayleigh_stiffness;
-  std::vector<NodeAttachment> att;
-  for (int n = 0; n < mesh.numNodes(); ++n)
-    if (opt.rigid || mesh.nodes[n].y() > -1.0 - 1e-12) att.push_back({n, 0});
-  auto term = addDeformableBody(sys, body, att);
+  TetMesh mesh;
+  auto term = addBlockOnLink(sys, opt.refinement, opt.E, opt.nu, opt.rho, opt.rayleigh_mass, opt.rayleigh_stiffness,
+                             opt.rigid, mesh);
   SoftInsertionRun out;
   for (int n = 0; n < mesh.numNodes(); ++n)
     if ((mesh.nodes[n] - Vec3(0.1, -1.1, -0.05)).norm() < 1e-12) out.insertion_node = n;
