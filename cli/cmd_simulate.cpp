@@ -310,9 +310,11 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
     }
     // contacts, sampled at the output rows (docs/contact.md)
     if (res.contacts.contacts > 0)
-      std::printf("contacts: %d pairs, %d active at the end (at most %d at once), largest penetration %.4g m (%s at t = %g)\n",
+      std::printf("contacts: %d pairs, %d active at the end (at most %d at once), largest penetration %.4g m (%s at t = %g), "
+                  "largest net contact force %.6g N (y %.6g N) at t = %g\n",
                   res.contacts.contacts, res.contacts.active_final, res.contacts.active_max, res.contacts.max_penetration,
-                  res.contacts.deepest.empty() ? "none" : res.contacts.deepest.c_str(), res.contacts.deepest_time);
+                  res.contacts.deepest.empty() ? "none" : res.contacts.deepest.c_str(), res.contacts.deepest_time,
+                  res.contacts.max_force, res.contacts.max_force_up, res.contacts.max_force_time);
   }
   if (hard && !quiet)
     std::printf("unilateral: %d joint limits, %d contact pairs; %ld of %ld steps solved a contact QP, at most %d "

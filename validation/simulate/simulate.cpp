@@ -467,9 +467,11 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
     ContactStats& cs = res.contacts;
     cs.contacts = static_cast<int>(reports.size());
     cs.active_final = 0;
+    Vec3 net = Vec3::Zero();
     for (const ContactReport& r : reports) {
       if (!r.active) continue;
       ++cs.active_final;
+      net += r.force_w;
       if (r.penetration > cs.max_penetration) {
         cs.max_penetration = r.penetration;
         cs.deepest = r.name;
@@ -499,6 +501,11 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
       }
     }
     cs.active_max = std::max(cs.active_max, cs.active_final);
+    if (net.norm() > cs.max_force) {
+      cs.max_force = net.norm();
+      cs.max_force_up = net.y();
+      cs.max_force_time = s_r.t;
+    }
     return true;
   };
 

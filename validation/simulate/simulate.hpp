@@ -143,6 +143,11 @@ struct ContactStats {
   double max_penetration = 0.0;  ///< m, over all rows and contacts
   std::string deepest;         ///< the contact that had it
   double deepest_time = 0.0;
+  /// the largest |sum of the contact forces| on the second surfaces (the spheres) at one row: the
+  /// ground reaction when the ground's half-space is every pair's first surface (N)
+  double max_force = 0.0;
+  double max_force_up = 0.0;   ///< its world y component (OpenSim's up) at that row (N)
+  double max_force_time = 0.0;
 };
 
 struct SimulationResult {
