@@ -218,6 +218,27 @@ double objectiveValue(const System& sys, const Objective& obj, const State& fin,
   return J;
 }
 
+// the tracking terms at one state (step k >= 1): h w/2 |x - target(t)|^2 each, and their
+// derivative with respect to y added to dJ_dy (when given)
+double trackValue(const System& sys, const Objective& obj, const State& s, double h, VecX* dJ_dy) {
+  if (obj.tracks.empty()) return 0.0;
+  const Model& model = sys.model();
+  SkeletonWorkspace ws(model);
+  calcKinematics(model, s, ws);
+  MatX Jp(3, model.nr());
+  double J = 0.0;
+  for (const Objective::Track& tr : obj.tracks) {
+    const Vec3 e = pointPosition(ws, tr.body, tr.x_i) - tr.at(s.t);
+    J += 0.5 * h * tr.weight * e.squaredNorm();
+    if (dJ_dy) {
+      Jp.setZero();
+      pointJacobian(model, ws, tr.body, tr.x_i, Jp);
+      dJ_dy->head(model.nr()) += h * tr.weight * (Jp.transpose() * e);
+    }
+  }
+  return J;
+}
+
 void checkProblem(const Problem& pr, const VecX& p, const System& sys) {
   if (p.size() != pr.numParameters())
     throw AdjointError("adjoint: " + std::to_string(p.size()) + " parameter values for " +
@@ -236,6 +257,15 @@ void checkProblem(const Problem& pr, const VecX& p, const System& sys) {
 }
 
 }  // namespace
+
+Vec3 Objective::Track::at(double time) const {
+  if (t.empty()) return Vec3::Zero();
+  if (time <= t.front()) return target.front();
+  if (time >= t.back()) return target.back();
+  const size_t i = static_cast<size_t>(std::upper_bound(t.begin(), t.end(), time) - t.begin());  // t[i-1] <= time < t[i]
+  const double w = (time - t[i - 1]) / (t[i] - t[i - 1]);
+  return (1.0 - w) * target[i - 1] + w * target[i];
+}
 
 Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool with_gradient) {
   const int nf = static_cast<int>(pr.forces.size());
@@ -264,7 +294,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   std::vector<VecX> y(N + 1);
   y[0] = Stepper::pack(s0);
   checkFinite(s0, h, pr.integrator.c_str(), &z_names);
-  double effort = 0.0, excitation_effort = 0.0;
+  double effort = 0.0, excitation_effort = 0.0, tracking = 0.0;
   const int nub = rs.nu_base;
   const int nd = static_cast<int>(rs.driven.size());
   const auto forward_start = std::chrono::steady_clock::now();
@@ -274,6 +304,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     for (const Excited& ex : rs.excited) excitation_effort += h * u[ex.control] * u[ex.control];
     y[k + 1] = stepper.step(y[k], timeAt(k), h, u);
     checkFinite(stepper.unpack(y[k + 1], timeAt(k + 1)), h, pr.integrator.c_str(), &z_names);
+    tracking += trackValue(sys, obj, stepper.unpack(y[k + 1], timeAt(k + 1)), h, nullptr);
   }
 
   Result res;
@@ -282,7 +313,8 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   res.steps = N;
   VecX lambda;
   res.objective = objectiveValue(sys, obj, res.final, with_gradient ? &lambda : nullptr) + obj.effort_weight * effort +
-                  obj.excitation_weight * excitation_effort;
+                  obj.excitation_weight * excitation_effort + tracking;
+  if (with_gradient) trackValue(sys, obj, res.final, h, &lambda);  // the last step's tracking term
   if (!with_gradient) {
     res.step_evaluations = stepper.evaluations;
     return res;
@@ -354,6 +386,8 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
       Jy.col(i) = (stepper.step(yp, t, h, u) - stepper.step(ym, t, h, u)) / (2.0 * e);
     }
     lambda = (Jy.transpose() * lambda).eval();
+    // the tracking term at y_k (k >= 1) joins its adjoint
+    if (k >= 1) trackValue(sys, obj, stepper.unpack(y[k], t), h, &lambda);
   }
   for (int j = 0; j < nq0; ++j) res.gradient[iq0 + j] += lambda[pr.initial_q[j]];
   for (int j = 0; j < nv0; ++j) res.gradient[iq0 + nq0 + j] += lambda[n + pr.initial_qdot[j]];

@@ -95,6 +95,9 @@ struct Problem {
 ///   speed:  w/2 |qdot_N|^2 (come to rest)
 ///   effort: w sum_steps h |u_k|^2 (the integral of the squared generalized forces)
 ///   excitation effort: w sum_steps h |e_k|^2 over the excitation-driven controls (clamped)
+///   track: w/2 sum_{k=1..N} h |x(q_k) - target(t_k)|^2 for a body point against a sampled
+///          trajectory (linear between samples; the run must lie within them), the integral of the
+///          squared tracking error by the right-endpoint rule
 struct Objective {
   struct Point {
     int body = -1;
@@ -102,7 +105,17 @@ struct Objective {
     Vec3 target = Vec3::Zero();
     double weight = 1.0;
   };
+  struct Track {
+    int body = -1;
+    Vec3 x_i = Vec3::Zero();
+    std::vector<double> t;       ///< sample times, increasing (s)
+    std::vector<Vec3> target;    ///< ground positions at t (m)
+    double weight = 1.0;
+    /// the target at time `time` (linear between samples; clamped to the first and last)
+    Vec3 at(double time) const;
+  };
   std::vector<Point> points;
+  std::vector<Track> tracks;
   double speed_weight = 0.0;
   double effort_weight = 0.0;
   double excitation_weight = 0.0;

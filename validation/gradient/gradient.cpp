@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "converter/osim_reader.hpp"
+#include "converter/trc_file.hpp"
 #include "core/dynamics/muscle_force_term.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/muscles/path.hpp"
@@ -276,6 +277,61 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
     } else if (term == "excitation") {
       if (pr.excitations.empty()) throw bad(oflag, term_text, "needs excitation parameters (--params 'excitations:...')");
       g.objective.excitation_weight += w;
+    } else if (term.rfind("marker:", 0) == 0 || term.rfind("track:", 0) == 0) {
+      // a marker of the model's MarkerSet: at the final time against a point, or over the run
+      // against the same-named marker of a TRC file
+      const bool track = term.rfind("track:", 0) == 0;
+      const std::string spec = term.substr(track ? 6 : 7);
+      const auto eq = spec.find('=');
+      if (eq == std::string::npos || eq == 0)
+        throw bad(oflag, term_text, track ? "expected track:MARKER=FILE.trc" : "expected marker:NAME=X,Y,Z");
+      const std::string name = spec.substr(0, eq);
+      int body = -1;
+      Vec3 x_i = Vec3::Zero();
+      for (const auto& mk : description->markers) {
+        if (mk.name != name) continue;
+        const int db = description->findBody(mk.body);
+        body = db >= 0 && db < static_cast<int>(g.model.build.body_index.size()) ? g.model.build.body_index[db] : -1;
+        x_i = transformPoint(mk.X_body_frame, mk.location);
+        if (body < 0) throw bad(oflag, term_text, "marker '" + name + "' is not on a moving body");
+        break;
+      }
+      if (body < 0) throw bad(oflag, term_text, "no marker named '" + name + "' in the model's MarkerSet");
+      if (!track) {
+        adjoint::Objective::Point pt;
+        pt.body = body;
+        pt.x_i = x_i;
+        if (!parseVec3(spec.substr(eq + 1), pt.target))
+          throw bad(oflag, term_text, "the target must be three numbers X,Y,Z (m, ground)");
+        pt.weight = w;
+        g.objective.points.push_back(pt);
+        continue;
+      }
+      const std::string file = spec.substr(eq + 1);
+      const osim::MarkerTable trc = osim::readTrc(file);  // ConvertError names the file and line
+      const int c = trc.findMarker(name);
+      if (c < 0) throw bad(oflag, term_text, "'" + file + "' has no marker '" + name + "'");
+      adjoint::Objective::Track tr;
+      tr.body = body;
+      tr.x_i = x_i;
+      tr.weight = w;
+      const double t0 = pr.initial.t, t1 = pr.initial.t + pr.duration;
+      // the rows from the last at or before the start to the first at or after the end; a gap there
+      // is refused (no interpolation across it)
+      int lo = 0, hi = trc.numRows() - 1;
+      while (lo + 1 < trc.numRows() && trc.time[lo + 1] <= t0 + 1e-12) ++lo;
+      while (hi - 1 >= 0 && trc.time[hi - 1] >= t1 - 1e-12) --hi;
+      for (int r = lo; r <= hi; ++r) {
+        if (!trc.present(r, c))
+          throw bad(oflag, term_text, "marker '" + name + "' has a gap at t = " + std::to_string(trc.time[r]) +
+                                          " s in '" + file + "', inside the run");
+        tr.t.push_back(trc.time[r]);
+        tr.target.push_back(trc.position(r, c));
+      }
+      if (tr.t.empty() || tr.t.front() > t0 + 1e-12 || tr.t.back() < t1 - 1e-12)
+        throw bad(oflag, term_text, "'" + file + "' does not cover the run [" + std::to_string(t0) + ", " +
+                                        std::to_string(t1) + "] s");
+      g.objective.tracks.push_back(std::move(tr));
     } else if (term.rfind("point:", 0) == 0) {
       const std::string body_spec = term.substr(6);
       const auto at = body_spec.find('@');
@@ -293,7 +349,9 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
       pt.weight = w;
       g.objective.points.push_back(pt);
     } else {
-      throw bad(oflag, term_text, "unknown term (point:BODY@x,y,z=X,Y,Z, speed, effort or excitation)");
+      throw bad(oflag, term_text,
+                "unknown term (point:BODY@x,y,z=X,Y,Z, marker:NAME=X,Y,Z, track:MARKER=FILE.trc, speed, effort or "
+                "excitation)");
     }
   }
   return g;
