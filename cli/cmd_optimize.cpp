@@ -18,7 +18,7 @@ namespace {
 
 struct OptimizeFlags {
   std::string task, model, body = "hand", target, point = "0,0,0", integrator = "euler", method = "lbfgs,bobyqa";
-  std::string coordinates, report, muscle_mass_kg, drive = "torques", muscles;
+  std::string coordinates, report, muscle_mass_kg, drive = "torques", muscles, torques_in_time;
   double duration = 0.0, dt = 0.01, rest = 0.0, tolerance = 1e-3, max_torque = 100.0, initial_step = 1.0;
   double initial_excitation = 0.1, excitation_weight = 0.0;
   int nodes = 5;
@@ -42,6 +42,7 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
     return 2;
   }
   if (!f.coordinates.empty()) o.coordinates = splitList(f.coordinates);
+  o.torques_in_time = f.torques_in_time;
   o.duration = f.duration;
   o.dt = f.dt;
   o.integrator = f.integrator;
@@ -62,6 +63,10 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
         std::cerr << "error: " << n << ": needs --drive excitations\n";
         return 2;
       }
+  if (excite && given(app, "--torques-in-time")) {
+    std::cerr << "error: --torques-in-time: the excitation drive has no torques\n";
+    return 2;
+  }
   o.max_simulations = f.max_simulations;
   const std::vector<std::string> methods = splitList(f.method);
   for (const auto& m : methods) {
@@ -140,6 +145,10 @@ CommandRegistration reg(
        app.add_option("--coordinates", f->coordinates,
                       "the coordinates that get a constant torque (default: all of the model's)")
            ->type_name("C,...");
+       app.add_option("--torques-in-time", f->torques_in_time,
+                      "the torques as functions of time: K constant pieces, K~linear (K nodes, piecewise\n"
+                      "linear) or K~cubic (K >= 4 control points of a cubic B-spline); default constant")
+           ->type_name("K[~linear|~cubic]");
        app.add_option("--duration", f->duration, "simulated seconds; the hand is judged at the end; required")
            ->type_name("S")
            ->check(positive());

@@ -78,6 +78,9 @@ RunSystem makeRunSystem(const Problem& pr, const VecX& system_params) {
     if (fp.pieces < 1 || fp.piece < 0 || fp.piece >= fp.pieces)
       throw AdjointError("adjoint: force parameter piece " + std::to_string(fp.piece) + " of " +
                          std::to_string(fp.pieces));
+    if (fp.shape == ForceParameter::Shape::Cubic && fp.pieces < 4)
+      throw AdjointError("adjoint: a cubic B-spline force needs at least 4 control points, got " +
+                         std::to_string(fp.pieces));
     auto [it, fresh] = index.emplace(fp.coordinate, static_cast<int>(rs.driven.size()));
     if (fresh) {
       rs.driven.push_back(fp.coordinate);
@@ -111,6 +114,48 @@ void hatWeights(int nodes, int k, int n, int& i0, double& w0, double& w1) {
   w0 = 1.0 - w1;
 }
 
+// basis function i of the clamped uniform cubic B-spline with m control points at x in [0, 1]
+// (Cox-de Boor; knots 0,0,0,0, 1/(m-3), ..., (m-4)/(m-3), 1,1,1,1)
+double cubicBSpline(int i, int m, double x) {
+  const int segments = m - 3;
+  auto knot = [&](int j) { return std::clamp(static_cast<double>(j - 3) / segments, 0.0, 1.0); };
+  if (x >= 1.0) return i == m - 1 ? 1.0 : 0.0;
+  // degree 0 on [knot(j), knot(j + 1)), then the recursion up to degree 3
+  double N[4][4] = {};
+  for (int d = 0; d <= 3; ++d)
+    for (int j = 0; j <= 3 - d; ++j) {
+      const int a = i + j;  // N_{a,d}
+      if (d == 0) {
+        N[0][j] = (knot(a) <= x && x < knot(a + 1)) ? 1.0 : 0.0;
+        continue;
+      }
+      double v = 0.0;
+      const double l = knot(a + d) - knot(a), r = knot(a + d + 1) - knot(a + 1);
+      if (l > 0.0) v += (x - knot(a)) / l * N[d - 1][j];
+      if (r > 0.0) v += (knot(a + d + 1) - x) / r * N[d - 1][j + 1];
+      N[d][j] = v;
+    }
+  return N[3][0];
+}
+
+}  // namespace
+
+double forceBasis(const ForceParameter& fp, int k, int n) {
+  switch (fp.shape) {
+    case ForceParameter::Shape::Pieces: return static_cast<long>(k) * fp.pieces / n == fp.piece ? 1.0 : 0.0;
+    case ForceParameter::Shape::Linear: {
+      int i0 = 0;
+      double w0 = 0.0, w1 = 0.0;
+      hatWeights(fp.pieces, k, n, i0, w0, w1);
+      return fp.piece == i0 ? w0 : fp.piece == i0 + 1 ? w1 : 0.0;
+    }
+    case ForceParameter::Shape::Cubic: return cubicBSpline(fp.piece, fp.pieces, static_cast<double>(k) / n);
+  }
+  return 0.0;
+}
+
+namespace {
+
 // the interpolated excitation of ex at step k of n, before clamping
 double excitationAt(const Excited& ex, const VecX& p, int nf, int k, int n) {
   int i0 = 0;
@@ -130,8 +175,8 @@ VecX controlsAt(const Problem& pr, const RunSystem& rs, const VecX& p, int k, in
   for (const Excited& ex : rs.excited)
     u[ex.control] = std::clamp(excitationAt(ex, p, nf, k, n), ex.min, ex.max);
   for (size_t j = 0; j < pr.forces.size(); ++j) {
-    const ForceParameter& fp = pr.forces[j];
-    if (static_cast<long>(k) * fp.pieces / n == fp.piece) u[rs.control_of[j]] += p[static_cast<Eigen::Index>(j)];
+    const double b = forceBasis(pr.forces[j], k, n);
+    if (b != 0.0) u[rs.control_of[j]] += b * p[static_cast<Eigen::Index>(j)];
   }
   return u;
 }
@@ -351,8 +396,8 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
       Ju[c] = lambda.dot(stepper.step(y[k], t, h, up) - stepper.step(y[k], t, h, um)) / (2.0 * e);
     }
     for (int j = 0; j < nf; ++j) {
-      const ForceParameter& fp = pr.forces[j];
-      if (static_cast<long>(k) * fp.pieces / N == fp.piece) res.gradient[j] += Ju[rs.control_of[j]];
+      const double b = forceBasis(pr.forces[j], k, N);
+      if (b != 0.0) res.gradient[j] += b * Ju[rs.control_of[j]];
     }
     // excitation columns: one central difference per excitation-driven control, at the clamped
     // value the step used; through the clamp (zero outside [min, max]) and the hat weights to the
@@ -396,9 +441,8 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     for (int k = 0; k < N; ++k) {
       const VecX u = controlsAt(pr, rs, p, k, N);
       for (int j = 0; j < nf; ++j) {
-        const ForceParameter& fp = pr.forces[j];
-        if (static_cast<long>(k) * fp.pieces / N == fp.piece)
-          res.gradient[j] += 2.0 * obj.effort_weight * h * u[rs.control_of[j]];
+        const double b = forceBasis(pr.forces[j], k, N);
+        if (b != 0.0) res.gradient[j] += 2.0 * obj.effort_weight * h * b * u[rs.control_of[j]];
       }
     }
   }

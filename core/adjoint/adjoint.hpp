@@ -30,13 +30,25 @@
 
 namespace redmax::adjoint {
 
-/// One generalized-force parameter: a constant force (N m or N) on a system coordinate during
-/// time piece `piece` of `pieces` equal pieces of the run (step k of N is in piece k * pieces / N).
+/// One generalized-force parameter (N m or N) on a system coordinate: the weight of one basis
+/// function of time, evaluated at each step's start t_k = t0 + k h (the force is constant within a
+/// step); a coordinate's force is the sum over its parameters.
+///   Pieces  1 during time piece `piece` of `pieces` equal pieces (step k of N in piece k pieces / N)
+///   Linear  the hat of node `piece` of `pieces` nodes at t0 + i duration / (pieces - 1): a
+///           piecewise-linear force (one node: a constant)
+///   Cubic   basis function `piece` of the clamped uniform cubic B-spline with `pieces` (>= 4)
+///           control points over the run: a C2 force in time; the first and last control points
+///           are its values at the start and the end
 struct ForceParameter {
+  enum class Shape { Pieces, Linear, Cubic };
   int coordinate = -1;
   int piece = 0;
   int pieces = 1;
+  Shape shape = Shape::Pieces;
 };
+
+/// The weight of fp's basis function at step k of n (see ForceParameter).
+double forceBasis(const ForceParameter& fp, int k, int n);
 
 /// One muscle-excitation parameter: node `node` of the `nodes` nodes of a piecewise-linear
 /// excitation in time on the system's control `control` (a MuscleForceTerm's excitation; nodes at

@@ -157,21 +157,37 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
       if (kind == "torques") {
         std::string name = nameAndValue(pflag, item_text, item, v, has_value);
         int pieces = 1;
+        auto shape = adjoint::ForceParameter::Shape::Pieces;
         const auto at = name.find('@');
         if (at != std::string::npos) {
+          // C@K: K constant pieces; C@K~linear: K nodes of a piecewise-linear force; C@K~cubic: K
+          // control points of a cubic B-spline
+          std::string count = name.substr(at + 1);
+          const auto tilde = count.find('~');
+          if (tilde != std::string::npos) {
+            const std::string how = count.substr(tilde + 1);
+            if (how == "linear") shape = adjoint::ForceParameter::Shape::Linear;
+            else if (how == "cubic") shape = adjoint::ForceParameter::Shape::Cubic;
+            else throw bad(pflag, item, "after '~' expected linear or cubic (constant pieces: no '~')");
+            count = count.substr(0, tilde);
+          }
           double k = 0.0;
-          if (!parseNumber(name.substr(at + 1), k) || k < 1.0 || k != static_cast<int>(k) || k > 100000)
+          if (!parseNumber(count, k) || k < 1.0 || k != static_cast<int>(k) || k > 100000)
             throw bad(pflag, item, "the piece count after '@' must be a whole number >= 1");
           pieces = static_cast<int>(k);
+          if (shape == adjoint::ForceParameter::Shape::Cubic && pieces < 4)
+            throw bad(pflag, item, "a cubic B-spline needs at least 4 control points (@4~cubic)");
           name = name.substr(0, at);
         }
         const int c = coordinateIndex(g.model, pflag, item, name);
+        const char* what = shape == adjoint::ForceParameter::Shape::Pieces  ? " piece "
+                           : shape == adjoint::ForceParameter::Shape::Linear ? " node "
+                                                                             : " control point ";
         for (int k = 0; k < pieces; ++k) {
-          pr.forces.push_back({c, k, pieces});
-          forces.push_back({"torque " + name + (pieces > 1 ? " piece " + std::to_string(k + 1) + "/" +
-                                                                 std::to_string(pieces)
-                                                           : std::string()),
-                            v});
+          pr.forces.push_back({c, k, pieces, shape});
+          forces.push_back(
+              {"torque " + name + (pieces > 1 ? what + std::to_string(k + 1) + "/" + std::to_string(pieces) : std::string()),
+               v});
         }
       } else if (kind == "excitations") {
         std::string name = nameAndValue(pflag, item_text, item, v, has_value);

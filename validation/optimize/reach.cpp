@@ -12,6 +12,7 @@
 #include <fstream>
 #include <exception>
 #include <limits>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
@@ -200,7 +201,21 @@ ReachSetup makeReachSetup(const ReachOptions& options) {
   const bool excite = options.drive == "excitations";
   if (!excite && options.drive != "torques")
     throw std::invalid_argument("--drive '" + options.drive + "': unknown (torques or excitations)");
-  std::string params = "torques:" + joined(coords, ",");
+  std::vector<std::string> torque_items = coords;
+  if (!options.torques_in_time.empty()) {
+    // K, K~linear or K~cubic after each coordinate (the gradient's torques SPEC, docs/gradients.md §3)
+    const std::string& t = options.torques_in_time;
+    const auto tilde = t.find('~');
+    const std::string count = t.substr(0, tilde), how = tilde == std::string::npos ? "" : t.substr(tilde + 1);
+    char* end = nullptr;
+    const long k = std::strtol(count.c_str(), &end, 10);
+    if (count.empty() || *end != '\0' || k < 1 || k > 100000 || (tilde != std::string::npos && how != "linear" && how != "cubic") ||
+        (how == "cubic" && k < 4))
+      throw std::invalid_argument("--torques-in-time '" + t + "': expected K (constant pieces), K~linear or K~cubic "
+                                  "(K >= 4 for cubic)");
+    for (auto& c : torque_items) c += "@" + t;
+  }
+  std::string params = "torques:" + joined(torque_items, ",");
   if (excite) {
     if (options.nodes < 1) throw std::invalid_argument("--nodes: must be at least 1");
     std::vector<std::string> muscles = options.muscles;

@@ -47,6 +47,9 @@ struct ReachOptions {
   Vec3 point = Vec3::Zero();   ///< in the body's frame (m)
   Vec3 target = Vec3::Zero();  ///< in ground (m)
   std::vector<std::string> coordinates;  ///< torqued coordinates; empty: all of the model's
+  /// the torques in time: "" constant (the dissertation's), "K" K constant pieces, "K~linear" K
+  /// nodes of a piecewise-linear torque, "K~cubic" K (>= 4) control points of a cubic B-spline
+  std::string torques_in_time;
   double duration = 0.3, dt = 0.01;
   std::string integrator = "euler";      ///< euler, bdf1 or sdirk2
   double rest_weight = 0.0;              ///< weight of 1/2 |qdot_N|^2

@@ -298,5 +298,45 @@ TEST(AdjointExcitations, NodesAgainstTheClosedFormOfTheDiscreteRunWithTheClamp) 
   }
 }
 
+TEST(ForceBasis, PiecesHatsAndCubicBSplinesPartitionUnityAndTheSplineIsSmooth) {
+  // every shape's basis sums to 1 at every step (a constant force is reproduced exactly); the
+  // cubic B-spline starts and ends at its first and last control points, and a force built on it
+  // has second differences of order h^2 (C2), where the hats' have kinks of order h
+  const int N = 200;
+  using Shape = ForceParameter::Shape;
+  for (auto [shape, m] : {std::pair{Shape::Pieces, 5}, std::pair{Shape::Linear, 5}, std::pair{Shape::Cubic, 6}}) {
+    double worst = 0.0;
+    for (int k = 0; k < N; ++k) {
+      double sum = 0.0;
+      for (int i = 0; i < m; ++i) {
+        const double b = adjoint::forceBasis({0, i, m, shape}, k, N);
+        EXPECT_GE(b, -1e-15);
+        sum += b;
+      }
+      worst = std::max(worst, std::abs(sum - 1.0));
+    }
+    EXPECT_LE(worst, 1e-15) << static_cast<int>(shape);
+  }
+  EXPECT_DOUBLE_EQ(adjoint::forceBasis({0, 0, 6, Shape::Cubic}, 0, N), 1.0);
+  // smoothness: the force with control points c_i = i^2, its largest second difference at N and
+  // 2N steps: a C2 force's falls as h^2 (ratio 4), a kinked one's as h (ratio 2)
+  auto d2 = [&](Shape shape, int m, int n) {
+    auto f = [&](int k) {
+      double v = 0.0;
+      for (int i = 0; i < m; ++i) v += i * i * adjoint::forceBasis({0, i, m, shape}, k, n);
+      return v;
+    };
+    double worst = 0.0;
+    for (int k = 1; k + 1 < n; ++k) worst = std::max(worst, std::abs(f(k + 1) - 2 * f(k) + f(k - 1)));
+    return worst;
+  };
+  const double rc = d2(Shape::Cubic, 6, N) / d2(Shape::Cubic, 6, 2 * N);
+  const double rl = d2(Shape::Linear, 6, N) / d2(Shape::Linear, 6, 2 * N);
+  std::printf("[ measured ] second differences halving the step: cubic B-spline falls %.3f x, piecewise linear %.3f x\n",
+              rc, rl);
+  EXPECT_NEAR(rc, 4.0, 0.1);
+  EXPECT_NEAR(rl, 2.0, 0.1);
+}
+
 }  // namespace
 }  // namespace redmax
