@@ -72,9 +72,14 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   for (const char* n : {"--contact-restitution", "--contact-friction"})
     if (given(app, n) && f.contact != "hard") throw UsageError{std::string(n) + " needs --contact hard"};
   if (hard && engine != "core") throw UsageError{"--joint-limits and --contact hard need --engine core"};
-  if (hard && f.so.integrator != "bdf1")
-    throw UsageError{"--joint-limits and --contact hard need --integrator bdf1 (the linearly implicit step that "
-                     "solves the contact QP; " + f.so.integrator + " cannot enforce them, docs/contact.md §6)"};
+  // bdf1 takes both (the contact QP in its step); rk45 and cvode take joint limits by event location
+  const bool adaptive = f.so.integrator == "rk45" || f.so.integrator == "cvode";
+  if (f.contact == "hard" && f.so.integrator != "bdf1")
+    throw UsageError{"--contact hard needs --integrator bdf1 (the linearly implicit step that solves the contact "
+                     "QP; " + f.so.integrator + " cannot enforce it, docs/contact.md §6)"};
+  if (given(app, "--joint-limits") && f.so.integrator != "bdf1" && !adaptive)
+    throw UsageError{"--joint-limits needs --integrator bdf1, rk45 or cvode (" + f.so.integrator +
+                     " cannot enforce them, docs/contact.md §6)"};
   f.hard.joint_limits = f.joint_limits;
   f.hard.contact = f.contact == "hard";
   validation::SimbodyEngineOptions simbody_flags;
@@ -316,7 +321,10 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
                   res.contacts.deepest.empty() ? "none" : res.contacts.deepest.c_str(), res.contacts.deepest_time,
                   res.contacts.max_force, res.contacts.max_force_up, res.contacts.max_force_time);
   }
-  if (hard && !quiet)
+  if (hard && !quiet && (f.so.integrator == "rk45" || f.so.integrator == "cvode"))
+    std::printf("unilateral: %d joint limits by event location; %ld impacts, %ld releases\n", hard_made.limits,
+                res.stats.limit_impacts, res.stats.limit_releases);
+  else if (hard && !quiet)
     std::printf("unilateral: %d joint limits, %d contact pairs; %ld of %ld steps solved a contact QP, at most %d "
                 "contacts at once (%.3g on average), %ld QP iterations in %ld QPs, largest penetration %.3g "
                 "(m or rad)%s\n",
@@ -456,7 +464,8 @@ CommandRegistration reg(
        app.add_option("--joint-limits", f->joint_limits,
                       "enforce coordinate ranges as hard unilateral constraints: every coordinate's\n"
                       "range (hard) or those OpenSim marks clamped; locked and prescribed coordinates\n"
-                      "are left out; needs --integrator bdf1 (docs/contact.md §6)")
+                      "are left out; needs --integrator bdf1, or rk45 / cvode (event location)\n"
+                      "(docs/contact.md §6)")
            ->type_name("hard|clamped")
            ->check(oneOf({"hard", "clamped"}));
        app.add_option("--limit-restitution", f->hard.limit_restitution,

@@ -46,6 +46,9 @@ struct IntegratorOptions {
   // sparse from kSparseStepFrom coordinates on (measured crossover, docs/deformable.md §5) unless
   // the system has hard unilateral constraints or a coordinate map (dense only)
   std::string linear_solver = "auto";
+  // rk45 and cvode with hard joint limits (core/integrators/event_driven.hpp): the largest time
+  // between event checks (s); an impact and rebound both inside one interval would be missed
+  double event_check_interval = 1e-3;
 };
 
 /// Counters accumulated over the lifetime of one Integrator (all advance() calls).
@@ -63,6 +66,9 @@ struct IntegratorStats {
   int max_contacts = 0;        // most rows with a positive impulse in one step
   double max_penetration = 0.0;  // largest penetration at a step's start (m, or rad for limits)
   long friction_unconverged = 0; // steps whose friction fixed point hit its iteration limit
+  // hard joint limits under rk45 / cvode (event location, core/integrators/event_driven.hpp)
+  long limit_impacts = 0;        // impacts at limits resolved
+  long limit_releases = 0;       // held limits released
 };
 
 /// A simulation produced NaN/Inf or diverged: says when, what, and with which step.
@@ -91,8 +97,9 @@ class Integrator {
   /// across calls for the same system: callers that report run-time counts take them from its
   /// term slots (takeWrapFallbackCounts, core/dynamics/muscle_term.hpp)
   virtual DynamicsWorkspace* lastWorkspace() { return nullptr; }
-  /// true if the method enforces System::unilateral() (only bdf1); advance() of the others
-  /// throws std::invalid_argument for a system that has them
+  /// true if the method enforces System::unilateral(): bdf1 (limits and contacts, the contact
+  /// QP), rk45 and cvode (joint limits by event location); advance() of the others throws
+  /// std::invalid_argument for a system that has them
   virtual bool handlesUnilateral() const { return false; }
 
  protected:

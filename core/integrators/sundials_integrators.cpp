@@ -2,6 +2,7 @@
 // dense Newton). The only translation unit that includes SUNDIALS headers; the static SUNDIALS
 // archives are linked into libredmax_integrators with their symbols hidden (docs/build.md trap 2).
 #include "core/integrators/sundials_integrators.hpp"
+#include "core/integrators/event_driven.hpp"
 
 #include <arkode/arkode_erkstep.h>
 #include <cvode/cvode.h>
@@ -390,7 +391,14 @@ CvodeBdf::CvodeBdf(const IntegratorOptions& opt) : SundialsIntegrator(opt) {
 void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
   const std::string who = name();
   checkAdvanceArguments(sys, s, t_out, who.c_str());
-  checkUnilateralSupport(*this, sys);
+  if (sys.unilateral()) {
+    // hard joint limits: phases between events, each run by a fresh integrator of this kind
+    LimitEventCounts c;
+    advanceWithLimitEvents(who, opt_, sys, s, t_out, opt_.event_check_interval, stats_, &c);
+    stats_.limit_impacts += c.impacts;
+    stats_.limit_releases += c.releases;
+    return;
+  }
   if (t_out == s.t) return;
   SundialsSolver& S = *solver_;
   const int n = sys.ndof();

@@ -29,8 +29,10 @@ class SundialsIntegrator : public Integrator {
   ~SundialsIntegrator() override;
   SundialsIntegrator(const SundialsIntegrator&) = delete;
   SundialsIntegrator& operator=(const SundialsIntegrator&) = delete;
+  /// with hard joint limits (System::unilateral()): event location (core/integrators/event_driven.hpp)
   void advance(const System& sys, State& state, double t_out) override;
   DynamicsWorkspace* lastWorkspace() override { return ws_.get(); }
+  bool handlesUnilateral() const override { return true; }
 
  protected:
   IntegratorOptions opt_;

@@ -286,8 +286,31 @@ TEST_F(ContactCli, HardJointLimitHoldsTheClampedCoordinate) {
 TEST_F(ContactCli, HardModesNeedBdf1AndTheirFlags) {
   CmdResult r = run("simulate --model " + scene("ball_drop.osim") + " --contact hard --duration 0.1 --out " + path("x.sto"));
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("need --integrator bdf1"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--contact hard needs --integrator bdf1"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("x.sto")));
+  // joint limits: bdf1, or rk45 / cvode by event location; not the other fixed-step methods
+  r = run("simulate --model " + scene("finger.osim") + " --joint-limits hard --integrator euler --duration 0.1 --out " +
+          path("x.sto"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--joint-limits needs --integrator bdf1, rk45 or cvode"), std::string::npos) << r.err;
+  r = run("simulate --model " + scene("finger.osim") +
+          " --joint-limits hard --duration 0.5 --impulse fingertip:0,20,0:0.002 --full-precision --out " + path("rk.sto"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("joint limits by event location"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("; 0 impacts"), std::string::npos) << r.out;  // the flicked finger hits its limits
+  {
+    // never beyond a range (mcp -0.35 .. 1.57, pip 0 .. 1.92, dip 0 .. 1.57) at any output row
+    const Storage st = readStorage(path("rk.sto"));
+    const char* cols[3] = {"/jointset/mcp/mcp_flexion/value", "/jointset/pip/pip_flexion/value",
+                           "/jointset/dip/dip_flexion/value"};
+    const double lo[3] = {-0.35, 0.0, 0.0}, hi[3] = {1.57, 1.92, 1.57};
+    for (int j = 0; j < 3; ++j) {
+      const int c = st.findColumn(cols[j]);
+      ASSERT_GE(c, 0) << cols[j];
+      EXPECT_GE(st.data.col(c).minCoeff(), lo[j] - 1e-9) << cols[j];
+      EXPECT_LE(st.data.col(c).maxCoeff(), hi[j] + 1e-9) << cols[j];
+    }
+  }
   r = run("simulate --model " + scene("ball_drop.osim") + " --integrator bdf1 --limit-restitution 0.5 --duration 0.1 --out " +
           path("x.sto"));
   EXPECT_EQ(r.code, 2);
