@@ -13,6 +13,7 @@
 #include "core/integrators/integrator.hpp"
 #include "core/joints/free_joints.hpp"
 #include "core/spatial/se3.hpp"
+#include "tests/core/dynamics/unilateral/gap_rates.hpp"
 
 namespace redmax {
 namespace {
@@ -86,25 +87,7 @@ TEST(CollisionShapes, NormalRowsAreTheGapRatesByFiniteDifferences) {
     for (int k = 0; k < s.q.size(); ++k) s.q[k] = 0.5 * U(rng), s.qdot[k] = U(rng);
     s.q[1] = 0.35;
     s.q.segment<3>(6) = Vec3(0.2 * U(rng), 0.65, 0.3 * U(rng) + (trial == 2 ? 0.5 : 0.0));  // past the end in trial 2
-    DynamicsWorkspace ws(*sc.sys);
-    sc.sys->calcMassAndForce(s, ws);
-    UnilateralRows rows;
-    sc.u->detect(sc.sys->model(), s, ws.sk, sc.sys->ndof(), 1e-3, rows);
-    ASSERT_EQ(rows.c.size(), 3u);
-    auto gapsAt = [&](const VecX& q) {
-      State t = s;
-      t.q = q;
-      DynamicsWorkspace w(*sc.sys);
-      sc.sys->kineticEnergy(t, w);
-      return sc.u->gaps(sc.sys->model(), t, w.sk);
-    };
-    const double d = 1e-6;
-    const auto gp = gapsAt(s.q + d * s.qdot), gm = gapsAt(s.q - d * s.qdot);
-    for (size_t i = 0; i < rows.c.size(); ++i) {
-      const double fd = (gp[i] - gm[i]) / (2 * d);
-      EXPECT_NEAR(rows.Jn.row(static_cast<int>(i)).dot(s.qdot), fd, 1e-9 * (1 + std::abs(fd))) << "row " << i;
-      EXPECT_NEAR(rows.c[i].approach, fd, 1e-9 * (1 + std::abs(fd))) << "row " << i;
-    }
+    test::expectNormalRowsAreGapRates(*sc.sys, *sc.u, s, 3u, 1e-9);
   }
 }
 
