@@ -235,6 +235,20 @@ class Stepper {
 
 double fdStep(double rel, double x) { return rel * std::max(1.0, std::abs(x)); }
 
+// w/2 |x(q) - target|^2 for a point x_i of `body` (kinematics of the state in ws), its derivative
+// with respect to q added to dJ_dq (when given): dx/dq is the point's velocity Jacobian, since
+// dq/dt = qdot for every joint (integrator.hpp)
+double pointTerm(const Model& model, const SkeletonWorkspace& ws, int body, const Vec3& x_i, const Vec3& target,
+                 double w, MatX& Jp, Eigen::Ref<VecX> dJ_dq, bool gradient) {
+  const Vec3 e = pointPosition(ws, body, x_i) - target;
+  if (gradient) {
+    Jp.setZero();
+    pointJacobian(model, ws, body, x_i, Jp);
+    dJ_dq += w * (Jp.transpose() * e);
+  }
+  return 0.5 * w * e.squaredNorm();
+}
+
 // objective at the final state and its explicit derivatives (dJ/dy_N, dJ/du summed per step)
 double objectiveValue(const System& sys, const Objective& obj, const State& fin, VecX* dJ_dy) {
   const Model& model = sys.model();
@@ -245,16 +259,10 @@ double objectiveValue(const System& sys, const Objective& obj, const State& fin,
     SkeletonWorkspace ws(model);
     calcKinematics(model, fin, ws);
     MatX Jp(3, model.nr());
-    for (const Objective::Point& pt : obj.points) {
-      const Vec3 e = pointPosition(ws, pt.body, pt.x_i) - pt.target;
-      J += 0.5 * pt.weight * e.squaredNorm();
-      if (dJ_dy) {
-        // dx/dq = the point's velocity Jacobian, since dq/dt = qdot for every joint (integrator.hpp)
-        Jp.setZero();
-        pointJacobian(model, ws, pt.body, pt.x_i, Jp);
-        dJ_dy->head(model.nr()) += pt.weight * (Jp.transpose() * e);
-      }
-    }
+    VecX unused;
+    for (const Objective::Point& pt : obj.points)
+      J += pointTerm(model, ws, pt.body, pt.x_i, pt.target, pt.weight, Jp,
+                     dJ_dy ? dJ_dy->head(model.nr()) : unused.head(0), dJ_dy != nullptr);
   }
   if (obj.speed_weight != 0.0) {
     J += 0.5 * obj.speed_weight * fin.qdot.squaredNorm();
@@ -264,23 +272,17 @@ double objectiveValue(const System& sys, const Objective& obj, const State& fin,
 }
 
 // the tracking terms at one state (step k >= 1): h w/2 |x - target(t)|^2 each, and their
-// derivative with respect to y added to dJ_dy (when given)
+// derivative with respect to y added to dJ_dy (when given); callers skip it without tracks
 double trackValue(const System& sys, const Objective& obj, const State& s, double h, VecX* dJ_dy) {
-  if (obj.tracks.empty()) return 0.0;
   const Model& model = sys.model();
   SkeletonWorkspace ws(model);
   calcKinematics(model, s, ws);
   MatX Jp(3, model.nr());
+  VecX unused;
   double J = 0.0;
-  for (const Objective::Track& tr : obj.tracks) {
-    const Vec3 e = pointPosition(ws, tr.body, tr.x_i) - tr.at(s.t);
-    J += 0.5 * h * tr.weight * e.squaredNorm();
-    if (dJ_dy) {
-      Jp.setZero();
-      pointJacobian(model, ws, tr.body, tr.x_i, Jp);
-      dJ_dy->head(model.nr()) += h * tr.weight * (Jp.transpose() * e);
-    }
-  }
+  for (const Objective::Track& tr : obj.tracks)
+    J += pointTerm(model, ws, tr.body, tr.x_i, tr.at(s.t), h * tr.weight, Jp,
+                   dJ_dy ? dJ_dy->head(model.nr()) : unused.head(0), dJ_dy != nullptr);
   return J;
 }
 
@@ -349,7 +351,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     for (const Excited& ex : rs.excited) excitation_effort += h * u[ex.control] * u[ex.control];
     y[k + 1] = stepper.step(y[k], timeAt(k), h, u);
     checkFinite(stepper.unpack(y[k + 1], timeAt(k + 1)), h, pr.integrator.c_str(), &z_names);
-    tracking += trackValue(sys, obj, stepper.unpack(y[k + 1], timeAt(k + 1)), h, nullptr);
+    if (!obj.tracks.empty()) tracking += trackValue(sys, obj, stepper.unpack(y[k + 1], timeAt(k + 1)), h, nullptr);
   }
 
   Result res;
@@ -359,7 +361,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   VecX lambda;
   res.objective = objectiveValue(sys, obj, res.final, with_gradient ? &lambda : nullptr) + obj.effort_weight * effort +
                   obj.excitation_weight * excitation_effort + tracking;
-  if (with_gradient) trackValue(sys, obj, res.final, h, &lambda);  // the last step's tracking term
+  if (with_gradient && !obj.tracks.empty()) trackValue(sys, obj, res.final, h, &lambda);  // the last step's term
   if (!with_gradient) {
     res.step_evaluations = stepper.evaluations;
     return res;
@@ -432,7 +434,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     }
     lambda = (Jy.transpose() * lambda).eval();
     // the tracking term at y_k (k >= 1) joins its adjoint
-    if (k >= 1) trackValue(sys, obj, stepper.unpack(y[k], t), h, &lambda);
+    if (k >= 1 && !obj.tracks.empty()) trackValue(sys, obj, stepper.unpack(y[k], t), h, &lambda);
   }
   for (int j = 0; j < nq0; ++j) res.gradient[iq0 + j] += lambda[pr.initial_q[j]];
   for (int j = 0; j < nv0; ++j) res.gradient[iq0 + nq0 + j] += lambda[n + pr.initial_qdot[j]];
