@@ -3,6 +3,8 @@
 // errors that name the line.
 #include "converter/trc_file.hpp"
 
+#include <algorithm>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -79,6 +81,15 @@ int MarkerTable::findMarker(const std::string& name) const {
 bool MarkerTable::present(int row, int marker) const {
   return std::isfinite(data(row, 3 * marker)) && std::isfinite(data(row, 3 * marker + 1)) &&
          std::isfinite(data(row, 3 * marker + 2));
+}
+
+void MarkerTable::bracketRows(double t0, double t1, int& lo, int& hi) const {
+  const int n = numRows();
+  lo = 0;
+  hi = n - 1;
+  while (lo + 1 < n && time[lo + 1] <= t0 + 1e-12) ++lo;
+  while (hi - 1 >= 0 && time[hi - 1] >= t1 - 1e-12) --hi;
+  hi = std::max(hi, lo);
 }
 
 MarkerTable readTrc(const std::string& path) {

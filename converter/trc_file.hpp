@@ -38,6 +38,9 @@ struct MarkerTable {
   /// false where any of the marker's three values is missing in that row
   bool present(int row, int marker) const;
   Vec3 position(int row, int marker) const { return data.block<1, 3>(row, 3 * marker).transpose(); }
+  /// the rows a run over [t0, t1] needs: from the last at or before t0 to the first at or after t1
+  /// (clamped to the table; 1e-12 s of slack)
+  void bracketRows(double t0, double t1, int& lo, int& hi) const;
 };
 
 /// Read a .trc file. Units mm, cm and m are converted to m; any other unit is an error. Throws

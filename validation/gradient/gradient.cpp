@@ -302,17 +302,11 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
       if (eq == std::string::npos || eq == 0)
         throw bad(oflag, term_text, track ? "expected track:MARKER=FILE.trc" : "expected marker:NAME=X,Y,Z");
       const std::string name = spec.substr(0, eq);
-      int body = -1;
-      Vec3 x_i = Vec3::Zero();
-      for (const auto& mk : description->markers) {
-        if (mk.name != name) continue;
-        const int db = description->findBody(mk.body);
-        body = db >= 0 && db < static_cast<int>(g.model.build.body_index.size()) ? g.model.build.body_index[db] : -1;
-        x_i = transformPoint(mk.X_body_frame, mk.location);
-        if (body < 0) throw bad(oflag, term_text, "marker '" + name + "' is not on a moving body");
-        break;
-      }
-      if (body < 0) throw bad(oflag, term_text, "no marker named '" + name + "' in the model's MarkerSet");
+      const CoreMarker cm = findCoreMarker(g.model, name);
+      if (!cm.mk) throw bad(oflag, term_text, "no marker named '" + name + "' in the model's MarkerSet");
+      if (cm.body < 0) throw bad(oflag, term_text, "marker '" + name + "' is not on a moving body");
+      const int body = cm.body;
+      const Vec3 x_i = cm.point;
       if (!track) {
         adjoint::Objective::Point pt;
         pt.body = body;
@@ -334,9 +328,8 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
       const double t0 = pr.initial.t, t1 = pr.initial.t + pr.duration;
       // the rows from the last at or before the start to the first at or after the end; a gap there
       // is refused (no interpolation across it)
-      int lo = 0, hi = trc.numRows() - 1;
-      while (lo + 1 < trc.numRows() && trc.time[lo + 1] <= t0 + 1e-12) ++lo;
-      while (hi - 1 >= 0 && trc.time[hi - 1] >= t1 - 1e-12) --hi;
+      int lo = 0, hi = 0;
+      trc.bracketRows(t0, t1, lo, hi);
       for (int r = lo; r <= hi; ++r) {
         if (!trc.present(r, c))
           throw bad(oflag, term_text, "marker '" + name + "' has a gap at t = " + std::to_string(trc.time[r]) +

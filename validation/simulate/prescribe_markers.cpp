@@ -78,16 +78,14 @@ MarkerPrescription prescribeMarkers(SimulationModel& m, const osim::MarkerTable&
     fail(0, os.str());
   }
   const int n = trc.numRows();
-  int lo = 0, hi = n - 1;
-  while (lo + 1 < n && trc.time[lo + 1] <= a + 1e-12) ++lo;
-  while (hi - 1 >= 0 && trc.time[hi - 1] >= b - 1e-12) --hi;
-  hi = std::max(hi, lo);
+  int lo = 0, hi = 0;
+  trc.bracketRows(a, b, lo, hi);
 
   p.free_coordinates = model.nr() - sys.numConstraintRows();
   for (const auto& [k, c] : chosen) {
     const osim::MarkerDesc& mk = d.markers[k];
-    const int db = d.findBody(mk.body);
-    const int body = db >= 0 && db < static_cast<int>(m.build.body_index.size()) ? m.build.body_index[db] : -1;
+    const CoreMarker cm = findCoreMarker(m, mk.name);
+    const int body = cm.body;
     if (body < 0)  // a model error: named at the marker's line of the .osim
       throw osim::ConvertError(d.source_file, mk.line,
                                "marker '" + mk.name + "' is on '" + mk.body +
@@ -124,7 +122,7 @@ MarkerPrescription prescribeMarkers(SimulationModel& m, const osim::MarkerTable&
       }
       return s;
     };
-    const Vec3 point = transformPoint(mk.X_body_frame, mk.location);
+    const Vec3 point = cm.point;
     auto constraint =
         std::make_shared<PrescribedPoint>(model, body, point, std::move(traj), "prescribed_marker_" + mk.name);
     m.system->addConstraint(constraint);

@@ -233,18 +233,15 @@ SimulationModel makeSimulationModel(const osim::ModelDescription& d, const Simul
         if (!parseVec3(spec.target.substr(at + 1), l.point_i))
           throw std::invalid_argument("--impulse: point of '" + spec.target + "' must be X,Y,Z in m");
       }
-      int b = d.findBody(body);
+      const int b = d.findBody(body);
+      l.body = b >= 0 && b < static_cast<int>(m.build.body_index.size()) ? m.build.body_index[b] : -1;
       if (b < 0 && at == std::string::npos) {
-        for (const auto& mk : d.markers) {
-          if (mk.name != body) continue;
-          b = d.findBody(mk.body);
-          l.point_i = transformPoint(mk.X_body_frame, mk.location);
-          break;
-        }
+        const CoreMarker cm = findCoreMarker(m, body);
+        l.body = cm.body;
+        l.point_i = cm.point;
       }
-      if (b < 0 || m.build.body_index[b] < 0)
+      if (l.body < 0)
         throw std::invalid_argument("--impulse: '" + body + "' is not a moving body or a marker of the model");
-      l.body = m.build.body_index[b];
       loads.push_back(l);
     }
     auto term = std::make_shared<ImpulseLoads>(std::move(loads));
@@ -306,6 +303,20 @@ State defaultSkeletonState(const SimulationModel& m) {
   return s;
 }
 }  // namespace
+
+CoreMarker findCoreMarker(const SimulationModel& m, const std::string& name) {
+  CoreMarker out;
+  const osim::ModelDescription& d = m.description;
+  for (const osim::MarkerDesc& mk : d.markers) {
+    if (mk.name != name) continue;
+    out.mk = &mk;
+    const int db = d.findBody(mk.body);
+    out.body = db >= 0 && db < static_cast<int>(m.build.body_index.size()) ? m.build.body_index[db] : -1;
+    out.point = transformPoint(mk.X_body_frame, mk.location);
+    break;
+  }
+  return out;
+}
 
 State defaultInitialState(const SimulationModel& m) { return finishInitialState(m, defaultSkeletonState(m)); }
 

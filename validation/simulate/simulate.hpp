@@ -105,6 +105,16 @@ struct SimulationModel {
 SimulationModel loadSimulationModel(const std::string& osim_path, const SimulationModelOptions& options);
 SimulationModel makeSimulationModel(const osim::ModelDescription& d, const SimulationModelOptions& options);
 
+/// Marker `name` of m's MarkerSet in the core model: its core body (-1 when it sits on ground or on
+/// a body the core model split away) and its location in that body's frame (the marker's frame
+/// offset applied); found false when the MarkerSet has no such marker (mk then null).
+struct CoreMarker {
+  const osim::MarkerDesc* mk = nullptr;
+  int body = -1;
+  Vec3 point = Vec3::Zero();
+};
+CoreMarker findCoreMarker(const SimulationModel& m, const std::string& name);
+
 /// The model's default state: each coordinate's default_value and default_speed_value, at t = 0,
 /// projected onto the constraints.
 State defaultInitialState(const SimulationModel& m);
