@@ -188,12 +188,17 @@ void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const Ve
   if (sc.ws.muscles.size() != massive_.size()) sc.ws = MuscleWorkspace(model, massive_);
   sc.id.resize(massive_.size());
   sc.evaluation = 0;  // the muscles' kinematics below are partial: no reuse by addMass & co.
-  calcBodyWorldMotion(motion, sc.bodies);
-  sc.w_world.assign(wrench.size(), Vec6::Zero());  // (zeroed here: a muscle that threw may have left sums)
+  // the bodies' world motion serves the path-wise muscles only (with none, e.g. all Type III, skip it)
+  const bool pathwise =
+      options_.quadratic_velocity && std::find(compact_id_.begin(), compact_id_.end(), false) != compact_id_.end();
+  if (pathwise) {
+    calcBodyWorldMotion(motion, sc.bodies);
+    sc.w_world.assign(wrench.size(), Vec6::Zero());  // (zeroed here: a muscle that threw may have left sums)
+  }
   for (size_t m = 0; m < massive_.size(); ++m) {
     const Muscle& mu = massive_[m];
     MuscleKinematics& mk = sc.ws.muscles[m];
-    if (!compact_id_[m] && options_.quadratic_velocity) {
+    if (pathwise && !compact_id_[m]) {
       addMuscleInverseDynamics(model, s, qddot, sc.bodies, model.gravity(), mu, mk, sc.id[m], sc.w_world, tau);
       continue;
     }
@@ -212,7 +217,7 @@ void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const Ve
     }
     scatterAddColumns(sc.fc, mk, tau);
   }
-  addWorldWrenches(sc.bodies, sc.w_world, wrench);
+  if (pathwise) addWorldWrenches(sc.bodies, sc.w_world, wrench);
 }
 
 double MuscleTerm::kineticEnergy(const Model& model, const State& s, const TermContext& ctx) const {

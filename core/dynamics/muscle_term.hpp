@@ -113,7 +113,8 @@ class MuscleTerm final : public ForceTerm {
 
   std::vector<Muscle> muscles_;
   std::vector<Muscle> massive_;        // the muscles with at least one mass point
-  std::vector<bool> compact_id_;       // massive_[m] needs its compact J_ar in inverse dynamics (Type III, fibre)
+  std::vector<bool> compact_id_;       // massive_[m] needs its compact J_ar in inverse dynamics (Type III,
+                                       // fibre-following, node points)
   bool adds_mass_ = false;             // a mass point of massive_ has non-zero mass (fixed at construction)
   bool node_points_ = false;           // a muscle of massive_ runs through a deformable node
   std::vector<MuscleStateIndex> massive_states_;  // their states (fibre-following placement)

@@ -25,37 +25,24 @@ bool LinearlyImplicitEuler::sparseRoute(const System& sys) const {
 }
 
 void LinearlyImplicitEuler::step(const System& sys, State& s, double h, DynamicsWorkspace& ws) {
-  if (sparseRoute(sys)) {
-    // the same step over sparse matrices: (M + h D + h^2 K) qdot+ = M qdot + h (f + D qdot)
+  const bool sparse = sparseRoute(sys);
+  // implicit matrix and right-hand side [D Eq. 4.80, 4.82]: (M + h D + h^2 K) qdot+ = M qdot + h (f + D qdot),
+  // dense or over sparse matrices (the same step)
+  MatX A;
+  Eigen::SparseMatrix<double> As;
+  VecX a;
+  if (sparse) {
     sys.calcSparseMatrices(s, ws, true, M_, K_, D_);
-    ++stats_.rhs_evals;
-    ++stats_.jacobian_evals;
-    const VecX a = M_ * s.qdot + h * (ws.f + D_ * s.qdot);
-    const Eigen::SparseMatrix<double> A = M_ + h * D_ + (h * h) * K_;
-    static const MatX no_rows;
-    static const VecX no_rhs;
-    VecX b;
-    if (sys.numConstraintRows() > 0) {
-      sys.calcConstraints(s, ws);
-      b = ws.G * s.qdot + h * ws.rhs - ws.vel_err;
-    }
-    try {
-      s.qdot = detail::solveImplicitSparse(A, sys.numConstraintRows() > 0 ? ws.G : no_rows,
-                                           a, sys.numConstraintRows() > 0 ? b : no_rhs, &ws.lambda);
-    } catch (const std::runtime_error& e) {
-      throw SimulationError(std::string("bdf1: ") + e.what() + " at t = " + std::to_string(s.t), s.t, h);
-    }
-    s.q += h * s.qdot;
-    s.t += h;
-    return;
+    a = M_ * s.qdot + h * (ws.f + D_ * s.qdot);
+    As = M_ + h * D_ + (h * h) * K_;
+  } else {
+    sys.calcMassAndForce(s, ws);
+    sys.calcStiffnessDamping(s, ws);
+    A = ws.M + h * ws.D + (h * h) * ws.K;
+    a = ws.M * s.qdot + h * (ws.f + ws.D * s.qdot);
   }
-  sys.calcMassAndForce(s, ws);
-  sys.calcStiffnessDamping(s, ws);
   ++stats_.rhs_evals;
   ++stats_.jacobian_evals;
-  // implicit matrix and right-hand side [D Eq. 4.80, 4.82]
-  const MatX A = ws.M + h * ws.D + (h * h) * ws.K;
-  const VecX a = ws.M * s.qdot + h * (ws.f + ws.D * s.qdot);
   static const MatX no_rows;
   static const VecX no_rhs;
   const bool bilateral = sys.numConstraintRows() > 0;
@@ -68,9 +55,16 @@ void LinearlyImplicitEuler::step(const System& sys, State& s, double h, Dynamics
   const MatX& G = bilateral ? ws.G : no_rows;
   const VecX& bb = bilateral ? b : no_rhs;
   bool done = false;
-  if (const auto& u = sys.unilateral()) {
-    // hard unilateral constraints: the contact QP on top of this step (docs/contact.md §6);
-    // calcMassAndForce left the kinematics of s at the velocity stage in ws.sk
+  if (sparse) {
+    try {
+      s.qdot = detail::solveImplicitSparse(As, G, a, bb, &ws.lambda);
+    } catch (const std::runtime_error& e) {
+      throw SimulationError(std::string("bdf1: ") + e.what() + " at t = " + std::to_string(s.t), s.t, h);
+    }
+    done = true;
+  } else if (const auto& u = sys.unilateral()) {
+    // hard unilateral constraints (dense route only): the contact QP on top of this step
+    // (docs/contact.md §6); calcMassAndForce left the kinematics of s at the velocity stage in ws.sk
     u->detect(sys.model(), s, ws.sk, sys.ndof(), h, rows_);
     stats_.max_penetration = std::max(stats_.max_penetration, rows_.max_penetration);
     if (!rows_.c.empty()) {
