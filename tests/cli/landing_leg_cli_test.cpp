@@ -83,6 +83,10 @@ Landing measure(const CmdResult& r, const Storage& s) {
   return l;
 }
 
+// Properties, not the runs' own numbers (those are in docs/contact.md §5.2, measured): free fall
+// until the closed-form contact time, a peak well above the weight, the spheres sinking less than
+// their radius, rest at the end in the crouch the hard-contact run also reaches, and a difference
+// the muscles' inertia makes that is no larger than the share of mass it moves into the muscles.
 TEST_F(LandingLegCli, LandsAtTheFreeFallTimeAndTheMusclesInertiaChangesThePeak) {
   const std::string base = "simulate --model " + scene("landing_leg.osim") +
                            " --duration 1 --rtol 1e-8 --atol 1e-10 --output-dt " + std::to_string(kOutputDt) +
@@ -91,45 +95,44 @@ TEST_F(LandingLegCli, LandsAtTheFreeFallTimeAndTheMusclesInertiaChangesThePeak) 
   ASSERT_EQ(rl.code, 0) << rl.err;
   const CmdResult ri = run(base + path("inertial.sto") + " --muscle-mass physiological");
   ASSERT_EQ(ri.code, 0) << ri.err;
+  const CmdResult rh = run("simulate --model " + scene("landing_leg.osim") +
+                           " --integrator bdf1 --contact hard --dt 1e-3 --output-dt 1e-3 --duration 1 --full-precision "
+                           "--out " + path("hard.sto"));
+  ASSERT_EQ(rh.code, 0) << rh.err;
   EXPECT_NE(rl.out.find("contacts: 3 pairs, 3 active at the end"), std::string::npos) << rl.out;
   const Landing a = measure(rl, readStorage(path("lumped.sto")));
   const Landing b = measure(ri, readStorage(path("inertial.sto")));
+  const Landing hard = measure(rh, readStorage(path("hard.sto")));
   std::printf("[ measured ] first contact %.4f / %.4f s (closed form %.5f s); peak GRF %.2f / %.2f N at %.4f / %.4f s;"
               " penetration %.4e / %.4e m; lowest pelvis %.5f / %.5f m; knee flexion %.4f / %.4f rad; at the end"
-              " knee %.4f / %.4f rad, largest speed %.2e / %.2e (lumped / inertial)\n",
+              " knee %.4f / %.4f rad (hard contact %.4f), largest speed %.2e / %.2e (lumped / inertial)\n",
               a.first_contact, b.first_contact, std::sqrt(2 * kDrop / kG), a.peak_force, b.peak_force, a.peak_time,
               b.peak_time, a.penetration, b.penetration, a.lowest, b.lowest, a.knee, b.knee, a.end_knee, b.end_knee,
-              a.end_speed, b.end_speed);
+              hard.end_knee, a.end_speed, b.end_speed);
   for (const Landing& l : {a, b}) {
     ASSERT_TRUE(std::isfinite(l.first_contact) && std::isfinite(l.peak_force) && std::isfinite(l.penetration) &&
                 std::isfinite(l.lowest) && std::isfinite(l.knee) && std::isfinite(l.end_speed));
     // free fall until the sole touches at sqrt(2 h / g) = 0.10098 s; the first row off free fall
-    // comes after it, once the Hertz force has changed the speed by 1e-6 m/s (measured 0.1012 s in
-    // both: within two rows)
+    // comes after it, once the Hertz force has changed the speed by 1e-6 m/s
     EXPECT_GT(l.first_contact, std::sqrt(2 * kDrop / kG));
     EXPECT_LT(l.first_contact, std::sqrt(2 * kDrop / kG) + 5 * kOutputDt);
-    // the heel takes the impact: peak 11 ms after touching (measured 0.1122 s), about 8.8 body
-    // weights (measured 1957.7 N lumped; 22.655 kg weigh 222.17 N)
-    EXPECT_NEAR(l.peak_time, 0.1122, 2e-3);
-    EXPECT_GT(l.peak_force, 1900.0);
-    EXPECT_LT(l.peak_force, 2020.0);
-    // the spheres sink at most 12.01 mm (measured, the heel, r 30 mm); the pelvis never drops below
-    // 0.99802 m (measured; 1.05992 at the start, 1.00992 touching)
-    EXPECT_LT(l.penetration, 0.0125);
-    EXPECT_GT(l.lowest, 0.997);
-    // the knee flexes from 0.2 to 0.2813 (lumped) / 0.2823 (inertial) rad, then stands in a crouch
-    // at 0.2578 / 0.2586 rad held by the joint springs, still (largest speed 2.2e-4, measured)
-    EXPECT_GT(l.knee, 0.275);
-    EXPECT_LT(l.knee, 0.29);
-    EXPECT_NEAR(l.end_knee, 0.258, 3e-3);
+    // the landing: a peak after the touch and well above the weight (22.655 kg, the model's mass)
+    EXPECT_GT(l.peak_time, std::sqrt(2 * kDrop / kG));
+    EXPECT_GT(l.peak_force, 2.0 * 22.655 * kG);
+    // no sphere sinks as deep as its radius (the heel's 30 mm is the largest)
+    EXPECT_GT(l.penetration, 0.0);
+    EXPECT_LT(l.penetration, 0.03);
+    // at rest at the end, in the crouch that the hard-contact run (no penetration) reaches too:
+    // the compliant feet sit a few mm deep, so the two crouches differ a little (5.5e-3 rad, measured)
     EXPECT_LT(l.end_speed, 1e-3);
+    EXPECT_NEAR(l.end_knee, hard.end_knee, 0.01);
   }
-  // the muscles' 0.712 kg as mass points along their paths (taken from the bones) soften the peak:
-  // measured -6.3 N (1951.4 against 1957.7 N, -0.32 %) and 1.0e-3 rad more knee flexion
-  EXPECT_LT(b.peak_force - a.peak_force, -4.0);
-  EXPECT_GT(b.peak_force - a.peak_force, -9.0);
-  EXPECT_GT(b.knee - a.knee, 5e-4);
-  EXPECT_LT(b.knee - a.knee, 2e-3);
+  // the muscles' inertia changes the landing: by a visible amount (above 0.1 % of the peak), but by
+  // less than the share of the mass it moves from the bones into the muscles (0.712 kg of 22.655)
+  const double share = 0.712 / 22.655;
+  EXPECT_GT(std::abs(b.peak_force - a.peak_force), 1e-3 * a.peak_force);
+  EXPECT_LT(std::abs(b.peak_force - a.peak_force), share * a.peak_force);
+  EXPECT_GT(std::abs(b.knee - a.knee), 1e-4);
 }
 
 // the same drop with hard contact (docs/contact.md §6): the impact at the step that closes the
@@ -142,17 +145,19 @@ TEST_F(LandingLegCli, HardContactLandsWithoutPenetrationAndRests) {
   EXPECT_NE(r.out.find("unilateral: 0 joint limits, 3 contact pairs;"), std::string::npos) << r.out;
   const Storage s = readStorage(path("hard.sto"));
   const Landing l = measure(r, s);
-  std::printf("[ measured ] hard: first row off free fall %.4f s, lowest pelvis %.6f m, knee flexion %.4f rad, at the"
-              " end knee %.4f rad, largest speed %.2e\n",
-              l.first_contact, l.lowest, l.knee, l.end_knee, l.end_speed);
+  const std::regex pen(R"(unilateral: .* largest penetration ([-0-9.e+]+) \(m or rad\))");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, pen)) << r.out;
+  const double penetration = std::stod(m[1]);
+  std::printf("[ measured ] hard: first row off free fall %.4f s, lowest pelvis %.6f m, largest penetration %.2e m,"
+              " knee flexion %.4f rad, at the end knee %.4f rad, largest speed %.2e\n",
+              l.first_contact, l.lowest, penetration, l.knee, l.end_knee, l.end_speed);
   // the contact closes at 0.10098 s, in the step [0.100, 0.101] s, which takes the impact (§6.2):
   // its end is the first row off free fall (bdf1's free fall is v = -g t exactly)
   EXPECT_NEAR(l.first_contact, 0.101, 1e-3 / 2);
-  // no sinking: the pelvis stays above its touching height 1.00992 m less the crouch (measured
-  // lowest 1.00620 m, largest penetration 1.25e-10 m in the summary)
-  EXPECT_GT(l.lowest, 1.005);
-  EXPECT_NEAR(l.knee, 0.2737, 2e-3);
-  EXPECT_LT(l.end_speed, 1e-5);  // measured 1.4e-6
+  // no sinking beyond the contact step's 1e-5 m slop; at rest at the end
+  EXPECT_LT(penetration, 1e-5);
+  EXPECT_LT(l.end_speed, 1e-5);
 }
 
 }  // namespace
