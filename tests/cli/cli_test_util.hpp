@@ -1,6 +1,7 @@
 #pragma once
 // Running the `redmax` executable of the same build from the CLI tests.
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -51,6 +53,27 @@ inline CmdResult runRedmax(const fs::path& dir, const std::string& args, bool in
 }
 
 /// a project-authored scene: <source>/osim_models/FILE
+/// A CLI test with its own temporary folder (redmax_<tag>_<pid>, made fresh and removed after), skipped
+/// when the redmax executable was not built: the fixture the CLI test files share.
+class CliTempDirTest : public ::testing::Test {
+ protected:
+  explicit CliTempDirTest(std::string tag) : tag_(std::move(tag)) {}
+  void SetUp() override {
+    if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to cli_tests (build target redmax)";
+    dir_ = fs::temp_directory_path() / ("redmax_" + tag_ + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!dir_.empty()) fs::remove_all(dir_);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+
+ private:
+  std::string tag_;
+};
+
 inline std::string scene(const std::string& file) { return std::string(REDMAX_SOURCE_DIR) + "/osim_models/" + file; }
 
 /// relative energy drift of written states: max |E(t) - E(0)| / max(|E(0)|, max kinetic energy)

@@ -30,18 +30,9 @@ double restPenetration(double mass, double r, double k) {
   return std::pow(3.0 * mass * kG / (4.0 * E * std::sqrt(r)), 2.0 / 3.0);
 }
 
-class ContactCli : public ::testing::Test {
+class ContactCli : public CliTempDirTest {
  protected:
-  void SetUp() override {
-    if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to cli_tests (build target redmax)";
-    dir_ = fs::temp_directory_path() / ("redmax_contact_cli_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    if (!dir_.empty()) fs::remove_all(dir_);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  ContactCli() : CliTempDirTest("contact_cli") {}
   std::string write(const std::string& name, const std::string& text) const {
     std::ofstream(dir_ / name) << text;
     return path(name);
@@ -62,7 +53,6 @@ class ContactCli : public ::testing::Test {
                      "</objects></ForceSet>");
     return write(name, text);
   }
-  fs::path dir_;
 };
 
 TEST_F(ContactCli, BallDropComesToRestAtTheHertzPenetration) {

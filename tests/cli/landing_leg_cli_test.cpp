@@ -29,20 +29,10 @@ const std::string kTy = "/jointset/ground_pelvis/pelvis_ty/value";
 const std::string kVy = "/jointset/ground_pelvis/pelvis_ty/speed";
 const std::string kKnee = "/jointset/knee_r/knee_angle_r/value";
 
-class LandingLegCli : public ::testing::Test {
+class LandingLegCli : public CliTempDirTest {
  protected:
-  void SetUp() override {
-    if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to cli_tests (build target redmax)";
-    dir_ = fs::temp_directory_path() / ("redmax_landing_leg_cli_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    if (!dir_.empty()) fs::remove_all(dir_);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  LandingLegCli() : CliTempDirTest("landing_leg_cli") {}
   CmdResult run(const std::string& args) const { return runRedmax(dir_, args); }
-  fs::path dir_;
 };
 
 struct Landing {

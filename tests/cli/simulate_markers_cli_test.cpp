@@ -87,22 +87,16 @@ std::vector<double> grid(double dt, int n) {
   return t;
 }
 
-class SimulateMarkersCli : public ::testing::Test {
+class SimulateMarkersCli : public CliTempDirTest {
  protected:
+  SimulateMarkersCli() : CliTempDirTest("simulate_markers_cli") {}
   void SetUp() override {
-    if (redmaxExe().empty()) GTEST_SKIP() << "redmax executable not built next to cli_tests (build target redmax)";
-    dir_ = fs::temp_directory_path() / ("redmax_simulate_markers_cli_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    CliTempDirTest::SetUp();
+    if (IsSkipped()) return;
     std::ofstream(path("p1.osim")) << pendulumOsim(1);
     std::ofstream(path("p2.osim")) << pendulumOsim(2);
   }
-  void TearDown() override {
-    if (!dir_.empty()) fs::remove_all(dir_);
-  }
   CmdResult run(const std::string& args) const { return runRedmax(dir_, "simulate " + args); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
 };
 
 TEST_F(SimulateMarkersCli, AMarkerOfAFreeRunPrescribedAgainTakesNoForce) {

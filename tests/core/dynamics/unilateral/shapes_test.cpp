@@ -13,18 +13,10 @@
 #include "core/integrators/integrator.hpp"
 #include "core/joints/free_joints.hpp"
 #include "core/spatial/se3.hpp"
-#include "tests/core/dynamics/unilateral/gap_rates.hpp"
+#include "tests/core/dynamics/unilateral/unilateral_test_util.hpp"
 
 namespace redmax {
 namespace {
-
-CollisionGeometry ground() {
-  CollisionGeometry g;
-  g.name = "ground";
-  g.shape = CollisionShape::HalfSpace;
-  g.X_body = makeE(rotationAxisAngle(Vec3::UnitZ(), -M_PI / 2), Vec3::Zero());  // outward normal +y
-  return g;
-}
 
 const Vec3 kSemiAxes(0.3, 0.1, 0.2);
 
@@ -49,7 +41,7 @@ struct Scene {
                           Vec3::Zero()};
     // the ball-bar pair names the sphere first: the constructor puts the capsule first
     std::vector<CollisionPair> p{{0, 1, friction, 0.0}, {0, 2, friction, 0.0}, {2, 3, friction, 0.0}};
-    u = std::make_shared<UnilateralConstraints>(sys->model(), std::vector<CollisionGeometry>{ground(), ell, ball, bar}, p,
+    u = std::make_shared<UnilateralConstraints>(sys->model(), std::vector<CollisionGeometry>{test::groundPlane(), ell, ball, bar}, p,
                                                 std::vector<JointLimit>{});
     sys->setUnilateral(u);
   }
@@ -175,7 +167,7 @@ TEST(CollisionShapes, BadPairsAreRefused) {
   b.addBody("a", 1.0, Vec3::Zero(), Mat3::Identity(), -1, "fa", Free3D{});
   const Model m = b.finalize();
   CollisionGeometry ell{"e", CollisionShape::Ellipsoid, 0, Mat4::Identity(), 0.0, 0.0, Vec3(0.1, 0.0, 0.1)};
-  EXPECT_THROW(UnilateralConstraints(m, {ground(), ell}, {{0, 1, 0.0, 0.0}}, {}), ModelError);  // a zero semi-axis
+  EXPECT_THROW(UnilateralConstraints(m, {test::groundPlane(), ell}, {{0, 1, 0.0, 0.0}}, {}), ModelError);  // a zero semi-axis
   ell.half_extents = Vec3(0.1, 0.2, 0.1);
   CollisionGeometry cap{"c", CollisionShape::Capsule, -1, Mat4::Identity(), 0.05, 0.2, Vec3::Zero()};
   try {

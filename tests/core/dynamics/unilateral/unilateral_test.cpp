@@ -13,18 +13,10 @@
 #include "core/joints/basic_joints.hpp"
 #include "core/joints/free_joints.hpp"
 #include "core/spatial/se3.hpp"
-#include "tests/core/dynamics/unilateral/gap_rates.hpp"
+#include "tests/core/dynamics/unilateral/unilateral_test_util.hpp"
 
 namespace redmax {
 namespace {
-
-CollisionGeometry groundPlane() {
-  CollisionGeometry g;
-  g.name = "ground";
-  g.shape = CollisionShape::HalfSpace;
-  g.X_body = makeE(rotationAxisAngle(Vec3::UnitZ(), -M_PI / 2), Vec3::Zero());  // outward normal +y
-  return g;
-}
 
 // a free box (body 0), a free capsule (body 1), a hinged arm with a sphere at its tip (body 2),
 // a free sphere (body 3); ground pairs for all, sphere-sphere between 2 and 3; a limit on the hinge
@@ -39,7 +31,7 @@ struct Scene {
     b.addBody("arm", 1.0, Vec3(0.5, 0, 0), I, -1, "hinge", Revolute{}, makeTranslation(Vec3(0, 1, 0)));
     b.addBody("ball", 1.0, Vec3::Zero(), I, -1, "f3", Free3D{});
     sys = std::make_shared<System>(b.finalize());
-    std::vector<CollisionGeometry> g{groundPlane()};
+    std::vector<CollisionGeometry> g{test::groundPlane()};
     CollisionGeometry box{"box", CollisionShape::Box, 0, makeE(rotationAxisAngle(Vec3::UnitX(), 0.3), Vec3(0, 0.1, 0)),
                           0.0, 0.0, Vec3(0.1, 0.2, 0.3)};
     CollisionGeometry cap{"capsule", CollisionShape::Capsule, 1, Mat4::Identity(), 0.05, 0.2, Vec3::Zero()};

@@ -1,15 +1,25 @@
 #pragma once
-// The normal rows of a unilateral-constraint set against central differences of its gaps along
-// the state's velocity (d gap / dt = J_n qdot, and the rows' recorded approach speeds): shared by
-// the unilateral tests.
+// Shared by the unilateral tests: the ground plane, and the normal rows of a unilateral-constraint
+// set against central differences of its gaps along the state's velocity (d gap / dt = J_n qdot,
+// and the rows' recorded approach speeds).
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "core/dynamics/system.hpp"
 #include "core/dynamics/unilateral/unilateral.hpp"
+#include "core/spatial/se3.hpp"
 
 namespace redmax::test {
+
+/// the ground as a half-space with outward normal +y (OpenSim's ContactHalfSpace fills x > 0)
+inline CollisionGeometry groundPlane() {
+  CollisionGeometry g;
+  g.name = "ground";
+  g.shape = CollisionShape::HalfSpace;
+  g.X_body = makeE(rotationAxisAngle(Vec3::UnitZ(), -M_PI / 2), Vec3::Zero());
+  return g;
+}
 
 /// detect's rows at s (asserting `expected_rows` of them) checked against (gap(q + d qdot) -
 /// gap(q - d qdot)) / 2d, d = 1e-6, to tol (1 + |rate|); returns the rows
