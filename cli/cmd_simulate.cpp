@@ -65,21 +65,19 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   for (const char* n : {"--prescribe-lowpass", "--prescribed-forces"})
     if (given(app, n) && !prescribing && !markers)
       throw UsageError{std::string(n) + " needs --prescribe MOTION or --prescribe-markers TRIAL.trc"};
-  // hard unilateral constraints: only bdf1 solves the contact QP (docs/contact.md §6)
+  // hard unilateral constraints: bdf1 solves the contact QP in its step, rk45 and cvode locate the
+  // events (docs/contact.md §6)
   const bool hard = given(app, "--joint-limits") || f.contact == "hard";
   if (given(app, "--limit-restitution") && !given(app, "--joint-limits"))
     throw UsageError{"--limit-restitution needs --joint-limits hard|clamped"};
   for (const char* n : {"--contact-restitution", "--contact-friction"})
     if (given(app, n) && f.contact != "hard") throw UsageError{std::string(n) + " needs --contact hard"};
   if (hard && engine != "core") throw UsageError{"--joint-limits and --contact hard need --engine core"};
-  // bdf1 takes both (the contact QP in its step); rk45 and cvode take joint limits by event location
   const bool adaptive = f.so.integrator == "rk45" || f.so.integrator == "cvode";
-  if (f.contact == "hard" && f.so.integrator != "bdf1")
-    throw UsageError{"--contact hard needs --integrator bdf1 (the linearly implicit step that solves the contact "
-                     "QP; " + f.so.integrator + " cannot enforce it, docs/contact.md §6)"};
-  if (given(app, "--joint-limits") && f.so.integrator != "bdf1" && !adaptive)
-    throw UsageError{"--joint-limits needs --integrator bdf1, rk45 or cvode (" + f.so.integrator +
-                     " cannot enforce them, docs/contact.md §6)"};
+  if (hard && f.so.integrator != "bdf1" && !adaptive)
+    throw UsageError{std::string(f.contact == "hard" ? "--contact hard" : "--joint-limits") +
+                     " needs --integrator bdf1, rk45 or cvode (" + f.so.integrator +
+                     " cannot enforce hard constraints, docs/contact.md §6)"};
   f.hard.joint_limits = f.joint_limits;
   f.hard.contact = f.contact == "hard";
   validation::SimbodyEngineOptions simbody_flags;
@@ -322,8 +320,10 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
                   res.contacts.max_force, res.contacts.max_force_up, res.contacts.max_force_time);
   }
   if (hard && !quiet && (f.so.integrator == "rk45" || f.so.integrator == "cvode"))
-    std::printf("unilateral: %d joint limits by event location; %ld impacts, %ld releases\n", hard_made.limits,
-                res.stats.limit_impacts, res.stats.limit_releases);
+    std::printf("unilateral: %d joint limits, %d contact pairs by event location; %ld impacts, %ld releases, %ld "
+                "slips, %ld sticks, largest penetration at the checks %.3g (m or rad)\n",
+                hard_made.limits, hard_made.pairs, res.stats.event_impacts, res.stats.event_releases,
+                res.stats.event_slips, res.stats.event_sticks, res.stats.max_penetration);
   else if (hard && !quiet)
     std::printf("unilateral: %d joint limits, %d contact pairs; %ld of %ld steps solved a contact QP, at most %d "
                 "contacts at once (%.3g on average), %ld QP iterations in %ld QPs, largest penetration %.3g "
@@ -476,7 +476,7 @@ CommandRegistration reg(
                       "compliant (default): HuntCrossleyForce and SmoothSphereHalfSpaceForce as\n"
                       "OpenSim computes them; hard: their ContactSphere / ContactHalfSpace pairs as\n"
                       "hard contacts with Coulomb friction (the forces' dynamic_friction), no\n"
-                      "penetration; needs --integrator bdf1")
+                      "penetration; needs --integrator bdf1, or rk45 / cvode (event location)")
            ->type_name("compliant|hard")
            ->check(oneOf({"compliant", "hard"}));
        app.add_option("--contact-restitution", f->hard.contact_restitution,

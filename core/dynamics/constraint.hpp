@@ -30,6 +30,15 @@ class Constraint {
   /// a body, core/deformable/node_constraint.hpp): calcAcceleration then gets a rows x ndof block
   /// and the State's q includes the extra coordinates (not combinable with a coordinate map)
   virtual bool actsOnExtraCoordinates() const { return false; }
+  /// true if the multipliers act through rows H other than G: M qddot = f - H^T lambda while
+  /// G qddot = rhs still holds (sliding Coulomb friction, whose force is tied to the normal
+  /// multiplier: core/dynamics/unilateral/held_contacts.hpp). The System then solves the
+  /// non-symmetric KKT system.
+  virtual bool hasForceRows() const { return false; }
+  /// H (rows x the same columns as G); called only when hasForceRows(); needs Stage::Velocity
+  virtual void calcForceRows(const Model&, const State&, const SkeletonWorkspace&, Eigen::Ref<MatX> H) const {
+    (void)H;
+  }
 };
 
 }  // namespace redmax

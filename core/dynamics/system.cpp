@@ -182,6 +182,7 @@ ForwardRoute System::plannedForwardRoute() const {
 void System::addConstraint(std::shared_ptr<const Constraint> c) {
   if (!c) throw ModelError("System::addConstraint: null constraint");
   nc_ += c->rows();
+  force_rows_ = force_rows_ || c->hasForceRows();
   id_.renew();
   constraints_.push_back(std::move(c));
 }
@@ -511,6 +512,29 @@ VecX System::solveKKT(const MatX& M, const MatX& G, const VecX& a, const VecX& b
   return x.head(n);
 }
 
+VecX System::solveKKT(const MatX& M, const MatX& G, const MatX& H, const VecX& a, const VecX& b, VecX* lambda) {
+  const int n = static_cast<int>(M.rows());
+  const int m = static_cast<int>(G.rows());
+  if (m == 0) return solveKKT(M, G, a, b, lambda);
+  Eigen::LLT<MatX> llt(M);
+  if (llt.info() == Eigen::Success) {
+    const MatX MinvHt = llt.solve(H.transpose());
+    const VecX Minva = llt.solve(a);
+    const VecX lam = (G * MinvHt).completeOrthogonalDecomposition().solve(G * Minva - b);
+    if (lambda) *lambda = lam;
+    return Minva - MinvHt * lam;
+  }
+  MatX A = MatX::Zero(n + m, n + m);
+  A.topLeftCorner(n, n) = M;
+  A.topRightCorner(n, m) = H.transpose();
+  A.bottomLeftCorner(m, n) = G;
+  VecX r(n + m);
+  r << a, b;
+  const VecX x = A.completeOrthogonalDecomposition().solve(r);
+  if (lambda) *lambda = x.tail(m);
+  return x.head(n);
+}
+
 bool System::forwardArticulated(const State& s, DynamicsWorkspace& ws, VecX& qddot) const {
   if (nz_ > 0 && s.z.size() != nz_)
     throw ModelError("System::forwardDynamics: state has " + std::to_string(s.z.size()) +
@@ -562,6 +586,18 @@ VecX System::forwardDynamics(const State& s, DynamicsWorkspace& ws) const {
   }
   ws.last_route = ForwardRoute::Dense;
   calcConstraints(s, ws);
+  if (force_rows_) {
+    if (map_) throw ModelError("System::forwardDynamics: constraints with force rows (sliding friction) and a coordinate map");
+    MatX H = ws.G;
+    int row = 0;
+    for (const auto& c : constraints_) {
+      const int m = c->rows();
+      const int cols = c->actsOnExtraCoordinates() ? ndof() : model_.nr();
+      if (c->hasForceRows()) c->calcForceRows(model_, s, ws.sk, H.block(row, 0, m, cols));
+      row += m;
+    }
+    return solveKKT(ws.M, ws.G, H, ws.f, ws.rhs, &ws.lambda);
+  }
   return solveKKT(ws.M, ws.G, ws.f, ws.rhs, &ws.lambda);
 }
 

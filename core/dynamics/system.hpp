@@ -259,6 +259,9 @@ class System {
   /// handled by a complete orthogonal decomposition: x is the consistent solution and lambda the
   /// minimum-norm multiplier; an inconsistent b is met in the least-squares sense.
   static VecX solveKKT(const MatX& M, const MatX& G, const VecX& a, const VecX& b, VecX* lambda);
+  /// the same with the multipliers acting through H: [M H^T; G 0] [x; lambda] = [a; b]
+  /// (Constraint::hasForceRows); the Schur complement G M^-1 H^T is not symmetric
+  static VecX solveKKT(const MatX& M, const MatX& G, const MatX& H, const VecX& a, const VecX& b, VecX* lambda);
 
  private:
   // a fresh process-wide serial number on construction, copy and renew()
@@ -300,6 +303,7 @@ class System {
   int nz_ = 0, nu_ = 0;
   bool mass_terms_ = false;  // a term adds mass (ForceTerm::addsMass), kept by addTerm/replaceTerm
   int nc_ = 0;
+  bool force_rows_ = false;  // some constraint has force rows other than G (Constraint::hasForceRows)
   std::shared_ptr<const CoordinateMap> map_;
   std::shared_ptr<const UnilateralConstraints> unilateral_;
   int ndof_ = 0;

@@ -3,38 +3,24 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
-#include "core/dynamics/constraints/prescribed_coordinate.hpp"
+#include "core/dynamics/unilateral/held_contacts.hpp"
 #include "core/dynamics/unilateral/unilateral.hpp"
+#include "core/skeleton/kinematics.hpp"
 
 namespace redmax {
 namespace {
 
-struct Side {
-  int limit = 0;
-  int sub = 0;  // 0: the lower bound, 1: the upper bound
-  bool operator==(const Side& o) const { return limit == o.limit && sub == o.sub; }
-};
-
-double bound(const JointLimit& l, int sub) { return sub == 0 ? l.lower : l.upper; }
-// signed distance from the bound (negative: beyond it) and its rate
-double gap(const JointLimit& l, int sub, const State& s) {
-  return sub == 0 ? s.q[l.coordinate] - l.lower : l.upper - s.q[l.coordinate];
-}
-double rate(const JointLimit& l, int sub, const State& s) { return sub == 0 ? s.qdot[l.coordinate] : -s.qdot[l.coordinate]; }
-
-// sys without its unilateral constraints, the active sides locked at their bounds (rows after sys's own)
-std::shared_ptr<System> phaseSystem(const System& sys, const std::vector<JointLimit>& limits,
-                                    const std::vector<Side>& active) {
-  auto p = std::make_shared<System>(sys);
-  p->setUnilateral(nullptr);
-  for (const Side& a : active)
-    p->addConstraint(PrescribedCoordinate::makeLocked(sys.model(), limits[a.limit].coordinate,
-                                                      bound(limits[a.limit], a.sub)));
-  return p;
-}
+// a free point counts as beyond its surface below -kGapTol (m or rad), so that one released at
+// zero gap with round-off on its gap does not re-enter at once; a sliding direction sticks when
+// its speed passes zero by kSpeedTol (m/s or rad/s)
+constexpr double kGapTol = 1e-12;
+constexpr double kSpeedTol = 1e-12;
+// mode changes at one instant before the run gives up (chattering, Painleve-like inconsistency)
+constexpr int kMaxChangesAtOneInstant = 200;
 
 void addStats(IntegratorStats& to, const IntegratorStats& from) {
   to.steps += from.steps;
@@ -44,67 +30,244 @@ void addStats(IntegratorStats& to, const IntegratorStats& from) {
   to.reparameterizations += from.reparameterizations;
 }
 
-enum class Event { None, Crossing, Release };
+// what a check at one state found (indices into the candidates or the held list)
+struct Found {
+  std::vector<ContactKey> crossing;               // free points beyond their surface, approaching
+  std::vector<std::pair<int, int>> stick;         // (held, direction) whose sliding speed passed zero
+  std::vector<int> release;                       // held contacts whose normal force would pull
+  std::vector<std::pair<int, int>> slip;          // (held, direction) outside the friction pyramid
+  std::vector<int> slip_sign;                     // the sliding sign each slip starts with
+  bool any() const { return !crossing.empty() || !stick.empty() || !release.empty() || !slip.empty(); }
+};
+
+class Driver {
+ public:
+  Driver(const System& sys, UnilateralEventCounts& cnt) : sys_(sys), model_(sys.model()), cnt_(cnt) {
+    u_ = sys.unilateral();
+    base_ = std::make_shared<System>(sys);
+    base_->setUnilateral(nullptr);
+    nc0_ = base_->numConstraintRows();
+  }
+
+  // points sitting on their surface (not moving off or into it) start held; the first check
+  // releases those that pull and lets those that cannot stick slip
+  void start(const State& s) {
+    UnilateralRows rows;
+    detectAt(s, rows);
+    std::vector<int> idx;
+    for (size_t i = 0; i < rows.c.size(); ++i)
+      if (std::abs(rows.c[i].gap) <= kGapTol && std::abs(rows.c[i].approach) <= speedTol()) idx.push_back(static_cast<int>(i));
+    held_ = classify(rows, idx, s.qdot);
+  }
+
+  std::shared_ptr<System> phase() {
+    auto p = std::make_shared<System>(*base_);
+    held_c_.reset();
+    if (!held_.empty()) {
+      held_c_ = std::make_shared<HeldContacts>(u_, held_);
+      p->addConstraint(held_c_);
+    }
+    return p;
+  }
+
+  Found check(const System& P, const State& x) {
+    Found f;
+    UnilateralRows rows;
+    detectAt(x, rows);
+    for (size_t i = 0; i < rows.c.size(); ++i) {
+      const auto& c = rows.c[i];
+      const int h = heldIndex(ContactKey::of(c));
+      if (h < 0) {
+        if (c.gap < -kGapTol && c.approach < 0.0) f.crossing.push_back(ContactKey::of(c));
+        continue;
+      }
+      for (int k = 0; k < 2; ++k) {
+        if (held_[h].slide[k] == 0) continue;
+        const double w = rows.Jt.row(c.tangent_row + k).dot(x.qdot);
+        if (w * held_[h].slide[k] < -kSpeedTol) f.stick.emplace_back(h, k);
+      }
+    }
+    if (f.any() || held_.empty()) return f;
+    DynamicsWorkspace ws(P);
+    P.forwardDynamics(x, ws);
+    const VecX& lam = ws.lambda;
+    const double scale = 1e-10 * (1.0 + lam.cwiseAbs().maxCoeff());
+    for (size_t h = 0; h < held_.size(); ++h) {
+      int r = nc0_ + held_c_->firstRow(static_cast<int>(h));
+      const double pn = -lam[r++];  // the contact force along the row (System: M qddot = f - G^T lambda)
+      if (pn < -scale) {
+        f.release.push_back(static_cast<int>(h));
+        continue;
+      }
+      if (held_[h].mu == 0.0) continue;
+      for (int k = 0; k < 2; ++k) {
+        if (held_[h].slide[k] != 0) continue;
+        const double pt = -lam[r++];
+        if (std::abs(pt) > held_[h].mu * std::max(pn, 0.0) + scale) {
+          f.slip.emplace_back(static_cast<int>(h), k);
+          f.slip_sign.push_back(pt > 0.0 ? -1 : 1);  // it slides against the force that held it
+        }
+      }
+    }
+    return f;
+  }
+
+  // change the modes as f says (impacts first; releases before slips, whose forces assumed them
+  // held), then project s onto the new held set
+  void apply(State& s, const Found& f) {
+    if (!f.crossing.empty()) {
+      impact(s, f.crossing);
+    } else if (!f.stick.empty()) {
+      for (const auto& [h, k] : f.stick) held_[h].slide[k] = 0;
+      cnt_.sticks += static_cast<long>(f.stick.size());
+    } else if (!f.release.empty()) {
+      for (auto it = f.release.rbegin(); it != f.release.rend(); ++it) held_.erase(held_.begin() + *it);
+      cnt_.releases += static_cast<long>(f.release.size());
+    } else {
+      for (size_t j = 0; j < f.slip.size(); ++j) held_[f.slip[j].first].slide[f.slip[j].second] = f.slip_sign[j];
+      cnt_.slips += static_cast<long>(f.slip.size());
+    }
+    std::shared_ptr<System> P = phase();
+    if (P->numConstraintRows() > 0) {
+      DynamicsWorkspace ws(*P);
+      P->projectPositions(s, ws);
+      P->projectVelocities(s, ws);
+    }
+  }
+
+ private:
+  double speedTol() const {
+    // the QP's regularisation leaves stopped rows at about 1e-9 of the speeds involved
+    return std::max(1e-9, 1e-6 * u_->options().restitution_threshold);
+  }
+
+  void detectAt(const State& x, UnilateralRows& rows) {
+    SkeletonWorkspace sk(model_);
+    calcKinematics(model_, x, sk);
+    u_->detect(model_, x, sk, sys_.ndof(), 1.0, rows);
+    cnt_.max_penetration = std::max(cnt_.max_penetration, rows.max_penetration);
+  }
+
+  int heldIndex(const ContactKey& key) const {
+    for (size_t h = 0; h < held_.size(); ++h)
+      if (held_[h].key == key) return static_cast<int>(h);
+    return -1;
+  }
+
+  // held contacts from candidates idx of rows at velocity qdot: sticking where a tangential speed is
+  // zero, sliding with its sign elsewhere
+  std::vector<HeldContact> classify(const UnilateralRows& rows, const std::vector<int>& idx, const VecX& qdot) const {
+    std::vector<HeldContact> out;
+    for (int i : idx) {
+      const auto& c = rows.c[i];
+      HeldContact h;
+      h.key = ContactKey::of(c);
+      h.mu = c.limit ? 0.0 : c.mu;
+      if (h.mu > 0.0)
+        for (int k = 0; k < 2; ++k) {
+          const double w = rows.Jt.row(c.tangent_row + k).dot(qdot);
+          h.slide[k] = std::abs(w) <= speedTol() ? 0 : (w > 0.0 ? 1 : -1);
+        }
+      out.push_back(h);
+    }
+    return out;
+  }
+
+  // the contact QP at velocity level over the held points and those crossing
+  void impact(State& s, const std::vector<ContactKey>& crossing) {
+    UnilateralRows rows;
+    detectAt(s, rows);
+    const UnilateralOptions& uo = u_->options();
+    UnilateralRows imp;
+    imp.h = 1.0;
+    std::vector<int> sel;
+    std::vector<VecX> jn, jt;
+    for (size_t i = 0; i < rows.c.size(); ++i) {
+      const ContactKey key = ContactKey::of(rows.c[i]);
+      const bool crosses = std::find(crossing.begin(), crossing.end(), key) != crossing.end();
+      if (!crosses && heldIndex(key) < 0) continue;
+      UnilateralRows::Candidate c = rows.c[i];
+      const double e = c.limit ? u_->limits()[c.source].restitution : u_->pairs()[c.source].restitution;
+      c.gap = 0.0;
+      c.target = crosses && c.approach < -uo.restitution_threshold ? -e * c.approach : 0.0;
+      if (c.tangent_row >= 0) {
+        const int t = c.tangent_row;
+        c.tangent_row = static_cast<int>(jt.size());
+        jt.push_back(rows.Jt.row(t).transpose());
+        jt.push_back(rows.Jt.row(t + 1).transpose());
+      }
+      jn.push_back(rows.Jn.row(static_cast<int>(i)).transpose());
+      imp.c.push_back(c);
+      sel.push_back(static_cast<int>(imp.c.size()) - 1);
+    }
+    const int n = sys_.ndof();
+    imp.Jn.resize(static_cast<int>(jn.size()), n);
+    for (size_t k = 0; k < jn.size(); ++k) imp.Jn.row(static_cast<int>(k)) = jn[k].transpose();
+    imp.Jt.resize(static_cast<int>(jt.size()), n);
+    for (size_t k = 0; k < jt.size(); ++k) imp.Jt.row(static_cast<int>(k)) = jt[k].transpose();
+
+    DynamicsWorkspace ws(*base_);
+    base_->calcMassAndForce(s, ws);
+    MatX G;
+    VecX b;
+    if (nc0_ > 0) {
+      base_->calcConstraints(s, ws);
+      G = ws.G;
+      b = G * s.qdot;
+    }
+    s.qdot = solveUnilateralStep(ws.M, ws.M * s.qdot, G, b, imp, uo, nullptr, nullptr, nullptr);
+    cnt_.impacts += static_cast<long>(crossing.size());
+    // held from now on: the points that stopped (the rest leave their surfaces)
+    std::vector<int> stopped;
+    for (int j : sel)
+      if (imp.Jn.row(j).dot(s.qdot) <= speedTol()) stopped.push_back(j);
+    held_ = classify(imp, stopped, s.qdot);
+  }
+
+  const System& sys_;
+  const Model& model_;
+  UnilateralEventCounts& cnt_;
+  std::shared_ptr<const UnilateralConstraints> u_;
+  std::shared_ptr<System> base_;
+  int nc0_ = 0;
+  std::vector<HeldContact> held_;
+  std::shared_ptr<HeldContacts> held_c_;
+};
 
 }  // namespace
 
-void advanceWithLimitEvents(const std::string& method, const IntegratorOptions& opt, const System& sys, State& s,
-                            double t_out, double check_interval, IntegratorStats& stats, LimitEventCounts* counts) {
+void advanceWithUnilateralEvents(const std::string& method, const IntegratorOptions& opt, const System& sys,
+                                 State& s, double t_out, double check_interval, IntegratorStats& stats,
+                                 UnilateralEventCounts* counts) {
   const auto& u = sys.unilateral();
-  if (!u) throw std::logic_error("advanceWithLimitEvents: the system has no unilateral constraints");
-  if (!u->pairs().empty())
+  if (!u) throw std::logic_error("advanceWithUnilateralEvents: the system has no unilateral constraints");
+  if (!u->pairs().empty() && sys.ndof() != sys.model().nr())
     throw std::invalid_argument("integrator '" + method +
-                                "' takes hard joint limits (by event location) but not contact pairs; use bdf1 "
-                                "(docs/contact.md §6)");
-  if (!(check_interval > 0.0)) throw std::invalid_argument("advanceWithLimitEvents: check interval must be positive");
-  const std::vector<JointLimit>& limits = u->limits();
-  const UnilateralOptions& uo = u->options();
-  const int nc0 = sys.numConstraintRows();
-  LimitEventCounts local;
-  LimitEventCounts& cnt = counts ? *counts : local;
+                                "' takes contact pairs by event location only on systems without extra coordinates; "
+                                "use bdf1 (docs/contact.md §6)");
+  if (!(check_interval > 0.0)) throw std::invalid_argument("advanceWithUnilateralEvents: check interval must be positive");
+  UnilateralEventCounts local;
+  UnilateralEventCounts& cnt = counts ? *counts : local;
+  Driver d(sys, cnt);
+  d.start(s);
 
-  // sides sitting on their bound (not moving off it) start locked; a pulling one is released below
-  std::vector<Side> active;
-  for (int i = 0; i < static_cast<int>(limits.size()); ++i)
-    for (int sub = 0; sub < 2; ++sub)
-      if (gap(limits[i], sub, s) <= 1e-12 && rate(limits[i], sub, s) <= 1e-12) active.push_back({i, sub});
-
-  // the event at state x of phase system P (None, a free side beyond its bound, or a locked side
-  // whose torque would pull)
-  auto eventAt = [&](const System& P, const State& x, std::vector<Side>* crossing, std::vector<Side>* release) {
-    Event ev = Event::None;
-    for (int i = 0; i < static_cast<int>(limits.size()); ++i)
-      for (int sub = 0; sub < 2; ++sub) {
-        const Side side{i, sub};
-        if (std::find(active.begin(), active.end(), side) != active.end()) continue;
-        if (gap(limits[i], sub, x) < 0.0) {
-          ev = Event::Crossing;
-          if (crossing) crossing->push_back(side);
-        }
-      }
-    if (ev != Event::None || active.empty()) return ev;
-    DynamicsWorkspace ws(P);
-    P.forwardDynamics(x, ws);
-    const double scale = 1e-10 * (1.0 + ws.lambda.cwiseAbs().maxCoeff());
-    for (size_t j = 0; j < active.size(); ++j) {
-      const double lam = ws.lambda[nc0 + static_cast<int>(j)];  // the torque the limit applies on its coordinate
-      if ((active[j].sub == 0 && lam < -scale) || (active[j].sub == 1 && lam > scale)) {
-        ev = Event::Release;
-        if (release) release->push_back(active[j]);
-      }
-    }
-    return ev;
-  };
-
-  int guard = 0;
+  int changes = 0;
+  double t_changes = s.t;
   while (s.t < t_out) {
-    if (++guard > 10'000'000) throw SimulationError(method + ": too many limit events", s.t, 0.0);
-    std::shared_ptr<System> P = phaseSystem(sys, limits, active);
-    // a locked side that pulls at the phase's start is released before integrating
-    std::vector<Side> pull;
-    if (eventAt(*P, s, nullptr, &pull) == Event::Release) {
-      for (const Side& r : pull) active.erase(std::find(active.begin(), active.end(), r));
-      cnt.releases += static_cast<long>(pull.size());
+    std::shared_ptr<System> P = d.phase();
+    const Found here = d.check(*P, s);
+    if (here.any()) {
+      if (s.t != t_changes) {
+        t_changes = s.t;
+        changes = 0;
+      }
+      if (++changes > kMaxChangesAtOneInstant) {
+        std::ostringstream os;
+        os << method << ": the contact modes do not settle at t = " << s.t << " (" << kMaxChangesAtOneInstant
+           << " changes at one instant: chattering or a frictional inconsistency); use bdf1";
+        throw SimulationError(os.str(), s.t, 0.0);
+      }
+      d.apply(s, here);
       continue;
     }
     std::unique_ptr<Integrator> inner = makeIntegrator(method, opt);
@@ -113,8 +276,7 @@ void advanceWithLimitEvents(const std::string& method, const IntegratorOptions& 
       const double tb = std::min(t_out, s.t + check_interval);
       State b = s;
       inner->advance(*P, b, tb);
-      std::vector<Side> crossing, release;
-      if (eventAt(*P, b, nullptr, nullptr) == Event::None) {
+      if (!d.check(*P, b).any()) {
         s = b;
         continue;
       }
@@ -128,53 +290,14 @@ void advanceWithLimitEvents(const std::string& method, const IntegratorOptions& 
         probe->advance(*P, m, mid);
         addStats(stats, probe->stats());
         ++cnt.bisections;
-        if (eventAt(*P, m, nullptr, nullptr) == Event::None) lo = m;
+        if (!d.check(*P, m).any()) lo = m;
         else hi = mid;
       }
       State e = lo;
       std::unique_ptr<Integrator> last = makeIntegrator(method, opt);
       last->advance(*P, e, hi);
       addStats(stats, last->stats());
-      const Event ev = eventAt(*P, e, &crossing, &release);
-      if (ev == Event::Crossing) {
-        // impact: the contact QP at velocity level (A = M, the locks and the system's own rows kept)
-        DynamicsWorkspace ws(*P);
-        P->calcMassAndForce(e, ws);
-        if (P->numConstraintRows() > 0) P->calcConstraints(e, ws);
-        UnilateralRows rows;
-        rows.h = 1.0;
-        rows.Jn.setZero(static_cast<int>(crossing.size()), P->ndof());
-        rows.Jt.resize(0, P->ndof());
-        for (size_t r = 0; r < crossing.size(); ++r) {
-          const JointLimit& l = limits[crossing[r].limit];
-          UnilateralRows::Candidate c;
-          c.limit = true;
-          c.source = crossing[r].limit;
-          c.sub = crossing[r].sub;
-          c.gap = 0.0;
-          c.approach = rate(l, c.sub, e);
-          c.target = c.approach < -uo.restitution_threshold ? -l.restitution * c.approach : 0.0;
-          rows.c.push_back(c);
-          rows.Jn(static_cast<int>(r), l.coordinate) = c.sub == 0 ? 1.0 : -1.0;
-        }
-        const MatX& G = ws.G;
-        const VecX b_rows = P->numConstraintRows() > 0 ? VecX(G * e.qdot) : VecX();
-        e.qdot = solveUnilateralStep(ws.M, ws.M * e.qdot, P->numConstraintRows() > 0 ? G : MatX(), b_rows, rows, uo,
-                                     nullptr, nullptr, nullptr);
-        for (const Side& c : crossing) {
-          const JointLimit& l = limits[c.limit];
-          e.q[l.coordinate] = bound(l, c.sub);  // (beyond it by at most the located time's error)
-          if (rate(l, c.sub, e) <= std::max(1e-12, 1e-9 * uo.restitution_threshold)) {
-            e.qdot[l.coordinate] = 0.0;  // stopped: held from now on
-            active.push_back(c);
-          }
-        }
-        cnt.impacts += static_cast<long>(crossing.size());
-      } else if (ev == Event::Release) {
-        for (const Side& r : release) active.erase(std::find(active.begin(), active.end(), r));
-        cnt.releases += static_cast<long>(release.size());
-      }
-      s = e;
+      s = e;  // the next pass applies the event found here
       phase_over = true;
     }
     addStats(stats, inner->stats());

@@ -46,8 +46,8 @@ struct IntegratorOptions {
   // sparse from kSparseStepFrom coordinates on (measured crossover, docs/deformable.md §5) unless
   // the system has hard unilateral constraints or a coordinate map (dense only)
   std::string linear_solver = "auto";
-  // rk45 and cvode with hard joint limits (core/integrators/event_driven.hpp): the largest time
-  // between event checks (s); an impact and rebound both inside one interval would be missed
+  // rk45 and cvode with hard unilateral constraints (core/integrators/event_driven.hpp): the largest
+  // time between event checks (s); an impact and rebound both inside one interval would be missed
   double event_check_interval = 1e-3;
 };
 
@@ -66,9 +66,12 @@ struct IntegratorStats {
   int max_contacts = 0;        // most rows with a positive impulse in one step
   double max_penetration = 0.0;  // largest penetration at a step's start (m, or rad for limits)
   long friction_unconverged = 0; // steps whose friction fixed point hit its iteration limit
-  // hard joint limits under rk45 / cvode (event location, core/integrators/event_driven.hpp)
-  long limit_impacts = 0;        // impacts at limits resolved
-  long limit_releases = 0;       // held limits released
+  // hard unilateral constraints under rk45 / cvode (event location, core/integrators/event_driven.hpp;
+  // max_penetration above is then the largest seen at the event checks)
+  long event_impacts = 0;        // contact points and limit sides in resolved impacts
+  long event_releases = 0;       // held contacts released
+  long event_slips = 0;          // sticking friction directions that began to slide
+  long event_sticks = 0;         // sliding friction directions that stuck
 };
 
 /// A simulation produced NaN/Inf or diverged: says when, what, and with which step.

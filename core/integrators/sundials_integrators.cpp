@@ -392,11 +392,14 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
   const std::string who = name();
   checkAdvanceArguments(sys, s, t_out, who.c_str());
   if (sys.unilateral()) {
-    // hard joint limits: phases between events, each run by a fresh integrator of this kind
-    LimitEventCounts c;
-    advanceWithLimitEvents(who, opt_, sys, s, t_out, opt_.event_check_interval, stats_, &c);
-    stats_.limit_impacts += c.impacts;
-    stats_.limit_releases += c.releases;
+    // hard joint limits and contacts: phases between events, each run by a fresh integrator of this kind
+    UnilateralEventCounts c;
+    advanceWithUnilateralEvents(who, opt_, sys, s, t_out, opt_.event_check_interval, stats_, &c);
+    stats_.event_impacts += c.impacts;
+    stats_.event_releases += c.releases;
+    stats_.event_slips += c.slips;
+    stats_.event_sticks += c.sticks;
+    stats_.max_penetration = std::max(stats_.max_penetration, c.max_penetration);
     return;
   }
   if (t_out == s.t) return;

@@ -62,7 +62,7 @@ ContactRun record(const System& sys, State s, double dt, double duration,
 
 }  // namespace
 
-BallDropResult runBallDrop(const BallDropOptions& o) {
+std::shared_ptr<System> makeBallDrop(const BallDropOptions& o, State& s) {
   ModelBuilder b("ball_drop");
   b.setGravity(Vec3(0, -kG, 0));
   const double I = 0.4 * o.mass * o.radius * o.radius;
@@ -75,8 +75,14 @@ BallDropResult runBallDrop(const BallDropOptions& o) {
   sys->setUnilateral(std::make_shared<UnilateralConstraints>(
       sys->model(), std::vector<CollisionGeometry>{ground(), ball},
       std::vector<CollisionPair>{{0, 1, o.friction, o.restitution}}, std::vector<JointLimit>{}));
-  State s = sys->defaultState();
+  s = sys->defaultState();
   s.q[1] = o.drop_height + o.radius;
+  return sys;
+}
+
+BallDropResult runBallDrop(const BallDropOptions& o) {
+  State s;
+  auto sys = makeBallDrop(o, s);
   BallDropResult r;
   // apexes: the top of each upward flight after an impact
   double prev_v = 0.0;
@@ -91,7 +97,7 @@ BallDropResult runBallDrop(const BallDropOptions& o) {
   return r;
 }
 
-BlockSlideResult runBlockSlide(const BlockSlideOptions& o) {
+std::shared_ptr<System> makeBlockSlide(const BlockSlideOptions& o, State& s) {
   ModelBuilder b("block_slide");
   b.setGravity(Vec3(0, -kG, 0));
   b.addBody("block", o.mass, Vec3::Zero(), boxInertia(o.mass, o.half_extents), -1, "free", Free3D{});
@@ -104,9 +110,15 @@ BlockSlideResult runBlockSlide(const BlockSlideOptions& o) {
   sys->setUnilateral(std::make_shared<UnilateralConstraints>(
       sys->model(), std::vector<CollisionGeometry>{ground(), box},
       std::vector<CollisionPair>{{0, 1, o.friction, 0.0}}, std::vector<JointLimit>{}));
-  State s = sys->defaultState();
+  s = sys->defaultState();
   s.q[1] = o.half_extents.y();
   s.qdot[0] = o.v0;
+  return sys;
+}
+
+BlockSlideResult runBlockSlide(const BlockSlideOptions& o) {
+  State s;
+  auto sys = makeBlockSlide(o, s);
   BlockSlideResult r;
   r.run = record(*sys, s, o.dt, o.duration, [&](const State& st) {
     if (r.stop_time < 0.0 && std::abs(st.qdot[0]) < 1e-9) r.stop_time = st.t;

@@ -38,6 +38,8 @@ struct BallDropResult {
   double rest_height = 0.0;     // centre height at the end (m)
 };
 BallDropResult runBallDrop(const BallDropOptions& o);
+/// the ball-drop system (a free sphere over the ground half-space y < 0) and its initial state
+std::shared_ptr<System> makeBallDrop(const BallDropOptions& o, State& initial);
 
 struct BlockSlideOptions {
   Vec3 half_extents = Vec3(0.1, 0.05, 0.1);
@@ -52,6 +54,8 @@ struct BlockSlideResult {
   double max_tilt = 0.0;        // largest rotation coordinate magnitude (rad)
 };
 BlockSlideResult runBlockSlide(const BlockSlideOptions& o);
+/// the block-slide system (a free box on the ground, sliding along +x) and its initial state
+std::shared_ptr<System> makeBlockSlide(const BlockSlideOptions& o, State& initial);
 
 struct BoxStackOptions {
   int boxes = 3;

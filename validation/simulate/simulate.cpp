@@ -550,8 +550,10 @@ SimulationResult simulate(const SimulationModel& m, const State& initial, const 
     res.stats.max_contacts = std::max(res.stats.max_contacts, st.max_contacts);
     res.stats.max_penetration = std::max(res.stats.max_penetration, st.max_penetration);
     res.stats.friction_unconverged += st.friction_unconverged;
-    res.stats.limit_impacts += st.limit_impacts;
-    res.stats.limit_releases += st.limit_releases;
+    res.stats.event_impacts += st.event_impacts;
+    res.stats.event_releases += st.event_releases;
+    res.stats.event_slips += st.event_slips;
+    res.stats.event_sticks += st.event_sticks;
   };
 
   // the network wrap model's counts live in the workspaces: the integrator's and the energies'
