@@ -321,7 +321,7 @@ int runSimulate(SimulateFlags& f, const CLI::App& app) {
   }
   if (hard && !quiet && (f.so.integrator == "rk45" || f.so.integrator == "cvode"))
     std::printf("unilateral: %d joint limits, %d contact pairs by event location; %ld impacts, %ld releases, %ld "
-                "slips, %ld sticks, largest penetration at the checks %.3g (m or rad)\n",
+                "slips, %ld sticks, largest penetration %.3g (m or rad; at the checks and events)\n",
                 hard_made.limits, hard_made.pairs, res.stats.event_impacts, res.stats.event_releases,
                 res.stats.event_slips, res.stats.event_sticks, res.stats.max_penetration);
   else if (hard && !quiet)

@@ -145,8 +145,17 @@ class Driver {
     SkeletonWorkspace sk(model_);
     calcKinematics(model_, x, sk);
     u_->detect(model_, x, sk, sys_.ndof(), 1.0, rows);
+  }
+
+ public:
+  // the deepest penetration of an accepted state (not of the checks beyond an event)
+  void notePenetration(const State& x) {
+    UnilateralRows rows;
+    detectAt(x, rows);
     cnt_.max_penetration = std::max(cnt_.max_penetration, rows.max_penetration);
   }
+
+ private:
 
   int heldIndex(const ContactKey& key) const {
     for (size_t h = 0; h < held_.size(); ++h)
@@ -250,6 +259,7 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
   UnilateralEventCounts& cnt = counts ? *counts : local;
   Driver d(sys, cnt);
   d.start(s);
+  d.notePenetration(s);
 
   int changes = 0;
   double t_changes = s.t;
@@ -268,6 +278,7 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
         throw SimulationError(os.str(), s.t, 0.0);
       }
       d.apply(s, here);
+      d.notePenetration(s);
       continue;
     }
     std::unique_ptr<Integrator> inner = makeIntegrator(method, opt);
@@ -278,6 +289,7 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
       inner->advance(*P, b, tb);
       if (!d.check(*P, b).any()) {
         s = b;
+        d.notePenetration(s);
         continue;
       }
       // the event lies in (s.t, tb]: bisection on re-runs from s
@@ -298,6 +310,7 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
       last->advance(*P, e, hi);
       addStats(stats, last->stats());
       s = e;  // the next pass applies the event found here
+      d.notePenetration(s);
       phase_over = true;
     }
     addStats(stats, inner->stats());

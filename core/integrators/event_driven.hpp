@@ -31,7 +31,7 @@ struct UnilateralEventCounts {
   long slips = 0;        ///< sticking directions that began to slide
   long sticks = 0;       ///< sliding directions that stuck
   long bisections = 0;   ///< re-runs spent locating events
-  double max_penetration = 0.0;  ///< largest penetration seen at the checks (m or rad)
+  double max_penetration = 0.0;  ///< largest penetration of the states reached at the checks and events (m or rad)
 };
 
 /// Advance s to t_out with `method` ("rk45" or "cvode") on sys (which has unilateral constraints),

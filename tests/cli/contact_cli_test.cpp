@@ -250,6 +250,19 @@ TEST_F(ContactCli, HardContactBlockSlidesTheCoulombDistance) {
   EXPECT_LT(std::abs(last(s, "/jointset/slide_x/block_x/speed")), 1e-8);
 }
 
+TEST_F(ContactCli, HardContactUnderRk45SlidesTheClosedFormDistance) {
+  // the same block under rk45 (the default) by event location: the slide is v0^2 / (2 ud g) to the
+  // integrator's tolerance (measured 5e-16 m), where bdf1 is first order in dt
+  const CmdResult r = run("simulate --model " + scene("sliding_block.osim") +
+                          " --contact hard --duration 1 --full-precision --out " + path("rk.sto"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("1 contact pairs by event location; 1 impacts, 0 releases, 0 slips, 1 sticks"), std::string::npos)
+      << r.out;
+  const Storage s = readStorage(path("rk.sto"));
+  EXPECT_NEAR(last(s, "/jointset/slide_x/block_x/value"), 4.0 / (2 * 0.5 * kG), 1e-12);
+  EXPECT_LT(std::abs(last(s, "/jointset/slide_x/block_x/speed")), 1e-12);
+}
+
 TEST_F(ContactCli, HardJointLimitHoldsTheClampedCoordinate) {
   std::string text = slurp(scene("double_pendulum_straight.osim"));
   // the second coordinate's range [-0.1, 0.6] rad, clamped
@@ -274,9 +287,10 @@ TEST_F(ContactCli, HardJointLimitHoldsTheClampedCoordinate) {
 }
 
 TEST_F(ContactCli, HardModesNeedBdf1AndTheirFlags) {
-  CmdResult r = run("simulate --model " + scene("ball_drop.osim") + " --contact hard --duration 0.1 --out " + path("x.sto"));
+  CmdResult r = run("simulate --model " + scene("ball_drop.osim") + " --contact hard --integrator sdirk2 --duration 0.1 --out " +
+                    path("x.sto"));
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--contact hard needs --integrator bdf1"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--contact hard needs --integrator bdf1, rk45 or cvode"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("x.sto")));
   // joint limits: bdf1, or rk45 / cvode by event location; not the other fixed-step methods
   r = run("simulate --model " + scene("finger.osim") + " --joint-limits hard --integrator euler --duration 0.1 --out " +
@@ -286,7 +300,7 @@ TEST_F(ContactCli, HardModesNeedBdf1AndTheirFlags) {
   r = run("simulate --model " + scene("finger.osim") +
           " --joint-limits hard --duration 0.5 --impulse fingertip:0,20,0:0.002 --full-precision --out " + path("rk.sto"));
   EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("joint limits by event location"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0 contact pairs by event location"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("; 0 impacts"), std::string::npos) << r.out;  // the flicked finger hits its limits
   {
     // never beyond a range (mcp -0.35 .. 1.57, pip 0 .. 1.92, dip 0 .. 1.57) at any output row
