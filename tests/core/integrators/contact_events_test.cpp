@@ -212,6 +212,65 @@ TEST(ContactEvents, AStackOfBoxesStaysAtRest) {
   EXPECT_LT(s.qdot.cwiseAbs().maxCoeff(), 1e-10);  // measured 1.5e-12
 }
 
+TEST(ContactEvents, SixBoxesDroppedOntoEachOtherSettle) {
+  // 24 corner contacts, four coplanar per box (rank deficient), closing in cascades of impacts
+  scenes::BoxStackOptions o;
+  o.boxes = 6;
+  o.initial_gap = 0.02;
+  State s;
+  auto sys = scenes::makeBoxStack(o, s);
+  auto integ = makeIntegrator("rk45", tight());
+  integ->advance(*sys, s, 2.0);
+  const VecX q2 = s.q;
+  integ->advance(*sys, s, 3.0);
+  const double drift = (s.q - q2).cwiseAbs().maxCoeff();
+  const auto& st = integ->stats();
+  std::printf("[ measured ] six boxes under rk45: %ld impacts, %ld releases, %ld slips, %ld sticks; drift over the "
+              "third second %.2e m, largest penetration %.2e m; %ld steps, %ld right-hand sides\n",
+              st.event_impacts, st.event_releases, st.event_slips, st.event_sticks, drift, st.max_penetration, st.steps,
+              st.rhs_evals);
+  // the five boxes above the bottom one land on their four corners each, all 24 corners end held
+  EXPECT_GE(st.event_impacts, 20);
+  SkeletonWorkspace sk(sys->model());
+  calcKinematics(sys->model(), s, sk);
+  int touching = 0;
+  for (double g : sys->unilateral()->gaps(sys->model(), s, sk)) touching += std::abs(g) < 1e-10;
+  EXPECT_EQ(touching, 24);
+  EXPECT_LT(drift, 1e-12);  // measured 2.5e-14 m
+  EXPECT_LT(st.max_penetration, 1e-10);  // measured 1.8e-12 m
+  EXPECT_LT(s.qdot.cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(ContactEvents, AnElasticBallKeepsBouncingToItsHeight) {
+  // e = 1, 5 mm high: the contact comes and goes every 64 ms; every apex is the drop height
+  scenes::BallDropOptions o;
+  o.restitution = 1.0;
+  o.drop_height = 5e-3;
+  State s;
+  auto sys = scenes::makeBallDrop(o, s);
+  auto integ = makeIntegrator("rk45", tight());
+  double apex = 0.0, worst = 0.0, lowest = 1.0;
+  double prev_v = 0.0;
+  int apexes = 0;
+  for (int k = 1; k <= 20000; ++k) {  // 2 s in 0.1 ms samples
+    integ->advance(*sys, s, 1e-4 * k);
+    lowest = std::min(lowest, s.q[1] - o.radius);
+    if (prev_v > 0.0 && s.qdot[1] <= 0.0) {
+      // the apex from the sampled state: height + v^2 / (2 g)
+      apex = s.q[1] - o.radius + s.qdot[1] * s.qdot[1] / (2 * kG);
+      worst = std::max(worst, std::abs(apex - o.drop_height));
+      ++apexes;
+    }
+    prev_v = s.qdot[1];
+  }
+  std::printf("[ measured ] elastic ball: %d apexes, %ld impacts, apex within %.2e m of the drop height, lowest %.2e "
+              "m\n",
+              apexes, integ->stats().event_impacts, worst, lowest);
+  EXPECT_GE(apexes, 30);
+  EXPECT_LT(worst, 5e-9);  // measured 6.2e-10 m
+  EXPECT_GT(lowest, -1e-12);
+}
+
 TEST(ContactEvents, SlidingFrictionMakesTheKktSystemNonSymmetric) {
   // the held block sliding along +x: its force rows are J_n - mu J_t, so the System solves
   // [M H^T; G 0]; the normal forces carry the weight and the friction is mu times it
