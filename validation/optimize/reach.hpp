@@ -41,6 +41,14 @@
 namespace redmax::validation {
 
 struct ReachOptions {
+  /// reach: a point to a target at the end (the dissertation's); track: a tracking objective
+  /// over the whole run (coordinates of a motion file and/or markers of a TRC file)
+  std::string task = "reach";
+  /// track: FILE.mot[@C,...], the gradient's coords: term (docs/gradients.md §3), weight 1
+  std::string motion;
+  /// track: further terms of the gradient's objective SPEC (e.g. "track:M=F.trc;1e-4*effort"),
+  /// added to the motion's; a tracked task needs a coords: or track: term among them
+  std::string objective;
   std::string model_path;
   SimulationModelOptions model_options;
   std::string body = "hand";
@@ -79,6 +87,15 @@ struct ReachSetup {
   VecX lower, upper;  ///< bounds on the scaled parameters (excitations: the muscles' control bounds)
   bool bounded = false;  ///< lbfgs runs L-BFGS-B within [lower, upper] (the excitations)
 };
+
+/// The objective at which every method stops: stop_objective when >= 0, else 1/2 tolerance^2
+/// (reach: the point within `tolerance` m) or 1/2 tolerance^2 duration (track: trackingError <=
+/// tolerance).
+double stopObjective(const ReachOptions& o);
+
+/// track: sqrt(2 J / duration), the run's root-mean-square tracking error when the objective is one
+/// unit-weight coords: term (rad or m, summed over the tracked coordinates)
+double trackingError(const ReachOptions& o, double objective);
 
 /// Throws std::invalid_argument ("--body 'x': ...", "--coordinates 'c': ...", "--target: ...")
 /// for bad input, osim::ConvertError / ModelError for the model.
@@ -130,6 +147,16 @@ struct ReachReplay {
   double lumped_error = -1.0;  ///< m, at the end (< 0: not replayed)
 };
 ReachReplay replayReach(const ReachSetup& setup, const VecX& params);
+
+/// track: the tracked coordinates of the run at params against their targets, per step (the
+/// state at t_k and the target there, the objective's linear interpolation of the file).
+struct TrackReplay {
+  std::vector<double> t;
+  std::vector<std::string> coordinates;
+  std::vector<std::vector<double>> simulated, target;  ///< [coordinate][state]
+  double rms = 0.0;  ///< the root-mean-square error over the tracked coordinates and the states t_1 .. t_N
+};
+TrackReplay replayTrack(const ReachSetup& setup, const VecX& params);
 
 /// Write the report into dir (see the top of this file); returns the plot's status line. Throws
 /// std::runtime_error "PATH: why" when the folder cannot be written.
