@@ -1,5 +1,6 @@
 // `redmax optimize --task reach`: constant shoulder and elbow torques that bring the hand to a
-// target, by L-BFGS on adjoint gradients and gradient-free (docs/gradients.md §7). The task and the
+// target, by L-BFGS on adjoint gradients and gradient-free (docs/gradients.md §7); `--task track`:
+// torques that make the run follow a motion's coordinates (--motion) and further tracking terms. The task and the
 // report are validation/optimize; this file parses flags, prints progress and the summary.
 // Exit codes: 0 success (also when a method did not reach the tolerance: the report says so),
 // 1 a run diverged or the report could not be written, 2 bad input or usage.

@@ -26,6 +26,13 @@
 // plots the hand path, the excitations and the tendon forces of the best run, and replays the
 // best excitations on the lumped model (no muscle mass) when the muscles carry mass.
 //
+// The tracking task (task = "track", docs/gradients.md §7): the same torque parameters and
+// methods, but the objective is the gradient's tracking SPEC (coords:FILE.mot[@C,...] from `motion`
+// and any further terms of `objective`, e.g. track:MARKER=FILE.trc) summed over the whole run; the
+// run starts from the motion's pose at its start for the tracked coordinates; the error reported is
+// sqrt(2 J / duration) (trackingError) and the report adds best_run.csv and tracking.png|svg (each
+// tracked coordinate of the best run against the motion).
+//
 // The report (writeReachReport) in DIR: report.md (setup, per method: converged torques,
 // simulations, step evaluations, wall time, final error and speed), <method>_iterations.csv (one
 // row per objective evaluation), objective.png|svg (best objective against simulations, every
@@ -108,7 +115,7 @@ struct ReachEvaluation {
   double seconds = 0.0;        ///< since the method started
   double objective = 0.0;
   double best_objective = 0.0; ///< the lowest so far
-  double error = 0.0;          ///< |p - target| of this run (m)
+  double error = 0.0;          ///< |p - target| of this run (m); track: trackingError
 };
 
 struct ReachResult {
@@ -120,7 +127,8 @@ struct ReachResult {
   long restarts = 0;           ///< L-BFGS restarts after a failed line search
   long failed_simulations = 0; ///< runs that diverged (counted in simulations, objective +inf)
   double seconds = 0.0;
-  double objective = 0.0, error = 0.0, final_speed = 0.0;  ///< at the best parameters (|qdot_N|)
+  /// at the best parameters: error |p - target| (m; track: trackingError), final_speed |qdot_N|
+  double objective = 0.0, error = 0.0, final_speed = 0.0;
   bool reached = false;        ///< error <= tolerance
   std::string stop;            ///< why it stopped
 };
