@@ -1,5 +1,6 @@
 // `redmax optimize --task reach`: constant shoulder and elbow torques that bring the hand to a
-// target, by L-BFGS on adjoint gradients and gradient-free (docs/gradients.md §7). The task and the
+// target, by L-BFGS on adjoint gradients and gradient-free (docs/gradients.md §7); `--task track`:
+// torques that make the run follow a motion's coordinates (--motion) and further tracking terms. The task and the
 // report are validation/optimize; this file parses flags, prints progress and the summary.
 // Exit codes: 0 success (also when a method did not reach the tolerance: the report says so),
 // 1 a run diverged or the report could not be written, 2 bad input or usage.
@@ -18,7 +19,7 @@ namespace {
 
 struct OptimizeFlags {
   std::string task, model, body = "hand", target, point = "0,0,0", integrator = "euler", method = "lbfgs,bobyqa";
-  std::string coordinates, report, muscle_mass_kg, drive = "torques", muscles, torques_in_time;
+  std::string coordinates, report, muscle_mass_kg, drive = "torques", muscles, torques_in_time, motion, objective;
   double duration = 0.0, dt = 0.01, rest = 0.0, tolerance = 1e-3, max_torque = 100.0, initial_step = 1.0;
   double initial_excitation = 0.1, excitation_weight = 0.0;
   int nodes = 5;
@@ -28,12 +29,29 @@ struct OptimizeFlags {
 };
 
 int runOptimize(OptimizeFlags& f, const CLI::App& app) {
-  for (const char* n : {"--task", "--model", "--target", "--duration"})
+  const bool track = f.task == "track";
+  for (const char* n : {"--task", "--model", "--duration"})
     if (!given(app, n)) throw UsageError{std::string("optimize needs ") + n};
+  if (!track && !given(app, "--target")) throw UsageError{"optimize needs --target (--task reach)"};
+  if (track && !given(app, "--motion") && !given(app, "--objective"))
+    throw UsageError{"optimize --task track needs --motion and/or --objective"};
+  for (const char* n : {"--target", "--body", "--point", "--drive"})
+    if (track && given(app, n)) {
+      std::cerr << "error: " << n << ": not used by --task track (the objective is --motion and --objective)\n";
+      return 2;
+    }
+  for (const char* n : {"--motion", "--objective"})
+    if (!track && given(app, n)) {
+      std::cerr << "error: " << n << ": needs --task track\n";
+      return 2;
+    }
   validation::ReachOptions o;
+  o.task = f.task;
+  o.motion = f.motion;
+  o.objective = f.objective;
   o.model_path = f.model;
   o.body = f.body;
-  if (!validation::parseVec3(f.target, o.target)) {
+  if (!track && !validation::parseVec3(f.target, o.target)) {
     std::cerr << "error: --target '" << f.target << "': must be three numbers X,Y,Z (m, ground)\n";
     return 2;
   }
@@ -85,7 +103,12 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
   for (const auto& w : setup.gradient.model.build.warnings) std::cerr << "warning: " << w << "\n";
   for (const auto& w : setup.gradient.warnings) std::cerr << "warning: " << w << "\n";
   for (const auto& w : setup.gradient.not_applied) std::cerr << "warning: not applied: " << w << "\n";
-  if (!f.quiet)
+  if (!f.quiet && track)
+    std::fprintf(stderr, "track: %s, %zu torques, %zu tracked coordinates, %zu tracked markers, %.4g kg of muscle mass\n",
+                 setup.gradient.model.description.name.c_str(), setup.gradient.param_names.size(),
+                 setup.gradient.objective.coordinate_tracks.size(), setup.gradient.objective.tracks.size(),
+                 setup.gradient.model.muscle_mass);
+  else if (!f.quiet)
     std::fprintf(stderr, "reach: %s, %zu %s, hand at (%.4g, %.4g, %.4g) m, target (%.4g, %.4g, %.4g) m, %.4g kg of muscle mass\n",
                  setup.gradient.model.description.name.c_str(), setup.gradient.param_names.size(),
                  excite ? "excitation nodes" : "torques", setup.start_point[0],
@@ -93,10 +116,10 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
                  setup.gradient.model.muscle_mass);
 
   std::vector<validation::ReachResult> results;
-  const validation::ReachProgress progress = [&f](const std::string& m, const validation::ReachEvaluation& e) {
+  const validation::ReachProgress progress = [&f, track](const std::string& m, const validation::ReachEvaluation& e) {
     if (!f.quiet)
-      std::fprintf(stderr, "%s: simulation %ld, J = %.6e (best %.6e), error %.4e m, %.3f s\n", m.c_str(), e.simulations,
-                   e.objective, e.best_objective, e.error, e.seconds);
+      std::fprintf(stderr, "%s: simulation %ld, J = %.6e (best %.6e), error %.4e%s, %.3f s\n", m.c_str(), e.simulations,
+                   e.objective, e.best_objective, e.error, track ? " (RMS)" : " m", e.seconds);
   };
   for (const auto& m : methods) {
     try {
@@ -107,7 +130,7 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
     }
   }
   std::printf("%-12s %12s %16s %12s %14s %14s %8s  %s\n", "method", "simulations", "step evaluations", "wall (s)",
-              "objective", "error (m)", "reached", "stop");
+              "objective", track ? "RMS error" : "error (m)", "reached", "stop");
   for (const auto& r : results)
     std::printf("%-12s %12ld %16ld %12.4f %14.6e %14.6e %8s  %s\n", r.method.c_str(), r.simulations, r.step_evaluations,
                 r.seconds, r.objective, r.error, r.reached ? "yes" : "no", r.stop.c_str());
@@ -129,16 +152,27 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
 }
 
 CommandRegistration reg(
-    {"optimize", "optimize a task through the simulation's adjoint gradient (--task reach)",
+    {"optimize", "optimize a task through the simulation's adjoint gradient (--task reach or track)",
      [](CLI::App& app) {
        auto f = std::make_shared<OptimizeFlags>();
-       app.add_option("--task", f->task, "the task: reach (constant torques bring a hand point to a target); required")
-           ->type_name("reach")
-           ->check(oneOf({"reach"}));
+       app.add_option("--task", f->task,
+                      "the task: reach (constant torques bring a hand point to a target) or track\n"
+                      "(torques that make the run follow --motion and/or --objective); required")
+           ->type_name("reach|track")
+           ->check(oneOf({"reach", "track"}));
+       app.add_option("--motion", f->motion,
+                      "--task track: the motion (.mot/.sto) whose coordinates the run tracks, all that the\n"
+                      "model has or the named ones C,... (the gradient's coords: term, weight 1); the run\n"
+                      "starts from its pose at t = 0")
+           ->type_name("FILE.mot[@C,...]");
+       app.add_option("--objective", f->objective,
+                      "--task track: further terms of `redmax gradient`'s --objective SPEC, e.g.\n"
+                      "'track:MARKER=FILE.trc;1e-4*effort' (docs/gradients.md §3)")
+           ->type_name("SPEC");
        app.add_option("--model", f->model, "the OpenSim model (.osim), e.g. osim_models/reach_arm.osim; required")
            ->type_name("M.osim")
            ->check(existingFile());
-       app.add_option("--target", f->target, "the target in ground (m); required")->type_name("X,Y,Z");
+       app.add_option("--target", f->target, "the target in ground (m); required for --task reach")->type_name("X,Y,Z");
        app.add_option("--body", f->body, "the body that reaches (default hand)")->type_name("BODY");
        app.add_option("--point", f->point, "the point of BODY that reaches, in its frame (m; default 0,0,0)")
            ->type_name("x,y,z");
@@ -165,7 +199,8 @@ CommandRegistration reg(
            ->check(nonNegative());
        app.add_option("--tolerance", f->tolerance,
                       "the reach error (m) that counts as reached; the methods stop at the objective\n"
-                      "1/2 T^2 (default 0.001)")
+                      "1/2 T^2 (default 0.001); --task track: the RMS error sqrt(2 J / duration), stop\n"
+                      "at 1/2 T^2 duration")
            ->type_name("T")
            ->check(positive());
        app.add_option("--max-simulations", f->max_simulations, "per method (default 2000)")
@@ -203,7 +238,8 @@ CommandRegistration reg(
        app.add_option("--report", f->report,
                       "write DIR/report.md, DIR/<method>_iterations.csv, DIR/objective.png (gnuplot);\n"
                       "with --drive excitations also DIR/best_run.csv and DIR/best_run.png (hand path,\n"
-                      "excitations, tendon forces; the lumped replay when the muscles carry mass)")
+                      "excitations, tendon forces; the lumped replay when the muscles carry mass); with\n"
+                      "--task track DIR/best_run.csv and DIR/tracking.png (tracked against simulated)")
            ->type_name("DIR");
        app.add_flag("--quiet", f->quiet, "no progress on stderr");
        app.add_option("--muscle-mass-kg", f->muscle_mass_kg,
@@ -217,11 +253,16 @@ CommandRegistration reg(
            "                       [--method lbfgs,nelder-mead,bobyqa] [--rest WEIGHT] [--tolerance T]\n"
            "                       [--drive excitations [--excite M,...] [--nodes K]]\n"
            "                       [MUSCLE-MASS OPTIONS] [--report DIR]\n"
+           "       redmax optimize --task track --model M.osim --duration S --motion FILE.mot[@C,...]\n"
+           "                       [--objective SPEC] [--coordinates C,...] [--torques-in-time K[~cubic]]\n"
+           "                       [--method ...] [--tolerance T] [--report DIR]\n"
            "Finds constant generalized forces on the model's coordinates that bring the point to the target\n"
            "at the end of a run from the default pose (gravity, muscle inertia; the muscles pull no force),\n"
            "or with --drive excitations the muscles' excitation nodes (the muscles pull),\n"
            "[D Sec. 6.2.11]: minimizes 1/2 |p - target|^2 (+ WEIGHT/2 |qdot|^2) with each method from zero\n"
            "and prints simulations, wall time and final error per method (docs/gradients.md §7).\n"
+           "--task track: the torques that make the run follow a motion's coordinates (and TRC markers),\n"
+           "from zero; the report adds best_run.csv and tracking.png (tracked against simulated).\n"
            "e.g. redmax optimize --task reach --model osim_models/reach_arm.osim --point 0,-0.08,0\n"
            "       --target 0.25,-0.35,0.1 --duration 0.4 --muscle-mass physiological --report reach\n") +
            muscleMassFooter());

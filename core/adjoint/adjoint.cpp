@@ -271,18 +271,26 @@ double objectiveValue(const System& sys, const Objective& obj, const State& fin,
   return J;
 }
 
-// the tracking terms at one state (step k >= 1): h w/2 |x - target(t)|^2 each, and their
-// derivative with respect to y added to dJ_dy (when given); callers skip it without tracks
+// the tracking terms at one state (step k >= 1): h w/2 |x - target(t)|^2 per marker and
+// h w/2 (q_c - target(t))^2 per coordinate, and their derivative with respect to y added to dJ_dy
+// (when given); callers skip it without tracking terms
 double trackValue(const System& sys, const Objective& obj, const State& s, double h, VecX* dJ_dy) {
   const Model& model = sys.model();
-  SkeletonWorkspace ws(model);
-  calcKinematics(model, s, ws);
-  MatX Jp(3, model.nr());
-  VecX unused;
   double J = 0.0;
-  for (const Objective::Track& tr : obj.tracks)
-    J += pointTerm(model, ws, tr.body, tr.x_i, tr.at(s.t), h * tr.weight, Jp,
-                   dJ_dy ? dJ_dy->head(model.nr()) : unused.head(0), dJ_dy != nullptr);
+  if (!obj.tracks.empty()) {
+    SkeletonWorkspace ws(model);
+    calcKinematics(model, s, ws);
+    MatX Jp(3, model.nr());
+    VecX unused;
+    for (const Objective::Track& tr : obj.tracks)
+      J += pointTerm(model, ws, tr.body, tr.x_i, tr.at(s.t), h * tr.weight, Jp,
+                     dJ_dy ? dJ_dy->head(model.nr()) : unused.head(0), dJ_dy != nullptr);
+  }
+  for (const Objective::CoordinateTrack& ct : obj.coordinate_tracks) {
+    const double e = s.q[ct.coordinate] - ct.at(s.t);
+    J += 0.5 * h * ct.weight * e * e;
+    if (dJ_dy) (*dJ_dy)[ct.coordinate] += h * ct.weight * e;
+  }
   return J;
 }
 
@@ -314,6 +322,15 @@ Vec3 Objective::Track::at(double time) const {
   return (1.0 - w) * target[i - 1] + w * target[i];
 }
 
+double Objective::CoordinateTrack::at(double time) const {
+  if (t.empty()) return 0.0;
+  if (time <= t.front()) return value.front();
+  if (time >= t.back()) return value.back();
+  const size_t i = static_cast<size_t>(std::upper_bound(t.begin(), t.end(), time) - t.begin());  // t[i-1] <= time < t[i]
+  const double w = (time - t[i - 1]) / (t[i] - t[i - 1]);
+  return (1.0 - w) * value[i - 1] + w * value[i];
+}
+
 Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool with_gradient) {
   const int nf = static_cast<int>(pr.forces.size());
   const int ne = static_cast<int>(pr.excitations.size());
@@ -324,6 +341,9 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   const System& sys = *rs.sys;
   checkProblem(pr, p, sys);
   const int n = sys.ndof();
+  for (const Objective::CoordinateTrack& ct : obj.coordinate_tracks)
+    if (ct.coordinate < 0 || ct.coordinate >= n || ct.t.empty() || ct.t.size() != ct.value.size())
+      throw AdjointError("adjoint: a coordinate track outside the coordinates or without samples");
   const int N = numSteps(pr);
   const double h = pr.duration / N;
   const double t0 = pr.initial.t;
@@ -351,7 +371,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     for (const Excited& ex : rs.excited) excitation_effort += h * u[ex.control] * u[ex.control];
     y[k + 1] = stepper.step(y[k], timeAt(k), h, u);
     checkFinite(stepper.unpack(y[k + 1], timeAt(k + 1)), h, pr.integrator.c_str(), &z_names);
-    if (!obj.tracks.empty()) tracking += trackValue(sys, obj, stepper.unpack(y[k + 1], timeAt(k + 1)), h, nullptr);
+    if (obj.tracking()) tracking += trackValue(sys, obj, stepper.unpack(y[k + 1], timeAt(k + 1)), h, nullptr);
   }
 
   Result res;
@@ -361,7 +381,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   VecX lambda;
   res.objective = objectiveValue(sys, obj, res.final, with_gradient ? &lambda : nullptr) + obj.effort_weight * effort +
                   obj.excitation_weight * excitation_effort + tracking;
-  if (with_gradient && !obj.tracks.empty()) trackValue(sys, obj, res.final, h, &lambda);  // the last step's term
+  if (with_gradient && obj.tracking()) trackValue(sys, obj, res.final, h, &lambda);  // the last step's term
   if (!with_gradient) {
     res.step_evaluations = stepper.evaluations;
     return res;
@@ -434,7 +454,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     }
     lambda = (Jy.transpose() * lambda).eval();
     // the tracking term at y_k (k >= 1) joins its adjoint
-    if (k >= 1 && !obj.tracks.empty()) trackValue(sys, obj, stepper.unpack(y[k], t), h, &lambda);
+    if (k >= 1 && obj.tracking()) trackValue(sys, obj, stepper.unpack(y[k], t), h, &lambda);
   }
   for (int j = 0; j < nq0; ++j) res.gradient[iq0 + j] += lambda[pr.initial_q[j]];
   for (int j = 0; j < nv0; ++j) res.gradient[iq0 + nq0 + j] += lambda[n + pr.initial_qdot[j]];

@@ -110,6 +110,8 @@ struct Problem {
 ///   track: w/2 sum_{k=1..N} h |x(q_k) - target(t_k)|^2 for a body point against a sampled
 ///          trajectory (linear between samples; the run must lie within them), the integral of the
 ///          squared tracking error by the right-endpoint rule
+///   coordinate track: w/2 sum_{k=1..N} h (q_c(t_k) - target(t_k))^2 for a coordinate against a
+///          sampled trajectory (e.g. a motion file's column), the same rule
 struct Objective {
   struct Point {
     int body = -1;
@@ -126,11 +128,22 @@ struct Objective {
     /// the target at time `time` (linear between samples; clamped to the first and last)
     Vec3 at(double time) const;
   };
+  struct CoordinateTrack {
+    int coordinate = -1;         ///< index into q
+    std::vector<double> t;       ///< sample times, increasing (s)
+    std::vector<double> value;   ///< the coordinate at t (rad or m)
+    double weight = 1.0;
+    /// the target at time `time` (linear between samples; clamped to the first and last)
+    double at(double time) const;
+  };
   std::vector<Point> points;
   std::vector<Track> tracks;
+  std::vector<CoordinateTrack> coordinate_tracks;
   double speed_weight = 0.0;
   double effort_weight = 0.0;
   double excitation_weight = 0.0;
+  /// true when a term is summed over the run's steps (tracks, coordinate_tracks)
+  bool tracking() const { return !tracks.empty() || !coordinate_tracks.empty(); }
 };
 
 struct Result {

@@ -7,7 +7,9 @@
 #include <filesystem>
 #include <string>
 
+#include "converter/storage.hpp"
 #include "tests/cli/cli_test_util.hpp"
+#include "validation/gradient/gradient.hpp"
 
 namespace {
 
@@ -102,6 +104,75 @@ TEST_F(OptimizeCli, ExcitationDriveWritesTheBestRun) {
   const CmdResult bad = run(kReach + " --nodes 3");
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("error: --nodes: needs --drive excitations"), std::string::npos) << bad.err;
+}
+
+// --task track: a motion made here by a run of reach_arm.osim with constant shoulder and elbow
+// flexion torques (written in degrees); L-BFGS finds the torques again, prints progress, and the
+// report has the tracked coordinates against the motion (CSV and plot); bad input exits 2
+TEST_F(OptimizeCli, TrackTaskRecoversTheTorquesOfAMotion) {
+  using namespace redmax;
+  validation::GradientSetup g =
+      validation::makeGradientSetup(scene("reach_arm.osim"), validation::SimulationModelOptions{}, "euler", 0.2, 0.01,
+                                    "torques:shoulder_flexion,elbow_flexion", "speed");
+  const adjoint::Trajectory tr = adjoint::simulateTrajectory(g.problem, (VecX(2) << 1.5, 0.8).finished());
+  osim::Storage st;
+  st.name = "made";
+  st.in_degrees = true;
+  st.labels = g.model.coordinate_names;
+  st.data.resize(static_cast<Eigen::Index>(tr.states.size()), static_cast<Eigen::Index>(st.labels.size()));
+  for (size_t k = 0; k < tr.states.size(); ++k) {
+    st.time.push_back(tr.states[k].t);
+    for (size_t c = 0; c < st.labels.size(); ++c)
+      st.data(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(c)) =
+          tr.states[k].q[static_cast<Eigen::Index>(c)] * 180.0 / M_PI;
+  }
+  osim::StorageWriteOptions wo;
+  wo.scientific = true;
+  wo.decimals = 17;
+  const fs::path motion = dir_ / "made.mot";
+  osim::writeStorage(motion.string(), st, wo);
+
+  const fs::path report = dir_ / "track";
+  const std::string base = "optimize --task track --model " + scene("reach_arm.osim") + " --duration 0.2 --dt 0.01 ";
+  const CmdResult r = runRedmax(dir_, base + "--motion " + motion.string() +
+                                          " --coordinates shoulder_flexion,elbow_flexion --method lbfgs --tolerance "
+                                          "1e-6 --report " + report.string());
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.err.find("track: reach_arm, 2 torques, 4 tracked coordinates"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("lbfgs: simulation 1, J = "), std::string::npos) << r.err;
+  for (const auto& [name, value] : {std::pair<std::string, double>{"shoulder_flexion", 1.5}, {"elbow_flexion", 0.8}}) {
+    const auto at = r.out.find("torque " + name + "=");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    // measured 1.2e-5 and 3.2e-6 N m off at the RMS tolerance 1e-6 rad
+    EXPECT_NEAR(std::stod(r.out.substr(at + 8 + name.size())), value, 1e-4) << r.out;
+  }
+  const std::string md = slurp(report / "report.md");
+  EXPECT_NE(md.find("# Tracking task"), std::string::npos) << md;
+  EXPECT_NE(md.find("| lbfgs | "), std::string::npos) << md;
+  const std::string csv = slurp(report / "best_run.csv");
+  EXPECT_EQ(csv.rfind("time,shoulder_flexion,shoulder_flexion_motion,", 0), 0u) << csv;
+  long rows = -1;
+  for (char c : csv) rows += c == '\n';
+  EXPECT_EQ(rows, 21);  // t = 0 .. 0.2 s at 10 ms
+  EXPECT_TRUE(fs::exists(report / "lbfgs_iterations.csv"));
+  if (md.find("plot skipped") == std::string::npos) {
+    EXPECT_TRUE(fs::exists(report / "tracking.png") || fs::exists(report / "tracking.svg")) << md;
+  }
+
+  CmdResult bad = runRedmax(dir_, base);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("needs --motion and/or --objective"), std::string::npos) << bad.err;
+  bad = runRedmax(dir_, base + "--motion " + motion.string() + " --target 0,0,0");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("error: --target: not used by --task track"), std::string::npos) << bad.err;
+  bad = run(kReach + " --motion " + motion.string());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("error: --motion: needs --task track"), std::string::npos) << bad.err;
+  bad = runRedmax(dir_, "optimize --task track --model " + scene("reach_arm.osim") + " --duration 0.3 --motion " +
+                            motion.string());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("error: --motion '" + motion.string() + "': '" + motion.string() + "' does not cover the run"),
+            std::string::npos) << bad.err;
 }
 
 }  // namespace

@@ -113,8 +113,8 @@ TEST(GradientSpec, BadSpecsNameTheItem) {
             "--objective 'point:link2@0,0=1,2,3': the point must be three numbers x,y,z (m, body frame)");
   EXPECT_EQ(message("torques:q1", "x*speed"), "--objective 'x*speed': the weight before '*' must be a number >= 0");
   EXPECT_EQ(message("torques:q1", "rest"),
-            "--objective 'rest': unknown term (point:BODY@x,y,z=X,Y,Z, marker:NAME=X,Y,Z, track:MARKER=FILE.trc, speed, "
-            "effort or excitation)");
+            "--objective 'rest': unknown term (point:BODY@x,y,z=X,Y,Z, marker:NAME=X,Y,Z, track:MARKER=FILE.trc, "
+            "coords:FILE.mot[@C,...], speed, effort or excitation)");
   EXPECT_EQ(message("torques:q1", "excitation"),
             "--objective 'excitation': needs excitation parameters (--params 'excitations:...')");
   EXPECT_EQ(message("excitations:nobody", "speed"), "--params 'excitations:nobody': no muscle named 'nobody'");

@@ -1,9 +1,12 @@
 #include "validation/gradient/gradient.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
+#include "converter/coordinates_file.hpp"
 #include "converter/osim_reader.hpp"
+#include "converter/storage.hpp"
 #include "converter/trc_file.hpp"
 #include "core/dynamics/muscle_force_term.hpp"
 #include "core/dynamics/muscle_term.hpp"
@@ -77,6 +80,88 @@ SimulationModel makeGradientModel(const osim::ModelDescription& description, con
                   pulling);
   if (hill) m.system = withMuscleForces(m);
   return m;
+}
+
+
+// coords:FILE.mot[@C,...] with weight w: the coordinates of the model that the motion (or states)
+// file has - all of them, or the named ones - tracked over the run (docs/gradients.md §3). The file
+// is read as `redmax lengths` and `simulate --initial` read motions (osim::readStorage: OpenSim's
+// inDegrees rule, Rotational coordinates of a degrees file converted; labels by name or state
+// path), linear between its rows, which must cover the run.
+void addCoordinateTracks(GradientSetup& g, const std::string& term_text, std::string spec, double w) {
+  const std::string oflag = "--objective";
+  std::vector<std::string> chosen;
+  const auto at = spec.rfind('@');
+  if (at != std::string::npos && spec.find('/', at) == std::string::npos) {
+    chosen = split(spec.substr(at + 1), ',');
+    spec = spec.substr(0, at);
+    if (chosen.empty() || std::any_of(chosen.begin(), chosen.end(), [](const std::string& c) { return c.empty(); }))
+      throw bad(oflag, term_text, "expected coordinate names after '@' (coords:FILE.mot@C1,C2)");
+  }
+  if (spec.empty()) throw bad(oflag, term_text, "expected coords:FILE.mot or coords:FILE.mot@C1,C2");
+  const std::string& file = spec;
+  const osim::Storage table = osim::readStorage(file);  // ConvertError names the file and line
+  const auto& coords = g.model.description.coordinates;
+  const auto& index = g.model.build.coordinate_index;
+  const osim::CoordinateColumns cols = osim::matchCoordinateColumns(table, coords);
+  std::vector<size_t> which;  // description coordinates tracked
+  if (chosen.empty()) {
+    for (size_t ci = 0; ci < coords.size(); ++ci)
+      if (cols.value_column[ci] >= 0 && index[ci] >= 0) which.push_back(ci);
+    if (which.empty()) throw bad(oflag, term_text, "'" + file + "' has no column for any coordinate of the model");
+  } else {
+    std::vector<std::string> unknown, absent;
+    for (const std::string& name : chosen) {
+      size_t ci = coords.size();
+      for (size_t k = 0; k < coords.size(); ++k)
+        if (coords[k].name == name && index[k] >= 0) ci = k;
+      if (ci == coords.size()) unknown.push_back(name);
+      else if (cols.value_column[ci] < 0) absent.push_back(name);
+      else if (std::find(which.begin(), which.end(), ci) != which.end())
+        throw bad(oflag, term_text, "coordinate '" + name + "' is named twice");
+      else which.push_back(ci);
+    }
+    auto list = [](const std::vector<std::string>& v) {
+      std::string s;
+      for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
+      return s;
+    };
+    if (!unknown.empty())
+      throw bad(oflag, term_text, "the model has no coordinate named " + list(unknown));
+    if (!absent.empty()) throw bad(oflag, term_text, "'" + file + "' has no column for " + list(absent));
+  }
+  // the rows from the last at or before the start to the first at or after the end
+  const adjoint::Problem& pr = g.problem;
+  const double t0 = pr.initial.t, t1 = pr.initial.t + pr.duration;
+  const int rows = table.numRows();
+  if (rows == 0 || table.time.front() > t0 + 1e-12 || table.time.back() < t1 - 1e-12)
+    throw bad(oflag, term_text,
+              "'" + file + "' does not cover the run [" + std::to_string(t0) + ", " + std::to_string(t1) + "] s" +
+                  (rows ? " (its times are " + std::to_string(table.time.front()) + " to " +
+                              std::to_string(table.time.back()) + " s)"
+                        : std::string(" (no rows)")));
+  int lo = 0, hi = rows - 1;
+  while (lo + 1 < rows && table.time[lo + 1] <= t0 + 1e-12) ++lo;
+  while (hi - 1 >= lo && table.time[hi - 1] >= t1 - 1e-12) --hi;
+  for (int r = lo; r < hi; ++r)
+    if (!(table.time[r + 1] > table.time[r]))
+      throw bad(oflag, term_text, "'" + file + "': the times must increase (t = " + std::to_string(table.time[r + 1]) +
+                                      " s follows " + std::to_string(table.time[r]) + " s)");
+  for (size_t ci : which) {
+    adjoint::Objective::CoordinateTrack ct;
+    ct.coordinate = index[ci];
+    ct.weight = w;
+    const int col = cols.value_column[ci];
+    for (int r = lo; r <= hi; ++r) {
+      const double v = table.data(r, col) * cols.scale[ci];
+      if (!std::isfinite(v))
+        throw bad(oflag, term_text, "'" + file + "': coordinate '" + coords[ci].name + "' is not a number at t = " +
+                                        std::to_string(table.time[r]) + " s, inside the run");
+      ct.t.push_back(table.time[r]);
+      ct.value.push_back(v);
+    }
+    g.objective.coordinate_tracks.push_back(std::move(ct));
+  }
 }
 
 }  // namespace
@@ -341,6 +426,8 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
         throw bad(oflag, term_text, "'" + file + "' does not cover the run [" + std::to_string(t0) + ", " +
                                         std::to_string(t1) + "] s");
       g.objective.tracks.push_back(std::move(tr));
+    } else if (term.rfind("coords:", 0) == 0) {
+      addCoordinateTracks(g, term_text, term.substr(7), w);
     } else if (term.rfind("point:", 0) == 0) {
       const std::string body_spec = term.substr(6);
       const auto at = body_spec.find('@');
@@ -359,8 +446,8 @@ GradientSetup makeGradientSetup(const std::string& osim_path, const SimulationMo
       g.objective.points.push_back(pt);
     } else {
       throw bad(oflag, term_text,
-                "unknown term (point:BODY@x,y,z=X,Y,Z, marker:NAME=X,Y,Z, track:MARKER=FILE.trc, speed, effort or "
-                "excitation)");
+                "unknown term (point:BODY@x,y,z=X,Y,Z, marker:NAME=X,Y,Z, track:MARKER=FILE.trc, coords:FILE.mot[@C,...], "
+                "speed, effort or excitation)");
     }
   }
   return g;

@@ -18,6 +18,12 @@
 //   --objective terms separated by ';', each [W*]TERM with weight W (default 1):
 //                 point:BODY@x,y,z=X,Y,Z  W/2 |p - target|^2 for the point (x,y,z) of BODY (body
 //                                         frame, m) against the ground point (X,Y,Z) at the end
+//                 marker:NAME=X,Y,Z       the same for a marker of the model's MarkerSet
+//                 track:MARKER=FILE.trc   W/2 sum_k h |p(t_k) - target(t_k)|^2 against a TRC's marker
+//                 coords:FILE.mot[@C,...] W/2 sum_k h sum_c (q_c(t_k) - q_file(t_k))^2 over the
+//                                         model's coordinates the motion has (or the named ones),
+//                                         Rotational ones from degrees per the file's inDegrees,
+//                                         linear between rows that must cover the run
 //                 speed                   W/2 |qdot|^2 at the end
 //                 effort                  W * integral of the squared generalized forces
 //                 excitation              W * integral of the squared excitations (of the muscles

@@ -36,10 +36,7 @@ Vec3 bodyPoint(const Model& model, const State& s, int body, const Vec3& x_i) {
   return transformPoint(sk.E_wi[body], x_i);
 }
 
-// the objective at which every method stops (ReachOptions::stop_objective)
-double stopObjective(const ReachOptions& o) {
-  return o.stop_objective >= 0.0 ? o.stop_objective : 0.5 * o.tolerance * o.tolerance;
-}
+bool isTrack(const ReachOptions& o) { return o.task == "track"; }
 
 // thrown from inside an objective evaluation to end a method once the stop objective is met
 struct Reached {};
@@ -91,8 +88,12 @@ class Tracker {
     result_.step_evaluations += r.step_evaluations;
     e.step_evaluations = result_.step_evaluations;
     e.objective = r.objective;
-    const auto& pt = setup_.gradient.objective.points.front();
-    e.error = (bodyPoint(setup_.gradient.model.system->model(), r.final, pt.body, pt.x_i) - pt.target).norm();
+    if (isTrack(setup_.options)) {
+      e.error = trackingError(setup_.options, r.objective);
+    } else {
+      const auto& pt = setup_.gradient.objective.points.front();
+      e.error = (bodyPoint(setup_.gradient.model.system->model(), r.final, pt.body, pt.x_i) - pt.target).norm();
+    }
     if (r.objective < best_) {
       best_ = r.objective;
       result_.torques = u;
@@ -176,6 +177,13 @@ void runNlopt(const ReachSetup& setup, nlopt_algorithm algorithm, Tracker& track
 
 }  // namespace
 
+double stopObjective(const ReachOptions& o) {
+  if (o.stop_objective >= 0.0) return o.stop_objective;
+  return 0.5 * o.tolerance * o.tolerance * (isTrack(o) ? o.duration : 1.0);
+}
+
+double trackingError(const ReachOptions& o, double objective) { return std::sqrt(2.0 * std::max(objective, 0.0) / o.duration); }
+
 const std::vector<std::string>& reachMethods() {
   static const std::vector<std::string> m{"lbfgs", "nelder-mead", "bobyqa"};
   return m;
@@ -184,7 +192,12 @@ const std::vector<std::string>& reachMethods() {
 ReachSetup makeReachSetup(const ReachOptions& options) {
   ReachSetup s;
   s.options = options;
-  for (int k = 0; k < 3; ++k)
+  const bool track = isTrack(options);
+  if (!track && options.task != "reach") throw std::invalid_argument("--task '" + options.task + "': unknown (reach or track)");
+  if (track && options.motion.empty() && options.objective.empty())
+    throw std::invalid_argument("--task track: needs --motion FILE.mot and/or --objective SPEC with a tracking term");
+  if (track && options.drive != "torques") throw std::invalid_argument("--task track: drives torques only");
+  for (int k = 0; k < 3 && !track; ++k)
     if (!std::isfinite(options.target[k])) throw std::invalid_argument("--target: must be three finite numbers X,Y,Z (m)");
   if (!(options.tolerance > 0.0)) throw std::invalid_argument("--tolerance: must be > 0");
   // the coordinates: all of the model's unless named; validated by the gradient SPEC
@@ -237,13 +250,22 @@ ReachSetup makeReachSetup(const ReachOptions& options) {
     }
     params = "excitations:" + joined(items, ",");
   }
+  // track: the motion's coords: term first, then the further terms; reach: the point is added below
+  std::string objective = "speed";
+  if (track) {
+    objective = options.motion.empty() ? "" : "coords:" + options.motion;
+    if (!options.objective.empty()) objective += (objective.empty() ? "" : ";") + options.objective;
+  }
   try {
     s.gradient = makeGradientSetup(options.model_path, options.model_options, options.integrator, options.duration,
-                                   options.dt, params, "speed");
+                                   options.dt, params, objective);
   } catch (const std::invalid_argument& e) {
     // "--params 'torques:x': no coordinate named 'x'" in the reach command's words
     std::string what = e.what();
     const std::string p = "--params";
+    const std::string motion_term = "--objective 'coords:" + options.motion + "'";
+    if (track && !options.motion.empty() && what.rfind(motion_term, 0) == 0)
+      what = "--motion '" + options.motion + "'" + what.substr(motion_term.size());
     if (what.rfind(p + " 'torques:", 0) == 0) what = "--coordinates '" + what.substr(p.size() + 10);
     if (what.rfind(p + " 'excitations:", 0) == 0) {
       // the item's value is the --initial-excitation, its name a --muscles entry
@@ -258,16 +280,33 @@ ReachSetup makeReachSetup(const ReachOptions& options) {
     throw std::invalid_argument(what);
   }
   const Model& model = s.gradient.model.system->model();
-  adjoint::Objective::Point pt;
-  pt.body = model.findBody(options.body);
-  if (pt.body < 0) throw std::invalid_argument("--body '" + options.body + "': no body named so in " + options.model_path);
-  pt.x_i = options.point;
-  pt.target = options.target;
-  s.gradient.objective = adjoint::Objective{};
-  s.gradient.objective.points.push_back(pt);
-  s.gradient.objective.speed_weight = options.rest_weight;
-  s.gradient.objective.excitation_weight = excite ? options.excitation_weight : 0.0;
-  s.start_point = bodyPoint(model, s.gradient.problem.initial, pt.body, pt.x_i);
+  if (track) {
+    if (!s.gradient.objective.tracking())
+      throw std::invalid_argument("--objective '" + options.objective +
+                                  "': --task track needs a tracking term (coords:FILE.mot or track:MARKER=FILE.trc)");
+    s.gradient.objective.speed_weight += options.rest_weight;
+    // the run starts from the motion's pose at the start for the coordinates it tracks (at the
+    // model's default speeds), projected onto the constraints as the default state is
+    State& s0 = s.gradient.problem.initial;
+    for (const auto& ct : s.gradient.objective.coordinate_tracks) s0.q[ct.coordinate] = ct.at(s0.t);
+    const System& sys = *s.gradient.model.system;
+    if (sys.numConstraintRows() > 0) {
+      DynamicsWorkspace pws(sys.model());
+      sys.projectPositions(s0, pws);
+      sys.projectVelocities(s0, pws);
+    }
+  } else {
+    adjoint::Objective::Point pt;
+    pt.body = model.findBody(options.body);
+    if (pt.body < 0) throw std::invalid_argument("--body '" + options.body + "': no body named so in " + options.model_path);
+    pt.x_i = options.point;
+    pt.target = options.target;
+    s.gradient.objective = adjoint::Objective{};
+    s.gradient.objective.points.push_back(pt);
+    s.gradient.objective.speed_weight = options.rest_weight;
+    s.gradient.objective.excitation_weight = excite ? options.excitation_weight : 0.0;
+    s.start_point = bodyPoint(model, s.gradient.problem.initial, pt.body, pt.x_i);
+  }
   const System& system = *s.gradient.model.system;
   DynamicsWorkspace ws(system);
   system.calcMassAndForce(s.gradient.problem.initial, ws);
@@ -425,6 +464,37 @@ ReachReplay replayReach(const ReachSetup& setup, const VecX& params) {
   return rp;
 }
 
+TrackReplay replayTrack(const ReachSetup& setup, const VecX& params) {
+  TrackReplay rp;
+  const GradientSetup& g = setup.gradient;
+  const adjoint::Trajectory tr = adjoint::simulateTrajectory(g.problem, params);
+  for (const State& st : tr.states) rp.t.push_back(st.t);
+  const auto& names = g.model.coordinate_names;
+  double sum = 0.0;
+  long count = 0;
+  for (const auto& ct : g.objective.coordinate_tracks) {
+    rp.coordinates.push_back(static_cast<size_t>(ct.coordinate) < names.size() ? names[static_cast<size_t>(ct.coordinate)]
+                                                                               : std::to_string(ct.coordinate));
+    std::vector<double> q, target;
+    for (size_t j = 0; j < tr.states.size(); ++j) {
+      const State& st = tr.states[j];
+      q.push_back(st.q[ct.coordinate]);
+      target.push_back(ct.at(st.t));
+      if (j > 0) {
+        sum += (q.back() - target.back()) * (q.back() - target.back());
+        ++count;
+      }
+    }
+    rp.simulated.push_back(std::move(q));
+    rp.target.push_back(std::move(target));
+  }
+  // per state, summed over the coordinates: the mean of the sum is what trackingError reports for
+  // a unit-weight coords: term
+  const double states = static_cast<double>(tr.states.size() > 1 ? tr.states.size() - 1 : 1);
+  rp.rms = count ? std::sqrt(sum / states) : 0.0;
+  return rp;
+}
+
 namespace {
 
 std::string fmt(double v, int digits = 6) {
@@ -463,7 +533,7 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
 
   // the best objective so far against simulations, every method on one log-scale panel
   PlotFigure fig;
-  fig.title = "reaching task: " + setup.gradient.model.description.name;
+  fig.title = (isTrack(o) ? "tracking task: " : "reaching task: ") + setup.gradient.model.description.name;
   PlotPanel panel;
   panel.title = "best objective so far";
   panel.xlabel = "simulations (forward runs)";
@@ -556,51 +626,129 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
     }
   }
 
-  std::ostringstream md;
-  md << "# Reaching task: " << setup.gradient.model.description.name << "\n\n";
-  md << "Command: `" << command_line << "`\n\n";
-  if (excite)
-    md << "Muscle excitations, " << o.nodes << " piecewise-linear node(s) per muscle (" << setup.gradient.param_names.size()
-       << " parameters) from " << fmt(o.initial_excitation)
-       << ", within each muscle's [min_control, max_control]; Hill-type muscles with activation and fibre states; "
-          "objective `1/2 |p - target|^2";
-  else
-    md << "Constant generalized forces on " << setup.gradient.param_names.size()
-       << " coordinates from zero; objective `1/2 |p - target|^2";
-  if (excite && o.excitation_weight > 0.0) md << " + " << fmt(o.excitation_weight) << " int |u|^2 dt";
-  if (o.rest_weight > 0.0) md << " + " << fmt(o.rest_weight) << "/2 |qdot|^2";
-  md << "` at t = " << fmt(o.duration) << " s (" << setup.gradient.problem.integrator << ", dt " << fmt(o.dt)
-     << " s, " << setup.gradient.model.muscle_mass << " kg of muscle mass in mass points).\n\n";
-  md << "- point " << vec3(o.point) << " m of body `" << o.body << "`, at the start " << vec3(setup.start_point)
-     << " m, target " << vec3(o.target) << " m (distance " << fmt((o.target - setup.start_point).norm()) << " m)\n";
-  md << "- stop: objective <= " << fmt(stopObjective(o))
-     << ", a method's own convergence test, or " << o.max_simulations << " simulations; reached means error <= "
-     << fmt(o.tolerance) << " m\n\n";
-  md << "| method | simulations (diverged) | step evaluations | wall time (s) | final objective | final error (m) | final |qdot| (rad/s) | reached | stop |\n";
-  md << "|---|---|---|---|---|---|---|---|---|\n";
-  for (const ReachResult& r : results)
-    md << "| " << r.method << " | " << r.simulations << " (" << r.failed_simulations << ") | " << r.step_evaluations << " | " << fmt(r.seconds, 4) << " | "
-       << fmt(r.objective) << " | " << fmt(r.error) << " | " << fmt(r.final_speed) << " | " << (r.reached ? "yes" : "no")
-       << " | " << r.stop << " |\n";
-  md << "\nOne simulation is one forward run; an L-BFGS evaluation also runs the adjoint sweep, whose cost is in the "
-        "step evaluations (docs/gradients.md §5).\n\n## Converged parameters" << (excite ? "" : " (N m)") << "\n\n| parameter |";
-  for (const ReachResult& r : results) md << " " << r.method << " |";
-  md << "\n|---|";
-  for (size_t k = 0; k < results.size(); ++k) md << "---|";
-  md << "\n";
-  for (size_t i = 0; i < setup.gradient.param_names.size(); ++i) {
-    md << "| " << setup.gradient.param_names[i] << " |";
-    for (const ReachResult& r : results) md << " " << fmt(r.torques[static_cast<Eigen::Index>(i)], 10) << " |";
-    md << "\n";
+  // track: the tracked coordinates of the best run against the motion
+  const bool track = isTrack(o);
+  TrackReplay tracked;
+  std::string track_plot, track_status;
+  if (track && best && !setup.gradient.objective.coordinate_tracks.empty()) {
+    tracked = replayTrack(setup, best->torques);
+    std::ostringstream c;
+    c.precision(12);
+    c << "time";
+    for (const auto& n : tracked.coordinates) c << "," << n << "," << n << "_motion";
+    c << "\n";
+    for (size_t j = 0; j < tracked.t.size(); ++j) {
+      c << tracked.t[j];
+      for (size_t m = 0; m < tracked.coordinates.size(); ++m) c << "," << tracked.simulated[m][j] << "," << tracked.target[m][j];
+      c << "\n";
+    }
+    osim::writeFileAtomic((tmp / "best_run.csv").string(), c.str());
+    PlotFigure tf;
+    tf.title = "tracked coordinates (" + best->method + "): " + setup.gradient.model.description.name;
+    for (size_t m = 0; m < tracked.coordinates.size(); ++m) {
+      PlotPanel pn;
+      pn.title = tracked.coordinates[m];
+      pn.xlabel = "t (s)";
+      pn.ylabel = "q (rad or m)";
+      pn.lines.push_back(makePlotLine("simulated", tracked.t, tracked.simulated[m]));
+      PlotLine target = makePlotLine("motion", tracked.t, tracked.target[m]);
+      target.dash_type = 2;
+      pn.lines.push_back(target);
+      tf.panels.push_back(pn);
+    }
+    const GnuplotInfo gp3 = findGnuplot();
+    if (!gp3.available) {
+      track_status = "plot skipped: " + gp3.why_not;
+    } else {
+      const PlotOutcome out = renderPlot(gp3, PlotFormat::Auto, tf, (tmp / "tracking").string());
+      if (out.ok) track_plot = fs::path(out.file).filename().string();
+      else track_status = "plot failed: " + out.error;
+    }
   }
-  if (excite && best) {
-    md << "\n## Best run (" << best->method << ")\n\n";
-    md << "- final hand error " << fmt(best->error) << " m";
-    if (replay.lumped_error >= 0.0)
-      md << "; the same excitations on the lumped model (no muscle mass): " << fmt(replay.lumped_error) << " m";
-    md << "\n- [best_run.csv](best_run.csv): time, hand point, excitations and tendon forces per step\n";
-    if (!replay_plot.empty()) md << "\n![hand path, excitations, tendon forces](" << replay_plot << ")\n";
-    else md << "\n(" << replay_status << ")\n";
+
+  std::ostringstream md;
+  if (track) {
+    md << "# Tracking task: " << setup.gradient.model.description.name << "\n\n";
+    md << "Command: `" << command_line << "`\n\n";
+    md << "Generalized forces on " << setup.gradient.param_names.size() << " parameter(s) from zero; objective";
+    if (!o.motion.empty()) md << " `coords:" << o.motion << "`";
+    if (!o.objective.empty()) md << (o.motion.empty() ? "" : " +") << " `" << o.objective << "`";
+    if (o.rest_weight > 0.0) md << " + `" << fmt(o.rest_weight) << "/2 |qdot|^2`";
+    md << " (docs/gradients.md §3) over " << fmt(o.duration) << " s (" << setup.gradient.problem.integrator << ", dt "
+       << fmt(o.dt) << " s, " << setup.gradient.model.muscle_mass << " kg of muscle mass in mass points), from the "
+       << "motion's pose at the start.\n\n";
+    md << "- error: sqrt(2 J / duration), the root-mean-square tracking error (rad or m, summed over the tracked "
+          "coordinates) for a unit-weight coords: term alone\n";
+    md << "- stop: objective <= " << fmt(stopObjective(o)) << ", a method's own convergence test, or "
+       << o.max_simulations << " simulations; reached means error <= " << fmt(o.tolerance) << "\n\n";
+    md << "| method | simulations (diverged) | step evaluations | wall time (s) | final objective | final error | reached | stop |\n";
+    md << "|---|---|---|---|---|---|---|---|\n";
+    for (const ReachResult& r : results)
+      md << "| " << r.method << " | " << r.simulations << " (" << r.failed_simulations << ") | " << r.step_evaluations
+         << " | " << fmt(r.seconds, 4) << " | " << fmt(r.objective) << " | " << fmt(r.error) << " | "
+         << (r.reached ? "yes" : "no") << " | " << r.stop << " |\n";
+    md << "\n## Converged parameters (N m or N)\n\n| parameter |";
+    for (const ReachResult& r : results) md << " " << r.method << " |";
+    md << "\n|---|";
+    for (size_t k = 0; k < results.size(); ++k) md << "---|";
+    md << "\n";
+    for (size_t i = 0; i < setup.gradient.param_names.size(); ++i) {
+      md << "| " << setup.gradient.param_names[i] << " |";
+      for (const ReachResult& r : results) md << " " << fmt(r.torques[static_cast<Eigen::Index>(i)], 10) << " |";
+      md << "\n";
+    }
+    if (!tracked.coordinates.empty()) {
+      md << "\n## Best run (" << best->method << ")\n\n- RMS tracking error over the run " << fmt(tracked.rms)
+         << "\n- [best_run.csv](best_run.csv): time, each tracked coordinate and the motion's value\n";
+      if (!track_plot.empty()) md << "\n![tracked against simulated coordinates](" << track_plot << ")\n";
+      else md << "\n(" << track_status << ")\n";
+    }
+  } else {
+    md << "# Reaching task: " << setup.gradient.model.description.name << "\n\n";
+    md << "Command: `" << command_line << "`\n\n";
+    if (excite)
+      md << "Muscle excitations, " << o.nodes << " piecewise-linear node(s) per muscle (" << setup.gradient.param_names.size()
+         << " parameters) from " << fmt(o.initial_excitation)
+         << ", within each muscle's [min_control, max_control]; Hill-type muscles with activation and fibre states; "
+            "objective `1/2 |p - target|^2";
+    else
+      md << "Constant generalized forces on " << setup.gradient.param_names.size()
+         << " coordinates from zero; objective `1/2 |p - target|^2";
+    if (excite && o.excitation_weight > 0.0) md << " + " << fmt(o.excitation_weight) << " int |u|^2 dt";
+    if (o.rest_weight > 0.0) md << " + " << fmt(o.rest_weight) << "/2 |qdot|^2";
+    md << "` at t = " << fmt(o.duration) << " s (" << setup.gradient.problem.integrator << ", dt " << fmt(o.dt)
+       << " s, " << setup.gradient.model.muscle_mass << " kg of muscle mass in mass points).\n\n";
+    md << "- point " << vec3(o.point) << " m of body `" << o.body << "`, at the start " << vec3(setup.start_point)
+       << " m, target " << vec3(o.target) << " m (distance " << fmt((o.target - setup.start_point).norm()) << " m)\n";
+    md << "- stop: objective <= " << fmt(stopObjective(o))
+       << ", a method's own convergence test, or " << o.max_simulations << " simulations; reached means error <= "
+       << fmt(o.tolerance) << " m\n\n";
+    md << "| method | simulations (diverged) | step evaluations | wall time (s) | final objective | final error (m) | final |qdot| (rad/s) | reached | stop |\n";
+    md << "|---|---|---|---|---|---|---|---|---|\n";
+    for (const ReachResult& r : results)
+      md << "| " << r.method << " | " << r.simulations << " (" << r.failed_simulations << ") | " << r.step_evaluations << " | " << fmt(r.seconds, 4) << " | "
+         << fmt(r.objective) << " | " << fmt(r.error) << " | " << fmt(r.final_speed) << " | " << (r.reached ? "yes" : "no")
+         << " | " << r.stop << " |\n";
+    md << "\nOne simulation is one forward run; an L-BFGS evaluation also runs the adjoint sweep, whose cost is in the "
+          "step evaluations (docs/gradients.md §5).\n\n## Converged parameters" << (excite ? "" : " (N m)") << "\n\n| parameter |";
+    for (const ReachResult& r : results) md << " " << r.method << " |";
+    md << "\n|---|";
+    for (size_t k = 0; k < results.size(); ++k) md << "---|";
+    md << "\n";
+    for (size_t i = 0; i < setup.gradient.param_names.size(); ++i) {
+      md << "| " << setup.gradient.param_names[i] << " |";
+      for (const ReachResult& r : results) md << " " << fmt(r.torques[static_cast<Eigen::Index>(i)], 10) << " |";
+      md << "\n";
+    }
+    if (excite && best) {
+      md << "\n## Best run (" << best->method << ")\n\n";
+      md << "- final hand error " << fmt(best->error) << " m";
+      if (replay.lumped_error >= 0.0)
+        md << "; the same excitations on the lumped model (no muscle mass): " << fmt(replay.lumped_error) << " m";
+      md << "\n- [best_run.csv](best_run.csv): time, hand point, excitations and tendon forces per step\n";
+      if (!replay_plot.empty()) md << "\n![hand path, excitations, tendon forces](" << replay_plot << ")\n";
+      else md << "\n(" << replay_status << ")\n";
+    }
   }
   md << "\n## Objective per evaluation\n\n";
   for (const ReachResult& r : results) md << "- [" << r.method << "_iterations.csv](" << r.method << "_iterations.csv)\n";

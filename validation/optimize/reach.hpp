@@ -26,6 +26,13 @@
 // plots the hand path, the excitations and the tendon forces of the best run, and replays the
 // best excitations on the lumped model (no muscle mass) when the muscles carry mass.
 //
+// The tracking task (task = "track", docs/gradients.md §7): the same torque parameters and
+// methods, but the objective is the gradient's tracking SPEC (coords:FILE.mot[@C,...] from `motion`
+// and any further terms of `objective`, e.g. track:MARKER=FILE.trc) summed over the whole run; the
+// run starts from the motion's pose at its start for the tracked coordinates; the error reported is
+// sqrt(2 J / duration) (trackingError) and the report adds best_run.csv and tracking.png|svg (each
+// tracked coordinate of the best run against the motion).
+//
 // The report (writeReachReport) in DIR: report.md (setup, per method: converged torques,
 // simulations, step evaluations, wall time, final error and speed), <method>_iterations.csv (one
 // row per objective evaluation), objective.png|svg (best objective against simulations, every
@@ -41,6 +48,14 @@
 namespace redmax::validation {
 
 struct ReachOptions {
+  /// reach: a point to a target at the end (the dissertation's); track: a tracking objective
+  /// over the whole run (coordinates of a motion file and/or markers of a TRC file)
+  std::string task = "reach";
+  /// track: FILE.mot[@C,...], the gradient's coords: term (docs/gradients.md §3), weight 1
+  std::string motion;
+  /// track: further terms of the gradient's objective SPEC (e.g. "track:M=F.trc;1e-4*effort"),
+  /// added to the motion's; a tracked task needs a coords: or track: term among them
+  std::string objective;
   std::string model_path;
   SimulationModelOptions model_options;
   std::string body = "hand";
@@ -80,6 +95,15 @@ struct ReachSetup {
   bool bounded = false;  ///< lbfgs runs L-BFGS-B within [lower, upper] (the excitations)
 };
 
+/// The objective at which every method stops: stop_objective when >= 0, else 1/2 tolerance^2
+/// (reach: the point within `tolerance` m) or 1/2 tolerance^2 duration (track: trackingError <=
+/// tolerance).
+double stopObjective(const ReachOptions& o);
+
+/// track: sqrt(2 J / duration), the run's root-mean-square tracking error when the objective is one
+/// unit-weight coords: term (rad or m, summed over the tracked coordinates)
+double trackingError(const ReachOptions& o, double objective);
+
 /// Throws std::invalid_argument ("--body 'x': ...", "--coordinates 'c': ...", "--target: ...")
 /// for bad input, osim::ConvertError / ModelError for the model.
 ReachSetup makeReachSetup(const ReachOptions& options);
@@ -91,7 +115,7 @@ struct ReachEvaluation {
   double seconds = 0.0;        ///< since the method started
   double objective = 0.0;
   double best_objective = 0.0; ///< the lowest so far
-  double error = 0.0;          ///< |p - target| of this run (m)
+  double error = 0.0;          ///< |p - target| of this run (m); track: trackingError
 };
 
 struct ReachResult {
@@ -103,7 +127,8 @@ struct ReachResult {
   long restarts = 0;           ///< L-BFGS restarts after a failed line search
   long failed_simulations = 0; ///< runs that diverged (counted in simulations, objective +inf)
   double seconds = 0.0;
-  double objective = 0.0, error = 0.0, final_speed = 0.0;  ///< at the best parameters (|qdot_N|)
+  /// at the best parameters: error |p - target| (m; track: trackingError), final_speed |qdot_N|
+  double objective = 0.0, error = 0.0, final_speed = 0.0;
   bool reached = false;        ///< error <= tolerance
   std::string stop;            ///< why it stopped
 };
@@ -130,6 +155,16 @@ struct ReachReplay {
   double lumped_error = -1.0;  ///< m, at the end (< 0: not replayed)
 };
 ReachReplay replayReach(const ReachSetup& setup, const VecX& params);
+
+/// track: the tracked coordinates of the run at params against their targets, per step (the
+/// state at t_k and the target there, the objective's linear interpolation of the file).
+struct TrackReplay {
+  std::vector<double> t;
+  std::vector<std::string> coordinates;
+  std::vector<std::vector<double>> simulated, target;  ///< [coordinate][state]
+  double rms = 0.0;  ///< the root-mean-square error over the tracked coordinates and the states t_1 .. t_N
+};
+TrackReplay replayTrack(const ReachSetup& setup, const VecX& params);
 
 /// Write the report into dir (see the top of this file); returns the plot's status line. Throws
 /// std::runtime_error "PATH: why" when the folder cannot be written.
