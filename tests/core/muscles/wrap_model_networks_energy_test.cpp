@@ -84,9 +84,9 @@ TEST(ModelWrapNetworks, PendulumEnergyWithItsOwnNetworkServingThroughout) {
               "  network for its wrap object (fresh-sample RMS %.3g radii): drift %.3e J, %d contact changes, "
               "%ld steps, %ld/%ld fallbacks, %.2f s\n"
               "  smooth model: drift %.3e J, %d contact changes, %ld steps, %.2f s\n"
-              "  committed cylinder_3x64 (0.5 s): %ld/%ld fallbacks\n",
+              "  committed cylinder_3x64 (0.5 s): %ld/%ld fallbacks (first: %s)\n",
               duration, r.E0, err.rms, r.max_drift, r.contact_changes, r.steps, r.fallbacks, r.evaluations, r.wall_s,
-              s.max_drift, s.contact_changes, s.steps, s.wall_s, g.fallbacks, g.evaluations);
+              s.max_drift, s.contact_changes, s.steps, s.wall_s, g.fallbacks, g.evaluations, g.first_fallback.c_str());
   ::testing::Test::RecordProperty("model_network_drift_J", std::to_string(r.max_drift));
   ::testing::Test::RecordProperty("smooth_drift_J", std::to_string(s.max_drift));
   // the model's network serves every evaluation
@@ -96,9 +96,11 @@ TEST(ModelWrapNetworks, PendulumEnergyWithItsOwnNetworkServingThroughout) {
   EXPECT_GE(s.contact_changes, 2);
   // where the generic network cannot
   EXPECT_GT(g.fallbacks, 0);
-  // integrator error only, with either model
-  EXPECT_LE(r.max_drift, 1e-8);
-  EXPECT_LE(s.max_drift, 1e-8);
+  EXPECT_LT(err.rms, 0.03);  // radii (measured 0.010)
+  // integrator error only, with either model (no jump: the network serves every evaluation);
+  // measured 2.1e-11 J (network, 1395 steps) and 1.4e-10 J (smooth, 2011 steps)
+  EXPECT_LE(r.max_drift, 1e-10);
+  EXPECT_LE(s.max_drift, 1e-9);
 }
 
 }  // namespace
