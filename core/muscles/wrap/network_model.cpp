@@ -154,7 +154,7 @@ std::string toString(NetworkWrapFallback why) {
     case NetworkWrapFallback::None: return "network";
     case NetworkWrapFallback::NoNetwork: return "no network";
     case NetworkWrapFallback::SurfaceType: return "network trained for another surface type";
-    case NetworkWrapFallback::Quadrant: return "the quadrant makes the path wrap round the active side";
+    case NetworkWrapFallback::Quadrant: return "the quadrant changes the path (a wrap round the active side, or none)";
     case NetworkWrapFallback::FiniteLength: return "both tangent points beyond the cylinder's ends";
     case NetworkWrapFallback::OutsideBox: return "outside the training box";
   }
