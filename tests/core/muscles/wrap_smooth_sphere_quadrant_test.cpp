@@ -177,7 +177,7 @@ TEST(WrapSmoothSphereQuadrant, C2AcrossBothEdgesOfTheBand) {
         gap2[k] = (a2 - b2).norm();
         x2 = std::max(a2.norm(), b2.norm());
       }
-      EXPECT_LT(gap1[1], 1e-5) << "sweep " << c << " edge " << edge;
+      EXPECT_LT(gap1[1], 1e-6) << "sweep " << c << " edge " << edge;
       EXPECT_LT(gap2[1], 1e-2 * (1.0 + x2)) << "sweep " << c << " edge " << edge;
       EXPECT_LE(gap1[1], 0.15 * gap1[0] + 1e-15) << "sweep " << c << " edge " << edge;
       EXPECT_LE(gap2[1], 0.15 * gap2[0] + 1e-12) << "sweep " << c << " edge " << edge;
