@@ -99,6 +99,7 @@ void wrapSphere(const WrapSurface& s, const Vec3& p1, const Vec3& p2, WrapResult
   r.arc_axis = values(ax);
   r.arc_rise = 0.0;
   if (far_side_wrap) angle = -(2.0 * kPi - angle);
+  r.far_side = far_side_wrap;
   r.arc_angle = angle;
   r.length = R * angle;
   r.code = code;

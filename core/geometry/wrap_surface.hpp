@@ -102,7 +102,8 @@ struct WrapResult {
   double arc_rise = 0.0;                ///< Helix: total advance h along the axis (m)
   std::vector<Vec3> polyline;           ///< Polyline: r1, interior points, r2
   /// Ellipsoid with a quadrant: the arc goes round the far side of its plane (the near arc would
-  /// bend back toward an end point)
+  /// bend back toward an end point). Sphere with a quadrant: OpenSim's far-side wrap (the long way
+  /// round, arc_angle = -(2 pi - short angle), the negative length quirk).
   bool far_side = false;
 
   /// Wrapped or MandatoryWrap: the path goes over the surface

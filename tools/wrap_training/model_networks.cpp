@@ -23,11 +23,22 @@ std::string fmt(double v) {
   return buf;
 }
 
-// the exact library on the unconstrained unit surface (radius 1; cylinder effectively infinite)
-WrapSample label(WrapType type, const Vec3& q1, const Vec3& q2, double alpha) {
+// the exact library on the unconstrained surface of radius R (cylinder effectively infinite: 1000
+// R long), end points q1, q2 in radii; the sample in radii. R matters: OpenSim's cylinder is not
+// scale-equivariant (it slides its tangent points along the axis within a segment of +-10 m and
+// tests with absolute tolerances of 1e-5), so a wrap object's labels are computed at its own
+// radius, the size the run-time model and the library meet (on a unit cylinder an end point more
+// than 10 radii along the axis from its tangent point keeps it at its own height: Rajagopal2016's
+// AL_at_femshaft_r, R = 2.5 cm, whose origin lies 9.4-10.5 radii along the axis, took paths up to
+// 5.6 radii off the real ones)
+WrapSample label(WrapType type, const Vec3& q1, const Vec3& q2, double alpha, double R) {
   VecX in(8);
-  in << q1, q2, alpha, 1.0;
-  return makeExactWrapOracle(type)(in);
+  in << R * q1, R * q2, alpha, R;
+  WrapSample s = makeExactWrapOracle(type)(in);
+  s.x /= R;
+  s.l /= R;
+  s.L /= R;
+  return s;
 }
 
 constexpr double kFarRadii = 1000.0;
@@ -62,8 +73,8 @@ struct SetBuilder {
 
 // draw candidates in blocks, label them on T threads, keep in order (the set does not depend on T)
 template <class Draw>
-WrapTrainingSet buildSet(WrapType type, long n, double threshold, double C, unsigned long long seed, int threads,
-                         Draw draw) {
+WrapTrainingSet buildSet(WrapType type, double R, long n, double threshold, double C, unsigned long long seed,
+                         int threads, Draw draw) {
   std::mt19937_64 rng(seed);
   SetBuilder b(n);
   const int T = std::max(1, threads);
@@ -74,7 +85,7 @@ WrapTrainingSet buildSet(WrapType type, long n, double threshold, double C, unsi
   while (b.kept < n && b.set.drawn < 50 * n) {
     for (long j = 0; j < block; ++j) draw(rng, a1[j], a2[j], al[j]);
     auto work = [&](int t) {
-      for (long j = t; j < block; j += T) s[j] = label(type, a1[j], a2[j], al[j]);
+      for (long j = t; j < block; j += T) s[j] = label(type, a1[j], a2[j], al[j], R);
     };
     if (T == 1) {
       work(0);
@@ -136,7 +147,8 @@ WrapTrainingSet makeWrapObjectTrainingSet(const WrapObjectInputs& in, long n, do
                                           double jitter, unsigned long long seed, int threads) {
   if (in.q1.empty()) throw std::invalid_argument("wrap object '" + in.name + "': no inputs to train on");
   const long m = static_cast<long>(in.q1.size());
-  return buildSet(in.surface.type, n, threshold, compact, seed, threads,
+  if (!(in.surface.radius > 0.0)) throw std::invalid_argument("wrap object '" + in.name + "': the radius must be positive");
+  return buildSet(in.surface.type, in.surface.radius, n, threshold, compact, seed, threads,
                   [&](std::mt19937_64& rng, Vec3& q1, Vec3& q2, double& alpha) {
                     const long k = static_cast<long>(rng() % static_cast<unsigned long long>(m));
                     q1 = in.q1[k];
@@ -168,7 +180,7 @@ WrapInputBox makeCompactWrapBox(const WrapTrainingSet& set, double compact, doub
 WrapTrainingSet makeCompactWrapTrainingSet(WrapType type, long n, double threshold, double compact,
                                            unsigned long long seed, int threads) {
   const WrapInputBox near = makeDefaultWrapBox(type);
-  return buildSet(type, n, threshold, compact, seed, threads, [&](std::mt19937_64& rng, Vec3& q1, Vec3& q2, double& alpha) {
+  return buildSet(type, 1.0, n, threshold, compact, seed, threads, [&](std::mt19937_64& rng, Vec3& q1, Vec3& q2, double& alpha) {
     for (int i = 0; i < 3; ++i) q1[i] = near.lo[i] + (near.hi[i] - near.lo[i]) * uniform01(rng);
     for (int i = 0; i < 3; ++i) q2[i] = near.lo[3 + i] + (near.hi[3 + i] - near.lo[3 + i]) * uniform01(rng);
     alpha = uniform01(rng);
@@ -217,6 +229,7 @@ Mlp trainWrapObjectNetwork(const WrapObjectInputs& in, const ModelWrapTrainOptio
   net.meta["surface"] = wrapTypeName(type);
   net.meta["wrap_object"] = in.name;
   net.meta["wrap_map"] = formatCompactWrapMap(o.compact);
+  net.meta["label_radius_m"] = fmt(in.surface.radius);  // the library's labels at the object's size
   net.meta["inputs_seen"] = std::to_string(in.q1.size()) + " wrapped-segment evaluations of " +
                             std::to_string(in.muscles.size()) + " muscle(s), jitter " + fmt(o.jitter);
   net.meta["threshold"] = fmt(o.threshold);

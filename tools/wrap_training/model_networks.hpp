@@ -7,9 +7,11 @@
 // networks on such inputs: how often each falls back to the smooth model, and its position error
 // against the exact library where it serves.
 //
-// Inputs are in radii (p / R): wrapping is scale-equivariant, and the network's radius input is 1.
-// Training labels come from the exact library on the unconstrained surface (no quadrant, the
-// cylinder effectively infinite), which is what the run-time model serves; configurations where a
+// Inputs are in radii (p / R), and the network's radius input is 1. Training labels come from the
+// exact library on the unconstrained surface of the object's own radius (no quadrant, the cylinder
+// effectively infinite), scaled to radii: OpenSim's cylinder is not scale-equivariant (absolute
+// lengths and tolerances in its tangent-point slide), so a network is for its object's size, and it
+// is what the run-time model serves; configurations where a
 // quadrant or the cylinder's finite length change the path fall back at run time
 // (NetworkWrapFallback::Quadrant, FiniteLength), and the check counts them.
 #include <functional>
@@ -49,8 +51,11 @@ struct ModelWrapTrainOptions {
 };
 
 /// Training set over what `in` sees (inputs mapped: u1, u2, alpha, 1; outputs: displacement from the
-/// straight line, radii). Labels from the exact library; end points beyond 1000 radii are not used
-/// (counted invalid: the library loses its precision there). std::runtime_error when too few usable.
+/// straight line, radii). Labels from the exact library on a surface of the object's own radius
+/// (OpenSim's cylinder has absolute lengths and tolerances, so a unit surface can give another path),
+/// scaled to radii; end points beyond 1000 radii are not used (counted invalid: the library loses its
+/// precision there). std::runtime_error when too few usable; std::invalid_argument for no inputs or a
+/// radius <= 0.
 WrapTrainingSet makeWrapObjectTrainingSet(const WrapObjectInputs& in, long n, double threshold, double compact,
                                           double jitter, unsigned long long seed, int threads = 1);
 

@@ -32,13 +32,29 @@ std::string num(double v) {
   return buf;
 }
 
-// Where a quadrant changes OpenSim's cylinder path from the unconstrained one (which the networks
-// learnt): a forced wrap round the active side (neither end active, or the ends on opposite sides
-// of the quadrant plane with the line's point nearest the axis, the "foot", on the inactive side),
-// or a contact (d > 0) whose foot lies on the inactive side, which the library also wraps round the
-// active side. The same split as the smooth model's (smooth.cpp smoothPoint), on plain doubles.
+// Where a quadrant changes OpenSim's path from the unconstrained one (which the networks learnt).
+// Cylinders: a forced wrap round the active side (neither end active, or the ends on opposite
+// sides of the quadrant plane with the line's point nearest the axis, the "foot", on the inactive
+// side), or a contact (d > 0) whose foot lies on the inactive side, which the library also wraps
+// round the active side. The same split as the smooth model's (smooth.cpp smoothSetup), on plain
+// doubles. Spheres: the library's quadrant choice is discrete (core/geometry/sphere.cpp), so it is
+// asked directly: the path changes where the library with the quadrant and without it disagree
+// (wrap or not, the tangent points, the far side).
+bool sphereQuadrantChangesPath(const WrapSurface& s, const Vec3& a, const Vec3& b) {
+  WrapSurface free = s;
+  free.quadrant_axis = -1;
+  free.quadrant_sign = 0;
+  const WrapResult q = calcWrap(s, a, b), u = calcWrap(free, a, b);
+  if (q.wraps() != u.wraps()) return true;
+  if (!q.wraps()) return false;
+  const double tol = 1e-12 * s.radius;
+  return q.far_side || (q.r1 - u.r1).norm() > tol || (q.r2 - u.r2).norm() > tol;
+}
+
 bool quadrantChangesPath(const WrapSurface& s, const Vec3& a, const Vec3& b) {
-  if (s.type != WrapType::Cylinder || s.quadrant_sign == 0 || s.quadrant_axis < 0) return false;
+  if (s.quadrant_sign == 0 || s.quadrant_axis < 0) return false;
+  if (s.type == WrapType::Sphere) return sphereQuadrantChangesPath(s, a, b);
+  if (s.type != WrapType::Cylinder) return false;
   const int axis = s.quadrant_axis, sign = s.quadrant_sign;
   auto dsign = [](double v) { return v >= 0.0 ? 1 : -1; };
   const Vec3 u = b - a;
@@ -138,7 +154,7 @@ std::string toString(NetworkWrapFallback why) {
     case NetworkWrapFallback::None: return "network";
     case NetworkWrapFallback::NoNetwork: return "no network";
     case NetworkWrapFallback::SurfaceType: return "network trained for another surface type";
-    case NetworkWrapFallback::Quadrant: return "the quadrant makes the path wrap round the active side";
+    case NetworkWrapFallback::Quadrant: return "the quadrant changes the path (a wrap round the active side, or none)";
     case NetworkWrapFallback::FiniteLength: return "both tangent points beyond the cylinder's ends";
     case NetworkWrapFallback::OutsideBox: return "outside the training box";
   }

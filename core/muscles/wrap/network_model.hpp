@@ -67,7 +67,7 @@ enum class NetworkWrapFallback {
   None,          ///< the network gave the points
   NoNetwork,     ///< no network was given
   SurfaceType,   ///< the network was trained for another surface type (meta surface)
-  Quadrant,      ///< a cylinder quadrant makes the path wrap round the active side
+  Quadrant,      ///< a quadrant changes the path (cylinder: a wrap round the active side; sphere: the library's own choice)
   FiniteLength,  ///< both tangent points lie beyond the cylinder's ends (no wrap there)
   OutsideBox     ///< a scaled input lies outside the training box
 };

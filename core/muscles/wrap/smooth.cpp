@@ -113,7 +113,16 @@ bool cylinderSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, Ar
   return true;
 }
 
-// the exact library's unconstrained sphere over any scalar (constructions.hpp, as core/geometry/sphere.cpp)
+// the exact library's sphere over any scalar (constructions.hpp, as core/geometry/sphere.cpp).
+// Without a quadrant the pair of tangent candidates closest together; with one, the library's
+// own choice (core/geometry/sphere.cpp: with an end on the inactive side the candidates facing
+// away from the ends' midpoint, flipped to the others when the path would bend away from the
+// active side, and the long way round where the arc faces away from the ends), taken from a run of
+// the library on values: the candidates it picked and its far-side decision, over T the same
+// construction. Returns false where the library's quadrant test gives no wrap although the
+// segment crosses the sphere (an end on the active side, the line's point nearest the centre
+// more than 1 m (OpenSim's distance-as-fraction test) from p1, and not the ends on opposite sides
+// with that point on the inactive side): the library's own jump, not smoothed.
 template <class T>
 bool sphereSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, ArcPath<T>& path) {
   const double R = surf.radius;
@@ -121,13 +130,29 @@ bool sphereSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, ArcP
   V3<T> r1a, r1b, r2a, r2b;
   sphereTangentPoints(R, p1, n, r1a, r1b);
   sphereTangentPoints(R, p2, n, r2a, r2b);
-  const int k = closestCandidatePair(values(r1a).normalized(), values(r1b).normalized(), values(r2a).normalized(),
-                                     values(r2b).normalized());
-  const V3<T>& r1 = k < 2 ? r1a : r1b;
-  const V3<T>& r2 = k % 2 == 0 ? r2a : r2b;
+  bool first_a, second_a, far_side = false;
+  if (surf.quadrant_sign == 0) {
+    const int k = closestCandidatePair(values(r1a).normalized(), values(r1b).normalized(), values(r2a).normalized(),
+                                       values(r2b).normalized());
+    first_a = k < 2;
+    second_a = k % 2 == 0;
+  } else {
+    const WrapResult lib = calcWrap(surf, values(p1), values(p2));
+    if (!lib.wraps()) return false;
+    // the library's candidates are these, computed by the same code on doubles: the nearer one
+    // (the two from an end point outside the sphere are 2 R sqrt(1 - R^2 / |p|^2) apart)
+    first_a = (lib.r1 - values(r1a)).squaredNorm() <= (lib.r1 - values(r1b)).squaredNorm();
+    second_a = (lib.r2 - values(r2a)).squaredNorm() <= (lib.r2 - values(r2b)).squaredNorm();
+    far_side = lib.far_side;
+  }
+  const V3<T>& r1 = first_a ? r1a : r1b;
+  const V3<T>& r2 = second_a ? r2a : r2b;
   T angle;
   V3<T> ax;
   sphereArc(r1, r2, n, angle, ax);
+  // the library's far-side wrap: the same great circle the long way round (the path's length is
+  // the geometric one, as calcWrappedPathLength's, not OpenSim's negative surface length)
+  if (far_side) angle = -(2.0 * kPi - angle);
   path = makeArcPath(p1, p2, r1, r2, ax, angle, T(0.0));
   return true;
 }
@@ -750,7 +775,6 @@ std::string smoothWrapUnsupportedReason(const WrapSurface& s) {
     if (!(s.inner_radius > 0.0) || !(s.outer_radius > 0.0)) return "the torus radii must be positive";
     return "";
   }
-  if (s.type == WrapType::Sphere && s.quadrant_sign != 0) return "quadrant-constrained spheres are not supported";
   if (!(s.radius > 0.0)) return "the radius must be positive";
   return "";
 }

@@ -32,8 +32,8 @@
 // would move many real poses off OpenSim's path), so the path turns straight, C2, before an end
 // reaches the surface. Outside both bands the path is the exact one. (The torus uses its own rule:
 // no wrap with an end inside its local cylinder, below.)
-// Supported: Cylinder and Ellipsoid (also with a quadrant), Sphere without a quadrant, and Torus,
-// single wrap (OpenSim's algorithms as the exact library reproduces them).
+// Supported: Cylinder, Sphere and Ellipsoid (also with a quadrant) and Torus, single wrap
+// (OpenSim's algorithms as the exact library reproduces them).
 // Quadrant cylinders. The library wraps on contact (d > 0) when an end lies on the active side;
 // it also forces a wrap round the active side when neither end is active, or when the ends lie on
 // opposite sides of the quadrant plane and the line's point nearest the axis ("foot") lies on
@@ -44,6 +44,23 @@
 // reaches 1 before the forced side begins. Not smoothed (the library itself jumps there): an end
 // point crossing the quadrant plane with neither end then active, the foot crossing the plane
 // with d < 0, and the library's candidate-table flips near the plane.
+// Quadrant spheres. The library wraps only where the segment crosses the sphere (d > 0), quadrant
+// or not; it then picks its tangent points by discrete tests (core/geometry/sphere.cpp): with
+// both ends on the active side the unconstrained pair; with an end on the inactive side the
+// candidates facing away from the ends' midpoint, flipped to the others where the path would bend
+// away from the active side, and the long way round where the arc would face away from the ends
+// (the far side). The model runs the library on values, takes the candidates and the side it
+// chose, and builds the same construction over Jet numbers, blended by d as without a quadrant.
+// Where the line passes on the inactive side the library's path jumps at contact from the straight
+// line onto a wrap round the active side (up to a diameter): the blend spreads that jump over the
+// band (C2, |J| of the jump over the width there). Not smoothed, because the library itself jumps
+// there and the model equals it outside the band: its side switch inside the wrapped region (the
+// bend of its chosen path crossing the quadrant plane), an end crossing the quadrant plane, and
+// OpenSim's intersection test with an end on the active side, which compares the distance from p1
+// to the line's point nearest the centre (in metres) with 1 as if it were a fraction: beyond 1 m
+// the library gives no wrap unless the ends lie on opposite sides with that point on the inactive
+// side. The model's length is the geometric one (calcWrappedPathLength), not OpenSim's negative
+// far-side surface length.
 // Tori. The library anchors a quadrant "+x" cylinder of the tube radius (length 1e4) at the point
 // of the centre circle nearest the line, found by a 1-D search from each end (the better one);
 // the model runs the same search on values, then refines the chosen solution over the dual
@@ -88,7 +105,7 @@
 // Cost: measured in docs/performance.md §7 (validation/bench/wrap_model_bench.cpp).
 // Penetration of an ellipsoid: 1 - the line's distance from the centre in coordinates divided by
 // the semi-axes, times the smallest semi-axis (> 0 exactly when the library wraps).
-// Not supported (smoothWrapUnsupportedReason() says why): spheres with a quadrant.
+// Not supported (smoothWrapUnsupportedReason() says why): inactive surfaces and non-positive sizes.
 // Also not smoothed: a mass point crossing a tangent point (the path's curvature changes there;
 // OpenSim's cylinder construction is not exactly tangent, so J has a small jump there too), and
 // the cylinder's finite length (both tangent points beyond the ends: the exact library stops

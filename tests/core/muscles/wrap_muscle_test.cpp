@@ -218,7 +218,10 @@ TEST(WrapMuscle, ValidationNamesTheUnsupportedShape) {
   EXPECT_NO_THROW(validateMuscle(m, two_wraps));
   Muscle sphere = pendulumWrapMuscle(WrapModel::Smooth);
   sphere.path.wraps[0].surface = WrapSurface::makeSphere(0.1, 0, -1);
-  expectThrow(sphere, "quadrant-constrained spheres are not supported");
+  EXPECT_NO_THROW(validateMuscle(m, sphere));  // quadrant spheres: smooth since issue 22
+  Muscle flat = pendulumWrapMuscle(WrapModel::Smooth);
+  flat.path.wraps[0].surface = WrapSurface::makeSphere(0.0, 0, -1);
+  expectThrow(flat, "surface dimensions must be positive");
   Muscle counted = pendulumWrapMuscle(WrapModel::Smooth);
   counted.path.wraps.clear();
   expectThrow(counted, "only counts its wrap objects");

@@ -356,6 +356,18 @@ TEST(NetworkWrapModel, FallbacksGiveTheSmoothModelExactly) {
   // ... but with both ends on the active side the quadrant does not change the path: the network
   EXPECT_TRUE(calcNetworkWrapModel(cyl.get(), q, Vec3(-0.05, 0.25, 0), Vec3(-0.05, -0.25, 0), v1, v2, alphas, true, mp, ws)
                   .usedNetwork());
+  // a quadrant sphere (+y; smooth since issue 22): both ends on the active side, the library's
+  // path is the unconstrained one the sphere network learnt, so it serves; both ends on the
+  // inactive side, the library wraps round the active side (the long way): the smooth model
+  const WrapSurface qs = WrapSurface::makeSphere(0.1, 1, +1);
+  const Vec3 up1(-0.25, 0.06, 0.01), up2(0.25, 0.06, -0.01), down1(-0.25, -0.06, 0.01), down2(0.25, -0.06, -0.01);
+  ASSERT_TRUE(calcWrap(qs, up1, up2).wraps());
+  ASSERT_TRUE(calcWrap(qs, down1, down2).wraps());
+  ev = calcNetworkWrapModel(sph.get(), qs, up1, up2, v1, v2, alphas, true, mp, ws);
+  EXPECT_TRUE(ev.usedNetwork()) << ev.describe(sph.get());
+  ev = calcNetworkWrapModel(sph.get(), qs, down1, down2, v1, v2, alphas, true, mp, ws);
+  EXPECT_EQ(ev.fallback, NetworkWrapFallback::Quadrant);
+  expectSmooth(qs, down1, down2, v1, v2, alphas, mp);
   // no network
   ev = calcNetworkWrapModel(nullptr, s, p1, p2, v1, v2, alphas, true, mp, ws);
   EXPECT_EQ(ev.fallback, NetworkWrapFallback::NoNetwork);

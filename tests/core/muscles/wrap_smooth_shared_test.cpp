@@ -27,6 +27,7 @@ std::vector<Case> cases() {
   return {{"cylinder", WrapSurface::makeCylinder(0.5, 10.0), 0.1},
           {"quadrant cylinder", WrapSurface::makeCylinder(0.5, 10.0, 0, 1), 0.1},
           {"sphere", WrapSurface::makeSphere(0.6), 0.1},
+          {"quadrant sphere", WrapSurface::makeSphere(0.6, 1, -1), 0.1},
           {"ellipsoid", WrapSurface::makeEllipsoid(Vec3(0.7, 0.5, 0.4)), 0.08},
           {"torus", WrapSurface::makeTorus(0.3, 1.2), 0.06}};
 }

@@ -183,10 +183,18 @@ TEST(WrapSmooth, BandErrorIsBoundedByTheWidth) {
 
 TEST(WrapSmooth, UnsupportedSurfacesAreRefusedWithAReason) {
   EXPECT_EQ(smoothWrapUnsupportedReason(WrapSurface::makeEllipsoid(Vec3(1, 2, 3), 2, -1)), "");
-  EXPECT_NE(smoothWrapUnsupportedReason(WrapSurface::makeSphere(1.0, 0, 1)), "");
+  EXPECT_EQ(smoothWrapUnsupportedReason(WrapSurface::makeSphere(1.0, 0, 1)), "");  // since issue 22
   EXPECT_EQ(smoothWrapUnsupportedReason(WrapSurface::makeCylinder(1.0, 1.0, 0, 1)), "");
-  EXPECT_THROW(calcSmoothWrapPoint(WrapSurface::makeSphere(1.0, 0, 1), Vec3(2, 0, 0), Vec3(-2, 0, 0), 0.5),
-               std::invalid_argument);
+  EXPECT_EQ(smoothWrapUnsupportedReason(WrapSurface::makeSphere(0.0, 0, 1)), "the radius must be positive");
+  WrapSurface off = WrapSurface::makeSphere(1.0, 0, 1);
+  off.active = false;
+  EXPECT_EQ(smoothWrapUnsupportedReason(off), "the surface is inactive");
+  try {
+    calcSmoothWrapPoint(WrapSurface::makeSphere(0.0, 0, 1), Vec3(2, 0, 0), Vec3(-2, 0, 0), 0.5);
+    ADD_FAILURE() << "accepted a sphere of radius 0";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "smooth wrap: the radius must be positive");
+  }
   // an end point inside the surface
   EXPECT_THROW(calcSmoothWrapPoint(WrapSurface::makeSphere(1.0), Vec3(0.5, 0, 0), Vec3(-2, 0, 0), 0.5),
                std::invalid_argument);
