@@ -101,7 +101,7 @@ class Integrator {
   /// term slots (takeWrapFallbackCounts, core/dynamics/muscle_term.hpp)
   virtual DynamicsWorkspace* lastWorkspace() { return nullptr; }
   /// true if the method enforces System::unilateral(): bdf1 (limits and contacts, the contact
-  /// QP), rk45 and cvode (joint limits by event location); advance() of the others throws
+  /// QP), rk45 and cvode (joint limits and contacts by event location); advance() of the others throws
   /// std::invalid_argument for a system that has them
   virtual bool handlesUnilateral() const { return false; }
 
