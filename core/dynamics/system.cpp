@@ -484,43 +484,24 @@ void System::calcConstraints(const State& s, DynamicsWorkspace& ws) const {
 }
 
 VecX System::solveKKT(const MatX& M, const MatX& G, const VecX& a, const VecX& b, VecX* lambda) {
+  return solveKKT(M, G, G, a, b, lambda);
+}
+
+VecX System::solveKKT(const MatX& M, const MatX& G, const MatX& H, const VecX& a, const VecX& b, VecX* lambda) {
   const int n = static_cast<int>(M.rows());
   const int m = static_cast<int>(G.rows());
   if (m == 0) {
     if (lambda) lambda->resize(0);
     return M.ldlt().solve(a);
   }
-  // Schur complement on the SPD M: (G M^-1 G^T) lambda = G M^-1 a - b. Falls back to a full
-  // pivoted LU of the KKT matrix if M is not positive definite (massless chains).
-  Eigen::LLT<MatX> llt(M);
-  if (llt.info() == Eigen::Success) {
-    const MatX MinvGt = llt.solve(G.transpose());
-    const VecX Minva = llt.solve(a);
-    const MatX S = G * MinvGt;
-    const VecX lam = S.completeOrthogonalDecomposition().solve(G * Minva - b);
-    if (lambda) *lambda = lam;
-    return Minva - MinvGt * lam;
-  }
-  MatX A = MatX::Zero(n + m, n + m);
-  A.topLeftCorner(n, n) = M;
-  A.topRightCorner(n, m) = G.transpose();
-  A.bottomLeftCorner(m, n) = G;
-  VecX r(n + m);
-  r << a, b;
-  const VecX x = A.completeOrthogonalDecomposition().solve(r);
-  if (lambda) *lambda = x.tail(m);
-  return x.head(n);
-}
-
-VecX System::solveKKT(const MatX& M, const MatX& G, const MatX& H, const VecX& a, const VecX& b, VecX* lambda) {
-  const int n = static_cast<int>(M.rows());
-  const int m = static_cast<int>(G.rows());
-  if (m == 0) return solveKKT(M, G, a, b, lambda);
+  // Schur complement on the SPD M: (G M^-1 H^T) lambda = G M^-1 a - b (symmetric when H = G). Falls
+  // back to a full pivoted LU of the KKT matrix if M is not positive definite (massless chains).
   Eigen::LLT<MatX> llt(M);
   if (llt.info() == Eigen::Success) {
     const MatX MinvHt = llt.solve(H.transpose());
     const VecX Minva = llt.solve(a);
-    const VecX lam = (G * MinvHt).completeOrthogonalDecomposition().solve(G * Minva - b);
+    const MatX S = G * MinvHt;
+    const VecX lam = S.completeOrthogonalDecomposition().solve(G * Minva - b);
     if (lambda) *lambda = lam;
     return Minva - MinvHt * lam;
   }

@@ -60,6 +60,9 @@ class Driver {
     held_ = classify(rows, idx, s.qdot);
   }
 
+  void resume(const std::vector<HeldContact>& held) { held_ = held; }
+  const std::vector<HeldContact>& held() const { return held_; }
+
   std::shared_ptr<System> phase() {
     auto p = std::make_shared<System>(*base_);
     held_c_.reset();
@@ -224,12 +227,30 @@ class Driver {
       G = ws.G;
       b = G * s.qdot;
     }
-    s.qdot = solveUnilateralStep(ws.M, ws.M * s.qdot, G, b, imp, uo, nullptr, nullptr, nullptr);
+    // a slow impact (none of the crossing points above the restitution threshold) holds every
+    // point it involves: the velocity-level QP would let a held point lift off at the speed of the
+    // impact, and a body rocking between two points would then impact again within microseconds
+    // without end (Zeno); lift-off is left to the release check, where the normal force decides it
+    double fastest = 0.0;
+    for (int j : sel)
+      if (std::find(crossing.begin(), crossing.end(), ContactKey::of(imp.c[j])) != crossing.end())
+        fastest = std::max(fastest, -imp.c[j].approach);
+    const bool slow = fastest < uo.restitution_threshold;
+    if (slow) {
+      MatX Ge(G.rows() + imp.Jn.rows(), n);
+      if (G.rows() > 0) Ge.topRows(G.rows()) = G;
+      Ge.bottomRows(imp.Jn.rows()) = imp.Jn;
+      VecX be = VecX::Zero(Ge.rows());
+      if (G.rows() > 0) be.head(G.rows()) = b;
+      s.qdot = System::solveKKT(ws.M, Ge, ws.M * s.qdot, be, nullptr);
+    } else {
+      s.qdot = solveUnilateralStep(ws.M, ws.M * s.qdot, G, b, imp, uo, nullptr, nullptr, nullptr);
+    }
     cnt_.impacts += static_cast<long>(crossing.size());
     // held from now on: the points that stopped (the rest leave their surfaces)
     std::vector<int> stopped;
     for (int j : sel)
-      if (imp.Jn.row(j).dot(s.qdot) <= speedTol()) stopped.push_back(j);
+      if (slow || imp.Jn.row(j).dot(s.qdot) <= speedTol()) stopped.push_back(j);
     held_ = classify(imp, stopped, s.qdot);
   }
 
@@ -247,7 +268,7 @@ class Driver {
 
 void advanceWithUnilateralEvents(const std::string& method, const IntegratorOptions& opt, const System& sys,
                                  State& s, double t_out, double check_interval, IntegratorStats& stats,
-                                 UnilateralEventCounts* counts) {
+                                 UnilateralEventCounts* counts, EventMemory* memory) {
   const auto& u = sys.unilateral();
   if (!u) throw std::logic_error("advanceWithUnilateralEvents: the system has no unilateral constraints");
   if (!u->pairs().empty() && sys.ndof() != sys.model().nr())
@@ -258,7 +279,12 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
   UnilateralEventCounts local;
   UnilateralEventCounts& cnt = counts ? *counts : local;
   Driver d(sys, cnt);
-  d.start(s);
+  if (memory && memory->valid && memory->sys == &sys && memory->end.t == s.t && memory->end.q == s.q &&
+      memory->end.qdot == s.qdot && memory->end.z == s.z)
+    d.resume(memory->held);
+  else
+    d.start(s);
+  if (memory) memory->valid = false;  // until this run ends
   d.notePenetration(s);
 
   int changes = 0;
@@ -316,6 +342,12 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
     addStats(stats, inner->stats());
   }
   s.t = t_out;
+  if (memory) {
+    memory->valid = true;
+    memory->sys = &sys;
+    memory->end = s;
+    memory->held = d.held();
+  }
 }
 
 }  // namespace redmax

@@ -17,9 +17,16 @@
 // Event times are located by bisection on re-runs from the last checked state, to 1e-12 s
 // relative; events are looked for every `check_interval` s of simulated time (an event that
 // starts and ends between two checks, e.g. a bounce shorter than the interval, is missed).
-// After a change the positions and velocities are projected onto the new held set.
+// After a change the positions and velocities are projected onto the new held set. An impact
+// slower than the restitution threshold holds every point it involves (no lift-off at velocity
+// level: a body rocking between two points would otherwise impact again and again within
+// microseconds); a point that should leave does so at the next check, by its normal force.
+// The held set carries over to the next call when that call starts from the state this one ended
+// at (EventMemory); a call from any other state starts with the points that sit on their surfaces.
 #include <string>
+#include <vector>
 
+#include "core/dynamics/unilateral/held_contacts.hpp"
 #include "core/integrators/integrator.hpp"
 
 namespace redmax {
@@ -34,12 +41,20 @@ struct UnilateralEventCounts {
   double max_penetration = 0.0;  ///< largest penetration of the states reached at the checks and events (m or rad)
 };
 
+/// The held set at the end of a run and the state it belongs to.
+struct EventMemory {
+  bool valid = false;
+  const System* sys = nullptr;
+  State end;
+  std::vector<HeldContact> held;
+};
+
 /// Advance s to t_out with `method` ("rk45" or "cvode") on sys (which has unilateral constraints),
 /// as the file header describes. Throws std::invalid_argument for contact pairs on a system with
 /// extra coordinates, SimulationError from the runs or when the contact modes do not settle at
 /// one instant (s left at the last state reached).
 void advanceWithUnilateralEvents(const std::string& method, const IntegratorOptions& opt, const System& sys,
                                  State& s, double t_out, double check_interval, IntegratorStats& stats,
-                                 UnilateralEventCounts* counts = nullptr);
+                                 UnilateralEventCounts* counts = nullptr, EventMemory* memory = nullptr);
 
 }  // namespace redmax

@@ -394,7 +394,7 @@ void SundialsIntegrator::advance(const System& sys, State& s, double t_out) {
   if (sys.unilateral()) {
     // hard joint limits and contacts: phases between events, each run by a fresh integrator of this kind
     UnilateralEventCounts c;
-    advanceWithUnilateralEvents(who, opt_, sys, s, t_out, opt_.event_check_interval, stats_, &c);
+    advanceWithUnilateralEvents(who, opt_, sys, s, t_out, opt_.event_check_interval, stats_, &c, &events_);
     stats_.event_impacts += c.impacts;
     stats_.event_releases += c.releases;
     stats_.event_slips += c.slips;

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "core/integrators/integrator.hpp"
+#include "core/integrators/event_driven.hpp"
 
 namespace redmax {
 
@@ -40,6 +41,7 @@ class SundialsIntegrator : public Integrator {
 
  private:
   std::unique_ptr<DynamicsWorkspace> ws_;  // kept across advance() calls for one system
+  EventMemory events_;                     // the held contacts, carried to the next advance()
 };
 
 /// Dormand-Prince 5(4) with local error control (ARKODE ERKStep, ARKODE_DORMAND_PRINCE_7_4_5),

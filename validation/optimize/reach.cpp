@@ -504,6 +504,19 @@ std::string fmt(double v, int digits = 6) {
   return o.str();
 }
 
+// the converged parameters, one column per method (after the table's heading line)
+void parameterTable(std::ostream& md, const std::vector<std::string>& names, const std::vector<ReachResult>& results) {
+  for (const ReachResult& r : results) md << " " << r.method << " |";
+  md << "\n|---|";
+  for (size_t k = 0; k < results.size(); ++k) md << "---|";
+  md << "\n";
+  for (size_t i = 0; i < names.size(); ++i) {
+    md << "| " << names[i] << " |";
+    for (const ReachResult& r : results) md << " " << fmt(r.torques[static_cast<Eigen::Index>(i)], 10) << " |";
+    md << "\n";
+  }
+}
+
 std::string vec3(const Vec3& v) { return fmt(v[0]) + ", " + fmt(v[1]) + ", " + fmt(v[2]); }
 
 }  // namespace
@@ -688,15 +701,7 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
          << " | " << fmt(r.seconds, 4) << " | " << fmt(r.objective) << " | " << fmt(r.error) << " | "
          << (r.reached ? "yes" : "no") << " | " << r.stop << " |\n";
     md << "\n## Converged parameters (N m or N)\n\n| parameter |";
-    for (const ReachResult& r : results) md << " " << r.method << " |";
-    md << "\n|---|";
-    for (size_t k = 0; k < results.size(); ++k) md << "---|";
-    md << "\n";
-    for (size_t i = 0; i < setup.gradient.param_names.size(); ++i) {
-      md << "| " << setup.gradient.param_names[i] << " |";
-      for (const ReachResult& r : results) md << " " << fmt(r.torques[static_cast<Eigen::Index>(i)], 10) << " |";
-      md << "\n";
-    }
+    parameterTable(md, setup.gradient.param_names, results);
     if (!tracked.coordinates.empty()) {
       md << "\n## Best run (" << best->method << ")\n\n- RMS tracking error over the run " << fmt(tracked.rms)
          << "\n- [best_run.csv](best_run.csv): time, each tracked coordinate and the motion's value\n";
@@ -731,15 +736,7 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
          << " | " << r.stop << " |\n";
     md << "\nOne simulation is one forward run; an L-BFGS evaluation also runs the adjoint sweep, whose cost is in the "
           "step evaluations (docs/gradients.md §5).\n\n## Converged parameters" << (excite ? "" : " (N m)") << "\n\n| parameter |";
-    for (const ReachResult& r : results) md << " " << r.method << " |";
-    md << "\n|---|";
-    for (size_t k = 0; k < results.size(); ++k) md << "---|";
-    md << "\n";
-    for (size_t i = 0; i < setup.gradient.param_names.size(); ++i) {
-      md << "| " << setup.gradient.param_names[i] << " |";
-      for (const ReachResult& r : results) md << " " << fmt(r.torques[static_cast<Eigen::Index>(i)], 10) << " |";
-      md << "\n";
-    }
+    parameterTable(md, setup.gradient.param_names, results);
     if (excite && best) {
       md << "\n## Best run (" << best->method << ")\n\n";
       md << "- final hand error " << fmt(best->error) << " m";

@@ -40,6 +40,14 @@ double energy(const System& sys, const State& s) {
   return sys.kineticEnergy(s, ws) + sys.potentialEnergy(s, ws);
 }
 
+// run to t_end; the largest coordinate change over its last second
+double driftOverTheLastSecond(const System& sys, State& s, Integrator& integ, double t_end) {
+  integ.advance(sys, s, t_end - 1.0);
+  const VecX q = s.q;
+  integ.advance(sys, s, t_end);
+  return (s.q - q).cwiseAbs().maxCoeff();
+}
+
 // the relative tangential velocity at every contact point of the system's pairs (world, m/s)
 double largestTangentialSpeed(const System& sys, const State& s) {
   SkeletonWorkspace sk(sys.model());
@@ -200,10 +208,7 @@ TEST(ContactEvents, AStackOfBoxesStaysAtRest) {
   State s;
   auto sys = scenes::makeBoxStack(o, s);
   auto integ = makeIntegrator("rk45", tight());
-  integ->advance(*sys, s, 1.0);
-  const VecX q1 = s.q;
-  integ->advance(*sys, s, 2.0);
-  const double drift = (s.q - q1).cwiseAbs().maxCoeff();
+  const double drift = driftOverTheLastSecond(*sys, s, *integ, 2.0);
   std::printf("[ measured ] box stack under rk45: drift over the second second %.2e m, speed %.2e; %ld steps, %ld "
               "right-hand sides, %ld releases, %ld slips\n",
               drift, s.qdot.cwiseAbs().maxCoeff(), integ->stats().steps, integ->stats().rhs_evals,
@@ -220,10 +225,7 @@ TEST(ContactEvents, SixBoxesDroppedOntoEachOtherSettle) {
   State s;
   auto sys = scenes::makeBoxStack(o, s);
   auto integ = makeIntegrator("rk45", tight());
-  integ->advance(*sys, s, 2.0);
-  const VecX q2 = s.q;
-  integ->advance(*sys, s, 3.0);
-  const double drift = (s.q - q2).cwiseAbs().maxCoeff();
+  const double drift = driftOverTheLastSecond(*sys, s, *integ, 3.0);
   const auto& st = integ->stats();
   std::printf("[ measured ] six boxes under rk45: %ld impacts, %ld releases, %ld slips, %ld sticks; drift over the "
               "third second %.2e m, largest penetration %.2e m; %ld steps, %ld right-hand sides\n",

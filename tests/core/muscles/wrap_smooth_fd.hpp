@@ -5,6 +5,7 @@
 // FD(2h) - FD(h) is 3 times it): a stencil that straddles a piece boundary of the construction (a
 // mass point crossing a tangent point, the library switching roots or cases) is no test of the
 // derivatives, and callers skip it.
+#include <algorithm>
 #include <Eigen/Core>
 
 #include "core/muscles/wrap/smooth.hpp"
@@ -31,6 +32,40 @@ inline SmoothWrapFd calcSmoothWrapFd(const WrapSurface& s, const Vec3& p1, const
   const Eigen::Matrix<double, 3, 6> Jdot2 = (J(2 * h) - J(-2 * h)) / (4 * h);
   fd.converged = (Jdot2 - fd.Jdot).norm() <= converge_tol * (1.0 + fd.Jdot.norm());
   return fd;
+}
+
+// t in [0, 1] where an increasing penetration pen(t) equals target (bisection)
+template <class Pen>
+double whereAlong(Pen&& pen, double target) {
+  double lo = 0.0, hi = 1.0;
+  for (int k = 0; k < 200; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (pen(mid) < target ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// C2 check at a band edge t0: the jumps of derivs' first and second derivatives (x1, x2) across t0
+// at distances 1e-6 and 1e-7, and the largest |x2| seen at the nearer one
+struct EdgeGaps {
+  double gap1[2] = {0.0, 0.0}, gap2[2] = {0.0, 0.0};
+  double x2 = 0.0;
+  bool finite = true;
+};
+template <class Derivs>
+EdgeGaps edgeGaps(Derivs&& derivs, double t0) {
+  EdgeGaps g;
+  for (int k = 0; k < 2; ++k) {
+    const double e = k == 0 ? 1e-6 : 1e-7;
+    Vec3 a1, a2, b1, b2;
+    derivs(t0 - e, a1, a2);
+    derivs(t0 + e, b1, b2);
+    g.finite = g.finite && a1.allFinite() && a2.allFinite() && b1.allFinite() && b2.allFinite();
+    g.gap1[k] = (a1 - b1).norm();
+    g.gap2[k] = (a2 - b2).norm();
+    g.x2 = std::max(a2.norm(), b2.norm());
+  }
+  return g;
 }
 
 }  // namespace redmax::test

@@ -121,12 +121,7 @@ struct Sweep {
   Vec3 v1, v2;  // dp1/dt, dp2/dt (linear sweeps)
   double pen(double t) const { return calcWrapPenetration(s, p1(t), p2(t)); }
   double where(double target) const {
-    double lo = 0.0, hi = 1.0;
-    for (int k = 0; k < 200; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      (pen(mid) < target ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
+    return test::whereAlong([this](double t) { return pen(t); }, target);
   }
   Vec3 exact(double t, double alpha) const {
     return calcWrappedPathPoint(s, calcWrap(s, p1(t), p2(t)), p1(t), p2(t), alpha);
@@ -166,17 +161,9 @@ TEST(WrapSmoothSphereQuadrant, C2AcrossBothEdgesOfTheBand) {
     };
     for (double edge : {0.0, width}) {
       const double t0 = sw.where(edge);
-      double gap1[2], gap2[2], x2 = 0.0;
-      for (int k = 0; k < 2; ++k) {
-        const double e = k == 0 ? 1e-6 : 1e-7;
-        Vec3 a1, a2, b1, b2;
-        derivs(t0 - e, a1, a2);
-        derivs(t0 + e, b1, b2);
-        ASSERT_TRUE(a1.allFinite() && a2.allFinite() && b1.allFinite() && b2.allFinite());
-        gap1[k] = (a1 - b1).norm();
-        gap2[k] = (a2 - b2).norm();
-        x2 = std::max(a2.norm(), b2.norm());
-      }
+      const test::EdgeGaps g = test::edgeGaps(derivs, t0);
+      ASSERT_TRUE(g.finite);
+      const double *gap1 = g.gap1, *gap2 = g.gap2, x2 = g.x2;
       EXPECT_LT(gap1[1], 1e-6) << "sweep " << c << " edge " << edge;
       EXPECT_LT(gap2[1], 1e-2 * (1.0 + x2)) << "sweep " << c << " edge " << edge;
       EXPECT_LE(gap1[1], 0.15 * gap1[0] + 1e-15) << "sweep " << c << " edge " << edge;

@@ -95,12 +95,7 @@ struct Sweep {
   double pen(double t) const { return calcWrapPenetration(s, p1, p2(t)); }
   // t where the penetration equals target (bisection; pen increases with t on [0, 1])
   double where(double target) const {
-    double lo = 0.0, hi = 1.0;
-    for (int k = 0; k < 200; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      (pen(mid) < target ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
+    return test::whereAlong([this](double t) { return pen(t); }, target);
   }
   // first and second derivatives of x along the sweep, from the model's J and Jdot
   void derivs(double t, double width, Vec3& x1, Vec3& x2) const {

@@ -95,14 +95,7 @@ TEST(WrapSmoothTorus, C2AcrossBothEdgesOfTheBand) {
   auto pen = [&](double t) { return calcWrapPenetration(s, p1, p2(t)); };
   ASSERT_LT(pen(0.0), 0.0);
   ASSERT_GT(pen(1.0), width);
-  auto where = [&](double target) {
-    double lo = 0.0, hi = 1.0;
-    for (int k = 0; k < 200; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      (pen(mid) < target ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
-  };
+  auto where = [&](double target) { return test::whereAlong(pen, target); };
   auto derivs = [&](double t, Vec3& x1, Vec3& x2) {
     const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(s, p1, p2(t), alpha, Vec3::Zero(), dir, SmoothWrapOptions{width});
     x1 = sp.J.rightCols<3>() * dir;
@@ -110,17 +103,9 @@ TEST(WrapSmoothTorus, C2AcrossBothEdgesOfTheBand) {
   };
   for (double edge : {0.0, width}) {
     const double t0 = where(edge);
-    double gap1[2], gap2[2], x2 = 0.0;
-    for (int k = 0; k < 2; ++k) {
-      const double e = k == 0 ? 1e-6 : 1e-7;
-      Vec3 a1, a2, b1, b2;
-      derivs(t0 - e, a1, a2);
-      derivs(t0 + e, b1, b2);
-      ASSERT_TRUE(a1.allFinite() && a2.allFinite() && b1.allFinite() && b2.allFinite());
-      gap1[k] = (a1 - b1).norm();
-      gap2[k] = (a2 - b2).norm();
-      x2 = std::max(a2.norm(), b2.norm());
-    }
+    const test::EdgeGaps g = test::edgeGaps(derivs, t0);
+    ASSERT_TRUE(g.finite);
+    const double *gap1 = g.gap1, *gap2 = g.gap2, x2 = g.x2;
     // the gaps shrink with the distance from the edge (no jump)
     EXPECT_LT(gap1[1], 1e-6) << "edge " << edge;
     EXPECT_LT(gap2[1], 1e-2 * (1.0 + x2)) << "edge " << edge;
