@@ -18,7 +18,13 @@ HeldContacts::HeldContacts(std::shared_ptr<const UnilateralConstraints> u, std::
     : u_(std::move(u)), held_(std::move(held)), opt_(opt) {
   if (!u_) throw ModelError("HeldContacts: no unilateral constraints");
   if (!(opt_.omega >= 0.0)) throw ModelError("HeldContacts: negative Baumgarte rate");
+  sources_.pairs.assign(u_->pairs().size(), 0);
+  sources_.limits.assign(u_->limits().size(), 0);
   for (const HeldContact& h : held_) {
+    auto& on = h.key.limit ? sources_.limits : sources_.pairs;
+    if (h.key.source < 0 || h.key.source >= static_cast<int>(on.size()))
+      throw ModelError("HeldContacts: a held contact names no pair or limit of the constraints");
+    on[h.key.source] = 1;
     first_.push_back(rows_);
     rows_ += 1;
     for (int k = 0; k < 2; ++k) {
@@ -36,7 +42,7 @@ void HeldContacts::rowsAt(const Model& model, const State& s, const SkeletonWork
                           VecX& gap) const {
   const int nr = model.nr();
   UnilateralRows rows;
-  u_->detect(model, s, sk, nr, 1.0, rows);
+  u_->detect(model, s, sk, nr, 1.0, rows, &sources_);
   G.setZero(rows_, nr);
   gap.setZero(rows_);
   for (size_t i = 0; i < held_.size(); ++i) {
@@ -98,7 +104,7 @@ void HeldContacts::calcForceRows(const Model& model, const State& s, const Skele
                                  Eigen::Ref<MatX> H) const {
   const int nr = model.nr();
   UnilateralRows rows;
-  u_->detect(model, s, sk, nr, 1.0, rows);
+  u_->detect(model, s, sk, nr, 1.0, rows, &sources_);
   for (size_t i = 0; i < held_.size(); ++i) {
     const HeldContact& h = held_[i];
     if (h.slide[0] == 0 && h.slide[1] == 0) continue;

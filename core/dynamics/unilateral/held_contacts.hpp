@@ -76,6 +76,7 @@ class HeldContacts final : public Constraint {
   std::vector<HeldContact> held_;
   HeldContactOptions opt_;
   std::vector<int> first_;
+  UnilateralConstraints::Subset sources_;  // the pairs and limits with a held point: all that is detected
   int rows_ = 0;
   bool sliding_ = false;
 };

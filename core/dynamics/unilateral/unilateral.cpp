@@ -145,7 +145,7 @@ UnilateralConstraints::UnilateralConstraints(const Model& model, std::vector<Col
 }
 
 void UnilateralConstraints::detect(const Model& model, const State& s, const SkeletonWorkspace& sk, int ndof,
-                                   double h, UnilateralRows& out) const {
+                                   double h, UnilateralRows& out, const Subset* only) const {
   const auto& o = options_;
   const int nr = model.nr();
   out.c.clear();
@@ -172,6 +172,7 @@ void UnilateralConstraints::detect(const Model& model, const State& s, const Ske
 
   // joint limits: reduced rows +-e_i
   for (size_t i = 0; i < limits_.size(); ++i) {
+    if (only && !only->limits[i]) continue;
     const JointLimit& l = limits_[i];
     const int k = l.coordinate;
     for (int side = 0; side < 2; ++side) {
@@ -192,6 +193,7 @@ void UnilateralConstraints::detect(const Model& model, const State& s, const Ske
   detail::PointKinematics ka, kb;
   std::vector<Vec3> pts;
   for (size_t i = 0; i < pairs_.size(); ++i) {
+    if (only && !only->pairs[i]) continue;
     const CollisionPair& p = pairs_[i];
     const CollisionGeometry &ga = geometry_[p.first], &gb = geometry_[p.second];
     const Mat4 Xa = worldPose(sk, ga), Xb = worldPose(sk, gb);

@@ -125,9 +125,13 @@ class UnilateralConstraints {
 
   /// the candidate rows at state s (every point of every pair and both sides of every limit;
   /// solveUnilateralStep keeps those that can close within the step) (sk at Stage::Velocity for s's skeleton part; ndof system
-  /// coordinates, the first nr the skeleton's) for a step of size h
+  /// coordinates, the first nr the skeleton's) for a step of size h. With `only`, just the pairs
+  /// and limits it marks (the same rows as the full detection gives them)
+  struct Subset {
+    std::vector<char> pairs, limits;  ///< one flag per pair / limit
+  };
   void detect(const Model& model, const State& s, const SkeletonWorkspace& sk, int ndof, double h,
-              UnilateralRows& out) const;
+              UnilateralRows& out, const Subset* only = nullptr) const;
   /// the signed distances of every geometry point of every pair and of every limit (negative:
   /// penetration), for reports and tests; needs Stage::Position
   std::vector<double> gaps(const Model& model, const State& s, const SkeletonWorkspace& sk) const;

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "core/dynamics/system.hpp"
+#include "core/dynamics/unilateral/held_contacts.hpp"
 #include "core/dynamics/unilateral/qp_solver.hpp"
 #include "core/integrators/integrator.hpp"
 #include "core/joints/basic_joints.hpp"
@@ -88,6 +89,43 @@ TEST(Unilateral, NormalRowsAreTheGapRatesByFiniteDifferences) {
       EXPECT_GT(c.mu, 0.0);
     }
   EXPECT_EQ(rows.Jt.rows(), 2 * (8 + 2 + 1));
+}
+
+// The held contacts of the event-driven integrators detect only their own pairs and limits: the
+// rows of a subset equal the full detection's rows of those sources, bit for bit.
+TEST(Unilateral, DetectingASubsetGivesThoseSourcesRowsUnchanged) {
+  Scene sc;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  State s = sc.sys->defaultState();
+  for (int k = 0; k < s.q.size(); ++k) s.q[k] = 0.3 * U(rng), s.qdot[k] = U(rng);
+  s.q[1] = 0.3, s.q[7] = 0.2, s.q[13] = 1.0, s.q[14] = 0.6;
+  DynamicsWorkspace ws(*sc.sys);
+  sc.sys->kineticEnergy(s, ws);
+  const int n = sc.sys->ndof();
+  UnilateralRows all;
+  sc.u->detect(sc.sys->model(), s, ws.sk, n, 1e-3, all);
+  for (int mask = 0; mask < 32; ++mask) {  // every subset of the 4 pairs and the limit
+    UnilateralConstraints::Subset only;
+    for (int i = 0; i < 4; ++i) only.pairs.push_back((mask >> i) & 1);
+    only.limits.push_back((mask >> 4) & 1);
+    UnilateralRows part;
+    sc.u->detect(sc.sys->model(), s, ws.sk, n, 1e-3, part, &only);
+    size_t expected = 0;
+    for (size_t i = 0; i < all.c.size(); ++i) {
+      const auto& c = all.c[i];
+      if (!(c.limit ? only.limits[c.source] : only.pairs[c.source])) continue;
+      ++expected;
+      const int j = findCandidate(part, ContactKey::of(c));
+      ASSERT_GE(j, 0) << "mask " << mask;
+      EXPECT_EQ(part.c[j].gap, c.gap);
+      EXPECT_EQ(part.c[j].approach, c.approach);
+      EXPECT_TRUE(part.Jn.row(j) == all.Jn.row(static_cast<int>(i)));
+      if (c.tangent_row >= 0)
+        EXPECT_TRUE(part.Jt.middleRows(part.c[j].tangent_row, 2) == all.Jt.middleRows(c.tangent_row, 2));
+    }
+    EXPECT_EQ(part.c.size(), expected) << "mask " << mask;
+  }
 }
 
 TEST(Unilateral, DualStepEqualsThePrimalQpOfEq347) {
