@@ -21,6 +21,10 @@ constexpr double kGapTol = 1e-12;
 constexpr double kSpeedTol = 1e-12;
 // mode changes at one instant before the run gives up (chattering, Painleve-like inconsistency)
 constexpr int kMaxChangesAtOneInstant = 200;
+// mode changes within kZenoWindow s of simulated time before the run gives up: events that
+// accumulate (a body rocking or bouncing ever faster between points) would otherwise run for ever
+constexpr int kMaxChangesInWindow = 300;
+constexpr double kZenoWindow = 1e-3;
 
 void addStats(IntegratorStats& to, const IntegratorStats& from) {
   to.steps += from.steps;
@@ -289,6 +293,8 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
 
   int changes = 0;
   double t_changes = s.t;
+  std::vector<double> recent;  // times of the last kMaxChangesInWindow changes (a ring)
+  size_t next_recent = 0;
   while (s.t < t_out) {
     std::shared_ptr<System> P = d.phase();
     const Found here = d.check(*P, s);
@@ -296,6 +302,20 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
       if (s.t != t_changes) {
         t_changes = s.t;
         changes = 0;
+      }
+      if (recent.size() < static_cast<size_t>(kMaxChangesInWindow)) {
+        recent.push_back(s.t);
+      } else {
+        const double oldest = recent[next_recent];
+        recent[next_recent] = s.t;
+        next_recent = (next_recent + 1) % recent.size();
+        if (s.t - oldest < kZenoWindow) {
+          std::ostringstream os;
+          os << method << ": the contact modes changed " << kMaxChangesInWindow << " times between t = " << oldest
+             << " and t = " << s.t << " (events accumulating: a body rocking or bouncing ever faster between contact "
+             << "points); use bdf1";
+          throw SimulationError(os.str(), s.t, 0.0);
+        }
       }
       if (++changes > kMaxChangesAtOneInstant) {
         std::ostringstream os;
@@ -318,8 +338,12 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
         d.notePenetration(s);
         continue;
       }
-      // the event lies in (s.t, tb]: bisection on re-runs from s
+      // the event lies in (s.t, tb]: bisection on re-runs from the last state without one. The
+      // run stops at the state in which the event was seen (not a re-run to the same time: near a
+      // slow crossing two runs' positions differ by their integration error, more than the gap
+      // tolerance, and a re-run may miss the event and find it again 1e-12 s later, for ever)
       State lo = s;
+      State at_hi = b;
       double hi = tb;
       while (hi - lo.t > 1e-12 * std::max(1.0, std::abs(hi))) {
         const double mid = 0.5 * (lo.t + hi);
@@ -328,14 +352,14 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
         probe->advance(*P, m, mid);
         addStats(stats, probe->stats());
         ++cnt.bisections;
-        if (!d.check(*P, m).any()) lo = m;
-        else hi = mid;
+        if (!d.check(*P, m).any()) {
+          lo = std::move(m);
+        } else {
+          hi = mid;
+          at_hi = std::move(m);
+        }
       }
-      State e = lo;
-      std::unique_ptr<Integrator> last = makeIntegrator(method, opt);
-      last->advance(*P, e, hi);
-      addStats(stats, last->stats());
-      s = e;  // the next pass applies the event found here
+      s = std::move(at_hi);  // the next pass applies the event found here
       d.notePenetration(s);
       phase_over = true;
     }
