@@ -25,6 +25,7 @@ struct OptimizeFlags {
   int nodes = 5;
   long max_simulations = 2000;
   bool quiet = false;
+  std::string initial_speeds = "default";
   MuscleMassFlags mm;
 };
 
@@ -40,7 +41,7 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
       std::cerr << "error: " << n << ": not used by --task track (the objective is --motion and --objective)\n";
       return 2;
     }
-  for (const char* n : {"--motion", "--objective"})
+  for (const char* n : {"--motion", "--objective", "--initial-speeds"})
     if (!track && given(app, n)) {
       std::cerr << "error: " << n << ": needs --task track\n";
       return 2;
@@ -49,6 +50,7 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
   o.task = f.task;
   o.motion = f.motion;
   o.objective = f.objective;
+  o.initial_speeds = f.initial_speeds;
   o.model_path = f.model;
   o.body = f.body;
   if (!track && !validation::parseVec3(f.target, o.target)) {
@@ -163,12 +165,18 @@ CommandRegistration reg(
        app.add_option("--motion", f->motion,
                       "--task track: the motion (.mot/.sto) whose coordinates the run tracks, all that the\n"
                       "model has or the named ones C,... (the gradient's coords: term, weight 1); the run\n"
-                      "starts from its pose at t = 0")
+                      "starts from its pose at t = 0 (its speeds: --initial-speeds)")
            ->type_name("FILE.mot[@C,...]");
        app.add_option("--objective", f->objective,
                       "--task track: further terms of `redmax gradient`'s --objective SPEC, e.g.\n"
                       "'track:MARKER=FILE.trc;1e-4*effort' (docs/gradients.md §3)")
            ->type_name("SPEC");
+       app.add_option("--initial-speeds", f->initial_speeds,
+                      "--task track: the tracked coordinates' speeds at the start: the model's defaults, the\n"
+                      "motion's rates there (second-order differences of its first rows), or free (optimized\n"
+                      "with the torques, from the motion's rates; reported as 'qdot0 C' parameters)")
+           ->type_name("default|motion|free")
+           ->check(oneOf({"default", "motion", "free"}));
        app.add_option("--model", f->model, "the OpenSim model (.osim), e.g. osim_models/reach_arm.osim; required")
            ->type_name("M.osim")
            ->check(existingFile());

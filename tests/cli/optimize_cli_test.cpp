@@ -168,6 +168,12 @@ TEST_F(OptimizeCli, TrackTaskRecoversTheTorquesOfAMotion) {
   bad = run(kReach + " --motion " + motion.string());
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("error: --motion: needs --task track"), std::string::npos) << bad.err;
+  bad = run(kReach + " --initial-speeds motion");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("error: --initial-speeds: needs --task track"), std::string::npos) << bad.err;
+  bad = runRedmax(dir_, base + "--motion " + motion.string() + " --initial-speeds sideways");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--initial-speeds"), std::string::npos) << bad.err;
   bad = runRedmax(dir_, "optimize --task track --model " + scene("reach_arm.osim") + " --duration 0.3 --motion " +
                             motion.string());
   EXPECT_EQ(bad.code, 2);

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -243,6 +244,73 @@ TEST_F(TrackTest, LbfgsRecoversTheTorquesThatMadeTheMotion) {
   ASSERT_EQ(rp.coordinates.size(), 4u);
   EXPECT_EQ(rp.t.size(), tr.states.size());
   EXPECT_NEAR(rp.rms, r.error, 1e-9 * std::max(r.error, 1e-12) + 1e-15);
+}
+
+// A motion that starts moving: made by a run with known torques from known initial speeds. From
+// the model's default speeds (rest) constant torques cannot follow it; with --initial-speeds free
+// the speeds are parameters too and L-BFGS recovers both; --initial-speeds motion starts from the
+// file's rates (second-order differences of a first-order run: off by about h a / 2).
+TEST_F(TrackTest, InitialSpeedsFromTheMotionOrOptimized) {
+  const double duration = 0.3, dt = 0.01;
+  const VecX truth = (VecX(8) << 2.0, -1.5, 0.3, 1.0, 0.6, -0.4, 0.3, 0.8).finished();  // N m, then rad/s
+  GradientSetup g = makeGradientSetup(
+      kArm, SimulationModelOptions{}, "euler", duration, dt,
+      "torques:shoulder_flexion,shoulder_adduction,shoulder_rotation,elbow_flexion;"
+      "qdot0:shoulder_flexion,shoulder_adduction,shoulder_rotation,elbow_flexion",
+      "speed");
+  const adjoint::Trajectory tr = adjoint::simulateTrajectory(g.problem, truth);
+  std::vector<double> times;
+  for (const State& s : tr.states) times.push_back(s.t);
+  std::vector<int> q;
+  for (const auto& c : kArmCoordinates) q.push_back(g.model.system->model().findCoordinate(c));
+  const std::string file = path("moving.mot");
+  writeMotion(
+      file, kArmCoordinates, times,
+      [&](size_t c, double t) { return tr.states[static_cast<size_t>(std::lround(t / dt))].q[q[c]]; }, true);
+
+  ReachOptions o;
+  o.task = "track";
+  o.model_path = kArm;
+  o.motion = file;
+  o.coordinates = kArmCoordinates;
+  o.duration = duration;
+  o.dt = dt;
+  o.tolerance = 1e-6;
+  o.max_simulations = 300;
+  double error[3] = {0, 0, 0};
+  const char* modes[3] = {"default", "motion", "free"};
+  for (int m = 0; m < 3; ++m) {
+    o.initial_speeds = modes[m];
+    const ReachSetup s = makeReachSetup(o);
+    const ReachResult r = optimizeReach(s, "lbfgs");
+    error[m] = r.error;
+    std::cout << "[ measured ] --initial-speeds " << modes[m] << ": RMS error " << r.error << " rad, " << r.simulations
+              << " simulations; parameters " << r.torques.transpose() << "\n";
+    if (m == 1) {
+      // the start rates: the quadratic through the first three rows of the run's q_k gives
+      // qdot_0 + h (qddot_0 - qddot_1 / 2), about h qddot / 2 off
+      for (size_t c = 0; c < 4; ++c) {
+        const double a0 = (tr.states[1].qdot[q[c]] - tr.states[0].qdot[q[c]]) / dt;
+        const double a1 = (tr.states[2].qdot[q[c]] - tr.states[1].qdot[q[c]]) / dt;
+        EXPECT_NEAR(s.gradient.problem.initial.qdot[q[c]], truth[4 + static_cast<Eigen::Index>(c)] + dt * (a0 - a1 / 2),
+                    1e-9)
+            << c;
+      }
+    }
+    if (m == 2) {
+      ASSERT_EQ(r.torques.size(), 8);
+      EXPECT_EQ(s.gradient.param_names[4], "qdot0 shoulder_flexion");
+      EXPECT_TRUE(r.reached) << r.stop;
+      // measured: 117 simulations, RMS 9.0e-7 rad, parameters within 1.3e-5 of the truth
+      EXPECT_LE((r.torques - truth).cwiseAbs().maxCoeff(), 1e-4) << r.torques.transpose();
+      EXPECT_LT(r.simulations, 200) << r.stop;
+    }
+  }
+  EXPECT_GT(error[0], 1e3 * o.tolerance) << "rest at the start should not track a moving start";
+  EXPECT_LT(error[1], error[0]);
+  EXPECT_LT(error[2], error[1]);
+  o.initial_speeds = "sideways";
+  EXPECT_THROW(makeReachSetup(o), std::invalid_argument);
 }
 
 // The tracking task on markers alone: reach_arm.osim's hand_point along the path a run with known

@@ -29,7 +29,8 @@
 // The tracking task (task = "track", docs/gradients.md §7): the same torque parameters and
 // methods, but the objective is the gradient's tracking SPEC (coords:FILE.mot[@C,...] from `motion`
 // and any further terms of `objective`, e.g. track:MARKER=FILE.trc) summed over the whole run; the
-// run starts from the motion's pose at its start for the tracked coordinates; the error reported is
+// run starts from the motion's pose at its start for the tracked coordinates (at the model's
+// default speeds, the motion's rates or speeds optimized with the torques: initial_speeds); the error reported is
 // sqrt(2 J / duration) (trackingError) and the report adds best_run.csv and tracking.png|svg (each
 // tracked coordinate of the best run against the motion).
 //
@@ -78,7 +79,17 @@ struct ReachOptions {
   int nodes = 5;                         ///< excitation nodes per muscle over the run
   double initial_excitation = 0.1;       ///< every node's start value (within each muscle's bounds)
   double excitation_weight = 0.0;        ///< weight of the integral of the squared excitations
+  /// track: the run's initial speeds of the tracked coordinates: "default" (the model's), "motion"
+  /// (the motion's rates at the start, startRate) or "free" (parameters optimized with the torques,
+  /// from the motion's rates; they follow the torques in the parameter vector, unscaled, rad/s or m/s)
+  std::string initial_speeds = "default";
 };
+
+/// The rate at `time` of a tracked coordinate (rad/s or m/s): the derivative of the quadratic
+/// through the samples i, i+1, i+2 where t_i <= time < t_{i+1} (the last three samples near the
+/// end; the slope of two; 0 for one): second order in the spacing, unlike the linear
+/// interpolant's slope (first order), for motions sampled at 100 Hz or coarser.
+double startRate(const adjoint::Objective::CoordinateTrack& track, double time);
 
 /// The task resolved against the model.
 struct ReachSetup {
