@@ -194,28 +194,27 @@ TEST_F(TrackTest, BadInputIsNamed) {
   EXPECT_EQ(m.rfind(path("missing.mot") + ":", 0), 0u) << m;
 }
 
-// A motion made by a run with known constant torques (written in degrees at every step): tracking
-// it from zero torques, L-BFGS on the adjoint gradient recovers them.
-TEST_F(TrackTest, LbfgsRecoversTheTorquesThatMadeTheMotion) {
-  const double duration = 0.3, dt = 0.01;
-  const VecX truth = (VecX(4) << 2.0, -1.5, 0.3, 1.0).finished();  // N m, kArmCoordinates' order
-  GradientSetup g = makeGradientSetup(kArm, SimulationModelOptions{}, "euler", duration, dt,
-                                      "torques:shoulder_flexion,shoulder_adduction,shoulder_rotation,elbow_flexion",
-                                      "speed");
-  const adjoint::Trajectory tr = adjoint::simulateTrajectory(g.problem, truth);
+// a run of reach_arm with the given gradient parameters (params SPEC) at `truth`, its four
+// coordinates written to `file` in degrees at every step
+struct MadeMotion {
+  adjoint::Trajectory tr;
+  std::vector<int> q;  // kArmCoordinates' indices
+};
+MadeMotion makeMotion(const std::string& params, const VecX& truth, double duration, double dt, const std::string& file) {
+  GradientSetup g = makeGradientSetup(kArm, SimulationModelOptions{}, "euler", duration, dt, params, "speed");
+  MadeMotion m;
+  m.tr = adjoint::simulateTrajectory(g.problem, truth);
   std::vector<double> times;
-  for (const State& s : tr.states) times.push_back(s.t);
-  std::vector<int> q;
-  for (const auto& c : kArmCoordinates) q.push_back(g.model.system->model().findCoordinate(c));
-  const std::string file = path("made.mot");
+  for (const State& s : m.tr.states) times.push_back(s.t);
+  for (const auto& c : kArmCoordinates) m.q.push_back(g.model.system->model().findCoordinate(c));
   writeMotion(
       file, kArmCoordinates, times,
-      [&](size_t c, double t) {
-        const size_t k = static_cast<size_t>(std::lround(t / dt));
-        return tr.states[k].q[q[c]];
-      },
-      true);
+      [&](size_t c, double t) { return m.tr.states[static_cast<size_t>(std::lround(t / dt))].q[m.q[c]]; }, true);
+  return m;
+}
 
+// the tracking task on reach_arm: all four coordinates torqued and tracked from `file`
+ReachOptions armTrack(const std::string& file, double duration, double dt) {
   ReachOptions o;
   o.task = "track";
   o.model_path = kArm;
@@ -223,6 +222,19 @@ TEST_F(TrackTest, LbfgsRecoversTheTorquesThatMadeTheMotion) {
   o.coordinates = kArmCoordinates;
   o.duration = duration;
   o.dt = dt;
+  return o;
+}
+
+const char* kArmTorques = "torques:shoulder_flexion,shoulder_adduction,shoulder_rotation,elbow_flexion";
+
+// A motion made by a run with known constant torques (written in degrees at every step): tracking
+// it from zero torques, L-BFGS on the adjoint gradient recovers them.
+TEST_F(TrackTest, LbfgsRecoversTheTorquesThatMadeTheMotion) {
+  const double duration = 0.3, dt = 0.01;
+  const VecX truth = (VecX(4) << 2.0, -1.5, 0.3, 1.0).finished();  // N m, kArmCoordinates' order
+  const std::string file = path("made.mot");
+  const adjoint::Trajectory tr = makeMotion(kArmTorques, truth, duration, dt, file).tr;
+  ReachOptions o = armTrack(file, duration, dt);
   o.tolerance = 1e-7;  // rad, RMS over the run
   o.max_simulations = 400;
   const ReachSetup s = makeReachSetup(o);
@@ -253,28 +265,13 @@ TEST_F(TrackTest, LbfgsRecoversTheTorquesThatMadeTheMotion) {
 TEST_F(TrackTest, InitialSpeedsFromTheMotionOrOptimized) {
   const double duration = 0.3, dt = 0.01;
   const VecX truth = (VecX(8) << 2.0, -1.5, 0.3, 1.0, 0.6, -0.4, 0.3, 0.8).finished();  // N m, then rad/s
-  GradientSetup g = makeGradientSetup(
-      kArm, SimulationModelOptions{}, "euler", duration, dt,
-      "torques:shoulder_flexion,shoulder_adduction,shoulder_rotation,elbow_flexion;"
-      "qdot0:shoulder_flexion,shoulder_adduction,shoulder_rotation,elbow_flexion",
-      "speed");
-  const adjoint::Trajectory tr = adjoint::simulateTrajectory(g.problem, truth);
-  std::vector<double> times;
-  for (const State& s : tr.states) times.push_back(s.t);
-  std::vector<int> q;
-  for (const auto& c : kArmCoordinates) q.push_back(g.model.system->model().findCoordinate(c));
   const std::string file = path("moving.mot");
-  writeMotion(
-      file, kArmCoordinates, times,
-      [&](size_t c, double t) { return tr.states[static_cast<size_t>(std::lround(t / dt))].q[q[c]]; }, true);
-
-  ReachOptions o;
-  o.task = "track";
-  o.model_path = kArm;
-  o.motion = file;
-  o.coordinates = kArmCoordinates;
-  o.duration = duration;
-  o.dt = dt;
+  const MadeMotion made = makeMotion(
+      std::string(kArmTorques) + ";qdot0:shoulder_flexion,shoulder_adduction,shoulder_rotation,elbow_flexion", truth,
+      duration, dt, file);
+  const adjoint::Trajectory& tr = made.tr;
+  const std::vector<int>& q = made.q;
+  ReachOptions o = armTrack(file, duration, dt);
   o.tolerance = 1e-6;
   o.max_simulations = 300;
   double error[3] = {0, 0, 0};
