@@ -145,11 +145,6 @@ double nloptObjective(unsigned n, const double* x, double* /*grad*/, void* data)
 
 void runNlopt(const ReachSetup& setup, nlopt_algorithm algorithm, Tracker& tracker, ReachResult& res) {
   const unsigned n = static_cast<unsigned>(setup.gradient.p0.size());
-  nlopt_opt opt = nlopt_create(algorithm, n);
-  if (!opt) throw std::runtime_error("NLopt: cannot create the optimizer");
-  NloptData data;
-  data.tracker = &tracker;
-  data.opt = opt;
   const double box = setup.options.max_torque;
   std::vector<double> lo(n), hi(n), x(n, 0.0);
   for (unsigned i = 0; i < n; ++i) {
@@ -162,18 +157,40 @@ void runNlopt(const ReachSetup& setup, nlopt_algorithm algorithm, Tracker& track
       lo[i] = -hi[i];
     }
   }
-  nlopt_set_lower_bounds(opt, lo.data());
-  nlopt_set_upper_bounds(opt, hi.data());
-  nlopt_set_min_objective(opt, nloptObjective, &data);
-  nlopt_set_xtol_rel(opt, 1e-10);
-  nlopt_set_initial_step1(opt, setup.options.initial_step);  // rad/s^2, or excitation
-  double f = 0.0;
-  const nlopt_result r = nlopt_optimize(opt, x.data(), &f);
-  nlopt_destroy(opt);
-  if (data.reached) res.stop = "reached the stop objective";
-  else if (data.exhausted) res.stop = "max simulations";
-  else if (data.error) std::rethrow_exception(data.error);
-  else res.stop = std::string("NLopt: ") + nlopt_result_to_string(r);
+  // a method that converges (its step below xtol) short of the stop objective, e.g. against a
+  // jump of the objective (a wrap the library switches off, docs/wrapping.md), starts again from
+  // the best point with its first step, as long as the previous attempt improved the objective
+  double last_best = std::numeric_limits<double>::infinity();
+  for (;;) {
+    nlopt_opt opt = nlopt_create(algorithm, n);
+    if (!opt) throw std::runtime_error("NLopt: cannot create the optimizer");
+    NloptData data;
+    data.tracker = &tracker;
+    data.opt = opt;
+    nlopt_set_lower_bounds(opt, lo.data());
+    nlopt_set_upper_bounds(opt, hi.data());
+    nlopt_set_min_objective(opt, nloptObjective, &data);
+    nlopt_set_xtol_rel(opt, 1e-10);
+    nlopt_set_initial_step1(opt, setup.options.initial_step);  // rad/s^2, or excitation
+    double f = 0.0;
+    const nlopt_result r = nlopt_optimize(opt, x.data(), &f);
+    nlopt_destroy(opt);
+    if (data.reached) {
+      res.stop = "reached the stop objective";
+      return;
+    }
+    if (data.exhausted) {
+      res.stop = "max simulations";
+      return;
+    }
+    if (data.error) std::rethrow_exception(data.error);
+    res.stop = std::string("NLopt: ") + nlopt_result_to_string(r);
+    if (!(r == NLOPT_SUCCESS || r == NLOPT_XTOL_REACHED || r == NLOPT_FTOL_REACHED) || !(res.objective < last_best))
+      return;
+    last_best = res.objective;
+    for (unsigned i = 0; i < n; ++i) x[i] = res.torques[i] / setup.scale[i];
+    ++res.restarts;
+  }
 }
 
 }  // namespace

@@ -135,7 +135,7 @@ struct ReachResult {
   std::vector<std::string> names;
   std::vector<ReachEvaluation> evaluations;
   long simulations = 0, step_evaluations = 0;
-  long restarts = 0;           ///< L-BFGS restarts after a failed line search
+  long restarts = 0;           ///< L-BFGS restarts after a failed line search; NLopt restarts after converging short
   long failed_simulations = 0; ///< runs that diverged (counted in simulations, objective +inf)
   double seconds = 0.0;
   /// at the best parameters: error |p - target| (m; track: trackingError), final_speed |qdot_N|

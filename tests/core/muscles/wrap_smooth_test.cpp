@@ -3,6 +3,8 @@
 // Jacobian and Jdot against central differences.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <iostream>
 #include <random>
 
 #include "core/muscles/wrap/smooth.hpp"
@@ -174,6 +176,38 @@ TEST(WrapSmooth, BandErrorIsBoundedByTheWidth) {
     EXPECT_LT(worst_narrow, 0.01);
     EXPECT_LT(worst_narrow, 0.2 * worst_wide);
   }
+}
+
+// A shallow penetration with the muscle line passing 2.5e-7 m from the apex of OpenSim's slide
+// plane (the running leg's medial gastrocnemius over its quadrant condyle cylinder during a free
+// swing, in the surface frame): the plane, once formed from p1 - apex and p2 - apex, made J and
+// Jdot jump by 7e-8 and 7e-2 (|Jdot| 314) for any input change down to 1e-16 m, which stalled rk45
+// at 1e-11. Formed as the plane through the ends and the axis point, J and Jdot move with the
+// inputs as derivatives do (measured for 1e-15 m: 1.7e-12 and 1.1e-9).
+TEST(WrapSmooth, AShallowWrapNearTheSlidePlanesApexIsWellConditioned) {
+  const WrapSurface surf = WrapSurface::makeCylinder(0.022, 0.12, 0, -1);
+  const Vec3 p1(-0.010000000000000018, 0.03500000000000001, -0.023999999999999987);
+  const Vec3 p2(-0.18045697891038742, -0.44693587719737154, -0.0040000000000000018);
+  const Vec3 v1 = Vec3::Zero(), v2(-2.0173994652044711, 0.88090418241295787, 0.0);
+  const std::vector<double> alphas{0.025, 0.275, 0.525, 0.775, 0.975};
+  const SmoothWrapOptions so;
+  ASSERT_GT(calcWrapPenetration(surf, p1, p2), 0.0);
+  WrapMassPoints base;
+  calcSmoothWrapPoints(surf, p1, p2, v1, v2, alphas, {}, so, base);
+  double worst_j = 0.0, worst_jdot = 0.0;
+  for (int k = 0; k < 6; ++k) {
+    Vec3 q1 = p1, q2 = p2;
+    (k < 3 ? q1[k] : q2[k - 3]) += 1e-15;
+    WrapMassPoints w;
+    calcSmoothWrapPoints(surf, q1, q2, v1, v2, alphas, {}, so, w);
+    for (size_t a = 0; a < alphas.size(); ++a) {
+      worst_j = std::max(worst_j, (w.J[a] - base.J[a]).cwiseAbs().maxCoeff());
+      worst_jdot = std::max(worst_jdot, (w.Jdot[a] - base.Jdot[a]).cwiseAbs().maxCoeff());
+    }
+  }
+  std::cout << "[ measured ] inputs moved by 1e-15 m: J moves " << worst_j << ", Jdot " << worst_jdot << "\n";
+  EXPECT_LT(worst_j, 1e-11);
+  EXPECT_LT(worst_jdot, 1e-8);
 }
 
 TEST(WrapSmooth, UnsupportedSurfacesAreRefusedWithAReason) {
