@@ -138,13 +138,9 @@ bool cylinderTangentPoints(double R, double L, int axis, int sign, const V3<T>& 
     return true;
   };
   // only toward the other end: OpenSim projects onto the line through p11 with direction p22 (it
-  // passes the point p22 as the direction: the axis, up to sign, which the projection does not see;
-  // except where p2 lies in the surface frame's z = 0 plane, where p22 is the zero vector and
-  // OpenSim's test fails, so that r1 does not slide. That is a point, not a band: an insertion held
-  // at z = 0 by the model flipped between sliding and not with the round-off of its z (the reach
-  // arm's triceps: a 1 cm jump of the hand after 0.3 s). The axis serves as the direction there too.)
+  // passes the point p22 as the direction; the axis, up to sign)
   auto closestOnP11Line = [&](const Vec3& pt) {
-    const Vec3 a = values(p11), dir = Vec3::UnitZ();
+    const Vec3 a = values(p11), dir = values(p22).normalized();
     return Vec3(a + (pt - a).dot(dir) * dir);
   };
   V3<T> r1p, r2p;
