@@ -121,6 +121,24 @@ TEST(WrapCylinder, InclinedSegmentGivesAHelixOnTheSurface) {
   EXPECT_GT(calcWrappedPathLength(r, p1, p2), (p2 - p1).norm());
 }
 
+// An end point in the surface frame's z = 0 plane, as OpenSim computes it: its "only toward the
+// other end" test projects onto a line through p1's axis foot with p2's axis foot as the direction,
+// the zero vector there, and fails, so the p1-side tangent point does not slide along the axis,
+// while at z = +-1e-17 it does (0.018 m here). Reproduced, not smoothed: models place end points in
+// that plane (the spline leg's rect_fem_r at its default pose, whose slack length is fitted to the
+// length there; the reach arm's triceps, docs/notes.md).
+TEST(WrapCylinder, AnEndInTheMidPlaneDoesNotSlideAsInOpenSim) {
+  const WrapSurface cyl = WrapSurface::makeCylinder(0.025, 0.08, 0, -1);
+  const Vec3 p1(0.02892, 0.2902, 0.01919);
+  const WrapResult at = calcWrap(cyl, p1, Vec3(-0.02719, -0.01362, 0.0));
+  ASSERT_NE(at.code, WrapCode::NoWrap);
+  EXPECT_NEAR(at.r1.z(), p1.z(), 1e-12) << "r1 stays in p1's axis-normal plane";
+  for (double z : {1e-17, -1e-17}) {
+    const WrapResult near = calcWrap(cyl, p1, Vec3(-0.02719, -0.01362, z));
+    EXPECT_LT(std::abs(near.r1.z()), 0.005) << z << ": r1 slides toward the plane of the ends";
+  }
+}
+
 // ---- sphere -------------------------------------------------------------------------------
 
 TEST(WrapSphere, GreatCircleInAnyPlane) {
