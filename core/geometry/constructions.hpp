@@ -127,7 +127,7 @@ bool cylinderTangentPoints(double R, double L, int axis, int sign, const V3<T>& 
   // penetration): measured 2.5e-7 m off the line on the running leg's gastrocnemius, where that
   // normal's round-off reached 1e-9 and its second derivatives 1e-4 relative, enough to stall rk45
   // at 1e-11. The slide does not depend on the normal's sign.
-  const V3<T> pn = n;
+  const V3<T>& pn = n;
   const T dplane = -dot(p1, pn);
   auto slide = [&](const V3<T>& r, V3<T>& out) {
     const T dp = 20.0 * pn[2];

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -283,44 +284,34 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
   UnilateralEventCounts local;
   UnilateralEventCounts& cnt = counts ? *counts : local;
   Driver d(sys, cnt);
-  if (memory && memory->valid && memory->sys == &sys && memory->end.t == s.t && memory->end.q == s.q &&
-      memory->end.qdot == s.qdot && memory->end.z == s.z)
+  if (memory && memory->sys == &sys && memory->end.t == s.t && memory->end.q == s.q && memory->end.qdot == s.qdot &&
+      memory->end.z == s.z)
     d.resume(memory->held);
   else
     d.start(s);
-  if (memory) memory->valid = false;  // until this run ends
   d.notePenetration(s);
 
-  int changes = 0;
-  double t_changes = s.t;
-  std::vector<double> recent;  // times of the last kMaxChangesInWindow changes (a ring)
-  size_t next_recent = 0;
+  // the times of the last kMaxChangesInWindow + 1 mode changes: chattering at one instant and
+  // events accumulating over a short time are both read off them
+  std::deque<double> changes;
   while (s.t < t_out) {
     std::shared_ptr<System> P = d.phase();
     const Found here = d.check(*P, s);
     if (here.any()) {
-      if (s.t != t_changes) {
-        t_changes = s.t;
-        changes = 0;
-      }
-      if (recent.size() < static_cast<size_t>(kMaxChangesInWindow)) {
-        recent.push_back(s.t);
-      } else {
-        const double oldest = recent[next_recent];
-        recent[next_recent] = s.t;
-        next_recent = (next_recent + 1) % recent.size();
-        if (s.t - oldest < kZenoWindow) {
-          std::ostringstream os;
-          os << method << ": the contact modes changed " << kMaxChangesInWindow << " times between t = " << oldest
-             << " and t = " << s.t << " (events accumulating: a body rocking or bouncing ever faster between contact "
-             << "points); use bdf1";
-          throw SimulationError(os.str(), s.t, 0.0);
-        }
-      }
-      if (++changes > kMaxChangesAtOneInstant) {
+      changes.push_back(s.t);
+      if (changes.size() > static_cast<size_t>(kMaxChangesInWindow) + 1) changes.pop_front();
+      if (changes.size() > static_cast<size_t>(kMaxChangesAtOneInstant) &&
+          changes[changes.size() - 1 - kMaxChangesAtOneInstant] == s.t) {
         std::ostringstream os;
         os << method << ": the contact modes do not settle at t = " << s.t << " (" << kMaxChangesAtOneInstant
            << " changes at one instant: chattering or a frictional inconsistency); use bdf1";
+        throw SimulationError(os.str(), s.t, 0.0);
+      }
+      if (changes.size() == static_cast<size_t>(kMaxChangesInWindow) + 1 && s.t - changes.front() < kZenoWindow) {
+        std::ostringstream os;
+        os << method << ": the contact modes changed " << kMaxChangesInWindow << " times between t = "
+           << changes.front() << " and t = " << s.t << " (events accumulating: a body rocking or bouncing ever "
+           << "faster between contact points); use bdf1";
         throw SimulationError(os.str(), s.t, 0.0);
       }
       d.apply(s, here);
@@ -367,7 +358,6 @@ void advanceWithUnilateralEvents(const std::string& method, const IntegratorOpti
   }
   s.t = t_out;
   if (memory) {
-    memory->valid = true;
     memory->sys = &sys;
     memory->end = s;
     memory->held = d.held();

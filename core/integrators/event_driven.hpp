@@ -41,9 +41,8 @@ struct UnilateralEventCounts {
   double max_penetration = 0.0;  ///< largest penetration of the states reached at the checks and events (m or rad)
 };
 
-/// The held set at the end of a run and the state it belongs to.
+/// The held set at the end of a run and the state it belongs to (sys null: none yet).
 struct EventMemory {
-  bool valid = false;
   const System* sys = nullptr;
   State end;
   std::vector<HeldContact> held;

@@ -297,20 +297,6 @@ ReachSetup makeReachSetup(const ReachOptions& options) {
   try {
     s.gradient = makeGradientSetup(options.model_path, options.model_options, options.integrator, options.duration,
                                    options.dt, params, objective);
-    if (track && speeds == "free" && !s.gradient.objective.coordinate_tracks.empty()) {
-      // the tracked coordinates' initial speeds join the parameters, from the motion's rates
-      std::vector<std::string> items;
-      for (const auto& ct : s.gradient.objective.coordinate_tracks) {
-        std::ostringstream item;
-        item.precision(17);
-        item << s.gradient.model.coordinate_names.at(static_cast<size_t>(ct.coordinate)) << "="
-             << startRate(ct, s.gradient.problem.initial.t);
-        items.push_back(item.str());
-      }
-      params += ";qdot0:" + joined(items, ",");
-      s.gradient = makeGradientSetup(options.model_path, options.model_options, options.integrator, options.duration,
-                                     options.dt, params, objective);
-    }
   } catch (const std::invalid_argument& e) {
     // "--params 'torques:x': no coordinate named 'x'" in the reach command's words
     std::string what = e.what();
@@ -338,14 +324,23 @@ ReachSetup makeReachSetup(const ReachOptions& options) {
                                   "': --task track needs a tracking term (coords:FILE.mot or track:MARKER=FILE.trc)");
     s.gradient.objective.speed_weight += options.rest_weight;
     // the run starts from the motion's pose at the start for the coordinates it tracks (at the
-    // model's default speeds), projected onto the constraints as the default state is
+    // speeds initial_speeds names), projected onto the constraints as the default state is
     if (speeds != "default" && s.gradient.objective.coordinate_tracks.empty())
       throw std::invalid_argument("--initial-speeds " + speeds + ": needs --motion (the speeds are the tracked "
                                   "coordinates' rates)");
-    State& s0 = s.gradient.problem.initial;
-    for (const auto& ct : s.gradient.objective.coordinate_tracks) {
+    GradientSetup& g = s.gradient;
+    State& s0 = g.problem.initial;
+    for (const auto& ct : g.objective.coordinate_tracks) {
       s0.q[ct.coordinate] = ct.at(s0.t);
       if (speeds == "motion") s0.qdot[ct.coordinate] = startRate(ct, s0.t);
+      if (speeds == "free") {
+        // the speed joins the parameters after the torques (the gradient's qdot0: kind; the
+        // track's parameters are torques alone, so it goes last), from the motion's rate
+        g.problem.initial_qdot.push_back(ct.coordinate);
+        g.param_names.push_back("qdot0 " + g.model.coordinate_names.at(static_cast<size_t>(ct.coordinate)));
+        g.p0.conservativeResize(g.p0.size() + 1);
+        g.p0[g.p0.size() - 1] = startRate(ct, s0.t);
+      }
     }
     const System& sys = *s.gradient.model.system;
     if (sys.numConstraintRows() > 0) {
