@@ -23,6 +23,44 @@
 
 namespace redmax {
 
+/// A wrap model's points over one surface (frame s): WrapMassPoints (x, J = dx/d(p1, p2) 3x6, Jdot
+/// = dJ/dt along (p1dot, p2dot, alphadot)) plus, when asked for, the derivative along the fraction.
+struct WrapModelPoints : WrapMassPoints {
+  std::vector<Vec3> x_alpha;     ///< dx/dalpha (m)
+  std::vector<Vec3> x_alphadot;  ///< d/dt dx/dalpha along (p1dot, p2dot, alphadot)
+};
+
+/// Pose and motion of one wrap surface frame s (world): R = R_ws, p = p_ws (m), its angular
+/// velocity omega (rad/s) and origin velocity pdot (m/s), with J_om = d omega / d qdot and J_p =
+/// d pdot / d qdot in mk's compact columns (3 x k each) and their time derivatives [D Eq. 5.39-5.41].
+struct WrapSurfaceMotion {
+  Mat3 R = Mat3::Identity();
+  Vec3 p = Vec3::Zero();
+  MatX J_om, J_p, Jdot_om, Jdot_p;
+  Vec3 omega = Vec3::Zero(), pdot = Vec3::Zero();
+};
+
+/// Buffers of the Type III segment construction (core/muscles/wrap_muscle.cpp), kept between calls
+/// so that an evaluation at the sizes of the last one does not allocate (the allocations were a
+/// seventh of a 20-point muscle's cost, docs/performance.md §7)
+struct WrapStageScratch {
+  std::vector<int> seg_wrap, idx;
+  std::vector<double> betas, betadots, betadot;
+  std::vector<char> have_surface;
+  std::vector<WrapSurfaceMotion> surfaces;
+  MatX J_mb, Jdot_mb;  // a surface body's rows of J_mr, Jdot_mr
+  struct Ends {        // a wrapped segment's ends in its surface frame, A_j = dp_j/dq and d/dt
+    Vec3 p1 = Vec3::Zero(), p2 = Vec3::Zero(), p1dot = Vec3::Zero(), p2dot = Vec3::Zero();
+    MatX A1, A2, A1dot, A2dot;
+  };
+  std::vector<Ends> ends;
+  MatX B, T;  // R A_j and the bracket of its rate
+  VecX L, Ld;
+  MatX J_L, Jdot_L;
+  WrapModelPoints points;
+  MatX stackJ, stackD, coefJ, coefD, outJ, outD;  // a segment's stacked rows, its points' coefficients, products
+};
+
 struct MuscleKinematics {
   // columns (model- and path-dependent only): initMuscleKinematics
   std::vector<int> cols;            // reduced coordinates that can move the path, ascending  (k)
@@ -75,6 +113,7 @@ struct MuscleKinematics {
   // workspace was made (callers sum them: WrapFallbackMonitor::add)
   NetworkWrapWorkspace network;
   WrapFallbackCounts wrap_counts;
+  WrapStageScratch wrap_scratch;
 };
 
 /// Columns of a path on `model` (cols, col_of) and buffers sized for all its points; the

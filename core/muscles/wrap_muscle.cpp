@@ -73,7 +73,7 @@ bool wrapSegments(const PathWrap& w, const std::vector<int>& active, int np, int
 }
 
 void calcSurfaceMotion(const Model& model, const SkeletonWorkspace& sk, const PathWrap& w, const MuscleKinematics& mk,
-                       bool vel, WrapSurfaceMotion& sm) {
+                       bool vel, WrapSurfaceMotion& sm, MatX& J_mb, MatX& Jdot_mb) {
   const int k = static_cast<int>(mk.cols.size());
   const int b = w.body;
   const Mat4 E_ws = b >= 0 ? Mat4(sk.E_wi[b] * w.E_bs) : w.E_bs;
@@ -89,7 +89,6 @@ void calcSurfaceMotion(const Model& model, const SkeletonWorkspace& sk, const Pa
   const Vec3 x_bs = w.E_bs.topRightCorner<3, 1>();
   const Mat3 R_wb = sk.E_wi[b].topLeftCorner<3, 3>();
   const Mat3x6 G = R_wb * Gamma(x_bs);  // surface origin's point Jacobian block [D Eq. 5.9]
-  MatX J_mb;
   gatherBodyRows(model, sk.J_mr, b, mk, J_mb);
   sm.J_om.noalias() = R_wb * J_mb.topRows<3>();
   sm.J_p.noalias() = G * J_mb;
@@ -98,39 +97,50 @@ void calcSurfaceMotion(const Model& model, const SkeletonWorkspace& sk, const Pa
   const Vec3 omega_b = phi.head<3>();
   sm.omega = R_wb * omega_b;
   sm.pdot = G * phi;
-  MatX Jdot_mb;
   gatherBodyRows(model, sk.Jdot_mr, b, mk, Jdot_mb);
-  // d/dt R_wb = R_wb [omega_b]; x_bs is fixed in the body [D Eq. 5.11]
-  sm.Jdot_om.noalias() = R_wb * (skew(omega_b) * J_mb.topRows<3>() + Jdot_mb.topRows<3>());
-  sm.Jdot_p.noalias() = R_wb * (skew(omega_b) * Gamma(x_bs) * J_mb + Gamma(x_bs) * Jdot_mb);
+  // d/dt R_wb = R_wb [omega_b]; x_bs is fixed in the body [D Eq. 5.11]; products of fixed-size
+  // factors first, so that no 3 x k temporary is allocated
+  const Mat3 RW = R_wb * skew(omega_b);
+  sm.Jdot_om.noalias() = RW * J_mb.topRows<3>();
+  sm.Jdot_om.noalias() += R_wb * Jdot_mb.topRows<3>();
+  sm.Jdot_p.noalias() = (RW * Gamma(x_bs)) * J_mb;
+  sm.Jdot_p.noalias() += G * Jdot_mb;
 }
 
-// the ends (active points i, i + 1) of a segment in a surface frame, A_j = dp_j/dq and d/dt
-struct SegmentEnds {
-  Vec3 p1 = Vec3::Zero(), p2 = Vec3::Zero(), p1dot = Vec3::Zero(), p2dot = Vec3::Zero();
-  MatX A1, A2, A1dot, A2dot;
-};
+using SegmentEnds = WrapStageScratch::Ends;
 
-void calcSegmentEnds(const WrapSurfaceMotion& sm, const MuscleKinematics& mk, int i, bool vel, SegmentEnds& e) {
+// the ends (active points i, i + 1) of a segment in a surface frame (B, T: scratch)
+void calcSegmentEnds(const WrapSurfaceMotion& sm, const MuscleKinematics& mk, int i, bool vel, SegmentEnds& e, MatX& B,
+                     MatX& T) {
   const Mat3& R = sm.R;
-  const Vec3 r1 = mk.x_w[i] - sm.p, r2 = mk.x_w[i + 1] - sm.p;
-  e.p1 = R.transpose() * r1;
-  e.p2 = R.transpose() * r2;
-  const MatX B1 = mk.J_xr.middleRows<3>(3 * i) - sm.J_p + skew(r1) * sm.J_om;  // R A_1
-  const MatX B2 = mk.J_xr.middleRows<3>(3 * (i + 1)) - sm.J_p + skew(r2) * sm.J_om;
-  e.A1.noalias() = R.transpose() * B1;
-  e.A2.noalias() = R.transpose() * B2;
+  const Mat3 Rt = R.transpose();
+  const Vec3 r[2] = {mk.x_w[i] - sm.p, mk.x_w[i + 1] - sm.p};
+  e.p1 = Rt * r[0];
+  e.p2 = Rt * r[1];
   e.p1dot.setZero();
   e.p2dot.setZero();
-  if (!vel) return;
-  const Vec3 r1dot = mk.xdot_w[i] - sm.pdot, r2dot = mk.xdot_w[i + 1] - sm.pdot;
-  e.p1dot = R.transpose() * (r1dot - sm.omega.cross(r1));
-  e.p2dot = R.transpose() * (r2dot - sm.omega.cross(r2));
+  Vec3 rdot[2] = {Vec3::Zero(), Vec3::Zero()};
+  if (vel) {
+    rdot[0] = mk.xdot_w[i] - sm.pdot;
+    rdot[1] = mk.xdot_w[i + 1] - sm.pdot;
+    e.p1dot = Rt * (rdot[0] - sm.omega.cross(r[0]));
+    e.p2dot = Rt * (rdot[1] - sm.omega.cross(r[1]));
+  }
   const Mat3 W = skew(sm.omega);
-  e.A1dot.noalias() = R.transpose() * (-W * B1 + mk.Jdot_xr.middleRows<3>(3 * i) - sm.Jdot_p + skew(r1dot) * sm.J_om +
-                                       skew(r1) * sm.Jdot_om);
-  e.A2dot.noalias() = R.transpose() * (-W * B2 + mk.Jdot_xr.middleRows<3>(3 * (i + 1)) - sm.Jdot_p +
-                                       skew(r2dot) * sm.J_om + skew(r2) * sm.Jdot_om);
+  for (int j = 0; j < 2; ++j) {
+    const int row = 3 * (i + j);
+    B = mk.J_xr.middleRows<3>(row) - sm.J_p;  // R A_j
+    B.noalias() += skew(r[j]) * sm.J_om;
+    MatX& A = j == 0 ? e.A1 : e.A2;
+    A.noalias() = Rt * B;
+    if (!vel) continue;
+    // d/dt (R^T B) = R^T (-[omega] B + Bdot)
+    T = mk.Jdot_xr.middleRows<3>(row) - sm.Jdot_p;
+    T.noalias() -= W * B;
+    T.noalias() += skew(rdot[j]) * sm.J_om;
+    T.noalias() += skew(r[j]) * sm.Jdot_om;
+    (j == 0 ? e.A1dot : e.A2dot).noalias() = Rt * T;
+  }
 }
 
 // active segment and fraction of its length holding the point at alpha of the wrapped path
@@ -303,7 +313,8 @@ NetworkWrapEval calcWrapModelPoints(const WrapMassOptions& options, const WrapSu
       // moves or its derivative is asked for: its rate enters Jdot)
       SmoothWrapOptions so;
       so.width = options.width;
-      calcSmoothWrapPoints(surface, p1, p2, v1, v2, alphas, velocity ? alphadots : std::vector<double>{}, so, out,
+      static const std::vector<double> kResting;  // (a reference, not a copy of alphadots per call)
+      calcSmoothWrapPoints(surface, p1, p2, v1, v2, alphas, velocity ? alphadots : kResting, so, out,
                            with_alpha ? &out.x_alpha : nullptr, with_alpha ? &out.x_alphadot : nullptr);
       return {};
     }
@@ -409,18 +420,19 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
   const MusclePath& path = muscle.path;
   if (mk.x_w.size() < 2) throw std::logic_error("calcWrapMassPoints: needs the path stage");
   // which wrap acts on which segment (header): the candidate penetrating most
-  const std::vector<int> seg_wrap = calcSegmentWraps(muscle, mk.active, mk.x_w, sk.E_wi);
+  WrapStageScratch& sc = mk.wrap_scratch;
+  sc.seg_wrap = calcSegmentWraps(muscle, mk.active, mk.x_w, sk.E_wi);
   // the surfaces' motion from the skeleton, for the wraps that act
-  std::vector<WrapSurfaceMotion> sm(path.wraps.size());
-  std::vector<char> have_sm(path.wraps.size(), 0);
-  for (int w : seg_wrap) {
-    if (w < 0 || have_sm[w]) continue;
+  sc.surfaces.resize(path.wraps.size());
+  sc.have_surface.assign(path.wraps.size(), 0);
+  for (int w : sc.seg_wrap) {
+    if (w < 0 || sc.have_surface[w]) continue;
     if (!coversBody(model, mk, path.wraps[w].body))
       throw std::logic_error("calcWrapMassPoints: mk's columns do not cover the wrap body (initWrapMuscleColumns)");
-    calcSurfaceMotion(model, sk, path.wraps[w], mk, mk.velocity, sm[w]);
-    have_sm[w] = 1;
+    calcSurfaceMotion(model, sk, path.wraps[w], mk, mk.velocity, sc.surfaces[w], sc.J_mb, sc.Jdot_mb);
+    sc.have_surface[w] = 1;
   }
-  calcWrapMassPointsOnSurfaces(muscle, seg_wrap, sm, mk);
+  calcWrapMassPointsOnSurfaces(muscle, sc.seg_wrap, sc.surfaces, mk);
 }
 
 }  // namespace
@@ -440,10 +452,11 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
                                 std::to_string(seg_wrap.size()) + " segment wraps for " + std::to_string(nseg) +
                                 " segments, " + std::to_string(surfaces.size()) + " surfaces for " +
                                 std::to_string(path.wraps.size()) + " wrap objects");
-  const std::string who = "muscle '" + muscle.name + "'";
-  std::vector<SegmentEnds> ends(nseg);
+  auto who = [&] { return "muscle '" + muscle.name + "'"; };  // built only for a message
+  WrapStageScratch& sc = mk.wrap_scratch;
+  if (static_cast<int>(sc.ends.size()) < nseg) sc.ends.resize(nseg);
   for (int i = 0; i < nseg; ++i)
-    if (seg_wrap[i] >= 0) calcSegmentEnds(surfaces[seg_wrap[i]], mk, i, vel, ends[i]);
+    if (seg_wrap[i] >= 0) calcSegmentEnds(surfaces[seg_wrap[i]], mk, i, vel, sc.ends[i], sc.B, sc.T);
 
   // Eulerian coordinates s_i = S_i / sum L over the segment lengths (header); one segment: (0, 1)
   mk.s.setZero(P);
@@ -452,8 +465,14 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
   mk.sdot.setZero(P);
   if (vel) mk.Jdot_sr.setZero(P, k);
   if (nseg > 1) {
-    VecX L(nseg), Ld = VecX::Zero(nseg);
-    MatX J_L(nseg, k), Jdot_L = MatX::Zero(nseg, k);
+    VecX& L = sc.L;
+    VecX& Ld = sc.Ld;
+    MatX& J_L = sc.J_L;
+    MatX& Jdot_L = sc.Jdot_L;
+    L.resize(nseg);
+    Ld.setZero(nseg);
+    J_L.resize(nseg, k);
+    Jdot_L.setZero(nseg, k);
     for (int i = 0; i < nseg; ++i) {
       if (seg_wrap[i] < 0) {
         // straight: l = |dx|, dl/dq = dxbar^T (J_{i+1} - J_i) [D Eq. 5.18-5.19, 5.27-5.28]
@@ -471,26 +490,29 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
         }
       } else {
         const int w = seg_wrap[i];
-        const SegmentEnds& e = ends[i];
+        const SegmentEnds& e = sc.ends[i];
         SmoothWrapLength sl;
         try {
           sl = calcWrapModelLength(muscle.wrap, path.wraps[w].surface, e.p1, e.p2, e.p1dot, e.p2dot);
         } catch (const std::invalid_argument& ex) {
-          throw MuscleError(who + ", wrap object '" + path.wraps[w].name + "': " + ex.what());
+          throw MuscleError(who() + ", wrap object '" + path.wraps[w].name + "': " + ex.what());
         }
         L[i] = sl.length;
-        J_L.row(i).noalias() = sl.J.leftCols<3>() * e.A1 + sl.J.rightCols<3>() * e.A2;
+        J_L.row(i).noalias() = sl.J.leftCols<3>() * e.A1;
+        J_L.row(i).noalias() += sl.J.rightCols<3>() * e.A2;
         if (vel) {
           Ld[i] = sl.J.leftCols<3>().dot(e.p1dot) + sl.J.rightCols<3>().dot(e.p2dot);
-          Jdot_L.row(i).noalias() = sl.Jdot.leftCols<3>() * e.A1 + sl.Jdot.rightCols<3>() * e.A2 +
-                                    sl.J.leftCols<3>() * e.A1dot + sl.J.rightCols<3>() * e.A2dot;
+          Jdot_L.row(i).noalias() = sl.Jdot.leftCols<3>() * e.A1;
+          Jdot_L.row(i).noalias() += sl.Jdot.rightCols<3>() * e.A2;
+          Jdot_L.row(i).noalias() += sl.J.leftCols<3>() * e.A1dot;
+          Jdot_L.row(i).noalias() += sl.J.rightCols<3>() * e.A2dot;
         }
       }
     }
     const double Lam = L.sum();
     for (int i = 0; i < nseg; ++i)
       if (!(L[i] > 1e-12 * (1.0 + Lam)))
-        throw MuscleError(who + ": path segment " + std::to_string(i) + " (between active points " +
+        throw MuscleError(who() + ": path segment " + std::to_string(i) + " (between active points " +
                           std::to_string(mk.active[i]) + " and " + std::to_string(mk.active[i + 1]) +
                           ") has zero length here; mass points need distinct consecutive path points");
     const Eigen::RowVectorXd J_Lam = J_L.colwise().sum();
@@ -514,7 +536,8 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
 
   // mass points: segment, beta and betadot [D Eq. 5.29, 5.31]
   sizeMassPointOutputs(N, k, mk);
-  std::vector<double> betadot(N, 0.0);
+  std::vector<double>& betadot = sc.betadot;
+  betadot.assign(N, 0.0);
   for (int a = 0; a < N; ++a) {
     const double s_a = mp.alpha[a];
     int i = 0;
@@ -526,7 +549,10 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
   }
 
   // straight segments: Type II's EOL construction (via_point.hpp) with these s
-  MatX J_zr(8, k), Jdot_zr(8, k);
+  MatX& J_zr = sc.stackJ;
+  MatX& Jdot_zr = sc.stackD;
+  J_zr.resize(8, k);
+  Jdot_zr.resize(8, k);
   for (int a = 0; a < N; ++a) {
     const int i = mk.segment[a];
     if (seg_wrap[i] >= 0) continue;
@@ -552,13 +578,10 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
 
   // wrapped segments: one batch per segment through the dispatch, then the chain rule (header)
   const bool moving_beta = nseg > 1;
-  std::vector<int> idx;
-  std::vector<double> betas, betadots;
-  WrapModelPoints wp;
-  MatX stackJ, stackD;  // sized per segment, reused by its points
-  // per-point coefficients: at most 3 x 14 and 3 x 25, inline (no heap)
-  Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 14> cJ;
-  Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 25> cD;
+  std::vector<int>& idx = sc.idx;
+  std::vector<double>& betas = sc.betas;
+  std::vector<double>& betadots = sc.betadots;
+  WrapModelPoints& wp = sc.points;
   for (int i = 0; i < nseg; ++i) {
     const int w = seg_wrap[i];
     if (w < 0) continue;
@@ -574,66 +597,91 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
     if (idx.empty()) continue;
     const PathWrap& pw = path.wraps[w];
     const WrapSurfaceMotion& m = surfaces[w];
-    const SegmentEnds& e = ends[i];
+    const SegmentEnds& e = sc.ends[i];
     try {
       const NetworkWrapEval ev = calcWrapModelPoints(muscle.wrap, pw.surface, e.p1, e.p2, e.p1dot, e.p2dot, betas,
                                                      betadots, moving_beta, vel, wp, mk.network, pw.name);
       if (muscle.wrap.model == WrapModel::Neural) mk.wrap_counts.record(ev, w);  // summed by callers
     } catch (const std::invalid_argument& ex) {
-      throw MuscleError(who + ", wrap object '" + pw.name + "': " + ex.what());
+      throw MuscleError(who() + ", wrap object '" + pw.name + "': " + ex.what());
     }
     const Mat3& R = m.R;
     const double ds = mk.s[i + 1] - mk.s[i];
     const double dsdot = vel ? mk.sdot[i + 1] - mk.sdot[i] : 0.0;
-    // the segment's rows stacked once, so that each point's J_ar and Jdot_ar are one product of a
-    // 3 x r coefficient matrix with them (the header's formulas, terms regrouped):
+    // the segment's rows stacked once, and its n points' coefficient rows stacked, so that the
+    // segment's J_ar and Jdot_ar are one product each (the header's formulas, terms regrouped):
     //   J_ar    = [R Jw, -[Rw], I, R w_a c_i, R w_a c_i1] [A; J_om; J_p; J_s,i; J_s,i+1]
     //   Jdot_ar = [[omega] R Jw + R Jwdot, R Jw, -[Rwdot], -[Rw], I, (beta rows)]
     //             [A; Adot; J_om; Jdot_om; Jdot_p; J_s,i; J_s,i+1; Jdot_s,i; Jdot_s,i+1]
     // with A = [A_1; A_2] and J_beta = c_i J_s,i + c_i1 J_s,i+1 (c_i = -(1 - beta) / ds, c_i1 = -beta / ds)
     const int nb = moving_beta ? 2 : 0;
+    const int n = static_cast<int>(idx.size());
+    MatX& stackJ = sc.stackJ;
+    MatX& stackD = sc.stackD;
+    MatX& cJ = sc.coefJ;
+    MatX& cD = sc.coefD;
     stackJ.resize(12 + nb, k);
     stackJ.topRows(12) << e.A1, e.A2, m.J_om, m.J_p;
     if (moving_beta) stackJ.bottomRows(2) << mk.J_sr.row(i), mk.J_sr.row(i + 1);
+    cJ.resize(3 * n, 12 + nb);
     if (vel) {
       stackD.resize(21 + 2 * nb, k);
       stackD.topRows(21) << e.A1, e.A2, e.A1dot, e.A2dot, m.J_om, m.Jdot_om, m.Jdot_p;
       if (moving_beta) stackD.bottomRows(4) << mk.J_sr.row(i), mk.J_sr.row(i + 1), mk.Jdot_sr.row(i), mk.Jdot_sr.row(i + 1);
+      cD.resize(3 * n, 21 + 2 * nb);
     }
     const Mat3 WR = skew(m.omega) * R;
-    for (size_t j = 0; j < idx.size(); ++j) {
+    for (int j = 0; j < n; ++j) {
       const int a = idx[j];
       const double beta = betas[j];
       const Vec3 Rw = R * wp.x[j];
       mk.x_a[a] = Rw + m.p;
       const Eigen::Matrix<double, 3, 6> RJw = R * wp.J[j];
-      cJ.resize(3, 12 + nb);
-      cJ.leftCols(12) << RJw, -skew(Rw), Mat3::Identity();
+      auto rJ = cJ.middleRows<3>(3 * j);
+      rJ.leftCols<6>() = RJw;
+      rJ.middleCols<3>(6) = -skew(Rw);
+      rJ.middleCols<3>(9).setIdentity();
       const double ci = -(1.0 - beta) / ds, ci1 = -beta / ds;
       Vec3 Rwa = Vec3::Zero();
       if (moving_beta) {
         Rwa = R * wp.x_alpha[j];
-        cJ.col(12) = ci * Rwa;
-        cJ.col(13) = ci1 * Rwa;
+        rJ.col(12) = ci * Rwa;
+        rJ.col(13) = ci1 * Rwa;
       }
-      mk.J_ar.middleRows(3 * a, 3).noalias() = cJ * stackJ;
       if (!vel) continue;
       Vec3 wdot = wp.J[j].leftCols<3>() * e.p1dot + wp.J[j].rightCols<3>() * e.p2dot;
       const double bd = moving_beta ? betadots[j] : 0.0;
       if (moving_beta) wdot += wp.x_alpha[j] * bd;
       const Vec3 Rwdot = m.omega.cross(Rw) + R * wdot;
-      cD.resize(3, 21 + 2 * nb);
-      cD.leftCols(21) << WR * wp.J[j] + R * wp.Jdot[j], RJw, -skew(Rwdot), -skew(Rw), Mat3::Identity();
+      auto rD = cD.middleRows<3>(3 * j);
+      rD.leftCols<6>() = WR * wp.J[j] + R * wp.Jdot[j];
+      rD.middleCols<6>(6) = RJw;
+      rD.middleCols<3>(12) = -skew(Rwdot);
+      rD.middleCols<3>(15) = -skew(Rw);
+      rD.middleCols<3>(18).setIdentity();
       if (moving_beta) {
         // (WR w_a + R w_adot) J_beta + R w_a Jdot_beta, with Jdot_beta = c_i Jdot_s,i + c_i1 Jdot_s,i+1
         //   - (dsdot J_beta + bd (J_s,i+1 - J_s,i)) / ds
         const Vec3 cw = WR * wp.x_alpha[j] + R * wp.x_alphadot[j];
-        cD.col(21) = ci * cw - (dsdot * ci - bd) / ds * Rwa;
-        cD.col(22) = ci1 * cw - (dsdot * ci1 + bd) / ds * Rwa;
-        cD.col(23) = ci * Rwa;
-        cD.col(24) = ci1 * Rwa;
+        rD.col(21) = ci * cw - (dsdot * ci - bd) / ds * Rwa;
+        rD.col(22) = ci1 * cw - (dsdot * ci1 + bd) / ds * Rwa;
+        rD.col(23) = ci * Rwa;
+        rD.col(24) = ci1 * Rwa;
       }
-      mk.Jdot_ar.middleRows(3 * a, 3).noalias() = cD * stackD;
+    }
+    // the points of a segment are consecutive rows of J_ar when alpha increases (makeMassPoints);
+    // otherwise the products go through a buffer
+    const bool consecutive = idx.back() - idx.front() == n - 1;
+    if (consecutive) {
+      mk.J_ar.middleRows(3 * idx.front(), 3 * n).noalias() = cJ * stackJ;
+      if (vel) mk.Jdot_ar.middleRows(3 * idx.front(), 3 * n).noalias() = cD * stackD;
+    } else {
+      sc.outJ.noalias() = cJ * stackJ;
+      for (int j = 0; j < n; ++j) mk.J_ar.middleRows<3>(3 * idx[j]) = sc.outJ.middleRows<3>(3 * j);
+      if (vel) {
+        sc.outD.noalias() = cD * stackD;
+        for (int j = 0; j < n; ++j) mk.Jdot_ar.middleRows<3>(3 * idx[j]) = sc.outD.middleRows<3>(3 * j);
+      }
     }
   }
 }

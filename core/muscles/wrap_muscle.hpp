@@ -97,12 +97,7 @@ void calcWrapMassPoints(const Model& model, const State& state, const SkeletonWo
 void calcWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, const Muscle& muscle,
                         MuscleKinematics& mk);
 
-/// A wrap model's points over one surface (frame s): WrapMassPoints (x, J = dx/d(p1, p2) 3x6, Jdot
-/// = dJ/dt along (p1dot, p2dot, alphadot)) plus, when asked for, the derivative along the fraction.
-struct WrapModelPoints : WrapMassPoints {
-  std::vector<Vec3> x_alpha;     ///< dx/dalpha (m)
-  std::vector<Vec3> x_alphadot;  ///< d/dt dx/dalpha along (p1dot, p2dot, alphadot)
-};
+/// WrapModelPoints and WrapSurfaceMotion: core/muscles/muscle_workspace.hpp (the stage's scratch holds them).
 
 /// THE wrap-model dispatch point: mass points at fractions `alphas` of the wrapped segment p1 -> p2
 /// (frame s) by options.model, moving with (p1dot, p2dot) and fraction rates `alphadots` (empty:
@@ -132,16 +127,6 @@ SmoothWrapLength calcWrapModelLength(const WrapMassOptions& options, const WrapS
 /// `redmax lengths --wrap smooth|neural`.
 std::vector<int> calcSegmentWraps(const Muscle& muscle, const std::vector<int>& active, const std::vector<Vec3>& x_w,
                                   const std::vector<Mat4>& E_wi);
-
-/// Pose and motion of one wrap surface frame s (world): R = R_ws, p = p_ws (m), its angular
-/// velocity omega (rad/s) and origin velocity pdot (m/s), with J_om = d omega / d qdot and J_p =
-/// d pdot / d qdot in mk's compact columns (3 x k each) and their time derivatives [D Eq. 5.39-5.41].
-struct WrapSurfaceMotion {
-  Mat3 R = Mat3::Identity();
-  Vec3 p = Vec3::Zero();
-  MatX J_om, J_p, Jdot_om, Jdot_p;
-  Vec3 omega = Vec3::Zero(), pdot = Vec3::Zero();
-};
 
 /// The segment construction of the header on surfaces whose motion is given instead of taken from
 /// the skeleton: seg_wrap from calcSegmentWraps (one entry per segment), surfaces[w] for each wrap

@@ -29,6 +29,11 @@ template <class T>
 struct ArcPath {
   V3<T> p1{}, p2{}, r1{}, r2{}, k{};
   T phi{}, h{}, l1{}, la{}, l2{}, total{};  // total: the geometric length |p1 r1| + arc + |r2 p2|
+  // shared by the points (issue 18: a point then costs a sine, a cosine and ten products): the
+  // pieces' directions, r1 = kr + u about k with k x r1 = kxr, and each piece's fraction f as
+  // alpha * scale - offset (f = (alpha total - start) / piece length)
+  V3<T> d1{}, d2{}, kr{}, u{}, kxr{};
+  T f1{}, fa{}, fa0{}, f2{}, f20{};
 };
 
 template <class T>
@@ -41,22 +46,32 @@ ArcPath<T> makeArcPath(const V3<T>& p1, const V3<T>& p2, const V3<T>& r1, const 
   a.la = dsqrt(rho_phi * rho_phi + h * h);
   a.l2 = norm(p2 - r2);
   a.total = a.l1 + a.la + a.l2;
+  a.d1 = r1 - p1;
+  a.d2 = p2 - r2;
+  a.kr = dot(k, r1) * k;
+  a.u = r1 - a.kr;
+  a.kxr = cross(k, r1);
+  // (a zero-length piece is never evaluated: the branches below test the values first)
+  if (value(a.l1) > 0.0) a.f1 = a.total / a.l1;
+  if (value(a.la) > 0.0) a.fa = a.total / a.la, a.fa0 = a.l1 / a.la;
+  if (value(a.l2) > 0.0) a.f2 = a.total / a.l2, a.f20 = (a.l1 + a.la) / a.l2;
   return a;
 }
 
-// point at fraction alpha of the path
+// point at fraction alpha of the path (the branches on values as s = alpha total, less each
+// piece's length, walks along it)
 template <class T>
 V3<T> arcPathPoint(const ArcPath<T>& a, const Alpha<T>& alpha) {
-  T s = alpha * a.total;
-  if (value(s) <= value(a.l1)) return a.p1 + (s / a.l1) * (a.r1 - a.p1);
-  s = s - a.l1;
-  if (value(s) <= value(a.la)) {
-    const T f = s / a.la;
-    return rotate(a.k, f * a.phi, a.r1) + (f * a.h) * a.k;
+  double s = value(alpha) * value(a.total);
+  if (s <= value(a.l1)) return a.p1 + (alpha * a.f1) * a.d1;
+  s = s - value(a.l1);
+  if (s <= value(a.la)) {
+    const T f = alpha * a.fa - a.fa0;
+    const T th = f * a.phi;
+    return a.kr + dcos(th) * a.u + dsin(th) * a.kxr + (f * a.h) * a.k;
   }
-  s = s - a.la;
-  const T f = s / a.l2;
-  return value(f) < 1.0 ? a.r2 + f * (a.p2 - a.r2) : a.p2;
+  s = s - value(a.la);
+  return s / value(a.l2) < 1.0 ? a.r2 + (alpha * a.f2 - a.f20) * a.d2 : a.p2;
 }
 
 // ---------------------------------------------------------------------------------------------
