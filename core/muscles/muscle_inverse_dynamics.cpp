@@ -188,19 +188,37 @@ void addMuscleInverseDynamics(const Model& model, const State& state, const VecX
   if (sc.alpha_sorted < 0) sc.alpha_sorted = std::is_sorted(mp.alpha.begin(), mp.alpha.end()) ? 1 : 0;
   if (sc.alpha_sorted == 1) {
     // points in increasing alpha (as makeMassPoints places them): each segment's points are one
-    // run [lo, hi), whose moments are vectorised sums (no search per point, no chain of adds)
-    using ArrayMap = Eigen::Map<const Eigen::ArrayXd>;
+    // run [lo, hi), whose moments come from the run's centred sums (MuscleIdScratch::Run), formed
+    // again only when the run changes (a point crossing a path point)
+    if (sc.runs_of != mp.mass.data()) {
+      sc.runs.clear();
+      sc.runs_of = mp.mass.data();
+    }
+    if (static_cast<int>(sc.runs.size()) < ns) sc.runs.resize(ns);
     int lo = 0;
     for (int i = 0; i < ns && lo < N; ++i) {
+      MuscleIdScratch::Run& run = sc.runs[i];
       int hi = lo;
       if (i + 1 == ns) hi = N;
-      else while (hi < N && mp.alpha[hi] < s[i + 1]) ++hi;
+      else if (run.lo == lo && (run.hi == N || mp.alpha[run.hi] >= s[i + 1]) && (run.hi == lo || mp.alpha[run.hi - 1] < s[i + 1]))
+        hi = run.hi;  // the run is unchanged (alpha increasing: the end test suffices)
+      else
+        while (hi < N && mp.alpha[hi] < s[i + 1]) ++hi;
       if (hi == lo) continue;
-      const ArrayMap alpha(mp.alpha.data() + lo, hi - lo), mass(mp.mass.data() + lo, hi - lo);
-      const double inv_ds = 1.0 / (s[i + 1] - s[i]);
-      sc.m0[i] = mass.sum();
-      sc.m1[i] = (mass * (alpha - s[i])).sum() * inv_ds;
-      sc.m2[i] = (mass * (alpha - s[i]).square()).sum() * (inv_ds * inv_ds);
+      if (run.lo != lo || run.hi != hi) {
+        run.lo = lo;
+        run.hi = hi;
+        run.m = 0.0;
+        double ma = 0.0;
+        for (int a = lo; a < hi; ++a) run.m += mp.mass[a], ma += mp.mass[a] * mp.alpha[a];
+        run.c = run.m > 0.0 ? ma / run.m : mp.alpha[lo];
+        run.c2 = 0.0;
+        for (int a = lo; a < hi; ++a) run.c2 += mp.mass[a] * (mp.alpha[a] - run.c) * (mp.alpha[a] - run.c);
+      }
+      const double inv_ds = 1.0 / (s[i + 1] - s[i]), d = (run.c - s[i]) * inv_ds;
+      sc.m0[i] = run.m;
+      sc.m1[i] = run.m * d;
+      sc.m2[i] = run.c2 * (inv_ds * inv_ds) + run.m * d * d;
       lo = hi;
     }
   } else {

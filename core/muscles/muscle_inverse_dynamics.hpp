@@ -51,6 +51,16 @@ struct MuscleIdScratch {
   VecX tri_c, tri_d, rhs;         // tridiagonal solve                                 (P-2)
   int alpha_sorted = -1;          // the muscle's mass points come in increasing alpha (1) or not (0);
                                   // found on the first call: a scratch serves one muscle
+  // each segment's run of mass points [lo, hi) (alpha increasing) with its mass, mass-weighted
+  // mean alpha c and sum m (alpha - c)^2, kept while the run stays the same: the segment's
+  // moments are then O(1) per frame, m (c - s_i) and c2 + m (c - s_i)^2 (no cancellation);
+  // rebuilt when the mass points' storage changes
+  struct Run {
+    int lo = -1, hi = -1;
+    double m = 0.0, c = 0.0, c2 = 0.0;
+  };
+  std::vector<Run> runs;          //                                                   (P-1)
+  const double* runs_of = nullptr;  // the mass points' storage the runs were found for
 };
 
 /// A body's motion in world axes, formed once per pass for all the muscles that attach to it, so

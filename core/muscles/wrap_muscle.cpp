@@ -670,19 +670,22 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
       }
     }
     // the points of a segment are consecutive rows of J_ar when alpha increases (makeMassPoints);
-    // otherwise the products go through a buffer
+    // otherwise the products go through a buffer. A matrix-vector product per column: k is a
+    // muscle's few coordinates, where a general product's packing of the 3n rows costs more
+    // than the product (measured, docs/performance.md §7)
     const bool consecutive = idx.back() - idx.front() == n - 1;
-    if (consecutive) {
-      mk.J_ar.middleRows(3 * idx.front(), 3 * n).noalias() = cJ * stackJ;
-      if (vel) mk.Jdot_ar.middleRows(3 * idx.front(), 3 * n).noalias() = cD * stackD;
-    } else {
-      sc.outJ.noalias() = cJ * stackJ;
-      for (int j = 0; j < n; ++j) mk.J_ar.middleRows<3>(3 * idx[j]) = sc.outJ.middleRows<3>(3 * j);
-      if (vel) {
-        sc.outD.noalias() = cD * stackD;
-        for (int j = 0; j < n; ++j) mk.Jdot_ar.middleRows<3>(3 * idx[j]) = sc.outD.middleRows<3>(3 * j);
+    auto product = [&](const MatX& coef, const MatX& stack, MatX& buffer, MatX& out) {
+      if (consecutive) {
+        auto rows = out.middleRows(3 * idx.front(), 3 * n);
+        for (int c = 0; c < k; ++c) rows.col(c).noalias() = coef * stack.col(c);
+        return;
       }
-    }
+      buffer.resize(3 * n, k);
+      for (int c = 0; c < k; ++c) buffer.col(c).noalias() = coef * stack.col(c);
+      for (int j = 0; j < n; ++j) out.middleRows<3>(3 * idx[j]) = buffer.middleRows<3>(3 * j);
+    };
+    product(cJ, stackJ, sc.outJ, mk.J_ar);
+    if (vel) product(cD, stackD, sc.outD, mk.Jdot_ar);
   }
 }
 

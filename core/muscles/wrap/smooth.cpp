@@ -734,14 +734,17 @@ void smoothSetup(const WrapSurface& surf, const V3<T>& p1, const V3<T>& p2, doub
 template <class T>
 V3<T> smoothEval(const SmoothSetup<T>& st, const Alpha<T>& alpha, T* length_out = nullptr) {
   using Mode = typename SmoothSetup<T>::Mode;
-  V3<T> x = st.p1 + alpha * (st.p2 - st.p1);
-  if (length_out) *length_out = st.l_straight;
-  if (st.mode == Mode::Wrapped) {
+  V3<T> x;
+  if (st.mode == Mode::Wrapped) {  // (the straight point is not needed)
     x = st.wrappedPoint(alpha);
     if (length_out) *length_out = st.wrappedLength();
-  } else if (st.mode == Mode::Blend) {
-    x = x + st.w * (st.wrappedPoint(alpha) - x);
-    if (length_out) *length_out = st.l_straight + st.w * (st.wrappedLength() - st.l_straight);
+  } else {
+    x = st.p1 + alpha * (st.p2 - st.p1);
+    if (length_out) *length_out = st.l_straight;
+    if (st.mode == Mode::Blend) {
+      x = x + st.w * (st.wrappedPoint(alpha) - x);
+      if (length_out) *length_out = st.l_straight + st.w * (st.wrappedLength() - st.l_straight);
+    }
   }
   return st.torus ? st.frame.toTorus(x) : x;
 }
