@@ -7,6 +7,7 @@
 
 #include "core/muscles/path_kinematics.hpp"
 #include "core/muscles/via_point.hpp"
+#include "core/muscles/wrap_composite.hpp"
 #include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap/wrap_path.hpp"
 #include "core/skeleton/kinematics.hpp"
@@ -196,7 +197,8 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
     const std::string why = smoothWrapUnsupportedReason(w.surface);
     if (!why.empty()) return "the smooth wrap model cannot take wrap object '" + w.name + "': " + why;
     // two ranges sharing two points can land on one segment: OpenSim then applies both in turn
-    // (and iterates), which the smooth model does not compose
+    // (and iterates); the smooth model composes them (wrap_composite.hpp), the network does not
+    if (muscle.wrap.model == WrapModel::Smooth) continue;
     int lo = 0, hi = 0;
     wrapRange(w, np, lo, hi);
     for (size_t j = 0; j < k; ++j) {
@@ -205,13 +207,26 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
       int lo2 = 0, hi2 = 0;
       wrapRange(v, np, lo2, hi2);
       if (std::min(hi, hi2) > std::max(lo, lo2))
-        return "the smooth wrap model takes one wrap object per segment, but wrap objects '" + v.name + "' and '" +
+        return "the neural wrap model takes one wrap object per segment, but wrap objects '" + v.name + "' and '" +
                w.name + "' can both act on the segment between path points " + std::to_string(std::max(lo, lo2) + 1) +
                " and " + std::to_string(std::min(hi, hi2) + 1) +
-               " (OpenSim applies them in turn and iterates; the smooth model does not compose surfaces): use the "
+               " (OpenSim applies them in turn and iterates; the smooth model composes them): use the smooth or the "
                "exact model";
     }
   }
+  if (muscle.wrap.model == WrapModel::Smooth)  // the composition's limit (wrap/smooth_composite.hpp)
+    for (int j = 0; j + 1 < np; ++j) {
+      int n = 0;
+      for (const PathWrap& w : path.wraps) {
+        int lo = 0, hi = 0;
+        wrapRange(w, np, lo, hi);
+        n += w.surface.active && lo <= j && hi >= j + 1 ? 1 : 0;
+      }
+      if (n > 3)
+        return "the smooth wrap model composes at most 3 wrap objects on one segment, but " + std::to_string(n) +
+               " can act on the segment between path points " + std::to_string(j + 1) + " and " +
+               std::to_string(j + 2) + ": use the exact model";
+    }
   return "";
 }
 
@@ -410,10 +425,16 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
   if (mk.x_w.size() < 2) throw std::logic_error("calcWrapMassPoints: needs the path stage");
   // which wrap acts on which segment (header): the candidate penetrating most
   const std::vector<int> seg_wrap = calcSegmentWraps(muscle, mk.active, mk.x_w, sk.E_wi);
-  // the surfaces' motion from the skeleton, for the wraps that act
+  // the surfaces' motion from the skeleton, for the wraps that act (every active one when
+  // several may share a segment: the composition picks its own, wrap_composite.hpp)
+  const bool compose = muscle.wrap.model == WrapModel::Smooth && hasSharedWrapSegments(muscle);
+  std::vector<int> acting = seg_wrap;
+  if (compose)
+    for (size_t w = 0; w < path.wraps.size(); ++w)
+      if (path.wraps[w].surface.active) acting.push_back(static_cast<int>(w));
   std::vector<WrapSurfaceMotion> sm(path.wraps.size());
   std::vector<char> have_sm(path.wraps.size(), 0);
-  for (int w : seg_wrap) {
+  for (int w : acting) {
     if (w < 0 || have_sm[w]) continue;
     if (!coversBody(model, mk, path.wraps[w].body))
       throw std::logic_error("calcWrapMassPoints: mk's columns do not cover the wrap body (initWrapMuscleColumns)");
@@ -427,6 +448,10 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
 
 void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& seg_wrap,
                                   const std::vector<WrapSurfaceMotion>& surfaces, MuscleKinematics& mk) {
+  if (muscle.wrap.model == WrapModel::Smooth && hasSharedWrapSegments(muscle)) {
+    calcCompositeWrapMassPointsOnSurfaces(muscle, surfaces, mk);  // several wraps on a segment
+    return;
+  }
   const MassPoints& mp = muscle.mass_points;
   const MusclePath& path = muscle.path;
   const int N = mp.size();
