@@ -197,8 +197,8 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
     const std::string why = smoothWrapUnsupportedReason(w.surface);
     if (!why.empty()) return "the smooth wrap model cannot take wrap object '" + w.name + "': " + why;
     // two ranges sharing two points can land on one segment: OpenSim then applies both in turn
-    // (and iterates); the smooth model composes them (wrap_composite.hpp), the network does not
-    if (muscle.wrap.model == WrapModel::Smooth) continue;
+    // (and iterates); the smooth model composes cylinders and spheres there (wrap_composite.hpp),
+    // the network nothing
     int lo = 0, hi = 0;
     wrapRange(w, np, lo, hi);
     for (size_t j = 0; j < k; ++j) {
@@ -206,12 +206,20 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
       if (!v.surface.active) continue;
       int lo2 = 0, hi2 = 0;
       wrapRange(v, np, lo2, hi2);
-      if (std::min(hi, hi2) > std::max(lo, lo2))
-        return "the neural wrap model takes one wrap object per segment, but wrap objects '" + v.name + "' and '" +
-               w.name + "' can both act on the segment between path points " + std::to_string(std::max(lo, lo2) + 1) +
-               " and " + std::to_string(std::min(hi, hi2) + 1) +
-               " (OpenSim applies them in turn and iterates; the smooth model composes them): use the smooth or the "
-               "exact model";
+      if (!(std::min(hi, hi2) > std::max(lo, lo2))) continue;
+      auto composable = [](const WrapSurface& x) { return x.type == WrapType::Cylinder || x.type == WrapType::Sphere; };
+      if (muscle.wrap.model == WrapModel::Smooth) {
+        if (composable(v.surface) && composable(w.surface)) continue;
+        return "the smooth wrap model composes cylinders and spheres on one segment, but wrap objects '" + v.name +
+               "' (" + wrapTypeName(v.surface.type) + ") and '" + w.name + "' (" + wrapTypeName(w.surface.type) +
+               ") can both act on the segment between path points " + std::to_string(std::max(lo, lo2) + 1) +
+               " and " + std::to_string(std::min(hi, hi2) + 1) + ": use the exact model";
+      }
+      return "the neural wrap model takes one wrap object per segment, but wrap objects '" + v.name + "' and '" +
+             w.name + "' can both act on the segment between path points " + std::to_string(std::max(lo, lo2) + 1) +
+             " and " + std::to_string(std::min(hi, hi2) + 1) +
+             " (OpenSim applies them in turn and iterates; the smooth model composes them): use the smooth or the "
+             "exact model";
     }
   }
   if (muscle.wrap.model == WrapModel::Smooth)  // the composition's limit (wrap/smooth_composite.hpp)

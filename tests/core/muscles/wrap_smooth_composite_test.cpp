@@ -20,7 +20,7 @@
 namespace redmax {
 namespace {
 
-// K cylinders (radius 0.05-0.09 m, length 1 m, axes tilted up to 0.3 rad) 0.3 m apart along x, a
+// K cylinders (the last one a sphere when asked; radius 0.05-0.09 m, length 1 m, axes tilted up to 0.3 rad) 0.3 m apart along x, a
 // segment from x = -0.25 to 0.25 + 0.3 (K - 1) passing above them at heights 0.02-0.14 m: each
 // surface wrapped, in its band or clear, at random; velocities of the ends and the surfaces random
 struct Scene {
@@ -29,14 +29,15 @@ struct Scene {
   Vec3 p1, p2, v1, v2;
 };
 
-Scene randomScene(std::mt19937& rng, int K) {
+Scene randomScene(std::mt19937& rng, int K, bool sphere_last = false) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   auto in = [&](double lo, double hi) { return lo + (hi - lo) * 0.5 * (u(rng) + 1.0); };
   Scene sc;
   sc.surf.resize(K);
   sc.s.resize(K);
   for (int k = 0; k < K; ++k) {
-    sc.surf[k] = WrapSurface::makeCylinder(in(0.05, 0.09), 1.0);
+    sc.surf[k] = sphere_last && k == K - 1 ? WrapSurface::makeSphere(in(0.05, 0.09))
+                                           : WrapSurface::makeCylinder(in(0.05, 0.09), 1.0);
     const Mat3 R = (Eigen::AngleAxisd(0.3 * u(rng), Vec3::UnitX()) * Eigen::AngleAxisd(0.3 * u(rng), Vec3::UnitY()))
                        .toRotationMatrix();
     sc.s[k].R = R;
@@ -109,13 +110,14 @@ bool outsideBands(const CompositeWrapResult& r) {
 }
 
 TEST(WrapSmoothComposite, EqualsTheLibrarysConvergedPathOutsideTheBands) {
+ for (const bool sphere : {false, true}) {
   std::mt19937 rng(22);
   const std::vector<double> alphas{0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0};
   int clean = 0, both = 0, one = 0, banded = 0, unconverged = 0, mismatch = 0;
   double worst = 0.0, worst_len = 0.0, worst_opensim = 0.0;
   int max_newton = 0;
   for (int n = 0; n < 2000; ++n) {
-    const Scene sc = randomScene(rng, 2);
+    const Scene sc = randomScene(rng, 2, sphere);
     const CompositeWrapResult r = compose(sc, alphas, {}, false);
     max_newton = std::max(max_newton, r.newton_iterations);
     if (!outsideBands(r)) {
@@ -162,28 +164,30 @@ TEST(WrapSmoothComposite, EqualsTheLibrarysConvergedPathOutsideTheBands) {
         worst_opensim = std::max(worst_opensim, (r.x[a] - calcWrappedPathPointAt(wp, E_ws, alphas[a])).norm());
     }
   }
-  std::printf("[ measured ] two cylinders on one segment, 2000 random: %d outside the bands (%d both wrapped, %d one), "
+  std::printf("[ measured ] %s on one segment, 2000 random: %d outside the bands (%d both wrapped, %d one), "
               "%d in a band, %d where the library does not converge, %d where it wraps other surfaces; max |x - "
               "converged library| %.1e m, |L - L_lib| %.1e m; both wrapped, against OpenSim's passes (calcWrappedPathAt) "
               "%.1e m; Newton iterations at most %d\n",
-              clean, both, one, banded, unconverged, mismatch, worst, worst_len, worst_opensim, max_newton);
+              sphere ? "a cylinder and a sphere" : "two cylinders", clean, both, one, banded, unconverged, mismatch, worst,
+              worst_len, worst_opensim, max_newton);
   EXPECT_GT(both, 200);
   EXPECT_GT(one, 100);
   EXPECT_EQ(unconverged, 0);
   EXPECT_EQ(mismatch, 0);
   EXPECT_LE(worst, 1e-12);
   EXPECT_LE(worst_len, 1e-12);
+ }
 }
 
 // central differences of the composition in all its inputs (u, then alpha) and of J along the rates
-void checkAgainstDifferences(int K, int count, unsigned seed, double* worst_J, double* worst_Jdot, int* checked,
+void checkAgainstDifferences(int K, bool sphere, int count, unsigned seed, double* worst_J, double* worst_Jdot, int* checked,
                              int* skipped, int* in_band) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u01(-1.0, 1.0);
   const std::vector<double> alphas{0.05, 0.25, 0.45, 0.65, 0.85};
   const double h = 1e-6;
   for (int n = 0; n < count; ++n) {
-    const Scene sc = randomScene(rng, K);
+    const Scene sc = randomScene(rng, K, sphere);
     std::vector<double> alphadots;
     for (size_t a = 0; a < alphas.size(); ++a) alphadots.push_back(0.2 * u01(rng));
     const CompositeWrapResult r = compose(sc, alphas, alphadots, true);
@@ -224,13 +228,13 @@ void checkAgainstDifferences(int K, int count, unsigned seed, double* worst_J, d
 }
 
 TEST(WrapSmoothComposite, JacobianAndJdotMatchCentralDifferences) {
-  for (int K : {2, 3}) {
+  for (int K : {2, 3}) for (const bool sphere : {false, true}) {
     double wJ = 0.0, wJd = 0.0;
     int checked = 0, skipped = 0, in_band = 0;
-    checkAgainstDifferences(K, K == 2 ? 150 : 40, 7 + K, &wJ, &wJd, &checked, &skipped, &in_band);
-    std::printf("[ measured ] %d cylinders on one segment: %d points checked (%d scenes with a surface in its band), "
+    checkAgainstDifferences(K, sphere, K == 2 ? 150 : 40, 7 + K, &wJ, &wJd, &checked, &skipped, &in_band);
+    std::printf("[ measured ] %d surfaces (%s) on one segment: %d points checked (%d scenes with a surface in its band), "
                 "%d skipped (stencil across a tangent point); worst relative J error %.1e, Jdot %.1e\n",
-                K, checked, in_band, skipped, wJ, wJd);
+                K, sphere ? "the last a sphere" : "cylinders", checked, in_band, skipped, wJ, wJd);
     EXPECT_GT(checked, K == 2 ? 500 : 120);
     EXPECT_GT(in_band, 5);
     EXPECT_LE(wJ, 1e-6);
@@ -305,6 +309,8 @@ TEST(WrapSmoothComposite, OneSurfaceIsTheSmoothModel) {
     Scene sc = randomScene(rng, 1);
     sc.s[0].R.setIdentity();
     sc.s[0].p.setZero();
+    sc.s[0].Rdot.setZero();  // a still surface: the single model's frame
+    sc.s[0].pdot.setZero();
     const CompositeWrapResult r = compose(sc, alphas, {}, true);
     for (size_t a = 0; a < alphas.size(); ++a) {
       const SmoothWrapPoint sp = calcSmoothWrapPointDerivatives(sc.surf[0], sc.p1, sc.p2, alphas[a], sc.v1, sc.v2);
