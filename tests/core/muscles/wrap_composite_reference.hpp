@@ -2,7 +2,7 @@
 // The exact library's path over several surfaces on one segment, converged (issue 22's reference
 // for the smooth composition, core/muscles/wrap/smooth_composite.hpp): OpenSim's passes (each
 // surface wrapped, calcWrap, on the segment between the previous surface's exit and the next
-// surface's entry) repeated until the tangent points stop moving (1e-15 m), in a given order along
+// surface's entry) repeated until the tangent points stop moving (1e-14 m, above its round-off), in a given order along
 // the segment. Each surface as the library wraps one object (WrapOptions::single_wrap: closed-form
 // tangent points; OpenSim's multi-object cylinder adds its 2 mm tangency correction, measured
 // separately), the geometric path p1 -> r1 -> arc -> r2 -> ... -> p2.
@@ -20,6 +20,7 @@ struct ConvergedLibraryPath {
   std::vector<WrapResult> result;  ///< per surface (caller's order), its frame
   double length = 0.0;
   int passes = 0;
+  double last_moved = 0.0;  ///< the last pass's largest move of a tangent point (m)
   std::vector<Vec3> points;  ///< p1, (r1, r2 per wrapping surface, path order), p2 (common frame)
   std::vector<int> arc_of;   ///< per piece: the surface whose arc it is, or -1 (straight)
 };
@@ -48,7 +49,8 @@ inline ConvergedLibraryPath convergeLibraryPath(const std::vector<CompositeWrapS
       out.result[k] = r;
     }
     out.passes = pass + 1;
-    if (moved < 1e-15) {
+    out.last_moved = moved;
+    if (moved < 1e-14) {  // the construction's round-off at coordinates of 0.5 m: moves of 2e-15 m
       out.converged = true;
       break;
     }
