@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -150,8 +151,26 @@ int solveValues(const std::vector<const WrapSurface*>& surf, const std::vector<C
   for (const Vec3& v : {p1, p2}) scale = std::max(scale, v.cwiseAbs().maxCoeff());
   const double tol = 1e-14 * scale;
   VecX G, Gt;
+  // the passes themselves (x <- F(x)) first: within a band the maps are steep (the weight's slope
+  // over a band of a few mm times a lever of tens of cm), where Newton from the sweep can stall far
+  // from the root, while the passes contract toward it; Newton then finishes quadratically
+  auto passes = [&](int n) {
+    double best = std::numeric_limits<double>::infinity();
+    int stalled = 0;
+    for (int it = 0; it < n; ++it) {
+      residual(false, G, nullptr);
+      const double g = G.cwiseAbs().maxCoeff();
+      if (!std::isfinite(g) || g <= tol) return;
+      stalled = g < 0.5 * best ? 0 : stalled + 1;
+      best = std::min(best, g);
+      if (stalled > 10) return;
+      step(G, 1.0);
+    }
+  };
+  passes(60);
   residual(true, G, &Gx);
-  for (int it = 1; it <= 60; ++it) {
+  bool retried = false;
+  for (int it = 1; it <= 80; ++it) {
     const double g0 = G.cwiseAbs().maxCoeff();
     if (!std::isfinite(g0)) break;
     if (g0 <= tol) return it;
@@ -175,7 +194,10 @@ int solveValues(const std::vector<const WrapSurface*>& surf, const std::vector<C
     if (!ok) {
       // round-off floor: accept a residual near the tolerance
       if (g0 <= 1e3 * tol) return it;
-      break;
+      if (retried) break;
+      // Newton stalled: more passes, then Newton again
+      retried = true;
+      passes(500);
     }
     residual(true, G, &Gx);
   }
