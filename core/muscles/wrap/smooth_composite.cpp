@@ -268,7 +268,14 @@ void compose(const std::vector<CompositeWrapSurface>& surfaces, const Vec3& p1, 
     std::array<Vec3, K> e{}, s{};
     MatX Gx;
     out.newton_iterations = solveValues<K>(surf, ordered, p1, p2, width, e, s, Gx);
-    const MatX Minv = Gx.inverse();
+    // a singular I - dF/dx: the fixed point is not locally unique (e.g. parallel cylinders with
+    // every point in their common normal plane: the path may slide along the axes), no derivative
+    const Eigen::PartialPivLU<MatX> lu(Gx);
+    const MatX Minv = lu.inverse();
+    if (!Minv.allFinite() || !(lu.rcond() > 1e-12))
+      throw std::invalid_argument(
+          "the smooth composition of wrap objects on one segment has a degenerate fixed point here (I - dF/dx "
+          "singular: the path is not locally unique)");
     for (int m = 0; m < K; ++m) ej[m] = constantV<N>(e[m]), sj[m] = constantV<N>(s[m]);
     for (int it = 0; it < 2; ++it) {
       Chain<N, K> ch;
@@ -297,6 +304,8 @@ void compose(const std::vector<CompositeWrapSurface>& surfaces, const Vec3& p1, 
     if (m + 1 < K) sig[m + 1] = sig[m] + ch.seg[m].weight * ch.seg[m].lead;
   }
   const J L = sig[K - 1] + T[K - 1];
+  if (!std::isfinite(L.v))
+    throw std::invalid_argument("the smooth composition of wrap objects on one segment is not finite here");
   for (int m = 0; m + 1 < K; ++m) {
     const J a = T[m] - (sig[m + 1] - sig[m]), b = T[m + 1];
     h[m] = (a * b) / (a + b);
