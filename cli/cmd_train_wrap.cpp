@@ -26,6 +26,7 @@
 #include "converter/osim_reader.hpp"
 #include "converter/storage.hpp"
 #include "core/muscles/wrap/network_set.hpp"
+#include "core/muscles/wrap_composite.hpp"
 #include "core/muscles/wrap_muscle.hpp"
 #include "tools/wrap_training/model_networks.hpp"
 #include "core/muscles/wrap/network_model.hpp"
@@ -582,7 +583,10 @@ int runForModel(const FlagValues& a, const CLI::App& app) {
     if (mu.path.wraps.empty()) continue;
     Muscle probe = mu;
     probe.wrap = WrapMassOptions{};
-    const std::string why = wrapMassPointsUnsupportedReason(probe);
+    // two wrap objects able to share a segment: the smooth model composes them, a network does not
+    const std::string why = hasSharedWrapSegments(probe) ? "two wrap objects can share a segment, which a network "
+                                                           "does not compose"
+                                                         : wrapMassPointsUnsupportedReason(probe);
     if (why.empty()) muscles.push_back(mu);
     else std::cout << "train-wrap: muscle '" << mu.name << "' skipped (the wrap models cannot take its path: " << why << ")\n";
   }

@@ -28,7 +28,7 @@ void addWrapFlags(CLI::App& app, WrapFlags& f, bool with_model, const std::strin
                                  "smooth wrap model (C2 across contact changes, energy-consistent); exact\n"
                                  "over OpenSim's wrapping with finite-difference Jacobians (energy jumps\n"
                                  "at contact changes); neural over a trained network; lumped keeps them\n"
-                                 "massless. smooth takes paths with at most one wrap object per segment\n"
+                                 "massless. smooth takes paths with up to three wrap objects per segment\n"
                                  "over the surfaces it supports, exact any path OpenSim wraps; other\n"
                                  "wrapping muscles stay lumped and the summary says why (\"wrapping\n"
                                  "(Type III): W of N carry mass\"). Simbody engines take the same paths")

@@ -46,7 +46,6 @@ struct WrapSurfaceMotion {
 struct WrapStageScratch {
   std::vector<int> seg_wrap, idx;
   std::vector<double> betas, betadots, betadot;
-  std::vector<char> have_surface;
   std::vector<WrapSurfaceMotion> surfaces;
   MatX J_mb, Jdot_mb;  // a surface body's rows of J_mr, Jdot_mr
   struct Ends {        // a wrapped segment's ends in its surface frame, A_j = dp_j/dq and d/dt

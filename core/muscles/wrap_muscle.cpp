@@ -7,6 +7,7 @@
 
 #include "core/muscles/path_kinematics.hpp"
 #include "core/muscles/via_point.hpp"
+#include "core/muscles/wrap_composite.hpp"
 #include "core/muscles/wrap/network_model.hpp"
 #include "core/muscles/wrap/wrap_path.hpp"
 #include "core/skeleton/kinematics.hpp"
@@ -206,7 +207,8 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
     const std::string why = smoothWrapUnsupportedReason(w.surface);
     if (!why.empty()) return "the smooth wrap model cannot take wrap object '" + w.name + "': " + why;
     // two ranges sharing two points can land on one segment: OpenSim then applies both in turn
-    // (and iterates), which the smooth model does not compose
+    // (and iterates); the smooth model composes cylinders and spheres there (wrap_composite.hpp),
+    // the network nothing
     int lo = 0, hi = 0;
     wrapRange(w, np, lo, hi);
     for (size_t j = 0; j < k; ++j) {
@@ -214,14 +216,35 @@ std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
       if (!v.surface.active) continue;
       int lo2 = 0, hi2 = 0;
       wrapRange(v, np, lo2, hi2);
-      if (std::min(hi, hi2) > std::max(lo, lo2))
-        return "the smooth wrap model takes one wrap object per segment, but wrap objects '" + v.name + "' and '" +
-               w.name + "' can both act on the segment between path points " + std::to_string(std::max(lo, lo2) + 1) +
-               " and " + std::to_string(std::min(hi, hi2) + 1) +
-               " (OpenSim applies them in turn and iterates; the smooth model does not compose surfaces): use the "
-               "exact model";
+      if (!(std::min(hi, hi2) > std::max(lo, lo2))) continue;
+      auto composable = [](const WrapSurface& x) { return x.type == WrapType::Cylinder || x.type == WrapType::Sphere; };
+      if (muscle.wrap.model == WrapModel::Smooth) {
+        if (composable(v.surface) && composable(w.surface)) continue;
+        return "the smooth wrap model composes cylinders and spheres on one segment, but wrap objects '" + v.name +
+               "' (" + wrapTypeName(v.surface.type) + ") and '" + w.name + "' (" + wrapTypeName(w.surface.type) +
+               ") can both act on the segment between path points " + std::to_string(std::max(lo, lo2) + 1) +
+               " and " + std::to_string(std::min(hi, hi2) + 1) + ": use the exact model";
+      }
+      return "the neural wrap model takes one wrap object per segment, but wrap objects '" + v.name + "' and '" +
+             w.name + "' can both act on the segment between path points " + std::to_string(std::max(lo, lo2) + 1) +
+             " and " + std::to_string(std::min(hi, hi2) + 1) +
+             " (OpenSim applies them in turn and iterates; the smooth model composes them): use the smooth or the "
+             "exact model";
     }
   }
+  if (muscle.wrap.model == WrapModel::Smooth)  // the composition's limit (wrap/smooth_composite.hpp)
+    for (int j = 0; j + 1 < np; ++j) {
+      int n = 0;
+      for (const PathWrap& w : path.wraps) {
+        int lo = 0, hi = 0;
+        wrapRange(w, np, lo, hi);
+        n += w.surface.active && lo <= j && hi >= j + 1 ? 1 : 0;
+      }
+      if (n > 3)
+        return "the smooth wrap model composes at most 3 wrap objects on one segment, but " + std::to_string(n) +
+               " can act on the segment between path points " + std::to_string(j + 1) + " and " +
+               std::to_string(j + 2) + ": use the exact model";
+    }
   return "";
 }
 
@@ -422,15 +445,18 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
   // which wrap acts on which segment (header): the candidate penetrating most
   WrapStageScratch& sc = mk.wrap_scratch;
   sc.seg_wrap = calcSegmentWraps(muscle, mk.active, mk.x_w, sk.E_wi);
-  // the surfaces' motion from the skeleton, for the wraps that act
-  sc.surfaces.resize(path.wraps.size());
-  sc.have_surface.assign(path.wraps.size(), 0);
-  for (int w : sc.seg_wrap) {
-    if (w < 0 || sc.have_surface[w]) continue;
+  // the surfaces' motion from the skeleton, for the wraps that act (every active one when
+  // several may share a segment: the composition picks its own, wrap_composite.hpp)
+  const bool compose = muscle.wrap.model == WrapModel::Smooth && hasSharedWrapSegments(muscle);
+  const int nw = static_cast<int>(path.wraps.size());
+  sc.surfaces.resize(nw);
+  for (int w = 0; w < nw; ++w) {
+    const bool acts = compose ? path.wraps[w].surface.active
+                              : std::find(sc.seg_wrap.begin(), sc.seg_wrap.end(), w) != sc.seg_wrap.end();
+    if (!acts) continue;
     if (!coversBody(model, mk, path.wraps[w].body))
       throw std::logic_error("calcWrapMassPoints: mk's columns do not cover the wrap body (initWrapMuscleColumns)");
     calcSurfaceMotion(model, sk, path.wraps[w], mk, mk.velocity, sc.surfaces[w], sc.J_mb, sc.Jdot_mb);
-    sc.have_surface[w] = 1;
   }
   calcWrapMassPointsOnSurfaces(muscle, sc.seg_wrap, sc.surfaces, mk);
 }
@@ -439,6 +465,10 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
 
 void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& seg_wrap,
                                   const std::vector<WrapSurfaceMotion>& surfaces, MuscleKinematics& mk) {
+  if (muscle.wrap.model == WrapModel::Smooth && hasSharedWrapSegments(muscle)) {
+    calcCompositeWrapMassPointsOnSurfaces(muscle, surfaces, mk);  // several wraps on a segment
+    return;
+  }
   const MassPoints& mp = muscle.mass_points;
   const MusclePath& path = muscle.path;
   const int N = mp.size();

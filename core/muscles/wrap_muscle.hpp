@@ -3,9 +3,9 @@
 //
 // Supported shapes (wrapMassPointsUnsupportedReason() says why another is refused; validateMuscle
 // throws it): any path points (fixed, conditional, moving) and any wrap objects, with
-//   Smooth  at most one wrap object per segment: no two wrap ranges may share a segment (OpenSim
-//           applies wraps on one segment in turn and iterates; composing two smooth surfaces is
-//           not done), and every active surface one the smooth model takes (smoothWrapUnsupportedReason);
+//   Smooth  every active surface one the smooth model takes (smoothWrapUnsupportedReason); where
+//           wrap ranges share a segment, up to three cylinders and spheres, composed there
+//           (core/muscles/wrap_composite.hpp, issue 22);
 //   Exact   anything the exact library takes (several wraps on one segment included).
 //
 // Segments. The active path points split the path into segments (i, i+1). A wrap object acts on

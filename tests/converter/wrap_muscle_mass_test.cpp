@@ -68,28 +68,40 @@ TEST(WrapMuscleMass, RunningLegGastrocnemiiTakeMassWithWrapMass) {
 }
 
 // a wrapping muscle whose path the wrap model refuses stays lumped, and the plan gives the model's
-// own reason: subject_walk_armless's med_gas_r (two cylinders that can act on one segment) is
-// refused by the smooth model and taken by the exact one
+// own reason: arm26's TRIlong (two cylinders and an ellipsoid that can act on one segment) is
+// refused by the smooth model and taken by the exact one; subject_walk_armless's med_gas_r (two
+// cylinders on one segment) is taken by the smooth model's composition since issue 22
 TEST(WrapMuscleMass, RefusedWrappingMuscleStaysLumpedWithTheModelsReason) {
   REDMAX_REQUIRE_SHARED();
-  const ModelDescription d = readOsimModel(std::string(REDMAX_SHARED_DIR) +
-                                           "/opensim/opensim-core/OpenSim/Moco/Test/subject_walk_armless_18musc.osim");
   BuildOptions bo;
   bo.constraints = false;
   MuscleMassOptions o;
   o.source = MuscleMassOptions::Source::Physiological;
-  o.muscles = "med_gas_r";  // all of them would leave tibia_r non-physical
   o.wrap_mass = true;
   o.wrap.model = WrapModel::Smooth;
+  {
+    const ModelDescription d = readOsimModel(std::string(REDMAX_SHARED_DIR) +
+                                             "/opensim/opensim-core/OpenSim/Moco/Test/subject_walk_armless_18musc.osim");
+    o.muscles = "med_gas_r";  // all of them would leave tibia_r non-physical
+    const MuscleMassModel r = applyMuscleMass(d, bo, o);
+    const int k = findEntry(r.plan, "med_gas_r");
+    ASSERT_GE(k, 0);
+    EXPECT_GT(r.plan.muscles[k].mass, 0.0) << r.plan.muscles[k].lumped_why;
+    EXPECT_EQ(r.plan.muscles[k].lumped_why, "");
+  }
+  const ModelDescription d =
+      readOsimModel(std::string(REDMAX_SHARED_DIR) + "/opensim/opensim-models/Models/Arm26/arm26.osim");
+  o.muscles = "TRIlong";
   const MuscleMassModel r = applyMuscleMass(d, bo, o);
-  const int k = findEntry(r.plan, "med_gas_r");
+  const int k = findEntry(r.plan, "TRIlong");
   ASSERT_GE(k, 0);
   // the reason, asked of the plain build's muscle independently of the plan
   Muscle mu = buildCoreModel(d, bo).model.muscles()[k];
-  ASSERT_EQ(mu.name, "med_gas_r");
+  ASSERT_EQ(mu.name, "TRIlong");
   mu.wrap.model = WrapModel::Smooth;
   const std::string why = wrapMassPointsUnsupportedReason(mu);
   ASSERT_FALSE(why.empty());
+  EXPECT_NE(why.find("composes cylinders and spheres"), std::string::npos) << why;
   EXPECT_EQ(r.plan.muscles[k].mass, 0.0);
   EXPECT_EQ(r.plan.muscles[k].lumped_why, "Type III path (" + why + ")");
   o.wrap.model = WrapModel::Exact;

@@ -18,6 +18,7 @@
 #include "core/muscles/wrap/smooth.hpp"
 #include "core/muscles/wrap/wrap_path.hpp"
 #include "core/skeleton/kinematics.hpp"
+#include "core/muscles/wrap_composite.hpp"
 #include "core/muscles/wrap_muscle.hpp"
 #include "tests/converter/converter_test_util.hpp"
 #include "tests/core/muscles/muscle_test_util.hpp"
@@ -185,7 +186,9 @@ TEST(WrapPathModels, SmoothMusclesAtRandomPosesStayOnOpenSimsPath) {
       if (pathType(base.path) != redmax::PathType::III) continue;
       Muscle mu = base;
       mu.mass_points = makeMassPoints(1.0, 0.0, 0.0, {10, MassPointOptions::Region::WholePath});
-      if (!wrapMassPointsUnsupportedReason(mu).empty()) continue;
+      // two wraps on one segment (the gastrocnemii): the composition equals the converged library
+      // path, not OpenSim's truncated passes (tests/validation/wrap_composite_models_test.cpp)
+      if (!wrapMassPointsUnsupportedReason(mu).empty() || hasSharedWrapSegments(mu)) continue;
       for (int t = 0; t < 100; ++t) {
         State s;
         s.q = m.defaultQ() + 0.6 * VecX::NullaryExpr(m.nr(), [&] { return u(rng); });

@@ -6,6 +6,7 @@
 
 #include "converter/coordinates_file.hpp"
 #include "core/muscles/path_kinematics.hpp"
+#include "core/muscles/wrap_composite.hpp"
 #include "core/muscles/wrap/wrap_path.hpp"
 #include "core/skeleton/kinematics.hpp"
 #include "core/spatial/se3.hpp"
@@ -24,8 +25,14 @@ double calcModelPathLength(const Model& model, const Muscle& muscle, const VecX&
                            WrapFallbackMonitor* monitor) {
   const MusclePath& path = muscle.path;
   calcActivePoints(path, q, E_wi, active, x_w);
-  const std::vector<int> seg_wrap = calcSegmentWraps(muscle, active, x_w, E_wi);
   const WrapMassOptions& o = muscle.wrap;
+  if (o.model == WrapModel::Smooth && hasSharedWrapSegments(muscle)) {
+    // several wraps may share a segment: the smooth composition (core/muscles/wrap_composite.hpp)
+    std::vector<Mat4> E_ws;
+    for (const PathWrap& w : path.wraps) E_ws.push_back(w.body >= 0 ? Mat4(E_wi[w.body] * w.E_bs) : w.E_bs);
+    return calcCompositePathLength(muscle, active, x_w, E_ws);
+  }
+  const std::vector<int> seg_wrap = calcSegmentWraps(muscle, active, x_w, E_wi);
   double length = 0.0;
   for (size_t i = 0; i < seg_wrap.size(); ++i) {
     const double straight = (x_w[i + 1] - x_w[i]).norm();

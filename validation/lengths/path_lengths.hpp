@@ -10,7 +10,8 @@
 // (calcSegmentWraps, core/muscles/wrap_muscle.hpp), the model's length of that wrapped segment:
 // the smooth model's (calcWrapModelLength), or the polyline through the network's points
 // (calcNetworkWrapPathLength), with the smooth model where the network falls back. Paths the model
-// refuses (wrapMassPointsUnsupportedReason: two wraps on one segment, unsupported surfaces) keep
+// refuses (wrapMassPointsUnsupportedReason: unsupported surfaces, for the network two wraps on one
+// segment; several on one segment go through the smooth composition, wrap_composite.hpp) keep
 // OpenSim's exact length and are named once.
 #include <string>
 #include <vector>

@@ -1,4 +1,5 @@
 #include "core/muscles/wrap/smooth.hpp"
+#include "core/muscles/wrap/smooth_jet.hpp"
 
 #include <algorithm>
 #include <array>
@@ -942,6 +943,59 @@ SmoothWrapLength calcSmoothWrapLength(const WrapSurface& surface, const Vec3& p1
   for (int i = 0; i < 6; ++i) out.J(0, i) = L.g[i], out.Jdot(0, i) = L.gt[i];
   return out;
 }
+
+// one surface over Jets with the caller's seeds (smooth_jet.hpp; issue 22's composition)
+template <int N>
+struct SmoothWrapJetSegment<N>::Impl {
+  SmoothSetup<Jet<N>> st;
+};
+
+template <int N>
+SmoothWrapJetSegment<N>::SmoothWrapJetSegment(const WrapSurface& surface, const V& p1, const V& p2, double width)
+    : impl_(std::make_unique<Impl>()) {
+  SmoothSetup<J>& st = impl_->st;
+  smoothSetup(surface, p1, p2, smoothWrapWidth(surface, width), st);
+  weight = st.w;
+  length = st.l_straight;
+  lead = J(0.0);
+  r1 = p1;
+  r2 = p2;
+  if (st.mode == SmoothSetup<J>::Mode::Straight) return;
+  length = st.l_straight + st.w * (st.wrappedLength() - st.l_straight);
+  if (st.ellipsoid) {
+    lead = (st.ew.d1 + st.ew.la) / st.ew.factor;
+    r1 = (1.0 / st.ew.factor) * st.ew.r1;
+    r2 = (1.0 / st.ew.factor) * st.ew.r2;
+  } else {
+    lead = st.arc.l1 + st.arc.la;
+    r1 = st.torus ? st.frame.toTorus(st.arc.r1) : st.arc.r1;
+    r2 = st.torus ? st.frame.toTorus(st.arc.r2) : st.arc.r2;
+  }
+}
+
+template <int N> SmoothWrapJetSegment<N>::~SmoothWrapJetSegment() = default;
+template <int N> SmoothWrapJetSegment<N>::SmoothWrapJetSegment(SmoothWrapJetSegment&&) noexcept = default;
+template <int N>
+SmoothWrapJetSegment<N>& SmoothWrapJetSegment<N>::operator=(SmoothWrapJetSegment&&) noexcept = default;
+
+template <int N>
+typename SmoothWrapJetSegment<N>::V SmoothWrapJetSegment<N>::point(const J& alpha) const {
+  return smoothEval(impl_->st, alpha);
+}
+
+double smoothWrapWidth(const WrapSurface& surface, double width) {
+  SmoothWrapOptions o;
+  o.width = width;
+  return widthOf(surface, o);
+}
+
+// the sizes the composition uses: 6 unknowns per extra surface (the fixed point's Newton
+// Jacobian), 7 + 12 K inputs (ends, K surface poses, the fraction) for K = 1, 2, 3
+template class SmoothWrapJetSegment<6>;
+template class SmoothWrapJetSegment<12>;
+template class SmoothWrapJetSegment<19>;
+template class SmoothWrapJetSegment<31>;
+template class SmoothWrapJetSegment<43>;
 
 // the route before issue 18 (nested duals, one pass per input direction, per point): the tests'
 // reference for the shared route above

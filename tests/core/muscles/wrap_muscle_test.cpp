@@ -213,7 +213,14 @@ TEST(WrapMuscle, ValidationNamesTheUnsupportedShape) {
   Muscle two_wraps = pendulumWrapMuscle(WrapModel::Smooth);
   two_wraps.path.wraps.push_back(two_wraps.path.wraps[0]);
   two_wraps.path.num_wraps = 2;
-  expectThrow(two_wraps, "one wrap object per segment");
+  EXPECT_NO_THROW(validateMuscle(m, two_wraps));  // the smooth model composes them (issue 22)
+  Muscle four = two_wraps;  // beyond the composition's three per segment
+  four.path.wraps.push_back(four.path.wraps[0]);
+  four.path.wraps.push_back(four.path.wraps[0]);
+  four.path.num_wraps = 4;
+  expectThrow(four, "at most 3 wrap objects on one segment");
+  four.wrap.model = WrapModel::Exact;
+  EXPECT_NO_THROW(validateMuscle(m, four));
   two_wraps.wrap.model = WrapModel::Exact;  // the exact model composes them as OpenSim does
   EXPECT_NO_THROW(validateMuscle(m, two_wraps));
   Muscle sphere = pendulumWrapMuscle(WrapModel::Smooth);
