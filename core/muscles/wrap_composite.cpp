@@ -6,36 +6,12 @@
 #include <string>
 
 #include "core/muscles/via_point.hpp"
+#include "core/muscles/wrap_muscle.hpp"
 #include "core/muscles/wrap/smooth_composite.hpp"
 #include "core/spatial/se3.hpp"
 
 namespace redmax {
 namespace {
-
-// OpenSim's 1-based range of a PathWrap as 0-based first and last point indices (wrap_muscle.cpp)
-void rangeOf(const PathWrap& w, int np, int& lo, int& hi) {
-  lo = w.range_begin < 1 ? 0 : w.range_begin - 1;
-  hi = w.range_end < 1 ? np - 1 : std::min(w.range_end - 1, np - 1);
-}
-
-// the wrap's candidate segments [first, last) over the active points (wrap_muscle.cpp's wrapSegments)
-bool candidateSegments(const PathWrap& w, const std::vector<int>& active, int np, int& first, int& last) {
-  int lo = 0, hi = 0;
-  rangeOf(w, np, lo, hi);
-  const int P = static_cast<int>(active.size());
-  first = -1;
-  last = -1;
-  for (int i = 0; i < P; ++i) {
-    if (first < 0 && active[i] >= lo) first = i;
-    if (active[i] <= hi) last = i;
-  }
-  return first >= 0 && last > first;
-}
-
-bool endInside(const WrapSurface& surface, const Vec3& p1, const Vec3& p2) {
-  if (!p1.allFinite() || !p2.allFinite() || p1 == p2 || !smoothWrapUnsupportedReason(surface).empty()) return true;
-  return surface.contains(p1) || surface.contains(p2);
-}
 
 CompositeWrapSurface compositeSurface(const PathWrap& w, const WrapSurfaceMotion& m) {
   CompositeWrapSurface c;
@@ -109,11 +85,11 @@ bool hasSharedWrapSegments(const Muscle& muscle) {
   for (size_t k = 0; k < path.wraps.size(); ++k) {
     if (!path.wraps[k].surface.active) continue;
     int lo = 0, hi = 0;
-    rangeOf(path.wraps[k], np, lo, hi);
+    wrapRange(path.wraps[k], np, lo, hi);
     for (size_t j = 0; j < k; ++j) {
       if (!path.wraps[j].surface.active) continue;
       int lo2 = 0, hi2 = 0;
-      rangeOf(path.wraps[j], np, lo2, hi2);
+      wrapRange(path.wraps[j], np, lo2, hi2);
       if (std::min(hi, hi2) > std::max(lo, lo2)) return true;
     }
   }
@@ -132,7 +108,7 @@ std::vector<std::vector<int>> calcSegmentWrapSets(const Muscle& muscle, const st
     const PathWrap& pw = path.wraps[w];
     if (!pw.surface.active) continue;
     int first = 0, last = 0;
-    if (!candidateSegments(pw, active, np, first, last)) continue;
+    if (!wrapSegments(pw, active, np, first, last)) continue;
     const Mat3 R = E_ws[w].topLeftCorner<3, 3>();
     const Vec3 p = E_ws[w].topRightCorner<3, 1>();
     int best = -1;
@@ -143,7 +119,7 @@ std::vector<std::vector<int>> calcSegmentWrapSets(const Muscle& muscle, const st
         break;
       }
       const Vec3 p1 = R.transpose() * (x_w[i] - p), p2 = R.transpose() * (x_w[i + 1] - p);
-      if (endInside(pw.surface, p1, p2)) continue;  // OpenSim's InsideRadius: no wrap on it
+      if (endInsideSurface(pw.surface, p1, p2)) continue;  // OpenSim's InsideRadius: no wrap on it
       if (last - first == 1) {
         best = i;
         break;
@@ -235,18 +211,7 @@ void calcCompositeWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vect
     MatX J_L(nseg, k), Jdot_L = MatX::Zero(nseg, k);
     for (int i = 0; i < nseg; ++i) {
       if (sets[i].empty()) {
-        const Vec3& u = mk.dxbar[i];
-        const MatX dJ = mk.J_xr.middleRows<3>(3 * (i + 1)) - mk.J_xr.middleRows<3>(3 * i);
-        L[i] = mk.l[i];
-        J_L.row(i).noalias() = u.transpose() * dJ;
-        if (vel && L[i] > 0.0) {
-          const Vec3 dv = mk.xdot_w[i + 1] - mk.xdot_w[i];
-          const Vec3 ud = (Mat3::Identity() - u * u.transpose()) * dv / L[i];
-          Ld[i] = u.dot(dv);
-          Jdot_L.row(i).noalias() = ud.transpose() * dJ;
-          Jdot_L.row(i).noalias() +=
-              u.transpose() * (mk.Jdot_xr.middleRows<3>(3 * (i + 1)) - mk.Jdot_xr.middleRows<3>(3 * i));
-        }
+        straightSegmentLengthRow(mk, i, vel, L, Ld, J_L, Jdot_L);
       } else {
         CompositeWrapResult r;
         compose(i, {}, {}, r);
@@ -258,70 +223,18 @@ void calcCompositeWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vect
         }
       }
     }
-    const double Lam = L.sum();
-    for (int i = 0; i < nseg; ++i)
-      if (!(L[i] > 1e-12 * (1.0 + Lam)))
-        throw MuscleError(who + ": path segment " + std::to_string(i) + " (between active points " +
-                          std::to_string(mk.active[i]) + " and " + std::to_string(mk.active[i + 1]) +
-                          ") has zero length here; mass points need distinct consecutive path points");
-    const Eigen::RowVectorXd J_Lam = J_L.colwise().sum();
-    const double Lamdot = Ld.sum();
-    const Eigen::RowVectorXd Jdot_Lam = Jdot_L.colwise().sum();
-    double S = 0.0, Sdot = 0.0;
-    Eigen::RowVectorXd J_S = Eigen::RowVectorXd::Zero(k), Jdot_S = Eigen::RowVectorXd::Zero(k);
-    for (int i = 1; i < P - 1; ++i) {
-      S += L[i - 1];
-      J_S += J_L.row(i - 1);
-      mk.s[i] = S / Lam;
-      mk.J_sr.row(i) = (J_S - mk.s[i] * J_Lam) / Lam;
-      if (!vel) continue;
-      Sdot += Ld[i - 1];
-      Jdot_S += Jdot_L.row(i - 1);
-      mk.sdot[i] = (Sdot - mk.s[i] * Lamdot) / Lam;
-      mk.Jdot_sr.row(i) = (Jdot_S - mk.s[i] * Jdot_Lam - mk.sdot[i] * J_Lam - Lamdot * mk.J_sr.row(i)) / Lam;
-    }
+    calcEulerianFromSegmentLengths(L, Ld, J_L, Jdot_L, vel, muscle.name, mk);
   }
 
   // mass points: segment, beta and betadot [D Eq. 5.29, 5.31]
-  mk.x_a.resize(N);
-  mk.segment.assign(N, 0);
-  mk.beta.assign(N, 0.0);
-  if (mk.J_ar.rows() != 3 * N || mk.J_ar.cols() != k) mk.J_ar.resize(3 * N, k);
-  if (vel && (mk.Jdot_ar.rows() != 3 * N || mk.Jdot_ar.cols() != k)) mk.Jdot_ar.resize(3 * N, k);
-  std::vector<double> betadot(N, 0.0);
-  for (int a = 0; a < N; ++a) {
-    const double s_a = mp.alpha[a];
-    int i = 0;
-    while (i < P - 2 && mk.s[i + 1] <= s_a) ++i;
-    const double ds = mk.s[i + 1] - mk.s[i];
-    mk.segment[a] = i;
-    mk.beta[a] = (s_a - mk.s[i]) / ds;
-    if (vel) betadot[a] = -((1.0 - mk.beta[a]) * mk.sdot[i] + mk.beta[a] * mk.sdot[i + 1]) / ds;
-  }
+  std::vector<double> betadot;
+  locateWrapMassPoints(mp, mk, betadot);
   // straight segments: Type II's EOL construction (via_point.hpp) with these s
-  MatX J_zr(8, k), Jdot_zr(8, k);
-  for (int a = 0; a < N; ++a) {
-    const int i = mk.segment[a];
-    if (!sets[i].empty()) continue;
-    const double beta = mk.beta[a];
-    const double ds = mk.s[i + 1] - mk.s[i];
-    const Vec3 F = (mk.x_w[i + 1] - mk.x_w[i]) / ds;
-    mk.x_a[a] = (1.0 - beta) * mk.x_w[i] + beta * mk.x_w[i + 1];
-    J_zr.topRows<3>() = mk.J_xr.middleRows<3>(3 * i);
-    J_zr.middleRows<3>(3) = mk.J_xr.middleRows<3>(3 * (i + 1));
-    J_zr.row(6) = mk.J_sr.row(i);
-    J_zr.row(7) = mk.J_sr.row(i + 1);
-    const Eigen::Matrix<double, 3, 8> J_az = calcJ_az(beta, F);
-    mk.J_ar.middleRows<3>(3 * a).noalias() = J_az * J_zr;
-    if (!vel) continue;
-    const Vec3 Fdot = (mk.xdot_w[i + 1] - mk.xdot_w[i] - F * (mk.sdot[i + 1] - mk.sdot[i])) / ds;
-    Jdot_zr.topRows<3>() = mk.Jdot_xr.middleRows<3>(3 * i);
-    Jdot_zr.middleRows<3>(3) = mk.Jdot_xr.middleRows<3>(3 * (i + 1));
-    Jdot_zr.row(6) = mk.Jdot_sr.row(i);
-    Jdot_zr.row(7) = mk.Jdot_sr.row(i + 1);
-    mk.Jdot_ar.middleRows<3>(3 * a).noalias() = calcJdot_az(beta, betadot[a], F, Fdot) * J_zr;
-    mk.Jdot_ar.middleRows<3>(3 * a).noalias() += J_az * Jdot_zr;
-  }
+  std::vector<int> straight(nseg, -1);
+  for (int i = 0; i < nseg; ++i)
+    if (!sets[i].empty()) straight[i] = 0;
+  MatX J_zr, Jdot_zr;
+  calcStraightSegmentMassPoints(straight, betadot, J_zr, Jdot_zr, mk);
   // wrapped segments: the composition at the points' fractions, then du/dq (the fraction's row:
   // J_beta = c_i J_s,i + c_i1 J_s,i+1, c_i = -(1 - beta) / ds, c_i1 = -beta / ds, and its rate)
   const bool moving_beta = nseg > 1;

@@ -52,26 +52,6 @@ void exactPoints(const WrapSurface& surface, const Vec3& a, const Vec3& b, const
   for (size_t k = 0; k < alphas.size(); ++k) xs[k] = calcWrappedPathPoint(surface, r, a, b, alphas[k]);
 }
 
-// OpenSim's 1-based range of a PathWrap as 0-based first and last point indices (< 1: the ends)
-void wrapRange(const PathWrap& w, int np, int& lo, int& hi) {
-  lo = w.range_begin < 1 ? 0 : w.range_begin - 1;
-  hi = w.range_end < 1 ? np - 1 : std::min(w.range_end - 1, np - 1);
-}
-
-// the candidate segments [first, last) of wrap w over the active points (OpenSim's applyWrapObjects:
-// from the first active point at/after the range's begin to the last one at/before its end)
-bool wrapSegments(const PathWrap& w, const std::vector<int>& active, int np, int& first, int& last) {
-  int lo = 0, hi = 0;
-  wrapRange(w, np, lo, hi);
-  const int P = static_cast<int>(active.size());
-  first = -1;
-  last = -1;
-  for (int i = 0; i < P; ++i) {
-    if (first < 0 && active[i] >= lo) first = i;
-    if (active[i] <= hi) last = i;
-  }
-  return first >= 0 && last > first;
-}
 
 void calcSurfaceMotion(const Model& model, const SkeletonWorkspace& sk, const PathWrap& w, const MuscleKinematics& mk,
                        bool vel, WrapSurfaceMotion& sm, MatX& J_mb, MatX& Jdot_mb) {
@@ -180,6 +160,35 @@ void locateOnWrappedPath(const WrappedPath& wp, double alpha, int& segment, doub
 }
 
 }  // namespace
+
+// OpenSim's 1-based range of a PathWrap as 0-based first and last point indices (< 1: the ends)
+void wrapRange(const PathWrap& w, int np, int& lo, int& hi) {
+  lo = w.range_begin < 1 ? 0 : w.range_begin - 1;
+  hi = w.range_end < 1 ? np - 1 : std::min(w.range_end - 1, np - 1);
+}
+
+// the candidate segments [first, last) of wrap w over the active points (OpenSim's applyWrapObjects:
+// from the first active point at/after the range's begin to the last one at/before its end)
+bool wrapSegments(const PathWrap& w, const std::vector<int>& active, int np, int& first, int& last) {
+  int lo = 0, hi = 0;
+  wrapRange(w, np, lo, hi);
+  const int P = static_cast<int>(active.size());
+  first = -1;
+  last = -1;
+  for (int i = 0; i < P; ++i) {
+    if (first < 0 && active[i] >= lo) first = i;
+    if (active[i] <= hi) last = i;
+  }
+  return first >= 0 && last > first;
+}
+
+// true when the smooth (and network) wrap model refuses the segment p1 -> p2 (frame s): an end
+// inside the surface, or input it cannot take (its checkInputs), tested directly rather than by
+// computing a wrapped length that is thrown away on this per-evaluation path
+bool endInsideSurface(const WrapSurface& surface, const Vec3& p1, const Vec3& p2) {
+  if (!p1.allFinite() || !p2.allFinite() || p1 == p2 || !smoothWrapUnsupportedReason(surface).empty()) return true;
+  return surface.contains(p1) || surface.contains(p2);
+}
 
 std::string wrapMassPointsUnsupportedReason(const Muscle& muscle) {
   const MusclePath& path = muscle.path;
@@ -361,18 +370,6 @@ SmoothWrapLength calcWrapModelLength(const WrapMassOptions& options, const WrapS
   return calcSmoothWrapLength(surface, p1, p2, p1dot, p2dot, so);
 }
 
-namespace {
-
-// true when the smooth (and network) wrap model refuses the segment p1 -> p2 (frame s): an end
-// inside the surface, or input it cannot take (its checkInputs), tested directly rather than by
-// computing a wrapped length that is thrown away on this per-evaluation path
-bool endInsideSurface(const WrapSurface& surface, const Vec3& p1, const Vec3& p2) {
-  if (!p1.allFinite() || !p2.allFinite() || p1 == p2 || !smoothWrapUnsupportedReason(surface).empty()) return true;
-  return surface.contains(p1) || surface.contains(p2);
-}
-
-}  // namespace
-
 std::vector<int> calcSegmentWraps(const Muscle& muscle, const std::vector<int>& active, const std::vector<Vec3>& x_w,
                                   const std::vector<Mat4>& E_wi) {
   const MusclePath& path = muscle.path;
@@ -463,6 +460,97 @@ void calcSegmentWrapMassPoints(const Model& model, const SkeletonWorkspace& sk, 
 
 }  // namespace
 
+void straightSegmentLengthRow(const MuscleKinematics& mk, int i, bool vel, VecX& L, VecX& Ld, MatX& J_L, MatX& Jdot_L) {
+  // l = |dx|, dl/dq = dxbar^T (J_{i+1} - J_i) [D Eq. 5.18-5.19, 5.27-5.28]
+  const Vec3& u = mk.dxbar[i];
+  const auto dJ = mk.J_xr.middleRows<3>(3 * (i + 1)) - mk.J_xr.middleRows<3>(3 * i);
+  L[i] = mk.l[i];
+  J_L.row(i).noalias() = u.transpose() * dJ;
+  if (vel && L[i] > 0.0) {
+    const Vec3 dv = mk.xdot_w[i + 1] - mk.xdot_w[i];
+    const Vec3 ud = (Mat3::Identity() - u * u.transpose()) * dv / L[i];
+    Ld[i] = u.dot(dv);
+    Jdot_L.row(i).noalias() = ud.transpose() * dJ;
+    Jdot_L.row(i).noalias() +=
+        u.transpose() * (mk.Jdot_xr.middleRows<3>(3 * (i + 1)) - mk.Jdot_xr.middleRows<3>(3 * i));
+  }
+}
+
+void calcEulerianFromSegmentLengths(const VecX& L, const VecX& Ld, const MatX& J_L, const MatX& Jdot_L, bool vel,
+                                    const std::string& muscle_name, MuscleKinematics& mk) {
+  const int nseg = static_cast<int>(L.size()), P = nseg + 1;
+  const int k = static_cast<int>(J_L.cols());
+  const double Lam = L.sum();
+  for (int i = 0; i < nseg; ++i)
+    if (!(L[i] > 1e-12 * (1.0 + Lam)))
+      throw MuscleError("muscle '" + muscle_name + "': path segment " + std::to_string(i) + " (between active points " +
+                        std::to_string(mk.active[i]) + " and " + std::to_string(mk.active[i + 1]) +
+                        ") has zero length here; mass points need distinct consecutive path points");
+  const Eigen::RowVectorXd J_Lam = J_L.colwise().sum();
+  const double Lamdot = Ld.sum();
+  const Eigen::RowVectorXd Jdot_Lam = Jdot_L.colwise().sum();
+  double S = 0.0, Sdot = 0.0;
+  Eigen::RowVectorXd J_S = Eigen::RowVectorXd::Zero(k), Jdot_S = Eigen::RowVectorXd::Zero(k);
+  for (int i = 1; i < P - 1; ++i) {
+    S += L[i - 1];
+    J_S += J_L.row(i - 1);
+    // s_i Lam = S_i, differentiated once and twice (header)
+    mk.s[i] = S / Lam;
+    mk.J_sr.row(i) = (J_S - mk.s[i] * J_Lam) / Lam;
+    if (!vel) continue;
+    Sdot += Ld[i - 1];
+    Jdot_S += Jdot_L.row(i - 1);
+    mk.sdot[i] = (Sdot - mk.s[i] * Lamdot) / Lam;
+    mk.Jdot_sr.row(i) = (Jdot_S - mk.s[i] * Jdot_Lam - mk.sdot[i] * J_Lam - Lamdot * mk.J_sr.row(i)) / Lam;
+  }
+}
+
+void locateWrapMassPoints(const MassPoints& mp, MuscleKinematics& mk, std::vector<double>& betadot) {
+  const int N = mp.size(), P = static_cast<int>(mk.s.size());
+  sizeMassPointOutputs(N, static_cast<int>(mk.cols.size()), mk);
+  betadot.assign(N, 0.0);
+  for (int a = 0; a < N; ++a) {
+    const double s_a = mp.alpha[a];
+    int i = 0;
+    while (i < P - 2 && mk.s[i + 1] <= s_a) ++i;
+    const double ds = mk.s[i + 1] - mk.s[i];
+    mk.segment[a] = i;
+    mk.beta[a] = (s_a - mk.s[i]) / ds;
+    if (mk.velocity) betadot[a] = -((1.0 - mk.beta[a]) * mk.sdot[i] + mk.beta[a] * mk.sdot[i + 1]) / ds;
+  }
+}
+
+void calcStraightSegmentMassPoints(const std::vector<int>& seg_wrap, const std::vector<double>& betadot, MatX& J_zr,
+                                   MatX& Jdot_zr, MuscleKinematics& mk) {
+  const int k = static_cast<int>(mk.cols.size());
+  const int N = static_cast<int>(mk.segment.size());
+  const bool vel = mk.velocity;
+  J_zr.resize(8, k);
+  Jdot_zr.resize(8, k);
+  for (int a = 0; a < N; ++a) {
+    const int i = mk.segment[a];
+    if (seg_wrap[i] >= 0) continue;
+    const double beta = mk.beta[a];
+    const double ds = mk.s[i + 1] - mk.s[i];
+    const Vec3 F = (mk.x_w[i + 1] - mk.x_w[i]) / ds;  // [D Eq. 5.33]
+    mk.x_a[a] = (1.0 - beta) * mk.x_w[i] + beta * mk.x_w[i + 1];  // [D Eq. 5.30]
+    J_zr.topRows<3>() = mk.J_xr.middleRows<3>(3 * i);
+    J_zr.middleRows<3>(3) = mk.J_xr.middleRows<3>(3 * (i + 1));
+    J_zr.row(6) = mk.J_sr.row(i);
+    J_zr.row(7) = mk.J_sr.row(i + 1);
+    const Eigen::Matrix<double, 3, 8> J_az = calcJ_az(beta, F);  // [D Eq. 5.34, 5.36]
+    mk.J_ar.middleRows<3>(3 * a).noalias() = J_az * J_zr;
+    if (!vel) continue;
+    const Vec3 Fdot = (mk.xdot_w[i + 1] - mk.xdot_w[i] - F * (mk.sdot[i + 1] - mk.sdot[i])) / ds;
+    Jdot_zr.topRows<3>() = mk.Jdot_xr.middleRows<3>(3 * i);
+    Jdot_zr.middleRows<3>(3) = mk.Jdot_xr.middleRows<3>(3 * (i + 1));
+    Jdot_zr.row(6) = mk.Jdot_sr.row(i);
+    Jdot_zr.row(7) = mk.Jdot_sr.row(i + 1);
+    mk.Jdot_ar.middleRows<3>(3 * a).noalias() = calcJdot_az(beta, betadot[a], F, Fdot) * J_zr;
+    mk.Jdot_ar.middleRows<3>(3 * a).noalias() += J_az * Jdot_zr;
+  }
+}
+
 void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& seg_wrap,
                                   const std::vector<WrapSurfaceMotion>& surfaces, MuscleKinematics& mk) {
   if (muscle.wrap.model == WrapModel::Smooth && hasSharedWrapSegments(muscle)) {
@@ -505,19 +593,7 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
     Jdot_L.setZero(nseg, k);
     for (int i = 0; i < nseg; ++i) {
       if (seg_wrap[i] < 0) {
-        // straight: l = |dx|, dl/dq = dxbar^T (J_{i+1} - J_i) [D Eq. 5.18-5.19, 5.27-5.28]
-        const Vec3& u = mk.dxbar[i];
-        const auto dJ = mk.J_xr.middleRows<3>(3 * (i + 1)) - mk.J_xr.middleRows<3>(3 * i);
-        L[i] = mk.l[i];
-        J_L.row(i).noalias() = u.transpose() * dJ;
-        if (vel && L[i] > 0.0) {
-          const Vec3 dv = mk.xdot_w[i + 1] - mk.xdot_w[i];
-          const Vec3 ud = (Mat3::Identity() - u * u.transpose()) * dv / L[i];
-          Ld[i] = u.dot(dv);
-          Jdot_L.row(i).noalias() = ud.transpose() * dJ;
-          Jdot_L.row(i).noalias() +=
-              u.transpose() * (mk.Jdot_xr.middleRows<3>(3 * (i + 1)) - mk.Jdot_xr.middleRows<3>(3 * i));
-        }
+        straightSegmentLengthRow(mk, i, vel, L, Ld, J_L, Jdot_L);
       } else {
         const int w = seg_wrap[i];
         const SegmentEnds& e = sc.ends[i];
@@ -539,72 +615,15 @@ void calcWrapMassPointsOnSurfaces(const Muscle& muscle, const std::vector<int>& 
         }
       }
     }
-    const double Lam = L.sum();
-    for (int i = 0; i < nseg; ++i)
-      if (!(L[i] > 1e-12 * (1.0 + Lam)))
-        throw MuscleError(who() + ": path segment " + std::to_string(i) + " (between active points " +
-                          std::to_string(mk.active[i]) + " and " + std::to_string(mk.active[i + 1]) +
-                          ") has zero length here; mass points need distinct consecutive path points");
-    const Eigen::RowVectorXd J_Lam = J_L.colwise().sum();
-    const double Lamdot = Ld.sum();
-    const Eigen::RowVectorXd Jdot_Lam = Jdot_L.colwise().sum();
-    double S = 0.0, Sdot = 0.0;
-    Eigen::RowVectorXd J_S = Eigen::RowVectorXd::Zero(k), Jdot_S = Eigen::RowVectorXd::Zero(k);
-    for (int i = 1; i < P - 1; ++i) {
-      S += L[i - 1];
-      J_S += J_L.row(i - 1);
-      // s_i Lam = S_i, differentiated once and twice (header)
-      mk.s[i] = S / Lam;
-      mk.J_sr.row(i) = (J_S - mk.s[i] * J_Lam) / Lam;
-      if (!vel) continue;
-      Sdot += Ld[i - 1];
-      Jdot_S += Jdot_L.row(i - 1);
-      mk.sdot[i] = (Sdot - mk.s[i] * Lamdot) / Lam;
-      mk.Jdot_sr.row(i) = (Jdot_S - mk.s[i] * Jdot_Lam - mk.sdot[i] * J_Lam - Lamdot * mk.J_sr.row(i)) / Lam;
-    }
+    calcEulerianFromSegmentLengths(L, Ld, J_L, Jdot_L, vel, muscle.name, mk);
   }
 
   // mass points: segment, beta and betadot [D Eq. 5.29, 5.31]
-  sizeMassPointOutputs(N, k, mk);
   std::vector<double>& betadot = sc.betadot;
-  betadot.assign(N, 0.0);
-  for (int a = 0; a < N; ++a) {
-    const double s_a = mp.alpha[a];
-    int i = 0;
-    while (i < P - 2 && mk.s[i + 1] <= s_a) ++i;
-    const double ds = mk.s[i + 1] - mk.s[i];
-    mk.segment[a] = i;
-    mk.beta[a] = (s_a - mk.s[i]) / ds;
-    if (vel) betadot[a] = -((1.0 - mk.beta[a]) * mk.sdot[i] + mk.beta[a] * mk.sdot[i + 1]) / ds;
-  }
+  locateWrapMassPoints(mp, mk, betadot);
 
   // straight segments: Type II's EOL construction (via_point.hpp) with these s
-  MatX& J_zr = sc.stackJ;
-  MatX& Jdot_zr = sc.stackD;
-  J_zr.resize(8, k);
-  Jdot_zr.resize(8, k);
-  for (int a = 0; a < N; ++a) {
-    const int i = mk.segment[a];
-    if (seg_wrap[i] >= 0) continue;
-    const double beta = mk.beta[a];
-    const double ds = mk.s[i + 1] - mk.s[i];
-    const Vec3 F = (mk.x_w[i + 1] - mk.x_w[i]) / ds;  // [D Eq. 5.33]
-    mk.x_a[a] = (1.0 - beta) * mk.x_w[i] + beta * mk.x_w[i + 1];  // [D Eq. 5.30]
-    J_zr.topRows<3>() = mk.J_xr.middleRows<3>(3 * i);
-    J_zr.middleRows<3>(3) = mk.J_xr.middleRows<3>(3 * (i + 1));
-    J_zr.row(6) = mk.J_sr.row(i);
-    J_zr.row(7) = mk.J_sr.row(i + 1);
-    const Eigen::Matrix<double, 3, 8> J_az = calcJ_az(beta, F);  // [D Eq. 5.34, 5.36]
-    mk.J_ar.middleRows<3>(3 * a).noalias() = J_az * J_zr;
-    if (!vel) continue;
-    const Vec3 Fdot = (mk.xdot_w[i + 1] - mk.xdot_w[i] - F * (mk.sdot[i + 1] - mk.sdot[i])) / ds;
-    Jdot_zr.topRows<3>() = mk.Jdot_xr.middleRows<3>(3 * i);
-    Jdot_zr.middleRows<3>(3) = mk.Jdot_xr.middleRows<3>(3 * (i + 1));
-    Jdot_zr.row(6) = mk.Jdot_sr.row(i);
-    Jdot_zr.row(7) = mk.Jdot_sr.row(i + 1);
-    mk.Jdot_ar.middleRows<3>(3 * a).noalias() = calcJdot_az(beta, betadot[a], F, Fdot) * J_zr;
-    mk.Jdot_ar.middleRows<3>(3 * a).noalias() += J_az * Jdot_zr;
-  }
+  calcStraightSegmentMassPoints(seg_wrap, betadot, sc.stackJ, sc.stackD, mk);
 
   // wrapped segments: one batch per segment through the dispatch, then the chain rule (header)
   const bool moving_beta = nseg > 1;

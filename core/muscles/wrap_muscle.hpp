@@ -78,6 +78,34 @@ namespace redmax {
 /// muscle.wrap.model, else a sentence saying why not.
 std::string wrapMassPointsUnsupportedReason(const Muscle& muscle);
 
+/// OpenSim's 1-based range of a PathWrap as 0-based first and last point indices (< 1: the ends)
+/// of a path of np points.
+void wrapRange(const PathWrap& w, int np, int& lo, int& hi);
+/// The candidate segments [first, last) of wrap w over the active points (indices into the path's
+/// np points; OpenSim's applyWrapObjects: from the first active point at/after the range's begin to
+/// the last one at/before its end); false when there is none.
+bool wrapSegments(const PathWrap& w, const std::vector<int>& active, int np, int& first, int& last);
+/// True when the smooth (and network) wrap model refuses the segment p1 -> p2 (frame s): an end
+/// inside the surface, or input it cannot take (OpenSim gives such a segment no wrap).
+bool endInsideSurface(const WrapSurface& surface, const Vec3& p1, const Vec3& p2);
+
+/// Stages of the segment construction shared by the one-surface route and the composition
+/// (core/muscles/wrap_composite.cpp). From the segments' lengths L (model lengths of wrapped
+/// segments), their rates and rows dL/dq, d/dt dL/dq: the active points' Eulerian coordinates
+/// s_i = S_i / sum L with J_sr, sdot, Jdot_sr (mk.s, sdot, J_sr, Jdot_sr sized P = L.size() + 1
+/// with their ends set); MuscleError naming the muscle for a zero-length segment.
+void calcEulerianFromSegmentLengths(const VecX& L, const VecX& Ld, const MatX& J_L, const MatX& Jdot_L, bool vel,
+                                    const std::string& muscle_name, MuscleKinematics& mk);
+/// A straight segment i's entries of those: L[i] = l_i, dl_i/dq and (with vel) its rate.
+void straightSegmentLengthRow(const MuscleKinematics& mk, int i, bool vel, VecX& L, VecX& Ld, MatX& J_L, MatX& Jdot_L);
+/// Each mass point's segment and fraction beta in it from mk.s (and betadot with mk.velocity),
+/// with mk's mass-point outputs sized.
+void locateWrapMassPoints(const MassPoints& mp, MuscleKinematics& mk, std::vector<double>& betadot);
+/// Type II's EOL construction for the mass points on straight segments (seg_wrap[i] < 0); J_zr,
+/// Jdot_zr: scratch.
+void calcStraightSegmentMassPoints(const std::vector<int>& seg_wrap, const std::vector<double>& betadot, MatX& J_zr,
+                                   MatX& Jdot_zr, MuscleKinematics& mk);
+
 /// Make mk's compact columns cover every coordinate that moves the path's points or its wrap
 /// surfaces' bodies (re-initialising mk when they do not; no-op when they already do).
 void initWrapMuscleColumns(const Model& model, const Muscle& muscle, MuscleKinematics& mk);
