@@ -59,8 +59,9 @@ void cylinderTangentCandidates(double R, const V3<T>& p, V3<T>& pa, V3<T>& a, V3
 /// OpenSim's tangent points r1 (p1 side), r2 (p2 side) on a cylinder of radius R and length L
 /// with quadrant axis/sign (sign 0: none): the candidate pair (unconstrained: the best-agreeing
 /// radial directions; constrained: OpenSim's table over which candidates lie on the active side,
-/// with its far-side and long-wrap tests), each then slid along the axis into the plane through
-/// p1, p2 and the apex when that moves it toward the other end. long_wrap: the arc goes more than
+/// with its long-wrap test), each then slid along the axis into the plane through p1, p2 and
+/// OpenSim's apex (the plane through p1, p2 and the axis point) when that moves it toward the
+/// other end. long_wrap: the arc goes more than
 /// half way round. False when both tangent points lie beyond the ends (|z| > L/2): no wrap.
 template <class T>
 bool cylinderTangentPoints(double R, double L, int axis, int sign, const V3<T>& p1, const V3<T>& p2, V3<T>& r1,
@@ -69,7 +70,6 @@ bool cylinderTangentPoints(double R, double L, int axis, int sign, const V3<T>& 
   T rho1, rho2;
   cylinderTangentCandidates(R, p1, p11, r1a, r1b, rho1);
   cylinderTangentCandidates(R, p2, p22, r2a, r2b, rho2);
-  bool far_side_wrap = false;
   long_wrap = false;
   if (sign == 0) {
     const Vec3 u1a = (values(r1a) - values(p11)).normalized(), u1b = (values(r1b) - values(p11)).normalized();
@@ -84,41 +84,37 @@ bool cylinderTangentPoints(double R, double L, int axis, int sign, const V3<T>& 
     const double be = std::acos(r1bm.dot(r2am) / (r1bm.norm() * r2am.norm()));
     const bool a1 = dsign(value(r1a[axis])) == sign, b1 = dsign(value(r1b[axis])) == sign;
     const bool a2 = dsign(value(r2a[axis])) == sign, b2 = dsign(value(r2b[axis])) == sign;
-    auto pick_ba = [&](bool far_if) { r1 = r1b, r2 = r2a, far_side_wrap = (al > be) == far_if; };
-    auto pick_ab = [&](bool far_if) { r1 = r1a, r2 = r2b, far_side_wrap = (al > be) == far_if; };
+    // (OpenSim's far-side flag only chose its apex, whose plane is the one through the axis point)
+    auto pick_ba = [&] { r1 = r1b, r2 = r2a; };
+    auto pick_ab = [&] { r1 = r1a, r2 = r2b; };
     // OpenSim's case table over which candidates lie on the active side
     if (a1 && b1) {
-      if (a2) pick_ba(false);
-      else pick_ab(true);
+      if (a2) pick_ba();
+      else pick_ab();
     } else if (a1 && !b1) {
-      pick_ab(true);
+      pick_ab();
     } else if (!a1 && b1) {
-      pick_ba(false);
+      pick_ba();
     } else if (a2) {
-      pick_ba(false);
+      pick_ba();
     } else if (b2) {
-      pick_ab(true);
+      pick_ab();
     } else {
       if (al > be) r1 = r1a, r2 = r2b;
       else r1 = r1b, r2 = r2a;
-      far_side_wrap = true;
     }
     // a long wrap (more than half way round)
     const Vec3 sum_musc = (values(r1) - values(p1)) + (values(r2) - values(p2));
     const Vec3 sum_r = (values(r1) - values(p11)) + (values(r2) - values(p22));
     long_wrap = sum_r.dot(sum_musc) < 0.0;
   }
-  // apex: the surface point of the axis-normal plane through the muscle line's point at fraction
-  // rho1 / (rho1 + rho2), on the near side (far side for far-side wraps)
+  // OpenSim's apex is the surface point of the axis-normal plane through the muscle line's point at
+  // fraction rho1 / (rho1 + rho2), on the near (far-side wraps: far) side; only its plane is used
   const T t = rho1 / (rho1 + rho2);
   const V3<T> mpt = p1 + t * (p2 - p1);
   const V3<T> axispt{T(0.0), T(0.0), mpt[2]};
   const V3<T> l1 = normalizeOrZero(p1 - axispt), l2 = normalizeOrZero(p2 - axispt);
   const V3<T> n = normalizeOrZero(cross(l1, l2));
-  const V3<T> apex1 = axispt + R * normalizeOrZero(cross(zAxis<T>(), n));
-  const V3<T> apex2 = axispt + R * normalizeOrZero(cross(n, zAxis<T>()));
-  const double dist1 = (values(mpt) - values(apex1)).squaredNorm(), dist2 = (values(mpt) - values(apex2)).squaredNorm();
-  const V3<T> apex = far_side_wrap ? (dist1 < dist2 ? apex2 : apex1) : (dist1 < dist2 ? apex1 : apex2);
   // slide r1, r2 along the axis into the plane through p1, p2 and the apex: the segment r -/+ 10 z
   // meets the plane (OpenSim's segment-plane test, tolerance 1e-5; a degenerate plane slides
   // nothing). That plane is the one through p1, p2 and the axis point, normal n: the apex lies in
