@@ -6,7 +6,9 @@
 #include <map>
 
 #include "core/dynamics/coordinate_actuator_term.hpp"
+#include "core/dynamics/id_derivatives.hpp"
 #include "core/integrators/integrator.hpp"
+#include "core/integrators/sdirk2.hpp"
 #include "core/skeleton/kinematics.hpp"
 
 namespace redmax::adjoint {
@@ -223,6 +225,120 @@ class Stepper {
     if (nz_ > 0) s.z.noalias() += h * zdot;
     return pack(s);
   }
+
+  // Whether the step's Jacobians can be formed from the ID derivatives (docs/gradients.md §2.1):
+  // no auxiliary states, no constraint rows, every part with written derivatives.
+  bool analyticAvailable(std::string* why) const {
+    if (nz_ > 0) {
+      *why = "auxiliary states (Hill-type muscles)";
+      return false;
+    }
+    if (sys_.numConstraintRows() > 0) {
+      *why = "constraint rows (their G and Gdot have no written derivatives)";
+      return false;
+    }
+    return systemIdDerivativesAvailable(sys_, why);
+  }
+
+  // The step's Jacobians from the derivatives of inverse dynamics (docs/gradients.md §2.1):
+  // Jy = dy+/dy (2n x 2n) and Jf = dy+/dF (2n x n) for a generalized force F added to f during the
+  // step (the driven coordinates' controls enter so, with optimal force 1). With a = qddot(q, v),
+  // da/dq = -M^-1 dtau/dq, da/dv = -M^-1 dtau/dv at tau's qddot = a, da/dF = M^-1, each
+  // integrator's own equations are differentiated:
+  //   euler   v+ = v + h a,  q+ = q + h v+   (M^-1 (M v + h f) as computed)
+  //   bdf1    (M + h D + h^2 K) v+ = M v + h (f + D v), K and D constant (joint springs and
+  //           dampers: the terms with derivatives add none): A dv+ = -h dtau(a') dy + (M + h D) dv
+  //           + h dF, a' = (v+ - v) / h
+  //   sdirk2  the stage equations V - zv - hg a(zq + hg V, V) = 0 by the implicit function theorem
+  //           at the converged stages, chained through stage 2's start (zq, zv)
+  void analyticJacobians(const VecX& y, double t, double h, const VecX& u, MatX& Jy, MatX& Jf) {
+    const int n = n_;
+    const MatX I = MatX::Identity(n, n);
+    State s = unpack(y, t);
+    ws_.controls = u;
+    MatX Dq, Dv;
+    // the ID derivatives at a state and acceleration; M's factorization left in `lu`
+    auto idDerivatives = [&](const State& st, const VecX& a) {
+      std::string why;
+      if (!systemIdDerivatives(sys_, st, a, ws_, Dq, Dv, &why))
+        throw AdjointError("adjoint: analytic step Jacobians: " + why);
+    };
+    MatX dv_dy(n, 2 * n), dv_dF(n, n);
+    if (integ_->name() == "euler") {
+      sys_.calcMassAndForce(s, ws_);
+      const Eigen::LDLT<MatX> ldlt(ws_.M);
+      idDerivatives(s, ldlt.solve(ws_.f));
+      dv_dy.leftCols(n) = -h * ldlt.solve(Dq);
+      dv_dy.rightCols(n) = I - h * ldlt.solve(Dv);
+      dv_dF = h * ldlt.solve(I);
+    } else if (integ_->name() == "bdf1") {
+      sys_.calcMassAndForce(s, ws_);
+      sys_.calcStiffnessDamping(s, ws_);
+      const MatX M = ws_.M, D = ws_.D;
+      const Eigen::LDLT<MatX> A(M + h * D + (h * h) * ws_.K);
+      const VecX vplus = A.solve(M * s.qdot + h * (ws_.f + D * s.qdot));
+      idDerivatives(s, (vplus - s.qdot) / h);
+      dv_dy.leftCols(n) = -h * A.solve(Dq);
+      dv_dy.rightCols(n) = A.solve(M + h * D - h * Dv);
+      dv_dF = h * A.solve(I);
+    } else {  // sdirk2
+      const double g = Sdirk2::gamma(), hg = h * g, c = (1.0 - g) / g;
+      const VecX yplus = step(y, t, h, u);
+      const VecX V2 = yplus.segment(n, n);
+      // stage 1's velocity from q+ = q0 + h (1 - g) V1 + hg V2 (the integrator keeps no stages)
+      const VecX V1 = (yplus.head(n) - s.q - hg * V2) / (h * (1.0 - g));
+      // one stage's a_q, a_F and dR/dV for R = V - zv - hg a(zq + hg V, V); then
+      // dV = dR/dV^-1 (hg a_q dzq + dzv + hg a_F dF)
+      auto stage = [&](const VecX& zq, const VecX& zv, const VecX& V, double ts, MatX& a_q, MatX& dR_dV,
+                       MatX& a_F) {
+        State st;
+        st.t = ts;
+        st.q = zq + hg * V;
+        st.qdot = V;
+        sys_.calcMassAndForce(st, ws_);
+        const Eigen::LDLT<MatX> ldlt(ws_.M);
+        idDerivatives(st, (V - zv) / hg);
+        a_q = -ldlt.solve(Dq);
+        const MatX a_v = -ldlt.solve(Dv);
+        a_F = ldlt.solve(I);
+        dR_dV = I - hg * (hg * a_q + a_v);
+      };
+      MatX aq1, A1, aF1, aq2, A2, aF2;
+      stage(s.q, s.qdot, V1, t + hg, aq1, A1, aF1);
+      const Eigen::PartialPivLU<MatX> lu1(A1);
+      MatX dV1(n, 2 * n);
+      dV1.leftCols(n) = lu1.solve(hg * aq1);
+      dV1.rightCols(n) = lu1.solve(I);
+      const MatX dV1_dF = lu1.solve(hg * aF1);
+      const VecX zq2 = s.q + h * (1.0 - g) * V1;
+      const VecX zv2 = s.qdot + c * (V1 - s.qdot);
+      stage(zq2, zv2, V2, t + h, aq2, A2, aF2);
+      const Eigen::PartialPivLU<MatX> lu2(A2);
+      MatX dzq(n, 2 * n), dzv(n, 2 * n);
+      dzq << I, MatX::Zero(n, n);
+      dzq += h * (1.0 - g) * dV1;
+      dzv << MatX::Zero(n, n), I;
+      dzv += c * (dV1 - dzv);
+      dv_dy = lu2.solve(hg * aq2 * dzq + dzv);
+      dv_dF = lu2.solve(hg * aq2 * (h * (1.0 - g) * dV1_dF) + c * dV1_dF + hg * aF2);
+      // q+ = zq2 + hg V2
+      Jy.resize(2 * n, 2 * n);
+      Jy.topRows(n) = dzq + hg * dv_dy;
+      Jy.bottomRows(n) = dv_dy;
+      Jf.resize(2 * n, n);
+      Jf.topRows(n) = h * (1.0 - g) * dV1_dF + hg * dv_dF;
+      Jf.bottomRows(n) = dv_dF;
+      return;
+    }
+    // euler and bdf1: q+ = q + h v+
+    Jy.resize(2 * n, 2 * n);
+    Jy.topRows(n) = h * dv_dy;
+    Jy.topLeftCorner(n, n) += I;
+    Jy.bottomRows(n) = dv_dy;
+    Jf.resize(2 * n, n);
+    Jf.topRows(n) = h * dv_dF;
+    Jf.bottomRows(n) = dv_dF;
+  }
   long evaluations = 0;
 
  private:
@@ -305,6 +421,8 @@ void checkProblem(const Problem& pr, const VecX& p, const System& sys) {
     if (c < 0 || c >= n) throw AdjointError("adjoint: initial-q parameter outside the coordinates");
   for (int c : pr.initial_qdot)
     if (c < 0 || c >= n) throw AdjointError("adjoint: initial-qdot parameter outside the coordinates");
+  if (pr.step_jacobians != "auto" && pr.step_jacobians != "analytic" && pr.step_jacobians != "differences")
+    throw AdjointError("adjoint: step_jacobians must be auto, analytic or differences, not '" + pr.step_jacobians + "'");
   if (!(pr.jacobian_step > 0.0 && pr.jacobian_step < 1.0))
     throw AdjointError("adjoint: the step Jacobians' relative difference step must lie in (0, 1)");
   if (pr.num_system_params > 0 && pr.system_param_delta.size() != pr.num_system_params)
@@ -401,13 +519,38 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
       step_at.push_back(std::make_unique<Stepper>(pr, *sys_at.back().sys));
     }
 
+  // the step Jacobians' route (docs/gradients.md §2.1)
+  std::string why;
+  bool analytic = false;
+  if (pr.step_jacobians != "differences") {
+    if (ns > 0) why = "system parameters (muscle masses)";
+    else if (!rs.excited.empty()) why = "excitation parameters (Hill-type muscle states)";
+    else analytic = stepper.analyticAvailable(&why);
+  }
+  if (pr.step_jacobians == "analytic" && !analytic)
+    throw AdjointError("adjoint: analytic step Jacobians do not apply: " + why);
+  res.analytic_jacobians = analytic;
+  if (!analytic) res.jacobian_note = why;
+
   // reverse sweep: lambda_k = (dPhi_k/dy)^T lambda_{k+1}, parameter terms from lambda_{k+1}
   res.gradient = VecX::Zero(pr.numParameters());
-  MatX Jy(ny, ny);
+  MatX Jy(ny, ny), Jf;
   VecX Ju(nub + nd);
   for (int k = N - 1; k >= 0; --k) {
     const double t = timeAt(k);
     const VecX u = controlsAt(pr, rs, p, k, N);
+    if (analytic) {
+      stepper.analyticJacobians(y[k], t, h, u, Jy, Jf);
+      const VecX lf = Jf.transpose() * lambda;
+      for (int c = nub; c < nub + nd; ++c) Ju[c] = lf[rs.driven[c - nub]];
+      for (int j = 0; j < nf; ++j) {
+        const double b = forceBasis(pr.forces[j], k, N);
+        if (b != 0.0) res.gradient[j] += b * Ju[rs.control_of[j]];
+      }
+      lambda = (Jy.transpose() * lambda).eval();
+      if (k >= 1 && obj.tracking()) trackValue(sys, obj, stepper.unpack(y[k], t), h, &lambda);
+      continue;
+    }
     // generalized-force columns: one central difference per driven coordinate (the step is
     // linear in them for euler and bdf1, so this is exact up to round-off there)
     for (int c = nub; c < nub + nd; ++c) {

@@ -9,7 +9,11 @@
 // that does not grow with their number:
 //   lambda_N = dJ/dy_N,   lambda_k = (dPhi_k/dy_k)^T lambda_{k+1},
 //   dJ/dp    = dJ/dp|explicit + sum_k (dPhi_k/dp)^T lambda_{k+1} + (dy_0/dp)^T lambda_0.
-// What is differentiated how (docs/gradients.md §2): dPhi_k/dy_k is the central difference of the
+// What is differentiated how (docs/gradients.md §2): where every part of the system has written
+// derivatives (the skeleton, joint springs and dampers, coordinate limit forces, generalized
+// springs, the driven coordinates' forces; no constraints, no auxiliary states) dPhi_k/dy_k and
+// dPhi_k/du are exact, from the derivatives of inverse dynamics (core/dynamics/id_derivatives.hpp)
+// through each integrator's own equations (§2.1). Elsewhere dPhi_k/dy_k is the central difference of the
 // whole step, so every term the step evaluates (M, f with springs, dampers, muscle inertia of
 // every path type, K and D of bdf1, the KKT rows of constraints, the z update) is in it; the
 // generalized-force columns dPhi_k/du are central differences of the step along each driven
@@ -81,6 +85,11 @@ struct Problem {
   /// whose nonlinearity has the scale of the state; Hill-type tendons near their slack length
   /// bend on micrometres and want less (docs/gradients.md §2)
   double jacobian_step = 6e-6;
+  /// how the step Jacobians are formed (docs/gradients.md §2.1): "analytic" from the derivatives
+  /// of inverse dynamics (core/dynamics/id_derivatives.hpp; AdjointError where they do not
+  /// apply), "differences" (central differences of the whole step), "auto" analytic where they
+  /// apply, differences elsewhere
+  std::string step_jacobians = "auto";
   State initial;                     ///< the state the run starts from before p is applied
   std::vector<ForceParameter> forces;
   std::vector<ExcitationParameter> excitations;
@@ -153,6 +162,8 @@ struct Result {
   long steps = 0;
   long step_evaluations = 0; ///< calls of the integrator's step, forward and adjoint together
   double forward_seconds = 0.0;  ///< wall time of the forward pass (the simulation alone)
+  bool analytic_jacobians = false;  ///< the step Jacobians came from the ID derivatives
+  std::string jacobian_note;     ///< why they did not (empty when they did or were not asked)
 };
 
 /// Thrown for a problem that cannot be differentiated (bad sizes, unknown integrator, controls).

@@ -27,6 +27,13 @@ double step01(double x) {
   return x * x * x * (10.0 + x * (-15.0 + 6.0 * x));
 }
 
+// d step01 / dx
+double step01Derivative(double x) {
+  if (x <= 0.0 || x >= 1.0) return 0.0;
+  const double t = x * (1.0 - x);
+  return 30.0 * t * t;
+}
+
 Vec3 worldPoint(const SkeletonWorkspace& sk, int body, const Vec3& p) {
   return body < 0 ? p : transformPoint(sk.E_wi[body], p);
 }
@@ -55,6 +62,16 @@ double CoordinateLimitForceTerm::force(const Limit& l, double q, double qdot) {
   const double s_lo = step01((l.lower_limit - q) / l.transition);
   return -l.upper_stiffness * s_up * (q - l.upper_limit) + l.lower_stiffness * s_lo * (l.lower_limit - q) -
          l.damping * (s_up + s_lo) * qdot;
+}
+
+void CoordinateLimitForceTerm::forceDerivatives(const Limit& l, double q, double qdot, double& dq, double& dqdot) {
+  const double s_up = step01((q - l.upper_limit) / l.transition);
+  const double s_lo = step01((l.lower_limit - q) / l.transition);
+  const double ds_up = step01Derivative((q - l.upper_limit) / l.transition) / l.transition;
+  const double ds_lo = -step01Derivative((l.lower_limit - q) / l.transition) / l.transition;
+  dq = -l.upper_stiffness * (ds_up * (q - l.upper_limit) + s_up) +
+       l.lower_stiffness * (ds_lo * (l.lower_limit - q) - s_lo) - l.damping * (ds_up + ds_lo) * qdot;
+  dqdot = -l.damping * (s_up + s_lo);
 }
 
 double CoordinateLimitForceTerm::potential(const Limit& l, double q) {

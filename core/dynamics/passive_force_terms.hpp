@@ -44,6 +44,9 @@ class CoordinateLimitForceTerm final : public ForceTerm {
   const std::vector<Limit>& limits() const { return limits_; }
   /// the generalized force of one limit at (q, qdot), and its potential at q
   static double force(const Limit& l, double q, double qdot);
+  /// d force / dq and d force / dqdot at (q, qdot), analytic (the adjoint's step Jacobians,
+  /// core/dynamics/id_derivatives.hpp)
+  static void forceDerivatives(const Limit& l, double q, double qdot, double& dq, double& dqdot);
   static double potential(const Limit& l, double q);
 
  private:

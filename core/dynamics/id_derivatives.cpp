@@ -1,0 +1,257 @@
+#include "core/dynamics/id_derivatives.hpp"
+
+#include <cmath>
+#include <type_traits>
+#include <variant>
+#include <vector>
+
+#include "core/dynamics/coordinate_actuator_term.hpp"
+#include "core/dynamics/passive_force_terms.hpp"
+#include "core/skeleton/kinematics.hpp"
+
+namespace redmax {
+namespace {
+
+bool exactVelocityTerms(const Joint& j) {
+  return std::visit(
+      [](const auto& x) -> bool {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, FunctionBased>) return !x.simbody_compat;
+        else if constexpr (std::is_same_v<T, Reversed>) return !x.inner || exactVelocityTerms(*x.inner);
+        else if constexpr (std::is_same_v<T, Composite>) {
+          for (const Joint& p : x.parts)
+            if (!exactVelocityTerms(p)) return false;
+          return true;
+        } else {
+          return true;
+        }
+      },
+      j.v);
+}
+
+// What the base pass of recursive Newton-Euler keeps per body, and the joint-local derivatives.
+struct BodyData {
+  Mat6 Ad_ip, Ad_ij;     // Ad(E_ip) (parent twist into i) and Ad(E_im) (constant)
+  Mat6X S_i;             // Ad_ij S (6 x nq)
+  Vec6 psi, phi, phidot;
+  Vec6 g;                // gravity's wrench on the body, (c x g_i; g_i), body coordinates
+  Vec3 g_i;              // m R_wi^T g
+  Vec6 W;                // wrench the joint transmits (own net wrench + the children's)
+  // joint-local, per coordinate c of the joint: dS/dq_c (in M), d(Sdot qdot)/dq_c, /dqdot_c (in M)
+  std::vector<Mat6X> dS;
+  std::vector<Vec6> dSdq, dSdqd;
+};
+
+}  // namespace
+
+bool jointsHaveExactVelocityTerms(const Model& model, std::string* offending) {
+  for (int i = 0; i < model.nb(); ++i)
+    if (!exactVelocityTerms(model.joints()[i].joint)) {
+      if (offending) *offending = model.bodies()[i].name;
+      return false;
+    }
+  return true;
+}
+
+void skeletonIdDerivatives(const Model& model, const State& s, const VecX& qddot, MatX& dtau_dq, MatX& dtau_dqdot) {
+  const int nb = model.nb(), nr = model.nr();
+  std::vector<BodyData> bd(static_cast<size_t>(nb));
+  JointKinematics jk, jt;
+
+  // base pass (as recursiveIdForward, with 6 x 6 adjoints: the tangent needs them several times)
+  for (int i = 0; i < nb; ++i) {
+    const JointSlot& js = model.joints()[i];
+    BodyData& b = bd[static_cast<size_t>(i)];
+    const VecJ q = s.q.segment(js.q_index, js.nq), qd = s.qdot.segment(js.q_index, js.nq);
+    const VecJ qdd = qddot.segment(js.q_index, js.nq);
+    js.joint.calc(q, qd, jk);
+    const Mat4 E_pi = js.E_pf * jk.Q * js.E_mi;
+    b.Ad_ip = AdInv(E_pi);
+    b.Ad_ij = AdInv(js.E_mi);
+    b.S_i = b.Ad_ij * jk.S;
+    b.psi = b.S_i * qd;
+    const Vec6 acc = b.S_i * qdd + b.Ad_ij * (jk.Sdot * qd);
+    if (js.parent >= 0) {
+      const BodyData& p = bd[static_cast<size_t>(js.parent)];
+      b.phi = b.Ad_ip * p.phi + b.psi;
+      b.phidot = b.Ad_ip * p.phidot - ad(b.psi) * (b.Ad_ip * p.phi) + acc;
+    } else {
+      b.phi = b.psi;
+      b.phidot = acc;
+    }
+    // joint-local derivatives
+    const int nq = js.nq;
+    b.dS.assign(static_cast<size_t>(nq), Mat6X::Zero(6, nq));
+    b.dSdq.assign(static_cast<size_t>(nq), Vec6::Zero());
+    b.dSdqd.assign(static_cast<size_t>(nq), Vec6::Zero());
+    for (int c = 0; c < nq; ++c) {
+      VecJ e = VecJ::Zero(nq);
+      e[c] = 1.0;
+      js.joint.calc(q, e, jt);
+      b.dS[static_cast<size_t>(c)] = jt.Sdot;
+      b.dSdqd[static_cast<size_t>(c)] = jt.Sdot * qd + jk.Sdot.col(c);
+      // the second derivative: fourth-order central difference of Sdot(q, qd) qd along q_c
+      const double h = 1e-3 * std::max(1.0, std::abs(q[c]));
+      Vec6 d = Vec6::Zero();
+      const double at[4] = {-2.0, -1.0, 1.0, 2.0}, w[4] = {1.0, -8.0, 8.0, -1.0};
+      for (int m = 0; m < 4; ++m) {
+        VecJ qm = q;
+        qm[c] += at[m] * h;
+        js.joint.calc(qm, qd, jt);
+        d += w[m] * (jt.Sdot * qd);
+      }
+      b.dSdq[static_cast<size_t>(c)] = d / (12.0 * h);
+    }
+  }
+  // poses in world for gravity (rotations only)
+  std::vector<Mat4> E_wi;
+  calcBodyPoses(model, s.q, E_wi);
+  for (int i = 0; i < nb; ++i) {
+    BodyData& b = bd[static_cast<size_t>(i)];
+    const Body& body = model.bodies()[i];
+    b.g_i = E_wi[i].topLeftCorner<3, 3>().transpose() * (body.mass * model.gravity());
+    b.g.head<3>() = body.com.cross(b.g_i);
+    b.g.tail<3>() = b.g_i;
+    b.W = body.M * b.phidot - ad(b.phi).transpose() * (body.M * b.phi) - b.g;
+  }
+  for (int i = nb - 1; i >= 0; --i) {
+    const int p = model.joints()[i].parent;
+    if (p >= 0) bd[static_cast<size_t>(p)].W += bd[static_cast<size_t>(i)].Ad_ip.transpose() * bd[static_cast<size_t>(i)].W;
+  }
+
+  // tangent passes, one per coordinate and one per speed
+  dtau_dq.setZero(nr, nr);
+  dtau_dqdot.setZero(nr, nr);
+  std::vector<Vec6> dPose(static_cast<size_t>(nb)), dphi(static_cast<size_t>(nb)), dphidot(static_cast<size_t>(nb)),
+      dW(static_cast<size_t>(nb)), dpsi_pose(static_cast<size_t>(nb));
+  std::vector<Mat6X> dS_i(static_cast<size_t>(nb));
+  for (int col = 0; col < 2 * nr; ++col) {
+    const bool speed = col >= nr;
+    const int k = speed ? col - nr : col;
+    for (int i = 0; i < nb; ++i) {
+      const JointSlot& js = model.joints()[i];
+      BodyData& b = bd[static_cast<size_t>(i)];
+      const Body& body = model.bodies()[i];
+      const VecJ qd = s.qdot.segment(js.q_index, js.nq), qdd = qddot.segment(js.q_index, js.nq);
+      const bool own = k >= js.q_index && k < js.q_index + js.nq;
+      const int c = k - js.q_index;
+      // the joint's own variation: pose (in i), S_i, psi and acc
+      Vec6 dpose = Vec6::Zero(), dpsi = Vec6::Zero(), dacc = Vec6::Zero();
+      Mat6X& dSi = dS_i[static_cast<size_t>(i)];
+      dSi.setZero(6, js.nq);
+      if (own && !speed) {
+        dpose = b.S_i.col(c);
+        dSi = b.Ad_ij * b.dS[static_cast<size_t>(c)];
+        dpsi = dSi * qd;
+        dacc = dSi * qdd + b.Ad_ij * b.dSdq[static_cast<size_t>(c)];
+      } else if (own && speed) {
+        dpsi = b.S_i.col(c);
+        dacc = b.Ad_ij * b.dSdqd[static_cast<size_t>(c)];
+      }
+      dpsi_pose[static_cast<size_t>(i)] = dpose;
+      Vec6& dP = dPose[static_cast<size_t>(i)];
+      Vec6& dph = dphi[static_cast<size_t>(i)];
+      Vec6& dphd = dphidot[static_cast<size_t>(i)];
+      if (js.parent >= 0) {
+        const size_t p = static_cast<size_t>(js.parent);
+        const BodyData& pb = bd[p];
+        const Vec6 Xphi = b.Ad_ip * pb.phi, Xphid = b.Ad_ip * pb.phidot;
+        const Vec6 Xdphi = b.Ad_ip * dphi[p];
+        dP = b.Ad_ip * dPose[p] + dpose;
+        // d(Ad_ip x) = Ad_ip dx - ad(dpose) Ad_ip x (E_pi varies as E_pi exp([dpose]))
+        const Vec6 dXphi = Xdphi - ad(dpose) * Xphi;
+        dph = dXphi + dpsi;
+        dphd = b.Ad_ip * dphidot[p] - ad(dpose) * Xphid - ad(dpsi) * Xphi - ad(b.psi) * dXphi + dacc;
+      } else {
+        dP = dpose;
+        dph = dpsi;
+        dphd = dacc;
+      }
+      // net wrench w = M phidot - ad(phi)^T M phi - (c x g_i; g_i), g_i = m R_wi^T g
+      const Vec3 dg = -dP.head<3>().cross(b.g_i);
+      Vec6 dgw;
+      dgw.head<3>() = body.com.cross(dg);
+      dgw.tail<3>() = dg;
+      dW[static_cast<size_t>(i)] = body.M * dphd - ad(dph).transpose() * (body.M * b.phi) -
+                                   ad(b.phi).transpose() * (body.M * dph) - dgw;
+    }
+    for (int i = nb - 1; i >= 0; --i) {
+      const JointSlot& js = model.joints()[i];
+      const BodyData& b = bd[static_cast<size_t>(i)];
+      const Vec6& dWi = dW[static_cast<size_t>(i)];
+      if (js.nq > 0) {
+        const VecJ dt = dS_i[static_cast<size_t>(i)].transpose() * b.W + b.S_i.transpose() * dWi;
+        (speed ? dtau_dqdot : dtau_dq).block(js.q_index, k, js.nq, 1) = dt;
+      }
+      if (js.parent >= 0) {
+        // d(Ad_ip^T W) = Ad_ip^T dW - Ad_ip^T ad(dpose)^T W
+        dW[static_cast<size_t>(js.parent)] +=
+            b.Ad_ip.transpose() * (dWi - ad(dpsi_pose[static_cast<size_t>(i)]).transpose() * b.W);
+      }
+    }
+  }
+  // joint springs and dampers: tau -= -k (q - q0) - d qdot
+  for (int c = 0; c < nr; ++c) {
+    dtau_dq(c, c) += model.coordinates()[c].stiffness;
+    dtau_dqdot(c, c) += model.coordinates()[c].damping;
+  }
+}
+
+bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
+  auto refuse = [&](const std::string& w) {
+    if (why) *why = w;
+    return false;
+  };
+  if (sys.coordinateMap()) return refuse("a coordinate map (hyper-reduced coordinates)");
+  if (sys.numExtraCoordinates() > 0) return refuse("extra coordinates (deformables)");
+  std::string joint;
+  if (!jointsHaveExactVelocityTerms(sys.model(), &joint))
+    return refuse("the Simbody-compatible velocity terms of the joint of body '" + joint + "'");
+  // the terms with written derivatives; none adds K or D (the adjoint's bdf1 route relies on it)
+  for (const auto& t : sys.terms()) {
+    if (dynamic_cast<const CoordinateActuatorTerm*>(t.get()) || dynamic_cast<const CoordinateLimitForceTerm*>(t.get()) ||
+        dynamic_cast<const SpringGeneralizedForceTerm*>(t.get()))
+      continue;
+    return refuse("the term '" + t->name() + "'");
+  }
+  return true;
+}
+
+bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, const DynamicsWorkspace& ws,
+                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why) {
+  if (!ws.loads.empty()) {
+    if (why) *why = "external loads";
+    return false;
+  }
+  if (!systemIdDerivativesAvailable(sys, why)) return false;
+  skeletonIdDerivatives(sys.model(), s, qddot, dtau_dq, dtau_dqdot);
+  // the terms' share of tau is -f_t: dtau += -df_t/dq, -df_t/dqdot
+  for (const auto& t : sys.terms()) {
+    if (const auto* cl = dynamic_cast<const CoordinateLimitForceTerm*>(t.get())) {
+      for (const CoordinateLimitForceTerm::Limit& l : cl->limits()) {
+        double dq = 0.0, dqd = 0.0;
+        CoordinateLimitForceTerm::forceDerivatives(l, s.q[l.coordinate], s.qdot[l.coordinate], dq, dqd);
+        dtau_dq(l.coordinate, l.coordinate) -= dq;
+        dtau_dqdot(l.coordinate, l.coordinate) -= dqd;
+      }
+    } else if (const auto* sg = dynamic_cast<const SpringGeneralizedForceTerm*>(t.get())) {
+      for (const SpringGeneralizedForceTerm::Spring& sp : sg->springs()) {
+        dtau_dq(sp.coordinate, sp.coordinate) += sp.stiffness;
+        dtau_dqdot(sp.coordinate, sp.coordinate) += sp.viscosity;
+      }
+    }
+    // CoordinateActuatorTerm: optimal_force * u does not depend on q or qdot
+  }
+  return true;
+}
+
+MatX jacobianDerivative(const Model& model, const State& s, int c) {
+  State sc = s;
+  sc.qdot.setZero();
+  sc.qdot[c] = 1.0;
+  SkeletonWorkspace ws(model);
+  calcKinematics(model, sc, ws);
+  return ws.Jdot_mr;
+}
+
+}  // namespace redmax

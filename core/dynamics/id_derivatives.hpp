@@ -1,0 +1,51 @@
+#pragma once
+// Derivatives of inverse dynamics with respect to q and qdot (docs/gradients.md §2.1):
+//   tau(q, qdot, qddot) = M(q) qddot - f(q, qdot),
+//   dtau/dq = dM/dq qddot - df/dq,   dtau/dqdot = -df/dqdot.
+// They hold the derivatives of M and f: at qddot = 0 they are -df/dq and -df/dqdot, and
+// dtau/dq(qddot) - dtau/dq(0) = (dM/dq_k qddot)_k. The adjoint uses them for the step Jacobians of
+// `euler` (core/adjoint): qddot = M^-1 f, d qddot / dy = -M^-1 dtau/dy.
+//
+// The skeleton's derivatives are the tangent of recursive Newton-Euler inverse dynamics
+// (recursiveIdForward / Backward in skeleton_dynamics.cpp) along each coordinate and speed: poses,
+// twists, their rates and the wrenches carried forward, the wrenches' transmission carried back,
+// analytic in the tree [D Eq. 4.5, 4.8, 3.21-3.22]. A joint enters through Q, S and Sdot:
+//   dQ/dq_c = Q [S e_c],   dS/dq_c = Sdot(q, e_c)   (exact: Sdot(q, v) = sum_c dS/dq_c v_c),
+//   d(Sdot qdot)/dqdot_c = Sdot(q, e_c) qdot + Sdot(q, qdot) e_c   (exact, bilinear),
+//   d(Sdot qdot)/dq_c: a second derivative of S, the one entry no joint computes, taken as a
+//     fourth-order central difference of the joint's own Sdot qdot (joint-local, 4 calls per
+//     coordinate; relative error ~1e-12). Joints whose S is constant in M (revolute, prismatic,
+//     ...) have Sdot = 0 and so an exact zero here.
+// The derivative of J_mr follows from the same identity: dJ_mr/dq_c = Jdot_mr(q, e_c)
+// (jacobianDerivative). Terms: the joint springs and dampers, and the massless terms whose
+// derivatives are written (CoordinateLimitForceTerm, SpringGeneralizedForceTerm,
+// CoordinateActuatorTerm at fixed controls); any other term, external loads, extra coordinates,
+// a coordinate map or Simbody-compatible joint velocity terms make systemIdDerivatives refuse
+// (false, with the reason), and the adjoint then differences its step (docs/gradients.md §2).
+#include <string>
+
+#include "core/dynamics/system.hpp"
+
+namespace redmax {
+
+/// dtau/dq and dtau/dqdot (nr x nr) of the bare skeleton's inverse dynamics at (s, qddot): gravity,
+/// the bodies' inertia and Coriolis wrenches, joint springs and dampers.
+void skeletonIdDerivatives(const Model& model, const State& s, const VecX& qddot, MatX& dtau_dq, MatX& dtau_dqdot);
+
+/// Whether every joint's Sdot is the time derivative of its S (false for Simbody-compatible
+/// function-based joints, whose Sdot is Simbody's approximation); the name of the first that is not.
+bool jointsHaveExactVelocityTerms(const Model& model, std::string* offending = nullptr);
+
+/// The system's dtau/dq and dtau/dqdot (ndof x ndof) at (s, qddot) with the workspace's controls
+/// (ws.controls): the skeleton's plus each term's. False (and *why) when the system has a part
+/// whose derivatives are not written (see the file comment); the matrices are then unspecified.
+bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, const DynamicsWorkspace& ws,
+                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why = nullptr);
+/// Whether systemIdDerivatives can apply to this system (everything but the workspace's loads);
+/// false with the first part that has no written derivatives.
+bool systemIdDerivativesAvailable(const System& sys, std::string* why = nullptr);
+
+/// dJ_mr/dq_c (nm x nr) at s.q: Jdot_mr at the speeds e_c (Jdot_mr is linear in qdot).
+MatX jacobianDerivative(const Model& model, const State& s, int c);
+
+}  // namespace redmax

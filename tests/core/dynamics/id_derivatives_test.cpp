@@ -1,0 +1,278 @@
+// Derivatives of inverse dynamics with respect to q and qdot (core/dynamics/id_derivatives.hpp)
+// against fourth-order central differences of the ID itself, on random trees with every joint
+// type, random states and accelerations; and what they hold: dM/dq qddot, df/dq, df/dqdot and
+// dJ_mr/dq, each against central differences of M, f and J_mr.
+//
+// References are fourth-order central differences at 1e-4 (truncation ~1e-16 |tau^(5)|, round-off
+// ~eps |tau| / 1e-4 ~ 1e-12 of |tau|). Measured worst errors relative to max(1, |column|_inf):
+// printed by each test; the bound 1e-8 sits above the references' own error on these trees and far
+// below an error in any term (a missing term is of order 1).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+
+#include "core/dynamics/coordinate_actuator_term.hpp"
+#include "core/dynamics/id_derivatives.hpp"
+#include "core/dynamics/passive_force_terms.hpp"
+#include "core/dynamics/skeleton_dynamics.hpp"
+#include "core/dynamics/system.hpp"
+#include "core/skeleton/kinematics.hpp"
+#include "tests/core/muscles/muscle_test_util.hpp"
+#include "validation/scenes/scenes.hpp"
+
+namespace redmax {
+namespace {
+
+constexpr double kBound = 1e-8;
+
+// fourth-order central difference of a vector function of one scalar at x0
+template <class F>
+VecX diff4(F f, double x0, double h) {
+  return (f(x0 - 2.0 * h) - 8.0 * f(x0 - h) + 8.0 * f(x0 + h) - f(x0 + 2.0 * h)) / (12.0 * h);
+}
+
+// worst |a - b| per column relative to max(1, |b column|_inf)
+double worstColumnError(const MatX& a, const MatX& b) {
+  double worst = 0.0;
+  for (Eigen::Index c = 0; c < a.cols(); ++c)
+    worst = std::max(worst, (a.col(c) - b.col(c)).lpNorm<Eigen::Infinity>() /
+                                std::max(1.0, b.col(c).lpNorm<Eigen::Infinity>()));
+  return worst;
+}
+
+// a model with joint springs and dampers on every coordinate
+Model withSprings(const Model& m, std::mt19937& rng) {
+  ModelBuilder b(m);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < m.nr(); ++k) {
+    Coordinate& c = b.coordinateAt(k);
+    c.stiffness = 20.0 * u(rng);
+    c.damping = 2.0 * u(rng);
+    c.rest_value = u(rng) - 0.5;
+  }
+  return b.finalize();
+}
+
+struct Differences {
+  MatX dq, dqd;
+};
+
+Differences idDifferences(const Model& m, const State& s, const VecX& qddot) {
+  const int n = m.nr();
+  Differences d{MatX(n, n), MatX(n, n)};
+  for (int k = 0; k < n; ++k) {
+    d.dq.col(k) = diff4(
+        [&](double x) {
+          State t = s;
+          t.q[k] = x;
+          return inverseDynamicsRecursive(m, t, qddot);
+        },
+        s.q[k], 1e-4);
+    d.dqd.col(k) = diff4(
+        [&](double x) {
+          State t = s;
+          t.qdot[k] = x;
+          return inverseDynamicsRecursive(m, t, qddot);
+        },
+        s.qdot[k], 1e-4);
+  }
+  return d;
+}
+
+TEST(IdDerivatives, SkeletonEqualsCentralDifferencesForEveryJointType) {
+  std::mt19937 rng(41);
+  double worst = 0.0;
+  for (int seed = 0; seed < 6; ++seed) {
+    const Model m = withSprings(scenes::randomTree(8, 900 + seed, scenes::TreeJoints::All), rng);
+    for (int trial = 0; trial < 3; ++trial) {
+      const State s = test::randomState(m.nr(), rng);
+      const VecX qddot = test::randomState(m.nr(), rng).qdot;
+      MatX dq, dqd;
+      skeletonIdDerivatives(m, s, qddot, dq, dqd);
+      const Differences d = idDifferences(m, s, qddot);
+      worst = std::max({worst, worstColumnError(dq, d.dq), worstColumnError(dqd, d.dqd)});
+    }
+  }
+  std::printf("[ measured ] dtau/dq, dtau/dqdot against central differences: worst %.2e\n", worst);
+  EXPECT_LT(worst, kBound);
+}
+
+// every JointVariant alternative alone under a single body (so that a joint's own terms, not the
+// tree, dominate the columns)
+TEST(IdDerivatives, EachJointTypeAlone) {
+  std::mt19937 rng(7);
+  for (std::size_t index = 0; index < std::variant_size_v<JointVariant>; ++index) {
+    const Joint j = scenes::randomJoint(index, rng);
+    if (j.nq() == 0) continue;
+    ModelBuilder b("one");
+    b.addBody("b", 2.0, Vec3(0.05, -0.1, 0.02), Vec3(0.1, 0.2, 0.15).asDiagonal().toDenseMatrix(), -1, "j", j,
+              Mat4::Identity(), makeTranslation(Vec3(0.1, -0.2, 0.05)));
+    const Model m = b.finalize();
+    double worst = 0.0;
+    for (int trial = 0; trial < 4; ++trial) {
+      const State s = test::randomState(m.nr(), rng, 0.8);
+      const VecX qddot = test::randomState(m.nr(), rng).qdot;
+      MatX dq, dqd;
+      skeletonIdDerivatives(m, s, qddot, dq, dqd);
+      const Differences d = idDifferences(m, s, qddot);
+      worst = std::max({worst, worstColumnError(dq, d.dq), worstColumnError(dqd, d.dqd)});
+    }
+    std::printf("[ measured ] %-14s worst %.2e\n", j.typeName().c_str(), worst);
+    EXPECT_LT(worst, kBound) << j.typeName();
+  }
+}
+
+// what the ID derivatives hold: dtau/dq(qddot) - dtau/dq(0) = dM/dq qddot, dtau/dq(0) = -df/dq,
+// dtau/dqdot = -df/dqdot, each against differences of the REDMAX route's M and f [D Eq. 4.18];
+// and dJ_mr/dq_c = Jdot_mr(q, e_c) against differences of J_mr
+TEST(IdDerivatives, MassMatrixForceAndJacobianDerivatives) {
+  std::mt19937 rng(3);
+  const Model m = withSprings(scenes::randomTree(7, 77, scenes::TreeJoints::All), rng);
+  const System sys(m);
+  DynamicsWorkspace ws(sys);
+  const int n = m.nr();
+  double wM = 0.0, wf = 0.0, wfd = 0.0, wJ = 0.0;
+  for (int trial = 0; trial < 3; ++trial) {
+    const State s = test::randomState(n, rng);
+    const VecX qddot = test::randomState(n, rng).qdot;
+    MatX dq_a, dqd_a, dq_0, dqd_0;
+    skeletonIdDerivatives(m, s, qddot, dq_a, dqd_a);
+    skeletonIdDerivatives(m, s, VecX::Zero(n), dq_0, dqd_0);
+    auto mass = [&](const State& t) {
+      sys.calcMassAndForce(t, ws);
+      return MatX(ws.M);
+    };
+    auto force = [&](const State& t) {
+      sys.calcMassAndForce(t, ws);
+      return VecX(ws.f);
+    };
+    MatX dMa(n, n), df(n, n), dfd(n, n);
+    for (int k = 0; k < n; ++k) {
+      dMa.col(k) = diff4(
+          [&](double x) {
+            State t = s;
+            t.q[k] = x;
+            return VecX(mass(t) * qddot);
+          },
+          s.q[k], 1e-4);
+      df.col(k) = diff4(
+          [&](double x) {
+            State t = s;
+            t.q[k] = x;
+            return force(t);
+          },
+          s.q[k], 1e-4);
+      dfd.col(k) = diff4(
+          [&](double x) {
+            State t = s;
+            t.qdot[k] = x;
+            return force(t);
+          },
+          s.qdot[k], 1e-4);
+      const MatX dJ = jacobianDerivative(m, s, k);
+      const MatX dJref = diff4(
+          [&](double x) {
+            State t = s;
+            t.q[k] = x;
+            SkeletonWorkspace sk(m);
+            calcKinematics(m, t, sk);
+            return VecX(Eigen::Map<const VecX>(sk.J_mr.data(), sk.J_mr.size()));
+          },
+          s.q[k], 1e-4);
+      wJ = std::max(wJ, (Eigen::Map<const VecX>(dJ.data(), dJ.size()) - dJref).lpNorm<Eigen::Infinity>() /
+                            std::max(1.0, dJref.lpNorm<Eigen::Infinity>()));
+    }
+    wM = std::max(wM, worstColumnError(dq_a - dq_0, dMa));
+    wf = std::max(wf, worstColumnError(-dq_0, df));
+    wfd = std::max(wfd, worstColumnError(-dqd_0, dfd));
+  }
+  std::printf("[ measured ] dM/dq qddot %.2e, df/dq %.2e, df/dqdot %.2e, dJ_mr/dq %.2e\n", wM, wf, wfd, wJ);
+  EXPECT_LT(wM, kBound);
+  EXPECT_LT(wf, kBound);
+  EXPECT_LT(wfd, kBound);
+  EXPECT_LT(wJ, kBound);
+}
+
+// the system's: springs on coordinates, coordinate limit forces inside and across their
+// transitions, coordinate actuators; against differences of System::inverseDynamics
+TEST(IdDerivatives, SystemWithPassiveTermsAndActuators) {
+  std::mt19937 rng(5);
+  const Model m = scenes::randomTree(6, 31, scenes::TreeJoints::All);
+  const int n = m.nr();
+  System sys(m);
+  std::vector<CoordinateLimitForceTerm::Limit> limits;
+  for (int k = 0; k < n; k += 2)
+    limits.push_back({"limit" + std::to_string(k), k, 0.2, -0.2, 40.0, 30.0, 1.5, 0.5});
+  sys.addTerm(std::make_shared<CoordinateLimitForceTerm>(m, limits));
+  sys.addTerm(std::make_shared<SpringGeneralizedForceTerm>(
+      m, std::vector<SpringGeneralizedForceTerm::Spring>{{"s", 1, 12.0, 0.3, 0.7}}));
+  sys.addTerm(std::make_shared<CoordinateActuatorTerm>(
+      m, std::vector<CoordinateActuatorTerm::Actuator>{{"u", 0, 3.0}}));
+  DynamicsWorkspace ws(sys);
+  ws.controls = VecX::Constant(sys.numControls(), 0.4);
+  double worst = 0.0;
+  for (int trial = 0; trial < 4; ++trial) {
+    const State s = test::randomState(n, rng);  // q in [-1, 1]: inside, across and past the transitions
+    const VecX qddot = test::randomState(n, rng).qdot;
+    MatX dq, dqd;
+    std::string why;
+    ASSERT_TRUE(systemIdDerivatives(sys, s, qddot, ws, dq, dqd, &why)) << why;
+    MatX rq(n, n), rqd(n, n);
+    for (int k = 0; k < n; ++k) {
+      rq.col(k) = diff4(
+          [&](double x) {
+            State t = s;
+            t.q[k] = x;
+            return sys.inverseDynamics(t, qddot, ws);
+          },
+          s.q[k], 1e-5);
+      rqd.col(k) = diff4(
+          [&](double x) {
+            State t = s;
+            t.qdot[k] = x;
+            return sys.inverseDynamics(t, qddot, ws);
+          },
+          s.qdot[k], 1e-5);
+    }
+    worst = std::max({worst, worstColumnError(dq, rq), worstColumnError(dqd, rqd)});
+  }
+  std::printf("[ measured ] system with limit forces, springs, actuators: worst %.2e\n", worst);
+  EXPECT_LT(worst, kBound);
+}
+
+TEST(IdDerivatives, LimitForceDerivativesAcrossTheTransition) {
+  const CoordinateLimitForceTerm::Limit l{"l", 0, 0.5, -0.3, 80.0, 50.0, 2.0, 0.1};
+  double worst = 0.0;
+  for (double q = -0.6; q <= 0.8; q += 0.0137) {
+    for (double v : {-1.3, 0.0, 0.7}) {
+      double dq = 0.0, dv = 0.0;
+      CoordinateLimitForceTerm::forceDerivatives(l, q, v, dq, dv);
+      const double h = 1e-6;
+      const double rq = (CoordinateLimitForceTerm::force(l, q + h, v) - CoordinateLimitForceTerm::force(l, q - h, v)) / (2 * h);
+      const double rv = (CoordinateLimitForceTerm::force(l, q, v + h) - CoordinateLimitForceTerm::force(l, q, v - h)) / (2 * h);
+      worst = std::max({worst, std::abs(dq - rq) / std::max(1.0, std::abs(rq)), std::abs(dv - rv)});
+    }
+  }
+  std::printf("[ measured ] CoordinateLimitForce derivatives: worst %.2e\n", worst);
+  EXPECT_LT(worst, 1e-6);  // second-order differences at 1e-6 of a C2 force of stiffness 80 / 0.1
+}
+
+TEST(IdDerivatives, RefusesWhatHasNoWrittenDerivatives) {
+  const Model m = scenes::randomTree(4, 12, scenes::TreeJoints::All);
+  System sys(m);
+  sys.addTerm(std::make_shared<SpringGeneralizedForceTerm>(
+      m, std::vector<SpringGeneralizedForceTerm::Spring>{{"s", 0, 1.0, 0.0, 0.0}}));
+  DynamicsWorkspace ws(sys);
+  std::mt19937 rng(1);
+  const State s = test::randomState(m.nr(), rng);
+  MatX dq, dqd;
+  std::string why;
+  EXPECT_TRUE(systemIdDerivatives(sys, s, VecX::Zero(m.nr()), ws, dq, dqd, &why));
+  ws.loads.point_forces.push_back({0, Vec3::Zero(), Vec3(1.0, 0.0, 0.0)});
+  EXPECT_FALSE(systemIdDerivatives(sys, s, VecX::Zero(m.nr()), ws, dq, dqd, &why));
+  EXPECT_EQ(why, "external loads");
+}
+
+}  // namespace
+}  // namespace redmax
