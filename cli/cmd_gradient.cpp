@@ -17,7 +17,7 @@ namespace redmax::cli {
 namespace {
 
 struct GradientFlags {
-  std::string model, integrator = "euler", params, objective, muscle_mass_kg;
+  std::string model, integrator = "euler", params, objective, muscle_mass_kg, step_jacobians = "auto";
   double duration = 0.0, dt = 1e-3, check_tolerance = 1e-6, jacobian_step = 0.0;
   bool check = false;
   MuscleMassFlags mm;
@@ -42,6 +42,7 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
   for (const auto& w : g.warnings) std::cerr << "warning: " << w << "\n";
   for (const auto& w : g.not_applied) std::cerr << "warning: not applied: " << w << "\n";
   if (given(app, "--jacobian-step")) g.problem.jacobian_step = f.jacobian_step;
+  g.problem.step_jacobians = f.step_jacobians;
 
   adjoint::Result res;
   double adjoint_s = 0.0;
@@ -62,6 +63,11 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
   std::printf("gradient: %s, integrator %s, %ld steps of %.6g s, %d parameters, muscle mass %.4g kg\n",
               g.model.description.name.c_str(), f.integrator.c_str(), res.steps, f.duration / res.steps,
               static_cast<int>(g.p0.size()), g.model.muscle_mass);
+  if (res.analytic_jacobians)
+    std::printf("step Jacobians: analytic (derivatives of inverse dynamics, docs/gradients.md §2.1)\n");
+  else
+    std::printf("step Jacobians: central differences of the step%s%s\n", res.jacobian_note.empty() ? "" : "; not analytic: ",
+                res.jacobian_note.c_str());
   std::printf("objective %.12e\n", res.objective);
   std::printf("%-36s %20s %20s\n", "parameter", "value", "dJ/dp");
   for (Eigen::Index i = 0; i < g.p0.size(); ++i)
@@ -151,6 +157,12 @@ CommandRegistration reg(
                       "with excited muscles none of which wraps; docs/gradients.md §2)")
            ->type_name("REL")
            ->check(between(1e-12, 0.1, false));
+       app.add_option("--step-jacobians", f->step_jacobians,
+                      "how the step Jacobians are formed: analytic (derivatives of inverse dynamics;\n"
+                      "exit 2 where a part of the system has none), differences (central differences\n"
+                      "of the step), auto (default: analytic where they apply; docs/gradients.md §2.1)")
+           ->type_name("auto|analytic|differences")
+           ->check(oneOf({"auto", "analytic", "differences"}));
        app.add_option("--check-tolerance", f->check_tolerance, "the --check bound (default 1e-6)")
            ->type_name("T")
            ->check(positive());
@@ -166,6 +178,7 @@ CommandRegistration reg(
            "                       [--dt H] [--integrator euler|bdf1|sdirk2]\n"
            "                       [MUSCLE-MASS OPTIONS] [--muscle-mass-kg NAME=KG,...]\n"
            "                       [--check [--check-tolerance T]] [--jacobian-step REL]\n"
+           "                       [--step-jacobians auto|analytic|differences]\n"
            "Simulates the model from its default pose with the given parameters (gravity, joint springs\n"
            "and dampers, constraints, muscle inertia; the muscles pull only when --params has an\n"
            "excitations: group) and prints the objective and its gradient by the discrete adjoint of\n"
