@@ -81,7 +81,7 @@ TEST_F(GradientCli, StepJacobianRoutes) {
       "--objective 'point:link2@0,-1,0=0.5,-1.5,0;0.1*speed' --check --check-tolerance 1e-9";
   for (const char* integrator : {"euler", "bdf1", "sdirk2"}) {
     const CmdResult r = run(lumped + " --integrator " + integrator);
-    EXPECT_EQ(r.code, 0) << r.out << r.err;  // measured worst relative errors 4.6e-11 to 9.3e-11
+    EXPECT_EQ(r.code, 0) << r.out << r.err;  // measured worst relative errors 4.5e-11 (euler, bdf1), 3.9e-10 (sdirk2)
     EXPECT_NE(r.out.find("step Jacobians: analytic"), std::string::npos) << r.out;
   }
   const CmdResult d = run(lumped + " --step-jacobians differences");
