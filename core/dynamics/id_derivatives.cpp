@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "core/dynamics/coordinate_actuator_term.hpp"
+#include "core/dynamics/muscle_term.hpp"
+#include "core/muscles/muscle_id_tangent.hpp"
 #include "core/dynamics/passive_force_terms.hpp"
 #include "core/skeleton/kinematics.hpp"
 
@@ -53,7 +55,11 @@ bool jointsHaveExactVelocityTerms(const Model& model, std::string* offending) {
   return true;
 }
 
-void skeletonIdDerivatives(const Model& model, const State& s, const VecX& qddot, MatX& dtau_dq, MatX& dtau_dqdot) {
+namespace {
+
+// the skeleton's and the given Type I/II muscles' mass points' ID derivatives
+void idDerivatives(const Model& model, const State& s, const VecX& qddot, const std::vector<const Muscle*>& muscles,
+                   MatX& dtau_dq, MatX& dtau_dqdot) {
   const int nb = model.nb(), nr = model.nr();
   std::vector<BodyData> bd(static_cast<size_t>(nb));
   JointKinematics jk, jt;
@@ -114,10 +120,28 @@ void skeletonIdDerivatives(const Model& model, const State& s, const VecX& qddot
     b.g.tail<3>() = b.g_i;
     b.W = body.M * b.phidot - ad(b.phi).transpose() * (body.M * b.phi) - b.g;
   }
+  // the muscles' mass points: wrenches the bodies must supply for them (core/muscles/muscle_id_tangent.hpp)
+  std::vector<BodyWorldMotion> world;
+  std::vector<Vec6> mw(static_cast<size_t>(nb)), dmw(static_cast<size_t>(nb));
+  VecX mtau = VecX::Zero(nr), dmtau = VecX::Zero(nr);
+  const VecX zero = VecX::Zero(nr);
+  if (!muscles.empty()) {
+    std::vector<Vec6> phi(static_cast<size_t>(nb)), phidot(static_cast<size_t>(nb));
+    for (int i = 0; i < nb; ++i) {
+      phi[static_cast<size_t>(i)] = bd[static_cast<size_t>(i)].phi;
+      phidot[static_cast<size_t>(i)] = bd[static_cast<size_t>(i)].phidot;
+    }
+    calcBodyWorldMotion(BodyMotion{E_wi, phi, phidot}, world);
+    std::fill(mw.begin(), mw.end(), Vec6::Zero());
+    for (const Muscle* mu : muscles)
+      addMuscleIdShareTangent(*mu, s, qddot, zero, zero, world, nullptr, model.gravity(), mw, mtau, nullptr, nullptr);
+    for (int i = 0; i < nb; ++i) bd[static_cast<size_t>(i)].W += mw[static_cast<size_t>(i)];
+  }
   for (int i = nb - 1; i >= 0; --i) {
     const int p = model.joints()[i].parent;
     if (p >= 0) bd[static_cast<size_t>(p)].W += bd[static_cast<size_t>(i)].Ad_ip.transpose() * bd[static_cast<size_t>(i)].W;
   }
+  std::vector<BodyWorldTangent> world_t(static_cast<size_t>(nb));
 
   // tangent passes, one per coordinate and one per speed
   dtau_dq.setZero(nr, nr);
@@ -175,13 +199,40 @@ void skeletonIdDerivatives(const Model& model, const State& s, const VecX& qddot
       dW[static_cast<size_t>(i)] = body.M * dphd - ad(dph).transpose() * (body.M * b.phi) -
                                    ad(b.phi).transpose() * (body.M * dph) - dgw;
     }
+    if (!muscles.empty()) {
+      // the bodies' world motion's derivative from the body-coordinate one (dR = [R dPose_w] R)
+      for (int i = 0; i < nb; ++i) {
+        const BodyWorldMotion& o = world[static_cast<size_t>(i)];
+        BodyWorldTangent& t = world_t[static_cast<size_t>(i)];
+        const Vec6& dP = dPose[static_cast<size_t>(i)];
+        const Vec6& dph = dphi[static_cast<size_t>(i)];
+        const Vec6& dphd = dphidot[static_cast<size_t>(i)];
+        t.dtheta = o.R * dP.head<3>();
+        t.dp = o.R * dP.tail<3>();
+        t.domega = t.dtheta.cross(o.omega) + o.R * dph.head<3>();
+        t.dnu = t.dtheta.cross(o.nu) + o.R * dph.tail<3>();
+        t.dalpha = t.dtheta.cross(o.alpha) + o.R * dphd.head<3>();
+        // bias = R nudot + omega x nu
+        t.dbias = t.dtheta.cross(o.bias - o.omega.cross(o.nu)) + o.R * dphd.tail<3>() + t.domega.cross(o.nu) +
+                  o.omega.cross(t.dnu);
+      }
+      VecX dqv = VecX::Zero(nr), dqdv = VecX::Zero(nr);
+      (speed ? dqdv : dqv)[k] = 1.0;
+      std::fill(mw.begin(), mw.end(), Vec6::Zero());
+      std::fill(dmw.begin(), dmw.end(), Vec6::Zero());
+      dmtau.setZero();
+      for (const Muscle* mu : muscles)
+        addMuscleIdShareTangent(*mu, s, qddot, dqv, dqdv, world, &world_t, model.gravity(), mw, mtau, &dmw, &dmtau);
+      for (int i = 0; i < nb; ++i) dW[static_cast<size_t>(i)] += dmw[static_cast<size_t>(i)];
+      (speed ? dtau_dqdot : dtau_dq).col(k) += dmtau;
+    }
     for (int i = nb - 1; i >= 0; --i) {
       const JointSlot& js = model.joints()[i];
       const BodyData& b = bd[static_cast<size_t>(i)];
       const Vec6& dWi = dW[static_cast<size_t>(i)];
       if (js.nq > 0) {
         const VecJ dt = dS_i[static_cast<size_t>(i)].transpose() * b.W + b.S_i.transpose() * dWi;
-        (speed ? dtau_dqdot : dtau_dq).block(js.q_index, k, js.nq, 1) = dt;
+        (speed ? dtau_dqdot : dtau_dq).block(js.q_index, k, js.nq, 1) += dt;
       }
       if (js.parent >= 0) {
         // d(Ad_ip^T W) = Ad_ip^T dW - Ad_ip^T ad(dpose)^T W
@@ -195,6 +246,35 @@ void skeletonIdDerivatives(const Model& model, const State& s, const VecX& qddot
     dtau_dq(c, c) += model.coordinates()[c].stiffness;
     dtau_dqdot(c, c) += model.coordinates()[c].damping;
   }
+}
+
+// the muscles a MuscleTerm adds mass points for, when every one of them has written derivatives
+// (Types I and II, no deformable node points, uniform placement) and the term keeps the quadratic
+// velocity vector; false with the reason otherwise
+bool muscleTermSupported(const MuscleTerm& mt, std::vector<const Muscle*>* out, std::string* why) {
+  if (!mt.options().quadratic_velocity) {
+    if (why) *why = "the term '" + mt.name() + "' without its quadratic velocity vector";
+    return false;
+  }
+  for (const Muscle& mu : mt.muscles()) {
+    if (mu.mass_points.size() == 0) continue;
+    std::string reason;
+    if (pathType(mu.path) == PathType::III) reason = "wraps (Type III)";
+    else if (hasNodePoints(mu.path)) reason = "runs through a deformable node";
+    else if (mu.fibre.enabled()) reason = "has fibre-following mass points";
+    if (!reason.empty()) {
+      if (why) *why = "the mass points of muscle '" + mu.name + "', which " + reason;
+      return false;
+    }
+    if (out) out->push_back(&mu);
+  }
+  return true;
+}
+
+}  // namespace
+
+void skeletonIdDerivatives(const Model& model, const State& s, const VecX& qddot, MatX& dtau_dq, MatX& dtau_dqdot) {
+  idDerivatives(model, s, qddot, {}, dtau_dq, dtau_dqdot);
 }
 
 bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
@@ -212,6 +292,10 @@ bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
     if (dynamic_cast<const CoordinateActuatorTerm*>(t.get()) || dynamic_cast<const CoordinateLimitForceTerm*>(t.get()) ||
         dynamic_cast<const SpringGeneralizedForceTerm*>(t.get()))
       continue;
+    if (const auto* mt = dynamic_cast<const MuscleTerm*>(t.get())) {
+      if (!muscleTermSupported(*mt, nullptr, why)) return false;
+      continue;
+    }
     return refuse("the term '" + t->name() + "'");
   }
   return true;
@@ -224,7 +308,10 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
     return false;
   }
   if (!systemIdDerivativesAvailable(sys, why)) return false;
-  skeletonIdDerivatives(sys.model(), s, qddot, dtau_dq, dtau_dqdot);
+  std::vector<const Muscle*> muscles;
+  for (const auto& t : sys.terms())
+    if (const auto* mt = dynamic_cast<const MuscleTerm*>(t.get())) muscleTermSupported(*mt, &muscles, nullptr);
+  idDerivatives(sys.model(), s, qddot, muscles, dtau_dq, dtau_dqdot);
   // the terms' share of tau is -f_t: dtau += -df_t/dq, -df_t/dqdot
   for (const auto& t : sys.terms()) {
     if (const auto* cl = dynamic_cast<const CoordinateLimitForceTerm*>(t.get())) {
