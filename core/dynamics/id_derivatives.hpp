@@ -17,10 +17,13 @@
 //     coordinate; relative error ~1e-12). Joints whose S is constant in M (revolute, prismatic,
 //     ...) have Sdot = 0 and so an exact zero here.
 // The derivative of J_mr follows from the same identity: dJ_mr/dq_c = Jdot_mr(q, e_c)
-// (jacobianDerivative). Terms: the joint springs and dampers, and the massless terms whose
+// (jacobianDerivative). Terms: the joint springs and dampers, the massless terms whose
 // derivatives are written (CoordinateLimitForceTerm, SpringGeneralizedForceTerm,
-// CoordinateActuatorTerm at fixed controls); any other term, external loads, extra coordinates,
-// a coordinate map or Simbody-compatible joint velocity terms make systemIdDerivatives refuse
+// CoordinateActuatorTerm at fixed controls), and a MuscleTerm's mass points on Type I and II paths
+// (core/muscles/muscle_id_tangent.hpp: the path-wise pass over dual numbers, seeded by the tangent
+// of the bodies' world motion, its wrenches added to the tangent's backward pass); any other term
+// (Type III or fibre-following mass points among them), external loads, extra coordinates, a
+// coordinate map or Simbody-compatible joint velocity terms make systemIdDerivatives refuse
 // (false, with the reason), and the adjoint then differences its step (docs/gradients.md §2).
 #include <string>
 
