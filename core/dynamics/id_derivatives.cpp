@@ -122,6 +122,17 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
   }
   // the muscles' mass points: wrenches the bodies must supply for them (core/muscles/muscle_id_tangent.hpp)
   std::vector<BodyWorldMotion> world;
+  MuscleIdTangentScratch msc;
+  // which coordinates move each muscle: a path point's body below the coordinate's joint, or a
+  // moving point on it (the others' derivative along it is zero: skipped)
+  std::vector<std::vector<char>> moves(muscles.size(), std::vector<char>(static_cast<size_t>(nr), 0));
+  for (size_t m = 0; m < muscles.size(); ++m)
+    for (const PathPoint& pt : muscles[m]->path.points) {
+      if (pt.kind == PathPointKind::Moving && pt.coordinate >= 0) moves[m][static_cast<size_t>(pt.coordinate)] = 1;
+      if (pt.body < 0) continue;
+      for (int c = 0; c < nr; ++c)
+        if (model.isAncestor(model.coordinates()[c].joint, pt.body)) moves[m][static_cast<size_t>(c)] = 1;
+    }
   std::vector<Vec6> mw(static_cast<size_t>(nb)), dmw(static_cast<size_t>(nb));
   VecX mtau = VecX::Zero(nr), dmtau = VecX::Zero(nr);
   const VecX zero = VecX::Zero(nr);
@@ -134,7 +145,8 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
     calcBodyWorldMotion(BodyMotion{E_wi, phi, phidot}, world);
     std::fill(mw.begin(), mw.end(), Vec6::Zero());
     for (const Muscle* mu : muscles)
-      addMuscleIdShareTangent(*mu, s, qddot, zero, zero, world, nullptr, model.gravity(), mw, mtau, nullptr, nullptr);
+      addMuscleIdShareTangent(*mu, s, qddot, zero, zero, world, nullptr, model.gravity(), mw, mtau, nullptr, nullptr,
+                              msc);
     for (int i = 0; i < nb; ++i) bd[static_cast<size_t>(i)].W += mw[static_cast<size_t>(i)];
   }
   for (int i = nb - 1; i >= 0; --i) {
@@ -221,8 +233,10 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       std::fill(mw.begin(), mw.end(), Vec6::Zero());
       std::fill(dmw.begin(), dmw.end(), Vec6::Zero());
       dmtau.setZero();
-      for (const Muscle* mu : muscles)
-        addMuscleIdShareTangent(*mu, s, qddot, dqv, dqdv, world, &world_t, model.gravity(), mw, mtau, &dmw, &dmtau);
+      for (size_t m = 0; m < muscles.size(); ++m)
+        if (moves[m][static_cast<size_t>(k)])
+          addMuscleIdShareTangent(*muscles[m], s, qddot, dqv, dqdv, world, &world_t, model.gravity(), mw, mtau, &dmw,
+                                  &dmtau, msc);
       for (int i = 0; i < nb; ++i) dW[static_cast<size_t>(i)] += dmw[static_cast<size_t>(i)];
       (speed ? dtau_dqdot : dtau_dq).col(k) += dmtau;
     }

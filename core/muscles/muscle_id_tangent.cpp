@@ -51,10 +51,10 @@ Vec3 thirdDerivative(const PathPoint& pt, const VecX& q) {
 
 // Thomas solve of L x = b (in place), L tridiagonal (sub, diag, super by row; sub[0], super[n-1]
 // unused), without pivoting as muscle_inverse_dynamics.cpp (L is diagonally dominant by rows)
-void solveTridiagonal(const std::vector<D>& sub, const std::vector<D>& diag, const std::vector<D>& super,
-                      std::vector<D>& b) {
-  const int n = static_cast<int>(b.size());
-  std::vector<D> c(n), d(n);
+void solveTridiagonal(int n, const std::vector<D>& sub, const std::vector<D>& diag, const std::vector<D>& super,
+                      std::vector<D>& b, std::vector<D>& c, std::vector<D>& d) {
+  c.resize(n);
+  d.resize(n);
   for (int r = 0; r < n; ++r) {
     const D piv = r == 0 ? diag[0] : diag[r] - sub[r] * c[r - 1];
     c[r] = r + 1 < n ? super[r] / piv : D(0.0);
@@ -68,7 +68,8 @@ void solveTridiagonal(const std::vector<D>& sub, const std::vector<D>& diag, con
 void addMuscleIdShareTangent(const Muscle& muscle, const State& s, const VecX& qddot, const VecX& dq,
                              const VecX& dqdot, const std::vector<BodyWorldMotion>& bodies,
                              const std::vector<BodyWorldTangent>* tangents, const Vec3& gravity,
-                             std::vector<Vec6>& wrench, VecX& tau, std::vector<Vec6>* dwrench, VecX* dtau) {
+                             std::vector<Vec6>& wrench, VecX& tau, std::vector<Vec6>* dwrench, VecX* dtau,
+                             MuscleIdTangentScratch& sc) {
   const MusclePath& path = muscle.path;
   const MassPoints& mp = muscle.mass_points;
   if (pathType(path) == PathType::III)
@@ -77,11 +78,13 @@ void addMuscleIdShareTangent(const Muscle& muscle, const State& s, const VecX& q
   auto tangentOf = [&](int b) -> const BodyWorldTangent& { return tangents ? (*tangents)[b] : kNone; };
 
   // 1. active path points' world position, velocity, acceleration (as addMuscleInverseDynamics)
-  std::vector<int> active;
+  std::vector<int>& active = sc.active;
   activePathPoints(path, s.q, active);
   const int P = static_cast<int>(active.size());
   if (P < 2) throw std::logic_error("addMuscleIdShareTangent: fewer than two active path points");
-  std::vector<V> x(P), xd(P), xdd(P), r(P), dxw(P);  // dxw: a moving point's R x_b' (for tau)
+  // dxw: a moving point's R x_b' (for tau)
+  std::vector<V>&x = sc.x, &xd = sc.xd, &xdd = sc.xdd, &r = sc.r, &dxw = sc.dxw;
+  for (std::vector<V>* v : {&x, &xd, &xdd, &r, &dxw}) v->resize(P);
   for (int a = 0; a < P; ++a) {
     const PathPoint& pt = path.points[active[a]];
     if (pt.kind == PathPointKind::Node)
@@ -130,8 +133,10 @@ void addMuscleIdShareTangent(const Muscle& muscle, const State& s, const VecX& q
 
   // segments [D Eq. 5.17-5.19, 5.27-5.28]
   const int ns = P - 1, n = P - 2;
-  std::vector<D> l(ns), ld(ns), ldd(ns);
-  std::vector<V> u(ns);
+  std::vector<D>&l = sc.l, &ld = sc.ld, &ldd = sc.ldd;
+  for (std::vector<D>* v : {&l, &ld, &ldd}) v->resize(ns);
+  std::vector<V>& u = sc.u;
+  u.resize(ns);
   D length(0.0);
   for (int i = 0; i < ns; ++i) {
     const V dx = x[i + 1] - x[i], dxd = xd[i + 1] - xd[i];
@@ -151,11 +156,13 @@ void addMuscleIdShareTangent(const Muscle& muscle, const State& s, const VecX& q
   if (!(length.a > 0.0))
     throw MuscleError("muscle '" + muscle.name + "': origin and insertion coincide here; mass points need a path of positive length");
   // Eulerian coordinates s (arc fractions), sdot, sddot [D Eq. 5.20-5.24]; ends 0 and 1
-  std::vector<D> sv(P, D(0.0)), sd(P, D(0.0)), sdd(P, D(0.0));
+  std::vector<D>&sv = sc.sv, &sd = sc.sd, &sdd = sc.sdd;
+  for (std::vector<D>* v : {&sv, &sd, &sdd}) v->assign(P, D(0.0));
   for (int i = 1; i < P; ++i) sv[i] = sv[i - 1] + l[i - 1] / length;
   sv[P - 1] = D(1.0);
   if (n > 0) {
-    std::vector<D> sub(n), diag(n), super(n), rhs(n);
+    std::vector<D>&sub = sc.sub, &diag = sc.diag, &super = sc.super, &rhs = sc.rhs;
+    for (std::vector<D>* v : {&sub, &diag, &super, &rhs}) v->resize(n);
     for (int rr = 0; rr < n; ++rr) {
       sub[rr] = -l[rr + 1];
       diag[rr] = l[rr] + l[rr + 1];
@@ -166,7 +173,7 @@ void addMuscleIdShareTangent(const Muscle& muscle, const State& s, const VecX& q
       return -(sv[rr + 2] - sv[rr + 1]) * vv[rr] + (sv[rr + 1] - sv[rr]) * vv[rr + 1];
     };
     for (int rr = 0; rr < n; ++rr) rhs[rr] = -dS(ld, rr);
-    solveTridiagonal(sub, diag, super, rhs);
+    solveTridiagonal(n, sub, diag, super, rhs, sc.c, sc.d);
     for (int rr = 0; rr < n; ++rr) sd[rr + 1] = rhs[rr];
     // L sddot = -(DeltaS lddot + Ldot sdot + DeltaSdot ldot)
     for (int rr = 0; rr < n; ++rr) {
@@ -176,12 +183,13 @@ void addMuscleIdShareTangent(const Muscle& muscle, const State& s, const VecX& q
       const D dSd_ld = -(sd[rr + 2] - sd[rr + 1]) * ld[rr] + (sd[rr + 1] - sd[rr]) * ld[rr + 1];
       rhs[rr] = -(dS(ldd, rr) + Ld_sd + dSd_ld);
     }
-    solveTridiagonal(sub, diag, super, rhs);
+    solveTridiagonal(n, sub, diag, super, rhs, sc.c, sc.d);
     for (int rr = 0; rr < n; ++rr) sdd[rr + 1] = rhs[rr];
   }
 
   // 2. the mass points by segment (the segment rule of calcViaPointMassPoints), moments, forces
-  std::vector<D> m0(ns, D(0.0)), m1(ns, D(0.0)), m2(ns, D(0.0));
+  std::vector<D>&m0 = sc.m0, &m1 = sc.m1, &m2 = sc.m2;
+  for (std::vector<D>* v : {&m0, &m1, &m2}) v->assign(ns, D(0.0));
   for (int a = 0; a < mp.size(); ++a) {
     const double s_a = mp.alpha[a];
     int i = 0;
@@ -192,8 +200,10 @@ void addMuscleIdShareTangent(const Muscle& muscle, const State& s, const VecX& q
     m1[i] = m1[i] + m * beta;
     m2[i] = m2[i] + m * (beta * beta);
   }
-  std::vector<V> fx(P, zero());
-  std::vector<D> fs(P, D(0.0));
+  std::vector<V>& fx = sc.fx;
+  fx.assign(P, zero());
+  std::vector<D>& fs = sc.fs;
+  fs.assign(P, D(0.0));
   const V g = dual(gravity, Vec3::Zero());
   for (int i = 0; i < ns; ++i) {
     if (m0[i].a == 0.0 && m1[i].a == 0.0) continue;
@@ -212,14 +222,15 @@ void addMuscleIdShareTangent(const Muscle& muscle, const State& s, const VecX& q
   }
   // 3. Eulerian forces onto the path points: J_sx^T g = -DeltaXbar^T DeltaS^T L^-T g
   if (n > 0) {
-    std::vector<D> sub(n), diag(n), super(n), rhs(n);
+    std::vector<D>&sub = sc.sub, &diag = sc.diag, &super = sc.super, &rhs = sc.rhs;
+    for (std::vector<D>* v : {&sub, &diag, &super, &rhs}) v->resize(n);
     for (int rr = 0; rr < n; ++rr) {
       sub[rr] = rr > 0 ? -l[rr - 1] : D(0.0);        // L^T(r, r-1) = L(r-1, r) = -l[r-1]
       diag[rr] = l[rr] + l[rr + 1];
       super[rr] = rr + 1 < n ? -l[rr + 2] : D(0.0);  // L^T(r, r+1) = L(r+1, r) = -l[r+2]
       rhs[rr] = fs[rr + 1];
     }
-    solveTridiagonal(sub, diag, super, rhs);
+    solveTridiagonal(n, sub, diag, super, rhs, sc.c, sc.d);
     for (int i = 0; i < ns; ++i) {
       D k(0.0);
       if (i < n) k = k - (sv[i + 2] - sv[i + 1]) * rhs[i];

@@ -16,6 +16,7 @@
 // activity of the state (the derivative of the piecewise path away from its switches).
 #include <vector>
 
+#include "core/geometry/dual.hpp"
 #include "core/muscles/mass_points.hpp"
 #include "core/muscles/muscle_inverse_dynamics.hpp"
 #include "core/skeleton/state.hpp"
@@ -28,6 +29,15 @@ struct BodyWorldTangent {
   Vec3 dalpha = Vec3::Zero(), dbias = Vec3::Zero();
 };
 
+/// Buffers of addMuscleIdShareTangent, kept between calls (sized on use; one per caller).
+struct MuscleIdTangentScratch {
+  using D = detail::Dual<double>;
+  using V = detail::V3<D>;
+  std::vector<int> active;
+  std::vector<V> x, xd, xdd, r, dxw, u, fx;
+  std::vector<D> l, ld, ldd, sv, sd, sdd, sub, diag, super, rhs, m0, m1, m2, fs, c, d;
+};
+
 /// Adds one Type I or II muscle's share of inverse dynamics to wrench[b] (body coordinates, the
 /// wrench body b must supply) and tau (its moving points' coordinates), and, with `tangents`, the
 /// derivative of both along the direction (dq, dqdot) to dwrench and dtau. `bodies` is the bodies'
@@ -37,6 +47,7 @@ struct BodyWorldTangent {
 void addMuscleIdShareTangent(const Muscle& muscle, const State& s, const VecX& qddot, const VecX& dq,
                              const VecX& dqdot, const std::vector<BodyWorldMotion>& bodies,
                              const std::vector<BodyWorldTangent>* tangents, const Vec3& gravity,
-                             std::vector<Vec6>& wrench, VecX& tau, std::vector<Vec6>* dwrench, VecX* dtau);
+                             std::vector<Vec6>& wrench, VecX& tau, std::vector<Vec6>* dwrench, VecX* dtau,
+                             MuscleIdTangentScratch& scratch);
 
 }  // namespace redmax

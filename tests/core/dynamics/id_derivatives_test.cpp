@@ -317,7 +317,8 @@ TEST(IdDerivatives, TypeOneAndTwoMusclesWithMass) {
       for (const Muscle& mu : muscles) {
         std::vector<Vec6> w1(m.nb(), Vec6::Zero()), w2(m.nb(), Vec6::Zero()), ww(m.nb(), Vec6::Zero());
         VecX t1 = VecX::Zero(n), t2 = VecX::Zero(n), zero = VecX::Zero(n);
-        addMuscleIdShareTangent(mu, s, qddot, zero, zero, world, nullptr, m.gravity(), w1, t1, nullptr, nullptr);
+        MuscleIdTangentScratch tsc;
+        addMuscleIdShareTangent(mu, s, qddot, zero, zero, world, nullptr, m.gravity(), w1, t1, nullptr, nullptr, tsc);
         MuscleKinematics mk;
         initMuscleKinematics(m, mu, mk);
         MuscleIdScratch sc;
