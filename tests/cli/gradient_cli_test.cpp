@@ -73,8 +73,8 @@ TEST_F(GradientCli, WhatTheGradientDoesNotApplyIsNamed) {
 }
 
 // --step-jacobians (docs/gradients.md §2.1): the lumped pendulum takes the analytic route under
-// auto and meets central differences of whole runs; with muscle mass auto falls back and says why,
-// and analytic is refused naming the term
+// auto and meets central differences of whole runs; with a muscle mass as a parameter auto falls
+// back and says why; analytic is refused for a wrapping muscle's mass points, naming it
 TEST_F(GradientCli, StepJacobianRoutes) {
   const std::string lumped =
       "--duration 0.1 --dt 0.005 --params 'torques:q1@2=0.5,q2=-1;qdot0:q1=0.3' "
@@ -92,11 +92,18 @@ TEST_F(GradientCli, StepJacobianRoutes) {
   EXPECT_NE(massive.out.find("step Jacobians: central differences of the step; not analytic: system parameters"),
             std::string::npos)
       << massive.out;
-  const CmdResult refused = run(
-      "--duration 0.1 --dt 0.005 --muscle-mass-kg via_muscle=0.5 --params 'torques:q1' --objective speed "
-      "--step-jacobians analytic");
+  // Type II mass points take the analytic route; a wrapping (Type III) muscle's do not
+  const CmdResult via = run("--duration 0.1 --dt 0.005 --muscle-mass-kg via_muscle=0.5 --params 'torques:q1' --objective speed "
+                            "--step-jacobians analytic --check");
+  EXPECT_EQ(via.code, 0) << via.out << via.err;
+  const CmdResult refused = runRedmax(
+      dir_, "gradient --model " + scene("double_pendulum_wrap.osim") +
+                " --duration 0.1 --dt 0.005 --muscle-mass-kg wrap_muscle=0.5 --params 'torques:q1' --objective speed "
+                "--step-jacobians analytic");
   EXPECT_EQ(refused.code, 2) << refused.out << refused.err;
-  EXPECT_NE(refused.err.find("analytic step Jacobians do not apply: the term"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("analytic step Jacobians do not apply: the mass points of muscle 'wrap_muscle', which wraps"),
+            std::string::npos)
+      << refused.err;
   const CmdResult bad = run("--duration 0.1 --params 'torques:q1' --objective speed --step-jacobians exact");
   EXPECT_EQ(bad.code, 2) << bad.err;
 }

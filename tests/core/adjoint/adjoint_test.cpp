@@ -5,11 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "core/adjoint/adjoint.hpp"
 #include "core/dynamics/constraints/point_constraint.hpp"
 #include "../dynamics/constraint_scenes.hpp"
+#include "tests/core/adjoint/adjoint_test_util.hpp"
 #include "validation/scenes/scenes.hpp"
 
 namespace redmax {
@@ -29,15 +31,7 @@ Model springMass(double m, double k, double d) {
   return b.finalize();
 }
 
-Problem problemFor(std::shared_ptr<const System> sys, const std::string& integrator, double duration, double dt) {
-  Problem pr;
-  pr.integrator = integrator;
-  pr.duration = duration;
-  pr.dt = dt;
-  pr.initial = sys->defaultState();
-  pr.make_system = [sys](const VecX&) { return sys; };
-  return pr;
-}
+using test::problemFor;
 
 // Closed form of the discrete run: both steps are linear in y = (x, v) and F for a linear
 // spring-mass, y+ = A y + b F, so the sensitivities S = dy/d(F, x0, v0) follow S+ = A S + (b 0 0).
@@ -92,6 +86,7 @@ TEST_P(SpringMass, GradientEqualsTheClosedFormOfTheDiscreteRun) {
   obj.effort_weight = 0.01;
   VecX p(3);
   p << F, x0, v0;
+  pr.step_jacobians = "differences";  // the analytic route: the next test
   const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
   const Discrete c = closedForm(GetParam(), m, k, d, h, 500, F, x0, v0);
   EXPECT_NEAR(r.final.q[0], c.x, 1e-13);
@@ -102,6 +97,30 @@ TEST_P(SpringMass, GradientEqualsTheClosedFormOfTheDiscreteRun) {
   // measured: 1.9e-10 (euler), 1.2e-10 (bdf1) relative; the step Jacobians are central differences
   EXPECT_LE(adjoint::worstRelativeError(r.gradient, g.transpose()), 1e-9)
       << "adjoint " << r.gradient.transpose() << "\nclosed form " << g;
+}
+
+// the analytic step Jacobians (docs/gradients.md §2.1) meet the closed form to round-off
+TEST_P(SpringMass, AnalyticRouteEqualsTheClosedFormToRoundOff) {
+  const double m = 2.0, k = 50.0, d = 0.4, T = 0.5, h = 1e-3;
+  const double F = 3.0, x0 = -0.05, v0 = 0.2;
+  const auto sys = std::make_shared<System>(springMass(m, k, d));
+  Problem pr = problemFor(sys, GetParam(), T, h);
+  pr.step_jacobians = "analytic";
+  pr.forces = {{0, 0, 1}};
+  pr.initial_q = {0};
+  pr.initial_qdot = {0};
+  Objective obj;
+  obj.points.push_back({0, Vec3::Zero(), Vec3(0.3, 0.0, 0.0), 1.0});
+  obj.speed_weight = 0.5;
+  VecX p(3);
+  p << F, x0, v0;
+  const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
+  ASSERT_TRUE(r.analytic_jacobians);
+  const Discrete c = closedForm(GetParam(), m, k, d, h, 500, F, x0, v0);
+  const Eigen::RowVector3d g = (c.x - 0.3) * c.S.row(0) + 0.5 * c.v * c.S.row(1);
+  const double err = adjoint::worstRelativeError(r.gradient, g.transpose());
+  std::printf("[ measured ] %s, analytic step Jacobians: closed form %.2e relative\n", GetParam().c_str(), err);
+  EXPECT_LE(err, 1e-12);  // 500 steps of round-off (measured 1.3e-14 euler, 4.6e-15 bdf1)
 }
 
 TEST_P(SpringMass, TendsToTheContinuousClosedForm) {
@@ -152,11 +171,16 @@ TEST_P(AgainstCentralDifferences, DoublePendulumWithSpringsAndDampers) {
   for (int trial = 0; trial < 3; ++trial) {
     VecX p(6);
     for (int i = 0; i < 6; ++i) p[i] = u(rng);
-    const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
     const VecX fd = adjoint::finiteDifferenceGradient(pr, obj, p);
-    // measured: 7.8e-11 .. 3.8e-10 relative (euler, bdf1, sdirk2; the issue asks 1e-6)
-    EXPECT_LE(adjoint::worstRelativeError(r.gradient, fd), 3e-9)
-        << "adjoint " << r.gradient.transpose() << "\ndifferences " << fd.transpose();
+    for (const char* route : {"differences", "analytic"}) {
+      pr.step_jacobians = route;
+      const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
+      const double err = adjoint::worstRelativeError(r.gradient, fd);
+      std::printf("[ measured ] %s, %s step Jacobians: %.2e\n", GetParam().c_str(), route, err);
+      // measured over euler, bdf1, sdirk2: differences 5.2e-11 .. 4.1e-10, analytic 9.2e-12 .. 4.8e-10
+      // (the largest in the reference, whose error it shares with the differenced route); the issue asks 1e-6
+      EXPECT_LE(err, 3e-9) << route << "\nadjoint " << r.gradient.transpose() << "\ndifferences " << fd.transpose();
+    }
   }
 }
 

@@ -1,7 +1,7 @@
 // The adjoint's analytic step Jacobians (docs/gradients.md §2.1): formed from the derivatives of
 // inverse dynamics (core/dynamics/id_derivatives.hpp) through each integrator's equations.
 //   - a linear spring-mass: the gradient equals the closed form of the discrete run to round-off
-//     (the differenced route: 1e-10, adjoint_test.cpp);
+//     (SpringMass.AnalyticRouteEqualsTheClosedFormToRoundOff in adjoint_test.cpp);
 //   - random trees with every joint type, gravity, joint springs and dampers, coordinate limit
 //     forces and generalized springs: the gradient against central differences of whole runs and
 //     against the differenced route, for euler, bdf1 and sdirk2;
@@ -18,6 +18,7 @@
 #include "core/dynamics/passive_force_terms.hpp"
 #include "../dynamics/constraint_scenes.hpp"
 #include "tests/core/dynamics/random_muscle.hpp"
+#include "tests/core/adjoint/adjoint_test_util.hpp"
 #include "validation/scenes/scenes.hpp"
 
 namespace redmax {
@@ -25,72 +26,7 @@ namespace {
 
 using adjoint::Objective;
 using adjoint::Problem;
-
-Problem problemFor(std::shared_ptr<const System> sys, const std::string& integrator, double duration, double dt) {
-  Problem pr;
-  pr.integrator = integrator;
-  pr.duration = duration;
-  pr.dt = dt;
-  pr.initial = sys->defaultState();
-  pr.make_system = [sys](const VecX&) { return sys; };
-  return pr;
-}
-
-class AnalyticSpringMass : public ::testing::TestWithParam<std::string> {};
-
-// x'' m = F - k x - d x' on a slider: y+ = A y + b F for euler and bdf1 (closed form as in
-// adjoint_test.cpp), so dJ/dp is a matrix product; the analytic route meets it to round-off
-TEST_P(AnalyticSpringMass, EqualsTheClosedFormOfTheDiscreteRunToRoundOff) {
-  const double m = 2.0, k = 50.0, d = 0.4, T = 0.5, h = 1e-3;
-  const double F = 3.0, x0 = -0.05, v0 = 0.2;
-  ModelBuilder b("spring_mass");
-  b.setGravity(Vec3::Zero());
-  const int body = b.addBody("block", m, Vec3::Zero(), Mat3::Identity() * 0.01, -1, "slider", Prismatic{});
-  b.coordinate(body, 0).stiffness = k;
-  b.coordinate(body, 0).damping = d;
-  const auto sys = std::make_shared<System>(b.finalize());
-  Problem pr = problemFor(sys, GetParam(), T, h);
-  pr.step_jacobians = "analytic";
-  pr.forces = {{0, 0, 1}};
-  pr.initial_q = {0};
-  pr.initial_qdot = {0};
-  Objective obj;
-  obj.points.push_back({0, Vec3::Zero(), Vec3(0.3, 0.0, 0.0), 1.0});
-  obj.speed_weight = 0.5;
-  VecX p(3);
-  p << F, x0, v0;
-  const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
-  ASSERT_TRUE(r.analytic_jacobians);
-  // the closed form: S = dy/d(F, x0, v0), S+ = A S + (b 0 0)
-  Eigen::Matrix2d A;
-  Eigen::Vector2d bb;
-  if (GetParam() == "euler") {
-    A << 0.0, 0.0, -h * k / m, 1.0 - h * d / m;
-    bb << 0.0, h / m;
-  } else {
-    const double c = m + h * d + h * h * k;
-    A << 0.0, 0.0, -h * k / c, m / c;
-    bb << 0.0, h / c;
-  }
-  A.row(0) = Eigen::RowVector2d(1.0, 0.0) + h * A.row(1);
-  bb[0] = h * bb[1];
-  Eigen::Vector2d y(x0, v0);
-  Eigen::Matrix<double, 2, 3> S = Eigen::Matrix<double, 2, 3>::Zero();
-  S(0, 1) = 1.0;
-  S(1, 2) = 1.0;
-  for (int i = 0; i < 500; ++i) {
-    y = A * y + bb * F;
-    S = (A * S).eval();
-    S.col(0) += bb;
-  }
-  const Eigen::RowVector3d g = (y[0] - 0.3) * S.row(0) + 0.5 * y[1] * S.row(1);
-  const double err = adjoint::worstRelativeError(r.gradient, g.transpose());
-  std::printf("[ measured ] %s: closed form %.2e relative\n", GetParam().c_str(), err);
-  EXPECT_LE(err, 1e-12);  // 500 steps of round-off; the differenced route is at 1e-10
-}
-
-// the closed form is written for the two one-stage steps
-INSTANTIATE_TEST_SUITE_P(Integrators, AnalyticSpringMass, ::testing::Values("euler", "bdf1"));
+using test::problemFor;
 
 class AnalyticJacobians : public ::testing::TestWithParam<std::string> {};
 
