@@ -52,7 +52,7 @@ TEST_F(GradientCli, SplineForcesAgreeWithCentralDifferences) {
       "--duration 0.1 --dt 0.005 --muscle-mass-kg via_muscle=0.5 --mass-points 6 "
       "--params 'torques:q1@5~cubic=0.5,q2@3~linear=-1' "
       "--objective 'point:link2@0,-1,0=0.5,-1.5,0;0.1*speed;0.01*effort' --check --check-tolerance 5e-9");
-  EXPECT_EQ(r.code, 0) << r.out << r.err;  // measured worst relative error 6.2e-10
+  EXPECT_EQ(r.code, 0) << r.out << r.err;  // measured worst relative error 6.8e-11 (6.2e-10 differenced)
   EXPECT_NE(r.out.find("torque q1 control point 5/5"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("torque q2 node 3/3"), std::string::npos) << r.out;
   const CmdResult bad = run("--duration 0.1 --params 'torques:q1@3~cubic' --objective speed");
