@@ -53,6 +53,10 @@ TEST_F(OptimizeCli, WritesTheReport) {
     EXPECT_EQ(csv.rfind("evaluation,simulations,step_evaluations,seconds,objective,best_objective,error_m\n", 0), 0u);
   }
   EXPECT_NE(md.find("torque elbow_flexion"), std::string::npos) << md;
+  // the lumped arm's gradients take the analytic route (docs/gradients.md §2.1), said in both places
+  EXPECT_NE(r.out.find("lbfgs gradients: analytic step Jacobians\n"), std::string::npos) << r.out;
+  EXPECT_NE(md.find("- lbfgs gradients: analytic step Jacobians"), std::string::npos) << md;
+  EXPECT_EQ(md.find("- nelder-mead gradients"), std::string::npos) << md;
   if (md.find("plot skipped") == std::string::npos) {
     EXPECT_TRUE(fs::exists(report / "objective.png") || fs::exists(report / "objective.svg")) << md;
   }
@@ -90,6 +94,10 @@ TEST_F(OptimizeCli, ExcitationDriveWritesTheBestRun) {
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.err.find("6 excitation nodes"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("lbfgs excitations: excitation left_muscle node 1/3="), std::string::npos) << r.out;
+  // Hill-type states keep the differenced route, and the output says why
+  EXPECT_NE(r.out.find("lbfgs gradients: central differences of the step (not analytic: excitation parameters"),
+            std::string::npos)
+      << r.out;
   const std::string csv = slurp(report / "best_run.csv");
   EXPECT_EQ(csv.rfind("time,hand_x,hand_y,hand_z,lumped_hand_x,lumped_hand_y,lumped_hand_z,excitation_left_muscle,"
                       "excitation_right_muscle,tendon_force_left_muscle,tendon_force_right_muscle\n", 0), 0u) << csv;

@@ -85,7 +85,11 @@ class Tracker {
       if (progress_) progress_(result_.method, e);
       return e.objective;
     }
-    if (gradient) *gradient = setup_.scale.cwiseProduct(r.gradient);
+    if (gradient) {
+      *gradient = setup_.scale.cwiseProduct(r.gradient);
+      result_.gradient_route = r.analytic_jacobians ? "analytic step Jacobians"
+                                                    : "central differences of the step (not analytic: " + r.jacobian_note + ")";
+    }
     result_.step_evaluations += r.step_evaluations;
     e.step_evaluations = result_.step_evaluations;
     e.objective = r.objective;
@@ -560,6 +564,16 @@ std::string fmt(double v, int digits = 6) {
 }
 
 // the converged parameters, one column per method (after the table's heading line)
+// one line per method that took gradients: how its adjoint formed the step Jacobians
+void gradientRoutes(std::ostream& md, const std::vector<ReachResult>& results) {
+  bool any = false;
+  for (const ReachResult& r : results) {
+    if (r.gradient_route.empty()) continue;
+    md << (any ? "" : "\n") << "- " << r.method << " gradients: " << r.gradient_route << " (docs/gradients.md §2.1)\n";
+    any = true;
+  }
+}
+
 void parameterTable(std::ostream& md, const std::vector<std::string>& names, const std::vector<ReachResult>& results) {
   for (const ReachResult& r : results) md << " " << r.method << " |";
   md << "\n|---|";
@@ -755,6 +769,7 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
       md << "| " << r.method << " | " << r.simulations << " (" << r.failed_simulations << ") | " << r.step_evaluations
          << " | " << fmt(r.seconds, 4) << " | " << fmt(r.objective) << " | " << fmt(r.error) << " | "
          << (r.reached ? "yes" : "no") << " | " << r.stop << " |\n";
+    gradientRoutes(md, results);
     md << "\n## Converged parameters (N m or N)\n\n| parameter |";
     parameterTable(md, setup.gradient.param_names, results);
     if (!tracked.coordinates.empty()) {
@@ -790,7 +805,9 @@ std::string writeReachReport(const std::string& dir, const ReachSetup& setup, co
          << fmt(r.objective) << " | " << fmt(r.error) << " | " << fmt(r.final_speed) << " | " << (r.reached ? "yes" : "no")
          << " | " << r.stop << " |\n";
     md << "\nOne simulation is one forward run; an L-BFGS evaluation also runs the adjoint sweep, whose cost is in the "
-          "step evaluations (docs/gradients.md §5).\n\n## Converged parameters" << (excite ? "" : " (N m)") << "\n\n| parameter |";
+          "step evaluations (docs/gradients.md §5).\n";
+    gradientRoutes(md, results);
+    md << "\n## Converged parameters" << (excite ? "" : " (N m)") << "\n\n| parameter |";
     parameterTable(md, setup.gradient.param_names, results);
     if (excite && best) {
       md << "\n## Best run (" << best->method << ")\n\n";
