@@ -33,4 +33,26 @@ Muscle randomViaMuscle(const Model& m, std::mt19937& rng, double mass, const std
   return mu;
 }
 
+// a straight (Type I) muscle from the world to the last body, and a Type II one with a conditional
+// point, active for q_0 in [-10, 0.3] (random states switch it on and off)
+inline Muscle straightMuscle(const Model& m, std::mt19937& rng, double mass) {
+  Muscle mu;
+  mu.name = "straight";
+  mu.path.points = {makeFixedPoint(-1, randomVec(rng, 0.3)), makeFixedPoint(m.nb() - 1, randomVec(rng, 0.3))};
+  mu.mass_points = makeMassPoints(mass, 0.3, 0.2);
+  return mu;
+}
+
+inline Muscle conditionalMuscle(const Model& m, std::mt19937& rng, double mass) {
+  Muscle mu;
+  mu.name = "conditional";
+  mu.path.points = {makeFixedPoint(0, randomVec(rng, 0.3)),
+                    makeConditionalPoint(m.nb() / 2, randomVec(rng, 0.3), 0, -10.0, 0.3),
+                    makeFixedPoint(m.nb() / 2, randomVec(rng, 0.3)), makeFixedPoint(m.nb() - 1, randomVec(rng, 0.3))};
+  MassPointOptions opt;
+  opt.count = 13;
+  mu.mass_points = makeMassPoints(mass, 0.3, 0.1, opt);
+  return mu;
+}
+
 }  // namespace redmax::test

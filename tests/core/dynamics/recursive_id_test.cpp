@@ -31,30 +31,6 @@ ExternalLoads randomLoads(const Model& m, std::mt19937& rng) {
   return l;
 }
 
-// a straight (Type I) muscle between two random bodies, and a Type II one with a conditional point
-Muscle straightMuscle(const Model& m, std::mt19937& rng, double mass) {
-  Muscle mu;
-  mu.name = "straight";
-  mu.path.points = {makeFixedPoint(-1, test::randomVec(rng, 0.3)),
-                    makeFixedPoint(m.nb() - 1, test::randomVec(rng, 0.3))};
-  mu.mass_points = makeMassPoints(mass, 0.3, 0.2);
-  return mu;
-}
-
-Muscle conditionalMuscle(const Model& m, std::mt19937& rng, double mass) {
-  Muscle mu;
-  mu.name = "conditional";
-  // active for q_0 in [-10, 0.3]: the random states switch it on and off
-  mu.path.points = {makeFixedPoint(0, test::randomVec(rng, 0.3)),
-                    makeConditionalPoint(m.nb() / 2, test::randomVec(rng, 0.3), 0, -10.0, 0.3),
-                    makeFixedPoint(m.nb() / 2, test::randomVec(rng, 0.3)),
-                    makeFixedPoint(m.nb() - 1, test::randomVec(rng, 0.3))};
-  MassPointOptions opt;
-  opt.count = 13;
-  mu.mass_points = makeMassPoints(mass, 0.3, 0.1, opt);
-  return mu;
-}
-
 // largest |tau_recursive - tau_M| / max(1, |tau_M|_inf) over random states of `sys`
 double worstRelative(const System& sys, std::mt19937& rng, bool loads, int trials = 6) {
   const Model& m = sys.model();
@@ -88,7 +64,7 @@ TEST(RecursiveId, MusclesWithMassEqualTheMassMatrixRoute) {
   double worst = 0.0, effect = 0.0;
   for (int seed = 0; seed < 4; ++seed) {
     const Model m = scenes::randomTree(8, 600 + seed, scenes::TreeJoints::All);
-    std::vector<Muscle> muscles = {straightMuscle(m, rng, 0.8), conditionalMuscle(m, rng, 1.5)};
+    std::vector<Muscle> muscles = {test::straightMuscle(m, rng, 0.8), test::conditionalMuscle(m, rng, 1.5)};
     for (int k = 0; k < 3; ++k) muscles.push_back(test::randomViaMuscle(m, rng, 0.5 + k, "via" + std::to_string(k)));
     System sys(m);
     auto term = std::make_shared<MuscleTerm>(m, muscles);
@@ -174,7 +150,7 @@ TEST(RecursiveId, MassPointsInAnyOrderAndOfUnequalMassEqualTheMassMatrixRoute) {
 TEST(RecursiveId, WithoutTheQuadraticVelocityVectorTheCompactRouteEqualsTheMassMatrixRoute) {
   std::mt19937 rng(3);
   const Model m = scenes::randomTree(6, 77, scenes::TreeJoints::All);
-  std::vector<Muscle> muscles = {straightMuscle(m, rng, 1.0), test::randomViaMuscle(m, rng, 1.0, "via")};
+  std::vector<Muscle> muscles = {test::straightMuscle(m, rng, 1.0), test::randomViaMuscle(m, rng, 1.0, "via")};
   System sys(m);
   MuscleTermOptions o;
   o.quadratic_velocity = false;
