@@ -251,7 +251,12 @@ class Stepper {
   //           + h dF, a' = (v+ - v) / h
   //   sdirk2  the stage equations V - zv - hg a(zq + hg V, V) = 0 by the implicit function theorem
   //           at the converged stages, chained through stage 2's start (zq, zv)
-  void analyticJacobians(const VecX& y, double t, double h, const VecX& u, MatX& Jy, MatX& Jf) {
+  // System parameters s (muscle masses) enter as the generalized force -dtau/ds at the step's (or
+  // each stage's) state and acceleration: with `dtau_ds` (n x ns at a state and acceleration),
+  // Js = dy+/ds (2n x ns).
+  using ParamIdDerivative = std::function<MatX(const State&, const VecX&)>;
+  void analyticJacobians(const VecX& y, double t, double h, const VecX& u, MatX& Jy, MatX& Jf,
+                         const ParamIdDerivative* dtau_ds = nullptr, MatX* Js = nullptr) {
     const int n = n_;
     const MatX I = MatX::Identity(n, n);
     State s = unpack(y, t);
@@ -263,11 +268,13 @@ class Stepper {
       if (!systemIdDerivatives(sys_, st, a, ws_, Dq, Dv, &why))
         throw AdjointError("adjoint: analytic step Jacobians: " + why);
     };
-    MatX dv_dy(n, 2 * n), dv_dF(n, n);
+    MatX dv_dy(n, 2 * n), dv_dF(n, n), Gs;  // Gs: -dtau/ds at the step's state and acceleration
     if (integ_->name() == "euler") {
       sys_.calcMassAndForce(s, ws_);
       const Eigen::LDLT<MatX> ldlt(ws_.M);
-      idDerivatives(s, ldlt.solve(ws_.f));
+      const VecX a = ldlt.solve(ws_.f);
+      idDerivatives(s, a);
+      if (dtau_ds) Gs = -(*dtau_ds)(s, a);
       dv_dy.leftCols(n) = -h * ldlt.solve(Dq);
       dv_dy.rightCols(n) = I - h * ldlt.solve(Dv);
       dv_dF = h * ldlt.solve(I);
@@ -277,7 +284,9 @@ class Stepper {
       const MatX M = ws_.M, D = ws_.D;
       const Eigen::LDLT<MatX> A(M + h * D + (h * h) * ws_.K);
       const VecX vplus = A.solve(M * s.qdot + h * (ws_.f + D * s.qdot));
-      idDerivatives(s, (vplus - s.qdot) / h);
+      const VecX a = (vplus - s.qdot) / h;
+      idDerivatives(s, a);
+      if (dtau_ds) Gs = -(*dtau_ds)(s, a);
       dv_dy.leftCols(n) = -h * A.solve(Dq);
       dv_dy.rightCols(n) = A.solve(M + h * D - h * Dv);
       dv_dF = h * A.solve(I);
@@ -290,21 +299,23 @@ class Stepper {
       // one stage's a_q, a_F and dR/dV for R = V - zv - hg a(zq + hg V, V); then
       // dV = dR/dV^-1 (hg a_q dzq + dzv + hg a_F dF)
       auto stage = [&](const VecX& zq, const VecX& zv, const VecX& V, double ts, MatX& a_q, MatX& dR_dV,
-                       MatX& a_F) {
+                       MatX& a_F, MatX& G_s) {
         State st;
         st.t = ts;
         st.q = zq + hg * V;
         st.qdot = V;
         sys_.calcMassAndForce(st, ws_);
         const Eigen::LDLT<MatX> ldlt(ws_.M);
-        idDerivatives(st, (V - zv) / hg);
+        const VecX a = (V - zv) / hg;
+        idDerivatives(st, a);
+        if (dtau_ds) G_s = -(*dtau_ds)(st, a);
         a_q = -ldlt.solve(Dq);
         const MatX a_v = -ldlt.solve(Dv);
         a_F = ldlt.solve(I);
         dR_dV = I - hg * (hg * a_q + a_v);
       };
-      MatX aq1, A1, aF1, aq2, A2, aF2;
-      stage(s.q, s.qdot, V1, t + hg, aq1, A1, aF1);
+      MatX aq1, A1, aF1, aq2, A2, aF2, G1, G2;
+      stage(s.q, s.qdot, V1, t + hg, aq1, A1, aF1, G1);
       const Eigen::PartialPivLU<MatX> lu1(A1);
       MatX dV1(n, 2 * n);
       dV1.leftCols(n) = lu1.solve(hg * aq1);
@@ -312,7 +323,7 @@ class Stepper {
       const MatX dV1_dF = lu1.solve(hg * aF1);
       const VecX zq2 = s.q + h * (1.0 - g) * V1;
       const VecX zv2 = s.qdot + c * (V1 - s.qdot);
-      stage(zq2, zv2, V2, t + h, aq2, A2, aF2);
+      stage(zq2, zv2, V2, t + h, aq2, A2, aF2, G2);
       const Eigen::PartialPivLU<MatX> lu2(A2);
       MatX dzq(n, 2 * n), dzv(n, 2 * n);
       dzq << I, MatX::Zero(n, n);
@@ -328,6 +339,14 @@ class Stepper {
       Jf.resize(2 * n, n);
       Jf.topRows(n) = h * (1.0 - g) * dV1_dF + hg * dv_dF;
       Jf.bottomRows(n) = dv_dF;
+      if (dtau_ds && Js) {
+        // each stage's own force -dtau/ds, through the same chain as F
+        const MatX dV1_ds = dV1_dF * G1;
+        const MatX dV2_ds = lu2.solve(hg * aq2 * (h * (1.0 - g) * dV1_ds) + c * dV1_ds + hg * aF2 * G2);
+        Js->resize(2 * n, G1.cols());
+        Js->topRows(n) = h * (1.0 - g) * dV1_ds + hg * dV2_ds;
+        Js->bottomRows(n) = dV2_ds;
+      }
       return;
     }
     // euler and bdf1: q+ = q + h v+
@@ -338,6 +357,12 @@ class Stepper {
     Jf.resize(2 * n, n);
     Jf.topRows(n) = h * dv_dF;
     Jf.bottomRows(n) = dv_dF;
+    if (dtau_ds && Js) *Js = Jf * Gs;
+  }
+  /// the system's inverse dynamics at (st, a) with controls u (the system-parameter columns)
+  VecX inverseDynamics(const State& st, const VecX& a, const VecX& u) {
+    ws_.controls = u;
+    return sys_.inverseDynamics(st, a, ws_);
   }
   long evaluations = 0;
 
@@ -523,8 +548,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   std::string why;
   bool analytic = false;
   if (pr.step_jacobians != "differences") {
-    if (ns > 0) why = "system parameters (muscle masses)";
-    else if (!rs.excited.empty()) why = "excitation parameters (Hill-type muscle states)";
+    if (!rs.excited.empty()) why = "excitation parameters (Hill-type muscle states)";
     else analytic = stepper.analyticAvailable(&why);
   }
   if (pr.step_jacobians == "analytic" && !analytic)
@@ -540,7 +564,20 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     const double t = timeAt(k);
     const VecX u = controlsAt(pr, rs, p, k, N);
     if (analytic) {
-      stepper.analyticJacobians(y[k], t, h, u, Jy, Jf);
+      // system parameters: dtau/ds by the fourth-order difference of inverse dynamics between the
+      // systems at s -+ delta, -+ 2 delta (exact up to round-off where tau is linear in s, as in a
+      // muscle's mass: its mass points' share scales with it)
+      Stepper::ParamIdDerivative dtau_ds = [&](const State& st, const VecX& a) {
+        MatX d(n, ns);
+        for (int j = 0; j < ns; ++j) {
+          auto tau = [&](int m) { return step_at[4 * j + m]->inverseDynamics(st, a, u); };
+          d.col(j) = (tau(0) - 8.0 * tau(1) + 8.0 * tau(2) - tau(3)) / (12.0 * pr.system_param_delta[j]);
+        }
+        return d;
+      };
+      MatX Js;
+      stepper.analyticJacobians(y[k], t, h, u, Jy, Jf, ns > 0 ? &dtau_ds : nullptr, ns > 0 ? &Js : nullptr);
+      if (ns > 0) res.gradient.tail(ns) += Js.transpose() * lambda;
       const VecX lf = Jf.transpose() * lambda;
       for (int c = nub; c < nub + nd; ++c) Ju[c] = lf[rs.driven[c - nub]];
       for (int j = 0; j < nf; ++j) {

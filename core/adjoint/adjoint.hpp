@@ -12,9 +12,9 @@
 // What is differentiated how (docs/gradients.md §2): where every part of the system has written
 // derivatives (the skeleton, joint springs and dampers, coordinate limit forces, generalized
 // springs, the driven coordinates' forces, Type I and II muscles' mass points; no constraints, no
-// auxiliary states, no muscle-mass parameters) dPhi_k/dy_k and
-// dPhi_k/du are exact, from the derivatives of inverse dynamics (core/dynamics/id_derivatives.hpp)
-// through each integrator's own equations (§2.1). Elsewhere dPhi_k/dy_k is the central difference of the
+// auxiliary states) dPhi_k/dy_k, dPhi_k/du and dPhi_k/ds are exact, from the derivatives of
+// inverse dynamics (core/dynamics/id_derivatives.hpp; a muscle mass s through dtau/ds, linear in
+// s) through each integrator's own equations (§2.1). Elsewhere dPhi_k/dy_k is the central difference of the
 // whole step, so every term the step evaluates (M, f with springs, dampers, muscle inertia of
 // every path type, K and D of bdf1, the KKT rows of constraints, the z update) is in it; the
 // generalized-force columns dPhi_k/du are central differences of the step along each driven

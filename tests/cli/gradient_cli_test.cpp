@@ -73,8 +73,8 @@ TEST_F(GradientCli, WhatTheGradientDoesNotApplyIsNamed) {
 }
 
 // --step-jacobians (docs/gradients.md §2.1): the lumped pendulum takes the analytic route under
-// auto and meets central differences of whole runs; with a muscle mass as a parameter auto falls
-// back and says why; analytic is refused for a wrapping muscle's mass points, naming it
+// auto and meets central differences of whole runs, and so does a Type II muscle's mass as a
+// parameter; a wrapping muscle's mass points: auto falls back and says why, analytic is refused
 TEST_F(GradientCli, StepJacobianRoutes) {
   const std::string lumped =
       "--duration 0.1 --dt 0.005 --params 'torques:q1@2=0.5,q2=-1;qdot0:q1=0.3' "
@@ -87,11 +87,10 @@ TEST_F(GradientCli, StepJacobianRoutes) {
   const CmdResult d = run(lumped + " --step-jacobians differences");
   EXPECT_EQ(d.code, 0) << d.out << d.err;
   EXPECT_NE(d.out.find("step Jacobians: central differences of the step\n"), std::string::npos) << d.out;
-  const CmdResult massive = run(kRun);
+  // a Type II muscle's mass as a parameter takes the analytic route too (dtau/ds, docs/gradients.md §2.1)
+  const CmdResult massive = run(kRun + " --check --check-tolerance 1e-9");
   EXPECT_EQ(massive.code, 0) << massive.out << massive.err;
-  EXPECT_NE(massive.out.find("step Jacobians: central differences of the step; not analytic: system parameters"),
-            std::string::npos)
-      << massive.out;
+  EXPECT_NE(massive.out.find("step Jacobians: analytic"), std::string::npos) << massive.out;
   // Type II mass points take the analytic route; a wrapping (Type III) muscle's do not
   const CmdResult via = run("--duration 0.1 --dt 0.005 --muscle-mass-kg via_muscle=0.5 --params 'torques:q1' --objective speed "
                             "--step-jacobians analytic --check");
@@ -104,6 +103,15 @@ TEST_F(GradientCli, StepJacobianRoutes) {
   EXPECT_NE(refused.err.find("analytic step Jacobians do not apply: the mass points of muscle 'wrap_muscle', which wraps"),
             std::string::npos)
       << refused.err;
+  // under auto the same run differences its steps and says why
+  const CmdResult wrapped = runRedmax(
+      dir_, "gradient --model " + scene("double_pendulum_wrap.osim") +
+                " --duration 0.1 --dt 0.005 --muscle-mass-kg wrap_muscle=0.5 --params 'torques:q1' --objective speed");
+  EXPECT_EQ(wrapped.code, 0) << wrapped.out << wrapped.err;
+  EXPECT_NE(wrapped.out.find("step Jacobians: central differences of the step; not analytic: the mass points of "
+                             "muscle 'wrap_muscle', which wraps (Type III)"),
+            std::string::npos)
+      << wrapped.out;
   const CmdResult bad = run("--duration 0.1 --params 'torques:q1' --objective speed --step-jacobians exact");
   EXPECT_EQ(bad.code, 2) << bad.err;
 }
