@@ -80,7 +80,7 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
     if (js.parent >= 0) {
       const BodyData& p = bd[static_cast<size_t>(js.parent)];
       b.phi = b.Ad_ip * p.phi + b.psi;
-      b.phidot = b.Ad_ip * p.phidot - ad(b.psi) * (b.Ad_ip * p.phi) + acc;
+      b.phidot = b.Ad_ip * p.phidot - adTimes(b.psi, b.Ad_ip * p.phi) + acc;
     } else {
       b.phi = b.psi;
       b.phidot = acc;
@@ -118,7 +118,7 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
     b.g_i = E_wi[i].topLeftCorner<3, 3>().transpose() * (body.mass * model.gravity());
     b.g.head<3>() = body.com.cross(b.g_i);
     b.g.tail<3>() = b.g_i;
-    b.W = body.M * b.phidot - ad(b.phi).transpose() * (body.M * b.phi) - b.g;
+    b.W = body.M * b.phidot - adTransposeTimes(b.phi, body.M * b.phi) - b.g;
   }
   // the muscles' mass points: wrenches the bodies must supply for them (core/muscles/muscle_id_tangent.hpp)
   std::vector<BodyWorldMotion> world;
@@ -164,9 +164,20 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
   for (int col = 0; col < 2 * nr; ++col) {
     const bool speed = col >= nr;
     const int k = speed ? col - nr : col;
+    const int joint_k = model.coordinates()[k].joint;
     for (int i = 0; i < nb; ++i) {
       const JointSlot& js = model.joints()[i];
       BodyData& b = bd[static_cast<size_t>(i)];
+      if (!model.isAncestor(joint_k, i)) {
+        // a body outside the coordinate's subtree does not move with it
+        dPose[static_cast<size_t>(i)].setZero();
+        dphi[static_cast<size_t>(i)].setZero();
+        dphidot[static_cast<size_t>(i)].setZero();
+        dW[static_cast<size_t>(i)].setZero();
+        dpsi_pose[static_cast<size_t>(i)].setZero();
+        dS_i[static_cast<size_t>(i)].setZero(6, js.nq);
+        continue;
+      }
       const Body& body = model.bodies()[i];
       const VecJ qd = s.qdot.segment(js.q_index, js.nq), qdd = qddot.segment(js.q_index, js.nq);
       const bool own = k >= js.q_index && k < js.q_index + js.nq;
@@ -195,9 +206,9 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
         const Vec6 Xdphi = b.Ad_ip * dphi[p];
         dP = b.Ad_ip * dPose[p] + dpose;
         // d(Ad_ip x) = Ad_ip dx - ad(dpose) Ad_ip x (E_pi varies as E_pi exp([dpose]))
-        const Vec6 dXphi = Xdphi - ad(dpose) * Xphi;
+        const Vec6 dXphi = Xdphi - adTimes(dpose, Xphi);
         dph = dXphi + dpsi;
-        dphd = b.Ad_ip * dphidot[p] - ad(dpose) * Xphid - ad(dpsi) * Xphi - ad(b.psi) * dXphi + dacc;
+        dphd = b.Ad_ip * dphidot[p] - adTimes(dpose, Xphid) - adTimes(dpsi, Xphi) - adTimes(b.psi, dXphi) + dacc;
       } else {
         dP = dpose;
         dph = dpsi;
@@ -208,8 +219,8 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       Vec6 dgw;
       dgw.head<3>() = body.com.cross(dg);
       dgw.tail<3>() = dg;
-      dW[static_cast<size_t>(i)] = body.M * dphd - ad(dph).transpose() * (body.M * b.phi) -
-                                   ad(b.phi).transpose() * (body.M * dph) - dgw;
+      dW[static_cast<size_t>(i)] = body.M * dphd - adTransposeTimes(dph, body.M * b.phi) -
+                                   adTransposeTimes(b.phi, body.M * dph) - dgw;
     }
     if (!muscles.empty()) {
       // the bodies' world motion's derivative from the body-coordinate one (dR = [R dPose_w] R)
@@ -251,7 +262,7 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       if (js.parent >= 0) {
         // d(Ad_ip^T W) = Ad_ip^T dW - Ad_ip^T ad(dpose)^T W
         dW[static_cast<size_t>(js.parent)] +=
-            b.Ad_ip.transpose() * (dWi - ad(dpsi_pose[static_cast<size_t>(i)]).transpose() * b.W);
+            b.Ad_ip.transpose() * (dWi - adTransposeTimes(dpsi_pose[static_cast<size_t>(i)], b.W));
       }
     }
   }
