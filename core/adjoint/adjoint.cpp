@@ -233,10 +233,7 @@ class Stepper {
       *why = "auxiliary states (Hill-type muscles)";
       return false;
     }
-    if (sys_.numConstraintRows() > 0) {
-      *why = "constraint rows (their G and Gdot have no written derivatives)";
-      return false;
-    }
+    if (sys_.numConstraintRows() > 0 && !constraintRowDerivativesAvailable(sys_, why)) return false;
     return systemIdDerivativesAvailable(sys_, why);
   }
 
@@ -269,27 +266,52 @@ class Stepper {
         throw AdjointError("adjoint: analytic step Jacobians: " + why);
     };
     MatX dv_dy(n, 2 * n), dv_dF(n, n), Gs;  // Gs: -dtau/ds at the step's state and acceleration
-    if (integ_->name() == "euler") {
+    const int nc = sys_.numConstraintRows();
+    ConstraintRowDerivatives crd;
+    if (integ_->name() == "euler" || integ_->name() == "bdf1") {
+      // euler: M v+ = M v + h f;  bdf1: A v+ = M v + h (f + D v), A = M + h D + h^2 K (K, D the
+      // joint springs' and dampers' constants); with constraint rows, the KKT system
+      // [A G^T; G 0] [v+; lambda] = [.; G v + h rhs - vel_err] (A = M for euler). Differentiated:
+      //   [A G^T; G 0] [dv+; dlambda] = [-h dtau(a') - d(G^T lambda) + (M + h D) dv + h dF - h dtau/ds ds;
+      //                                  d(G (v - v+)) + h drhs - dvel_err + G dv]
+      // with a' = (v+ - v) / h, the acceleration at which dtau is taken.
+      const bool euler = integ_->name() == "euler";
       sys_.calcMassAndForce(s, ws_);
-      const Eigen::LDLT<MatX> ldlt(ws_.M);
-      const VecX a = ldlt.solve(ws_.f);
-      idDerivatives(s, a);
-      if (dtau_ds) Gs = -(*dtau_ds)(s, a);
-      dv_dy.leftCols(n) = -h * ldlt.solve(Dq);
-      dv_dy.rightCols(n) = I - h * ldlt.solve(Dv);
-      dv_dF = h * ldlt.solve(I);
-    } else if (integ_->name() == "bdf1") {
-      sys_.calcMassAndForce(s, ws_);
-      sys_.calcStiffnessDamping(s, ws_);
-      const MatX M = ws_.M, D = ws_.D;
-      const Eigen::LDLT<MatX> A(M + h * D + (h * h) * ws_.K);
-      const VecX vplus = A.solve(M * s.qdot + h * (ws_.f + D * s.qdot));
+      MatX Mv = ws_.M, A = ws_.M;
+      VecX top = ws_.M * s.qdot + h * ws_.f;
+      if (!euler) {
+        sys_.calcStiffnessDamping(s, ws_);
+        Mv += h * ws_.D;
+        A += h * ws_.D + (h * h) * ws_.K;
+        top += h * (ws_.D * s.qdot);
+      }
+      VecX vplus, lambda;
+      MatX G;
+      if (nc > 0) {
+        sys_.calcConstraints(s, ws_);
+        G = ws_.G;
+        vplus = System::solveKKT(A, G, top, G * s.qdot + h * ws_.rhs - ws_.vel_err, &lambda);
+      } else {
+        vplus = A.ldlt().solve(top);
+      }
       const VecX a = (vplus - s.qdot) / h;
       idDerivatives(s, a);
       if (dtau_ds) Gs = -(*dtau_ds)(s, a);
-      dv_dy.leftCols(n) = -h * A.solve(Dq);
-      dv_dy.rightCols(n) = A.solve(M + h * D - h * Dv);
-      dv_dF = h * A.solve(I);
+      if (nc == 0) {
+        const Eigen::LDLT<MatX> ldlt(A);
+        dv_dy.leftCols(n) = -h * ldlt.solve(Dq);
+        dv_dy.rightCols(n) = ldlt.solve(Mv - h * Dv);
+        dv_dF = h * ldlt.solve(I);
+      } else {
+        constraintRowDerivatives(sys_, s, s.qdot - vplus, lambda, crd);
+        auto kkt = [&](const VecX& t, const VecX& b) { return System::solveKKT(A, G, t, b, nullptr); };
+        for (int j = 0; j < n; ++j) {
+          dv_dy.col(j) = kkt(-h * Dq.col(j) - crd.dGTl_dq.col(j),
+                             crd.dGw_dq.col(j) + h * crd.drhs_dq.col(j) - crd.dverr_dq.col(j));
+          dv_dy.col(n + j) = kkt(-h * Dv.col(j) + Mv.col(j), G.col(j) + h * crd.drhs_dv.col(j) - crd.dverr_dv.col(j));
+          dv_dF.col(j) = kkt(h * I.col(j), VecX::Zero(nc));
+        }
+      }
     } else {  // sdirk2
       const double g = Sdirk2::gamma(), hg = h * g, c = (1.0 - g) / g;
       const VecX yplus = step(y, t, h, u);
@@ -305,13 +327,33 @@ class Stepper {
         st.q = zq + hg * V;
         st.qdot = V;
         sys_.calcMassAndForce(st, ws_);
-        const Eigen::LDLT<MatX> ldlt(ws_.M);
         const VecX a = (V - zv) / hg;
         idDerivatives(st, a);
         if (dtau_ds) G_s = -(*dtau_ds)(st, a);
-        a_q = -ldlt.solve(Dq);
-        const MatX a_v = -ldlt.solve(Dv);
-        a_F = ldlt.solve(I);
+        MatX a_v;
+        if (nc == 0) {
+          const Eigen::LDLT<MatX> ldlt(ws_.M);
+          a_q = -ldlt.solve(Dq);
+          a_v = -ldlt.solve(Dv);
+          a_F = ldlt.solve(I);
+        } else {
+          // the constrained acceleration [M G^T; G 0] [a; mu] = [f; rhs], differentiated:
+          // [M G^T; G 0] [da; dmu] = [-dtau(a) - d(G^T mu) + dF; drhs - d(G a)]
+          sys_.calcConstraints(st, ws_);
+          const MatX M = ws_.M, G = ws_.G;
+          VecX mu;
+          System::solveKKT(M, G, ws_.f, ws_.rhs, &mu);
+          constraintRowDerivatives(sys_, st, a, mu, crd);
+          auto kkt = [&](const VecX& t, const VecX& b) { return System::solveKKT(M, G, t, b, nullptr); };
+          a_q.resize(n, n);
+          a_v.resize(n, n);
+          a_F.resize(n, n);
+          for (int j = 0; j < n; ++j) {
+            a_q.col(j) = kkt(-Dq.col(j) - crd.dGTl_dq.col(j), crd.drhs_dq.col(j) - crd.dGw_dq.col(j));
+            a_v.col(j) = kkt(-Dv.col(j), crd.drhs_dv.col(j));
+            a_F.col(j) = kkt(I.col(j), VecX::Zero(nc));
+          }
+        }
         dR_dV = I - hg * (hg * a_q + a_v);
       };
       MatX aq1, A1, aF1, aq2, A2, aF2, G1, G2;

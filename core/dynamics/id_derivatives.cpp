@@ -1,10 +1,12 @@
 #include "core/dynamics/id_derivatives.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <type_traits>
 #include <variant>
 #include <vector>
 
+#include "core/dynamics/constraints/coordinate_coupler.hpp"
 #include "core/dynamics/coordinate_actuator_term.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/muscles/muscle_id_tangent.hpp"
@@ -355,6 +357,72 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
     // CoordinateActuatorTerm: optimal_force * u does not depend on q or qdot
   }
   return true;
+}
+
+bool constraintRowDerivativesAvailable(const System& sys, std::string* why) {
+  for (const auto& c : sys.constraints())
+    if (!dynamic_cast<const CoordinateCoupler*>(c.get())) {
+      if (why) *why = "the constraint '" + c->name() + "' (only coordinate couplers have written derivatives)";
+      return false;
+    }
+  return true;
+}
+
+void constraintRowDerivatives(const System& sys, const State& s, const VecX& w, const VecX& lambda,
+                              ConstraintRowDerivatives& out) {
+  const int n = sys.ndof(), nc = sys.numConstraintRows();
+  out.dGw_dq.setZero(nc, n);
+  out.dGTl_dq.setZero(n, n);
+  out.drhs_dq.setZero(nc, n);
+  out.drhs_dv.setZero(nc, n);
+  out.dverr_dq.setZero(nc, n);
+  out.dverr_dv.setZero(nc, n);
+  MatX dperr_dq = MatX::Zero(nc, n);
+  int r = 0;
+  FunctionValue fv, ft;
+  for (const auto& c : sys.constraints()) {
+    const auto& cc = dynamic_cast<const CoordinateCoupler&>(*c);
+    const std::vector<int>& I = cc.independent();
+    const int m = static_cast<int>(I.size()), d = cc.dependent();
+    const double sc = cc.scale();
+    VecJ x(m), xd(m), wI(m);
+    for (int k = 0; k < m; ++k) {
+      x[k] = s.q[I[k]];
+      xd[k] = s.qdot[I[k]];
+      wI[k] = w[I[k]];
+    }
+    evaluateWithArguments(cc.function(), x, 2, fv);
+    const VecJ Hxd = fv.hessian * xd, Hw = fv.hessian * wI;
+    for (int k = 0; k < m; ++k) {
+      const int col = I[k];
+      out.dGw_dq(r, col) += sc * Hw[k];
+      for (int j = 0; j < m; ++j) out.dGTl_dq(I[j], col) += lambda[r] * sc * fv.hessian(j, k);
+      out.dverr_dq(r, col) += sc * Hxd[k];
+      out.dverr_dv(r, col) += sc * fv.gradient[k];
+      dperr_dq(r, col) += sc * fv.gradient[k];
+      out.drhs_dv(r, col) += -2.0 * sc * Hxd[k];
+      // rhs along q_k: -scale xdot^T (dHess/dx_k) xdot, the Hessian differenced (fourth order)
+      const double h = 1e-3 * std::max(1.0, std::abs(x[k]));
+      const double at[4] = {-2.0, -1.0, 1.0, 2.0}, wt[4] = {1.0, -8.0, 8.0, -1.0};
+      double t = 0.0;
+      for (int q = 0; q < 4; ++q) {
+        VecJ xm = x;
+        xm[k] += at[q] * h;
+        evaluateWithArguments(cc.function(), xm, 2, ft);
+        t += wt[q] * xd.dot(ft.hessian * xd);
+      }
+      out.drhs_dq(r, col) += -sc * t / (12.0 * h);
+    }
+    out.dverr_dv(r, d) += -1.0;
+    dperr_dq(r, d) += -1.0;
+    r += cc.rows();
+  }
+  // System::calcConstraints' stabilization: rhs -= 2 alpha vel_err + beta^2 pos_err
+  const StabilizationOptions& st = sys.stabilization;
+  if (st.alpha != 0.0 || st.beta != 0.0) {
+    out.drhs_dq -= 2.0 * st.alpha * out.dverr_dq + st.beta * st.beta * dperr_dq;
+    out.drhs_dv -= 2.0 * st.alpha * out.dverr_dv;
+  }
 }
 
 MatX jacobianDerivative(const Model& model, const State& s, int c) {

@@ -48,6 +48,24 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
 /// false with the first part that has no written derivatives.
 bool systemIdDerivativesAvailable(const System& sys, std::string* why = nullptr);
 
+/// The derivatives of the constraint rows as System::calcConstraints forms them (G, the stabilized
+/// rhs, vel_err), written for coordinate couplers (OpenSim's CoordinateCouplerConstraint,
+/// C = scale f(q_I) - q_dep): G = (scale grad f, -1) and rhs = -scale qdot_I^T Hess f qdot_I, so the
+/// derivatives need f's Hessian (exact, the function's own) and, for rhs along q, its third
+/// derivative (a fourth-order difference of the Hessian, function-local as the joints' second
+/// derivative of S). For the KKT steps (docs/gradients.md §2.1), at a state, a vector w and the
+/// multipliers lambda:
+struct ConstraintRowDerivatives {
+  MatX dGw_dq;              ///< d(G w)/dq                       (nc x n)
+  MatX dGTl_dq;             ///< d(G^T lambda)/dq                (n x n)
+  MatX drhs_dq, drhs_dv;    ///< the stabilized rhs              (nc x n)
+  MatX dverr_dq, dverr_dv;  ///< the velocity error              (nc x n)
+};
+/// Whether every constraint of the system is a coordinate coupler; false with the first that is not.
+bool constraintRowDerivativesAvailable(const System& sys, std::string* why = nullptr);
+void constraintRowDerivatives(const System& sys, const State& s, const VecX& w, const VecX& lambda,
+                              ConstraintRowDerivatives& out);
+
 /// dJ_mr/dq_c (nm x nr) at s.q: Jdot_mr at the speeds e_c (Jdot_mr is linear in qdot).
 MatX jacobianDerivative(const Model& model, const State& s, int c);
 
