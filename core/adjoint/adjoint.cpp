@@ -227,7 +227,7 @@ class Stepper {
   }
 
   // Whether the step's Jacobians can be formed from the ID derivatives (docs/gradients.md §2.1):
-  // no auxiliary states, no constraint rows, every part with written derivatives.
+  // no auxiliary states, no constraints but coordinate couplers, every part with written derivatives.
   bool analyticAvailable(std::string* why) const {
     if (nz_ > 0) {
       *why = "auxiliary states (Hill-type muscles)";

@@ -11,8 +11,8 @@
 //   dJ/dp    = dJ/dp|explicit + sum_k (dPhi_k/dp)^T lambda_{k+1} + (dy_0/dp)^T lambda_0.
 // What is differentiated how (docs/gradients.md §2): where every part of the system has written
 // derivatives (the skeleton, joint springs and dampers, coordinate limit forces, generalized
-// springs, the driven coordinates' forces, Type I and II muscles' mass points; no constraints, no
-// auxiliary states) dPhi_k/dy_k, dPhi_k/du and dPhi_k/ds are exact, from the derivatives of
+// springs, the driven coordinates' forces, Type I and II muscles' mass points, coordinate
+// couplers; no other constraints, no auxiliary states) dPhi_k/dy_k, dPhi_k/du and dPhi_k/ds are exact, from the derivatives of
 // inverse dynamics (core/dynamics/id_derivatives.hpp; a muscle mass s through dtau/ds, linear in
 // s) through each integrator's own equations (§2.1). Elsewhere dPhi_k/dy_k is the central difference of the
 // whole step, so every term the step evaluates (M, f with springs, dampers, muscle inertia of
