@@ -434,4 +434,58 @@ MatX jacobianDerivative(const Model& model, const State& s, int c) {
   return ws.Jdot_mr;
 }
 
+void jacobianDerivatives(const Model& model, const State& s, int c, MatX& dJ, MatX& dJdot) {
+  SkeletonWorkspace ws(model);
+  calcKinematics(model, s, ws);
+  const int nb = model.nb();
+  dJ.setZero(model.nm(), model.nr());
+  dJdot.setZero(model.nm(), model.nr());
+  const int jc = model.coordinates()[c].joint;
+  JointKinematics jt;
+  for (int i = 0; i < nb; ++i) {
+    if (!model.isAncestor(jc, i)) continue;  // outside the coordinate's subtree nothing moves
+    const JointSlot& js = model.joints()[i];
+    const int r = 6 * i;
+    const VecJ q = s.q.segment(js.q_index, js.nq), qd = s.qdot.segment(js.q_index, js.nq);
+    // the joint's own variation: dS = Sdot(q, e_c'), dSdot by a fourth-order difference, the
+    // pose variation in body i and that of psi_i = Ad_ij S qdot
+    Vec6 dpose = Vec6::Zero(), dpsi = Vec6::Zero();
+    if (i == jc) {
+      const int cc = c - js.q_index;
+      VecJ e = VecJ::Zero(js.nq);
+      e[cc] = 1.0;
+      js.joint.calc(q, e, jt);
+      const Mat6X dS = ws.Ad_ij[i] * jt.Sdot;
+      const double h = 1e-3 * std::max(1.0, std::abs(q[cc]));
+      const double at[4] = {-2.0, -1.0, 1.0, 2.0}, w[4] = {1.0, -8.0, 8.0, -1.0};
+      Mat6X dSdot = Mat6X::Zero(6, js.nq);
+      for (int m = 0; m < 4; ++m) {
+        VecJ qm = q;
+        qm[cc] += at[m] * h;
+        js.joint.calc(qm, qd, jt);
+        dSdot += w[m] * jt.Sdot;
+      }
+      dJ.block(r, js.q_index, 6, js.nq) = dS;
+      dJdot.block(r, js.q_index, 6, js.nq) = ws.Ad_ij[i] * dSdot / (12.0 * h);
+      dpose = ws.J_mr.block(r, c, 6, 1);
+      dpsi = dS * qd;
+    }
+    if (js.parent < 0) continue;
+    const int p = js.parent, rp = 6 * p;
+    const Mat6& Ad = ws.Ad_ip[i];
+    const Mat6 dAd = -ad(dpose) * Ad;                              // d Ad_ip
+    const Mat6 Addot = -ad(ws.psi[i]) * Ad;                        // Addot_ip
+    const Mat6 dAddot = -ad(dpsi) * Ad - ad(ws.psi[i]) * dAd;      // d Addot_ip
+    for (int a : model.ancestors(p)) {
+      const JointSlot& sa = model.joints()[a];
+      if (sa.nq == 0) continue;
+      const auto Jp = ws.J_mr.block(rp, sa.q_index, 6, sa.nq);
+      const auto Jdp = ws.Jdot_mr.block(rp, sa.q_index, 6, sa.nq);
+      const MatX dJp = dJ.block(rp, sa.q_index, 6, sa.nq), dJdp = dJdot.block(rp, sa.q_index, 6, sa.nq);
+      dJ.block(r, sa.q_index, 6, sa.nq) = dAd * Jp + Ad * dJp;
+      dJdot.block(r, sa.q_index, 6, sa.nq) = dAddot * Jp + Addot * dJp + dAd * Jdp + Ad * dJdp;
+    }
+  }
+}
+
 }  // namespace redmax

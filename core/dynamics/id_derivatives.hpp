@@ -69,4 +69,10 @@ void constraintRowDerivatives(const System& sys, const State& s, const VecX& w, 
 /// dJ_mr/dq_c (nm x nr) at s.q: Jdot_mr at the speeds e_c (Jdot_mr is linear in qdot).
 MatX jacobianDerivative(const Model& model, const State& s, int c);
 
+/// dJ_mr/dq_c and dJdot_mr/dq_c (nm x nr each) at s: the tangent of calcKinematics' recursion
+/// [D Alg. 2] along q_c, analytic in the tree (dAd_ip = -ad(S_i e_c) Ad_ip on the coordinate's
+/// own joint, carried down its subtree); the joint's own dSdot/dq_c is a fourth-order difference of
+/// its Sdot (joint-local, as in skeletonIdDerivatives). dJdot_mr/dqdot_c = dJ_mr/dq_c.
+void jacobianDerivatives(const Model& model, const State& s, int c, MatX& dJ, MatX& dJdot);
+
 }  // namespace redmax

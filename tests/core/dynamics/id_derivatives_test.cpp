@@ -130,14 +130,15 @@ TEST(IdDerivatives, EachJointTypeAlone) {
 
 // what the ID derivatives hold: dtau/dq(qddot) - dtau/dq(0) = dM/dq qddot, dtau/dq(0) = -df/dq,
 // dtau/dqdot = -df/dqdot, each against differences of the REDMAX route's M and f [D Eq. 4.18];
-// and dJ_mr/dq_c = Jdot_mr(q, e_c) against differences of J_mr
+// dJ_mr/dq_c = Jdot_mr(q, e_c) against differences of J_mr, and the tangent of the kinematic
+// recursion (jacobianDerivatives): its dJ_mr against that, its dJdot_mr against differences
 TEST(IdDerivatives, MassMatrixForceAndJacobianDerivatives) {
   std::mt19937 rng(3);
   const Model m = withSprings(scenes::randomTree(7, 77, scenes::TreeJoints::All), rng);
   const System sys(m);
   DynamicsWorkspace ws(sys);
   const int n = m.nr();
-  double wM = 0.0, wf = 0.0, wfd = 0.0, wJ = 0.0;
+  double wM = 0.0, wf = 0.0, wfd = 0.0, wJ = 0.0, wJt = 0.0, wJd = 0.0;
   for (int trial = 0; trial < 3; ++trial) {
     const State s = test::randomState(n, rng);
     const VecX qddot = test::randomState(n, rng).qdot;
@@ -167,12 +168,28 @@ TEST(IdDerivatives, MassMatrixForceAndJacobianDerivatives) {
           s, k, false, 1e-3);
       wJ = std::max(wJ, (Eigen::Map<const VecX>(dJ.data(), dJ.size()) - dJref).lpNorm<Eigen::Infinity>() /
                             std::max(1.0, dJref.lpNorm<Eigen::Infinity>()));
+      // the tangent of the recursion: its dJ equals Jdot at unit speeds, its dJdot the differences
+      MatX tJ, tJdot;
+      jacobianDerivatives(m, s, k, tJ, tJdot);
+      wJt = std::max(wJt, (tJ - dJ).lpNorm<Eigen::Infinity>() / std::max(1.0, dJ.lpNorm<Eigen::Infinity>()));
+      const VecX dJdref = diffState(
+          [&](const State& t) {
+            SkeletonWorkspace sk(m);
+            calcKinematics(m, t, sk);
+            return VecX(Eigen::Map<const VecX>(sk.Jdot_mr.data(), sk.Jdot_mr.size()));
+          },
+          s, k, false, 1e-3);
+      wJd = std::max(wJd, (Eigen::Map<const VecX>(tJdot.data(), tJdot.size()) - dJdref).lpNorm<Eigen::Infinity>() /
+                              std::max(1.0, dJdref.lpNorm<Eigen::Infinity>()));
     }
     wM = std::max(wM, worstColumnError(dq_a - dq_0, dMa));
     wf = std::max(wf, worstColumnError(-dq_0, df));
     wfd = std::max(wfd, worstColumnError(-dqd_0, dfd));
   }
-  std::printf("[ measured ] dM/dq qddot %.2e, df/dq %.2e, df/dqdot %.2e, dJ_mr/dq %.2e\n", wM, wf, wfd, wJ);
+  std::printf("[ measured ] dM/dq qddot %.2e, df/dq %.2e, df/dqdot %.2e, dJ_mr/dq %.2e (the recursion's tangent "
+              "%.2e from it), dJdot_mr/dq %.2e\n", wM, wf, wfd, wJ, wJt, wJd);
+  EXPECT_LT(wJt, 1e-13);  // two exact routes to the same matrix
+  EXPECT_LT(wJd, kBound);
   EXPECT_LT(wM, kBound);
   EXPECT_LT(wf, kBound);
   EXPECT_LT(wfd, kBound);
