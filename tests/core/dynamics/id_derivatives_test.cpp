@@ -114,7 +114,7 @@ TEST(IdDerivatives, EachJointTypeAlone) {
     b.addBody("b", 2.0, Vec3(0.05, -0.1, 0.02), Vec3(0.1, 0.2, 0.15).asDiagonal().toDenseMatrix(), -1, "j", j,
               Mat4::Identity(), makeTranslation(Vec3(0.1, -0.2, 0.05)));
     const Model m = b.finalize();
-    double worst = 0.0;
+    double worst = 0.0, worst_jdot = 0.0;
     for (int trial = 0; trial < 4; ++trial) {
       const State s = test::randomState(m.nr(), rng, 0.8);
       const VecX qddot = test::randomState(m.nr(), rng).qdot;
@@ -122,9 +122,24 @@ TEST(IdDerivatives, EachJointTypeAlone) {
       skeletonIdDerivatives(m, s, qddot, dq, dqd);
       const Differences d = idDifferences(m, s, qddot);
       worst = std::max({worst, worstColumnError(dq, d.dq), worstColumnError(dqd, d.dqd)});
+      // and Jdot_mr's derivative (the joint's own dSdot/dq is all there is to it here)
+      for (int k = 0; k < m.nr(); ++k) {
+        MatX tJ, tJdot;
+        jacobianDerivatives(m, s, k, tJ, tJdot);
+        const VecX ref = diffState(
+            [&](const State& t) {
+              SkeletonWorkspace sk(m);
+              calcKinematics(m, t, sk);
+              return VecX(Eigen::Map<const VecX>(sk.Jdot_mr.data(), sk.Jdot_mr.size()));
+            },
+            s, k, false, 1e-3);
+        worst_jdot = std::max(worst_jdot, (Eigen::Map<const VecX>(tJdot.data(), tJdot.size()) - ref).lpNorm<Eigen::Infinity>() /
+                                              std::max(1.0, ref.lpNorm<Eigen::Infinity>()));
+      }
     }
-    std::printf("[ measured ] %-14s worst %.2e\n", j.typeName().c_str(), worst);
+    std::printf("[ measured ] %-14s worst %.2e, dJdot_mr/dq %.2e\n", j.typeName().c_str(), worst, worst_jdot);
     EXPECT_LT(worst, kBound) << j.typeName();
+    EXPECT_LT(worst_jdot, kBound) << j.typeName();
   }
 }
 
