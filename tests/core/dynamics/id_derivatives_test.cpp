@@ -49,6 +49,20 @@ VecX diffState(G g, const State& s, int k, bool speed, double h) {
       speed ? s.qdot[k] : s.q[k], h);
 }
 
+// J_mr (dot false) or Jdot_mr (dot true) at t, as one vector
+VecX kinematicMatrix(const Model& m, const State& t, bool dot) {
+  SkeletonWorkspace sk(m);
+  calcKinematics(m, t, sk);
+  const MatX& J = dot ? sk.Jdot_mr : sk.J_mr;
+  return Eigen::Map<const VecX>(J.data(), J.size());
+}
+
+// |a - ref|_inf / max(1, |ref|_inf) for a matrix a and its reference as one vector
+double flatError(const MatX& a, const VecX& ref) {
+  return (Eigen::Map<const VecX>(a.data(), a.size()) - ref).lpNorm<Eigen::Infinity>() /
+         std::max(1.0, ref.lpNorm<Eigen::Infinity>());
+}
+
 // worst |a - b| per column relative to max(1, |b column|_inf)
 double worstColumnError(const MatX& a, const MatX& b) {
   double worst = 0.0;
@@ -126,15 +140,8 @@ TEST(IdDerivatives, EachJointTypeAlone) {
       for (int k = 0; k < m.nr(); ++k) {
         MatX tJ, tJdot;
         jacobianDerivatives(m, s, k, tJ, tJdot);
-        const VecX ref = diffState(
-            [&](const State& t) {
-              SkeletonWorkspace sk(m);
-              calcKinematics(m, t, sk);
-              return VecX(Eigen::Map<const VecX>(sk.Jdot_mr.data(), sk.Jdot_mr.size()));
-            },
-            s, k, false, 1e-3);
-        worst_jdot = std::max(worst_jdot, (Eigen::Map<const VecX>(tJdot.data(), tJdot.size()) - ref).lpNorm<Eigen::Infinity>() /
-                                              std::max(1.0, ref.lpNorm<Eigen::Infinity>()));
+        const VecX ref = diffState([&](const State& t) { return kinematicMatrix(m, t, true); }, s, k, false, 1e-3);
+        worst_jdot = std::max(worst_jdot, flatError(tJdot, ref));
       }
     }
     std::printf("[ measured ] %-14s worst %.2e, dJdot_mr/dq %.2e\n", j.typeName().c_str(), worst, worst_jdot);
@@ -174,28 +181,14 @@ TEST(IdDerivatives, MassMatrixForceAndJacobianDerivatives) {
       df.col(k) = diffState([&](const State& t) { return force(t); }, s, k, false, 1e-3);
       dfd.col(k) = diffState([&](const State& t) { return force(t); }, s, k, true, 1e-3);
       const MatX dJ = jacobianDerivative(m, s, k);
-      const MatX dJref = diffState(
-          [&](const State& t) {
-            SkeletonWorkspace sk(m);
-            calcKinematics(m, t, sk);
-            return VecX(Eigen::Map<const VecX>(sk.J_mr.data(), sk.J_mr.size()));
-          },
-          s, k, false, 1e-3);
-      wJ = std::max(wJ, (Eigen::Map<const VecX>(dJ.data(), dJ.size()) - dJref).lpNorm<Eigen::Infinity>() /
-                            std::max(1.0, dJref.lpNorm<Eigen::Infinity>()));
+      wJ = std::max(wJ, flatError(dJ, diffState([&](const State& t) { return kinematicMatrix(m, t, false); }, s, k,
+                                                false, 1e-3)));
       // the tangent of the recursion: its dJ equals Jdot at unit speeds, its dJdot the differences
       MatX tJ, tJdot;
       jacobianDerivatives(m, s, k, tJ, tJdot);
       wJt = std::max(wJt, (tJ - dJ).lpNorm<Eigen::Infinity>() / std::max(1.0, dJ.lpNorm<Eigen::Infinity>()));
-      const VecX dJdref = diffState(
-          [&](const State& t) {
-            SkeletonWorkspace sk(m);
-            calcKinematics(m, t, sk);
-            return VecX(Eigen::Map<const VecX>(sk.Jdot_mr.data(), sk.Jdot_mr.size()));
-          },
-          s, k, false, 1e-3);
-      wJd = std::max(wJd, (Eigen::Map<const VecX>(tJdot.data(), tJdot.size()) - dJdref).lpNorm<Eigen::Infinity>() /
-                              std::max(1.0, dJdref.lpNorm<Eigen::Infinity>()));
+      wJd = std::max(wJd, flatError(tJdot, diffState([&](const State& t) { return kinematicMatrix(m, t, true); }, s,
+                                                     k, false, 1e-3)));
     }
     wM = std::max(wM, worstColumnError(dq_a - dq_0, dMa));
     wf = std::max(wf, worstColumnError(-dq_0, df));
