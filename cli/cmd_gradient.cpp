@@ -63,11 +63,7 @@ int runGradient(GradientFlags& f, const CLI::App& app) {
   std::printf("gradient: %s, integrator %s, %ld steps of %.6g s, %d parameters, muscle mass %.4g kg\n",
               g.model.description.name.c_str(), f.integrator.c_str(), res.steps, f.duration / res.steps,
               static_cast<int>(g.p0.size()), g.model.muscle_mass);
-  if (res.analytic_jacobians)
-    std::printf("step Jacobians: analytic (derivatives of inverse dynamics, docs/gradients.md §2.1)\n");
-  else
-    std::printf("step Jacobians: central differences of the step%s%s\n", res.jacobian_note.empty() ? "" : "; not analytic: ",
-                res.jacobian_note.c_str());
+  std::printf("step Jacobians: %s\n", adjoint::stepJacobiansText(res).c_str());
   std::printf("objective %.12e\n", res.objective);
   std::printf("%-36s %20s %20s\n", "parameter", "value", "dJ/dp");
   for (Eigen::Index i = 0; i < g.p0.size(); ++i)

@@ -137,7 +137,7 @@ int runOptimize(OptimizeFlags& f, const CLI::App& app) {
     std::printf("%-12s %12ld %16ld %12.4f %14.6e %14.6e %8s  %s\n", r.method.c_str(), r.simulations, r.step_evaluations,
                 r.seconds, r.objective, r.error, r.reached ? "yes" : "no", r.stop.c_str());
   for (const auto& r : results)
-    if (!r.gradient_route.empty()) std::printf("%s gradients: %s\n", r.method.c_str(), r.gradient_route.c_str());
+    if (!r.gradient_route.empty()) std::printf("%s step Jacobians: %s\n", r.method.c_str(), r.gradient_route.c_str());
   for (const auto& r : results) {
     std::printf(excite ? "%s excitations:" : "%s torques (N m):", r.method.c_str());
     for (Eigen::Index i = 0; i < r.torques.size(); ++i) std::printf(" %s=%.8g", setup.gradient.param_names[i].c_str(), r.torques[i]);

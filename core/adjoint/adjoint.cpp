@@ -600,79 +600,73 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
 
   // reverse sweep: lambda_k = (dPhi_k/dy)^T lambda_{k+1}, parameter terms from lambda_{k+1}
   res.gradient = VecX::Zero(pr.numParameters());
-  MatX Jy(ny, ny), Jf;
-  VecX Ju(nub + nd);
+  MatX Jy(ny, ny), Jf, Js;
+  VecX Ju(nub + nd), u;
+  // analytic route, system parameters: dtau/ds by the fourth-order difference of inverse dynamics
+  // between the systems at s -+ delta, -+ 2 delta (exact up to round-off where tau is linear in s,
+  // as in a muscle's mass: its mass points' share scales with it), at the step's controls u
+  const Stepper::ParamIdDerivative dtau_ds = [&](const State& st, const VecX& a) {
+    MatX d(n, ns);
+    for (int j = 0; j < ns; ++j) {
+      auto tau = [&](int m) { return step_at[4 * j + m]->inverseDynamics(st, a, u); };
+      d.col(j) = (tau(0) - 8.0 * tau(1) + 8.0 * tau(2) - tau(3)) / (12.0 * pr.system_param_delta[j]);
+    }
+    return d;
+  };
   for (int k = N - 1; k >= 0; --k) {
     const double t = timeAt(k);
-    const VecX u = controlsAt(pr, rs, p, k, N);
+    u = controlsAt(pr, rs, p, k, N);
     if (analytic) {
-      // system parameters: dtau/ds by the fourth-order difference of inverse dynamics between the
-      // systems at s -+ delta, -+ 2 delta (exact up to round-off where tau is linear in s, as in a
-      // muscle's mass: its mass points' share scales with it)
-      Stepper::ParamIdDerivative dtau_ds = [&](const State& st, const VecX& a) {
-        MatX d(n, ns);
-        for (int j = 0; j < ns; ++j) {
-          auto tau = [&](int m) { return step_at[4 * j + m]->inverseDynamics(st, a, u); };
-          d.col(j) = (tau(0) - 8.0 * tau(1) + 8.0 * tau(2) - tau(3)) / (12.0 * pr.system_param_delta[j]);
-        }
-        return d;
-      };
-      MatX Js;
       stepper.analyticJacobians(y[k], t, h, u, Jy, Jf, ns > 0 ? &dtau_ds : nullptr, ns > 0 ? &Js : nullptr);
       if (ns > 0) res.gradient.tail(ns) += Js.transpose() * lambda;
       const VecX lf = Jf.transpose() * lambda;
       for (int c = nub; c < nub + nd; ++c) Ju[c] = lf[rs.driven[c - nub]];
-      for (int j = 0; j < nf; ++j) {
-        const double b = forceBasis(pr.forces[j], k, N);
-        if (b != 0.0) res.gradient[j] += b * Ju[rs.control_of[j]];
+    } else {
+      // generalized-force columns: one central difference per driven coordinate (the step is
+      // linear in them for euler and bdf1, so this is exact up to round-off there)
+      for (int c = nub; c < nub + nd; ++c) {
+        const double e = fdStep(pr.jacobian_step, u[c]);
+        VecX up = u, um = u;
+        up[c] += e;
+        um[c] -= e;
+        Ju[c] = lambda.dot(stepper.step(y[k], t, h, up) - stepper.step(y[k], t, h, um)) / (2.0 * e);
       }
-      lambda = (Jy.transpose() * lambda).eval();
-      if (k >= 1 && obj.tracking()) trackValue(sys, obj, stepper.unpack(y[k], t), h, &lambda);
-      continue;
+      // excitation columns: one central difference per excitation-driven control, at the clamped
+      // value the step used; through the clamp (zero outside [min, max]) and the hat weights to
+      // the step's two nodes
+      for (const Excited& ex : rs.excited) {
+        const int c = ex.control;
+        const double e = fdStep(pr.jacobian_step, u[c]);
+        VecX up = u, um = u;
+        up[c] += e;
+        um[c] -= e;
+        const double d = lambda.dot(stepper.step(y[k], t, h, up) - stepper.step(y[k], t, h, um)) / (2.0 * e);
+        const double raw = excitationAt(ex, p, nf, k, N);
+        if (raw < ex.min || raw > ex.max) continue;
+        int i0 = 0;
+        double w0 = 0.0, w1 = 0.0;
+        hatWeights(ex.nodes, k, N, i0, w0, w1);
+        res.gradient[nf + ex.param[i0]] += w0 * d;
+        if (w1 != 0.0) res.gradient[nf + ex.param[i0 + 1]] += w1 * d;
+      }
+      for (int j = 0; j < ns; ++j) {
+        auto phi = [&](int m) { return step_at[4 * j + m]->step(y[k], t, h, u); };
+        const VecX d = phi(0) - 8.0 * phi(1) + 8.0 * phi(2) - phi(3);
+        res.gradient[iq0 + nq0 + nv0 + j] += lambda.dot(d) / (12.0 * pr.system_param_delta[j]);
+      }
+      // state Jacobian of the step, column by column
+      for (int i = 0; i < ny; ++i) {
+        const double e = fdStep(pr.jacobian_step, y[k][i]);
+        VecX yp = y[k], ym = y[k];
+        yp[i] += e;
+        ym[i] -= e;
+        Jy.col(i) = (stepper.step(yp, t, h, u) - stepper.step(ym, t, h, u)) / (2.0 * e);
+      }
     }
-    // generalized-force columns: one central difference per driven coordinate (the step is
-    // linear in them for euler and bdf1, so this is exact up to round-off there)
-    for (int c = nub; c < nub + nd; ++c) {
-      const double e = fdStep(pr.jacobian_step, u[c]);
-      VecX up = u, um = u;
-      up[c] += e;
-      um[c] -= e;
-      Ju[c] = lambda.dot(stepper.step(y[k], t, h, up) - stepper.step(y[k], t, h, um)) / (2.0 * e);
-    }
+    // the force parameters of this step, through their basis weights
     for (int j = 0; j < nf; ++j) {
       const double b = forceBasis(pr.forces[j], k, N);
       if (b != 0.0) res.gradient[j] += b * Ju[rs.control_of[j]];
-    }
-    // excitation columns: one central difference per excitation-driven control, at the clamped
-    // value the step used; through the clamp (zero outside [min, max]) and the hat weights to the
-    // step's two nodes
-    for (const Excited& ex : rs.excited) {
-      const int c = ex.control;
-      const double e = fdStep(pr.jacobian_step, u[c]);
-      VecX up = u, um = u;
-      up[c] += e;
-      um[c] -= e;
-      const double d = lambda.dot(stepper.step(y[k], t, h, up) - stepper.step(y[k], t, h, um)) / (2.0 * e);
-      const double raw = excitationAt(ex, p, nf, k, N);
-      if (raw < ex.min || raw > ex.max) continue;
-      int i0 = 0;
-      double w0 = 0.0, w1 = 0.0;
-      hatWeights(ex.nodes, k, N, i0, w0, w1);
-      res.gradient[nf + ex.param[i0]] += w0 * d;
-      if (w1 != 0.0) res.gradient[nf + ex.param[i0 + 1]] += w1 * d;
-    }
-    for (int j = 0; j < ns; ++j) {
-      auto phi = [&](int m) { return step_at[4 * j + m]->step(y[k], t, h, u); };
-      const VecX d = phi(0) - 8.0 * phi(1) + 8.0 * phi(2) - phi(3);
-      res.gradient[iq0 + nq0 + nv0 + j] += lambda.dot(d) / (12.0 * pr.system_param_delta[j]);
-    }
-    // state Jacobian of the step, column by column
-    for (int i = 0; i < ny; ++i) {
-      const double e = fdStep(pr.jacobian_step, y[k][i]);
-      VecX yp = y[k], ym = y[k];
-      yp[i] += e;
-      ym[i] -= e;
-      Jy.col(i) = (stepper.step(yp, t, h, u) - stepper.step(ym, t, h, u)) / (2.0 * e);
     }
     lambda = (Jy.transpose() * lambda).eval();
     // the tracking term at y_k (k >= 1) joins its adjoint
@@ -767,6 +761,11 @@ VecX finiteDifferenceGradient(const Problem& pr, const Objective& obj, const Vec
     g[i] = d[best + 1];
   }
   return g;
+}
+
+std::string stepJacobiansText(const Result& r) {
+  if (r.analytic_jacobians) return "analytic (derivatives of inverse dynamics, docs/gradients.md §2.1)";
+  return "central differences of the step" + (r.jacobian_note.empty() ? std::string() : "; not analytic: " + r.jacobian_note);
 }
 
 double worstRelativeError(const VecX& a, const VecX& b) {

@@ -167,6 +167,10 @@ struct Result {
   std::string jacobian_note;     ///< why they did not (empty when they did or were not asked)
 };
 
+/// How a result's step Jacobians were formed, as the commands print it: "analytic (...)" or
+/// "central differences of the step; not analytic: <why>"
+std::string stepJacobiansText(const Result& r);
+
 /// Thrown for a problem that cannot be differentiated (bad sizes, unknown integrator, controls).
 class AdjointError : public std::runtime_error {
  public:

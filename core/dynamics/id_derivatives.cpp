@@ -11,6 +11,8 @@
 #include "core/dynamics/muscle_term.hpp"
 #include "core/muscles/muscle_id_tangent.hpp"
 #include "core/dynamics/passive_force_terms.hpp"
+#include "core/dynamics/skeleton_dynamics.hpp"
+#include "core/geometry/local_difference.hpp"
 #include "core/skeleton/kinematics.hpp"
 
 namespace redmax {
@@ -33,18 +35,30 @@ bool exactVelocityTerms(const Joint& j) {
       j.v);
 }
 
-// What the base pass of recursive Newton-Euler keeps per body, and the joint-local derivatives.
+// What the tangent needs per body beyond recursiveIdForward's workspace, and the joint-local
+// derivatives.
 struct BodyData {
   Mat6 Ad_ip, Ad_ij;     // Ad(E_ip) (parent twist into i) and Ad(E_im) (constant)
-  Mat6X S_i;             // Ad_ij S (6 x nq)
-  Vec6 psi, phi, phidot;
-  Vec6 g;                // gravity's wrench on the body, (c x g_i; g_i), body coordinates
+  Vec6 psi;              // the joint's twist in i, S_i qdot
   Vec3 g_i;              // m R_wi^T g
   Vec6 W;                // wrench the joint transmits (own net wrench + the children's)
   // joint-local, per coordinate c of the joint: dS/dq_c (in M), d(Sdot qdot)/dq_c, /dqdot_c (in M)
   std::vector<Mat6X> dS;
   std::vector<Vec6> dSdq, dSdqd;
 };
+
+// dSdot(q, qdot)/dq_c of a joint (in its frame M, 6 x nq): the second derivative of S that no joint
+// computes, by the local fourth-order difference of its Sdot
+Mat6X jointSdotDerivative(const JointSlot& js, const VecJ& q, const VecJ& qd, int c, JointKinematics& jt) {
+  return localDerivative(
+      [&](double x) {
+        VecJ qm = q;
+        qm[c] = x;
+        js.joint.calc(qm, qd, jt);
+        return Mat6X(jt.Sdot);
+      },
+      q[c]);
+}
 
 }  // namespace
 
@@ -64,29 +78,22 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
                    MatX& dtau_dq, MatX& dtau_dqdot) {
   const int nb = model.nb(), nr = model.nr();
   std::vector<BodyData> bd(static_cast<size_t>(nb));
-  JointKinematics jk, jt;
+  JointKinematics jt;
 
-  // base pass (as recursiveIdForward, with 6 x 6 adjoints: the tangent needs them several times)
+  // base pass: recursive Newton-Euler's forward pass (poses, S_i, twists, rates, net wrenches),
+  // with the 6 x 6 adjoints the tangent applies several times
+  RecursiveIdWorkspace rid(model);
+  recursiveIdForward(model, s, qddot, rid);
   for (int i = 0; i < nb; ++i) {
     const JointSlot& js = model.joints()[i];
     BodyData& b = bd[static_cast<size_t>(i)];
+    const JointKinematics& jk = rid.jk[i];
     const VecJ q = s.q.segment(js.q_index, js.nq), qd = s.qdot.segment(js.q_index, js.nq);
-    const VecJ qdd = qddot.segment(js.q_index, js.nq);
-    js.joint.calc(q, qd, jk);
-    const Mat4 E_pi = js.E_pf * jk.Q * js.E_mi;
-    b.Ad_ip = AdInv(E_pi);
-    b.Ad_ij = AdInv(js.E_mi);
-    b.S_i = b.Ad_ij * jk.S;
-    b.psi = b.S_i * qd;
-    const Vec6 acc = b.S_i * qdd + b.Ad_ij * (jk.Sdot * qd);
-    if (js.parent >= 0) {
-      const BodyData& p = bd[static_cast<size_t>(js.parent)];
-      b.phi = b.Ad_ip * p.phi + b.psi;
-      b.phidot = b.Ad_ip * p.phidot - adTimes(b.psi, b.Ad_ip * p.phi) + acc;
-    } else {
-      b.phi = b.psi;
-      b.phidot = acc;
-    }
+    b.Ad_ip = AdInv(makeE(rid.R_pi[i], rid.p_pi[i]));
+    b.Ad_ij = Ad(makeE(rid.R_im[i], rid.p_im[i]));
+    b.psi = rid.S_i[i] * qd;
+    b.g_i = rid.E_wi[i].topLeftCorner<3, 3>().transpose() * (model.bodies()[i].mass * model.gravity());
+    b.W = rid.w[i];
     // joint-local derivatives
     const int nq = js.nq;
     b.dS.assign(static_cast<size_t>(nq), Mat6X::Zero(6, nq));
@@ -98,29 +105,8 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       js.joint.calc(q, e, jt);
       b.dS[static_cast<size_t>(c)] = jt.Sdot;
       b.dSdqd[static_cast<size_t>(c)] = jt.Sdot * qd + jk.Sdot.col(c);
-      // the second derivative: fourth-order central difference of Sdot(q, qd) qd along q_c
-      const double h = 1e-3 * std::max(1.0, std::abs(q[c]));
-      Vec6 d = Vec6::Zero();
-      const double at[4] = {-2.0, -1.0, 1.0, 2.0}, w[4] = {1.0, -8.0, 8.0, -1.0};
-      for (int m = 0; m < 4; ++m) {
-        VecJ qm = q;
-        qm[c] += at[m] * h;
-        js.joint.calc(qm, qd, jt);
-        d += w[m] * (jt.Sdot * qd);
-      }
-      b.dSdq[static_cast<size_t>(c)] = d / (12.0 * h);
+      b.dSdq[static_cast<size_t>(c)] = jointSdotDerivative(js, q, qd, c, jt) * qd;
     }
-  }
-  // poses in world for gravity (rotations only)
-  std::vector<Mat4> E_wi;
-  calcBodyPoses(model, s.q, E_wi);
-  for (int i = 0; i < nb; ++i) {
-    BodyData& b = bd[static_cast<size_t>(i)];
-    const Body& body = model.bodies()[i];
-    b.g_i = E_wi[i].topLeftCorner<3, 3>().transpose() * (body.mass * model.gravity());
-    b.g.head<3>() = body.com.cross(b.g_i);
-    b.g.tail<3>() = b.g_i;
-    b.W = body.M * b.phidot - adTransposeTimes(b.phi, body.M * b.phi) - b.g;
   }
   // the muscles' mass points: wrenches the bodies must supply for them (core/muscles/muscle_id_tangent.hpp)
   std::vector<BodyWorldMotion> world;
@@ -135,17 +121,11 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       for (int c = 0; c < nr; ++c)
         if (model.isAncestor(model.coordinates()[c].joint, pt.body)) moves[m][static_cast<size_t>(c)] = 1;
     }
-  std::vector<Vec6> mw(static_cast<size_t>(nb)), dmw(static_cast<size_t>(nb));
+  std::vector<Vec6> mw(static_cast<size_t>(nb), Vec6::Zero()), dmw(static_cast<size_t>(nb), Vec6::Zero());
   VecX mtau = VecX::Zero(nr), dmtau = VecX::Zero(nr);
   const VecX zero = VecX::Zero(nr);
   if (!muscles.empty()) {
-    std::vector<Vec6> phi(static_cast<size_t>(nb)), phidot(static_cast<size_t>(nb));
-    for (int i = 0; i < nb; ++i) {
-      phi[static_cast<size_t>(i)] = bd[static_cast<size_t>(i)].phi;
-      phidot[static_cast<size_t>(i)] = bd[static_cast<size_t>(i)].phidot;
-    }
-    calcBodyWorldMotion(BodyMotion{E_wi, phi, phidot}, world);
-    std::fill(mw.begin(), mw.end(), Vec6::Zero());
+    calcBodyWorldMotion(rid.motion(), world);
     for (const Muscle* mu : muscles)
       addMuscleIdShareTangent(*mu, s, qddot, zero, zero, world, nullptr, model.gravity(), mw, mtau, nullptr, nullptr,
                               msc);
@@ -189,12 +169,12 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       Mat6X& dSi = dS_i[static_cast<size_t>(i)];
       dSi.setZero(6, js.nq);
       if (own && !speed) {
-        dpose = b.S_i.col(c);
+        dpose = rid.S_i[i].col(c);
         dSi = b.Ad_ij * b.dS[static_cast<size_t>(c)];
         dpsi = dSi * qd;
         dacc = dSi * qdd + b.Ad_ij * b.dSdq[static_cast<size_t>(c)];
       } else if (own && speed) {
-        dpsi = b.S_i.col(c);
+        dpsi = rid.S_i[i].col(c);
         dacc = b.Ad_ij * b.dSdqd[static_cast<size_t>(c)];
       }
       dpsi_pose[static_cast<size_t>(i)] = dpose;
@@ -203,8 +183,7 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       Vec6& dphd = dphidot[static_cast<size_t>(i)];
       if (js.parent >= 0) {
         const size_t p = static_cast<size_t>(js.parent);
-        const BodyData& pb = bd[p];
-        const Vec6 Xphi = b.Ad_ip * pb.phi, Xphid = b.Ad_ip * pb.phidot;
+        const Vec6 Xphi = b.Ad_ip * rid.phi[p], Xphid = b.Ad_ip * rid.phidot[p];
         const Vec6 Xdphi = b.Ad_ip * dphi[p];
         dP = b.Ad_ip * dPose[p] + dpose;
         // d(Ad_ip x) = Ad_ip dx - ad(dpose) Ad_ip x (E_pi varies as E_pi exp([dpose]))
@@ -221,8 +200,8 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       Vec6 dgw;
       dgw.head<3>() = body.com.cross(dg);
       dgw.tail<3>() = dg;
-      dW[static_cast<size_t>(i)] = body.M * dphd - adTransposeTimes(dph, body.M * b.phi) -
-                                   adTransposeTimes(b.phi, body.M * dph) - dgw;
+      dW[static_cast<size_t>(i)] = body.M * dphd - adTransposeTimes(dph, body.M * rid.phi[i]) -
+                                   adTransposeTimes(rid.phi[i], body.M * dph) - dgw;
     }
     if (!muscles.empty()) {
       // the bodies' world motion's derivative from the body-coordinate one (dR = [R dPose_w] R)
@@ -243,8 +222,7 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       }
       VecX dqv = VecX::Zero(nr), dqdv = VecX::Zero(nr);
       (speed ? dqdv : dqv)[k] = 1.0;
-      std::fill(mw.begin(), mw.end(), Vec6::Zero());
-      std::fill(dmw.begin(), dmw.end(), Vec6::Zero());
+      std::fill(dmw.begin(), dmw.end(), Vec6::Zero());  // (mw, mtau: the values again, unused)
       dmtau.setZero();
       for (size_t m = 0; m < muscles.size(); ++m)
         if (moves[m][static_cast<size_t>(k)])
@@ -258,7 +236,7 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
       const BodyData& b = bd[static_cast<size_t>(i)];
       const Vec6& dWi = dW[static_cast<size_t>(i)];
       if (js.nq > 0) {
-        const VecJ dt = dS_i[static_cast<size_t>(i)].transpose() * b.W + b.S_i.transpose() * dWi;
+        const VecJ dt = dS_i[static_cast<size_t>(i)].transpose() * b.W + rid.S_i[i].transpose() * dWi;
         (speed ? dtau_dqdot : dtau_dq).block(js.q_index, k, js.nq, 1) += dt;
       }
       if (js.parent >= 0) {
@@ -401,17 +379,16 @@ void constraintRowDerivatives(const System& sys, const State& s, const VecX& w, 
       out.dverr_dv(r, col) += sc * fv.gradient[k];
       dperr_dq(r, col) += sc * fv.gradient[k];
       out.drhs_dv(r, col) += -2.0 * sc * Hxd[k];
-      // rhs along q_k: -scale xdot^T (dHess/dx_k) xdot, the Hessian differenced (fourth order)
-      const double h = 1e-3 * std::max(1.0, std::abs(x[k]));
-      const double at[4] = {-2.0, -1.0, 1.0, 2.0}, wt[4] = {1.0, -8.0, 8.0, -1.0};
-      double t = 0.0;
-      for (int q = 0; q < 4; ++q) {
-        VecJ xm = x;
-        xm[k] += at[q] * h;
-        evaluateWithArguments(cc.function(), xm, 2, ft);
-        t += wt[q] * xd.dot(ft.hessian * xd);
-      }
-      out.drhs_dq(r, col) += -sc * t / (12.0 * h);
+      // rhs along q_k: -scale xdot^T (dHess/dx_k) xdot, the Hessian differenced (local)
+      const double t = localDerivative(
+          [&](double v) {
+            VecJ xm = x;
+            xm[k] = v;
+            evaluateWithArguments(cc.function(), xm, 2, ft);
+            return xd.dot(ft.hessian * xd);
+          },
+          x[k]);
+      out.drhs_dq(r, col) += -sc * t;
     }
     out.dverr_dv(r, d) += -1.0;
     dperr_dq(r, d) += -1.0;
@@ -456,17 +433,8 @@ void jacobianDerivatives(const Model& model, const State& s, int c, MatX& dJ, Ma
       e[cc] = 1.0;
       js.joint.calc(q, e, jt);
       const Mat6X dS = ws.Ad_ij[i] * jt.Sdot;
-      const double h = 1e-3 * std::max(1.0, std::abs(q[cc]));
-      const double at[4] = {-2.0, -1.0, 1.0, 2.0}, w[4] = {1.0, -8.0, 8.0, -1.0};
-      Mat6X dSdot = Mat6X::Zero(6, js.nq);
-      for (int m = 0; m < 4; ++m) {
-        VecJ qm = q;
-        qm[cc] += at[m] * h;
-        js.joint.calc(qm, qd, jt);
-        dSdot += w[m] * jt.Sdot;
-      }
       dJ.block(r, js.q_index, 6, js.nq) = dS;
-      dJdot.block(r, js.q_index, 6, js.nq) = ws.Ad_ij[i] * dSdot / (12.0 * h);
+      dJdot.block(r, js.q_index, 6, js.nq) = ws.Ad_ij[i] * jointSdotDerivative(js, q, qd, cc, jt);
       dpose = ws.J_mr.block(r, c, 6, 1);
       dpsi = dS * qd;
     }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/geometry/dual.hpp"
+#include "core/geometry/local_difference.hpp"
 #include "core/muscles/path_kinematics.hpp"
 
 namespace redmax {
@@ -18,7 +19,7 @@ using detail::dot;
 V dual(const Vec3& value, const Vec3& tangent) {
   return {D(value[0], tangent[0]), D(value[1], tangent[1]), D(value[2], tangent[2])};
 }
-Vec3 values(const V& v) { return Vec3(v[0].a, v[1].a, v[2].a); }
+using detail::values;
 Vec3 tangentOf3(const V& v) { return Vec3(v[0].b, v[1].b, v[2].b); }
 // R v for a rotation varying as dR = [dtheta] R and a dual v: value R v, tangent dtheta x R v + R dv
 V rotate(const Mat3& R, const Vec3& dtheta, const V& v) {
@@ -29,24 +30,23 @@ V rotate(const Mat3& R, const Vec3& dtheta, const V& v) {
 V rotateBack(const Mat3& R, const Vec3& dtheta, const V& w) {
   return dual(R.transpose() * values(w), R.transpose() * (tangentOf3(w) - dtheta.cross(values(w))));
 }
-V zero() { return {D(0.0), D(0.0), D(0.0)}; }
+V zero() { return detail::constant<D>(Vec3::Zero()); }
 
-// the moving point's functions' third derivative along q_c: fourth-order central difference of the
-// second (calcPointLocation), zero where the clamp holds the point
+// the moving point's functions' third derivative along q_c: the local difference of the second
+// (calcPointLocation), zero where the clamp holds the point
 Vec3 thirdDerivative(const PathPoint& pt, const VecX& q) {
   if (pt.kind != PathPointKind::Moving || pt.coordinate < 0) return Vec3::Zero();
   const double qc = q[pt.coordinate];
   if (pt.clamp && (qc < pt.clamp_lo || qc > pt.clamp_hi)) return Vec3::Zero();
-  const double h = 1e-3 * std::max(1.0, std::abs(qc));
-  Vec3 d = Vec3::Zero(), x, dx, ddx;
-  const double at[4] = {-2.0, -1.0, 1.0, 2.0}, w[4] = {1.0, -8.0, 8.0, -1.0};
+  Vec3 x, dx, ddx;
   VecX qm = q;
-  for (int m = 0; m < 4; ++m) {
-    qm[pt.coordinate] = qc + at[m] * h;
-    calcPointLocation(pt, qm, x, dx, ddx);
-    d += w[m] * ddx;
-  }
-  return d / (12.0 * h);
+  return localDerivative(
+      [&](double v) {
+        qm[pt.coordinate] = v;
+        calcPointLocation(pt, qm, x, dx, ddx);
+        return Vec3(ddx);
+      },
+      qc);
 }
 
 // Thomas solve of L x = b (in place), L tridiagonal (sub, diag, super by row; sub[0], super[n-1]

@@ -87,8 +87,7 @@ class Tracker {
     }
     if (gradient) {
       *gradient = setup_.scale.cwiseProduct(r.gradient);
-      result_.gradient_route = r.analytic_jacobians ? "analytic step Jacobians"
-                                                    : "central differences of the step (not analytic: " + r.jacobian_note + ")";
+      result_.gradient_route = adjoint::stepJacobiansText(r);
     }
     result_.step_evaluations += r.step_evaluations;
     e.step_evaluations = result_.step_evaluations;
@@ -563,17 +562,17 @@ std::string fmt(double v, int digits = 6) {
   return o.str();
 }
 
-// the converged parameters, one column per method (after the table's heading line)
 // one line per method that took gradients: how its adjoint formed the step Jacobians
 void gradientRoutes(std::ostream& md, const std::vector<ReachResult>& results) {
   bool any = false;
   for (const ReachResult& r : results) {
     if (r.gradient_route.empty()) continue;
-    md << (any ? "" : "\n") << "- " << r.method << " gradients: " << r.gradient_route << " (docs/gradients.md §2.1)\n";
+    md << (any ? "" : "\n") << "- " << r.method << " step Jacobians: " << r.gradient_route << "\n";
     any = true;
   }
 }
 
+// the converged parameters, one column per method (after the table's heading line)
 void parameterTable(std::ostream& md, const std::vector<std::string>& names, const std::vector<ReachResult>& results) {
   for (const ReachResult& r : results) md << " " << r.method << " |";
   md << "\n|---|";

@@ -142,8 +142,8 @@ struct ReachResult {
   double objective = 0.0, error = 0.0, final_speed = 0.0;
   bool reached = false;        ///< error <= tolerance
   std::string stop;            ///< why it stopped
-  /// how its adjoint gradients formed the step Jacobians (docs/gradients.md §2.1); empty for the
-  /// gradient-free methods
+  /// how its adjoint gradients formed the step Jacobians (adjoint::stepJacobiansText); empty for
+  /// the gradient-free methods
   std::string gradient_route;
 };
 

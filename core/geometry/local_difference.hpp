@@ -1,0 +1,21 @@
+#pragma once
+// The one derivative the analytic Jacobians take by differences (docs/gradients.md §2.1): a
+// derivative that no code computes in closed form - a joint's dSdot/dq, a moving point's or a
+// coupling function's third derivative - of a function of one scalar that is cheap to evaluate
+// (joint-local, function-local). Fourth-order central difference at h = 1e-3 max(1, |x|):
+// truncation about h^4 |f^(5)| / 30 ~ 1e-12, round-off about eps |f| / h ~ 1e-13 of the value.
+#include <algorithm>
+#include <cmath>
+
+namespace redmax {
+
+/// d f / dx at x; f maps a double to a double or an Eigen object of fixed shape
+template <class F>
+auto localDerivative(F&& f, double x) {
+  const double h = 1e-3 * std::max(1.0, std::abs(x));
+  // evaluated in one full expression: an Eigen expression kept in `auto` would refer to the
+  // temporaries f returns after they are gone
+  return decltype(f(x))((f(x - 2.0 * h) - 8.0 * f(x - h) + 8.0 * f(x + h) - f(x + 2.0 * h)) / (12.0 * h));
+}
+
+}  // namespace redmax
