@@ -253,9 +253,9 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
   }
 }
 
-// the muscles a MuscleTerm adds mass points for, when every one of them has written derivatives
-// (Types I and II, no deformable node points, uniform placement) and the term keeps the quadratic
-// velocity vector; false with the reason otherwise
+// the muscles a MuscleTerm adds mass points for, when every one of them takes the path-wise ID
+// pass (whose tangent is written) and the term keeps the quadratic velocity vector; false with the
+// reason otherwise
 bool muscleTermSupported(const MuscleTerm& mt, std::vector<const Muscle*>* out, std::string* why) {
   if (!mt.options().quadratic_velocity) {
     if (why) *why = "the term '" + mt.name() + "' without its quadratic velocity vector";
@@ -263,11 +263,7 @@ bool muscleTermSupported(const MuscleTerm& mt, std::vector<const Muscle*>* out, 
   }
   for (const Muscle& mu : mt.muscles()) {
     if (mu.mass_points.size() == 0) continue;
-    std::string reason;
-    if (pathType(mu.path) == PathType::III) reason = "wraps (Type III)";
-    else if (hasNodePoints(mu.path)) reason = "runs through a deformable node";
-    else if (mu.fibre.enabled()) reason = "has fibre-following mass points";
-    if (!reason.empty()) {
+    if (const char* reason = pathwiseInverseDynamicsRefusal(mu)) {
       if (why) *why = "the mass points of muscle '" + mu.name + "', which " + reason;
       return false;
     }

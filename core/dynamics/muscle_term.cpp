@@ -13,10 +13,6 @@ namespace {
 // no path-wise inverse dynamics for Type III paths, nor for fibre-following points (their placement
 // moves with the fibre), nor for paths through deformable nodes (no body wrench carries a node's
 // force): those take the compact J_ar route (with a_z)
-bool needsCompactId(const Muscle& m) {
-  return pathType(m.path) == PathType::III || m.fibre.enabled() || hasNodePoints(m.path);
-}
-
 // fibre-following points: the fibre's own motion adds the bias acceleration a_z to each point
 bool hasFibreBias(const Muscle& m, const MuscleKinematics& mk) {
   return m.fibre.enabled() && mk.a_z.size() == 3 * m.mass_points.size();
@@ -38,7 +34,7 @@ MuscleTerm::MuscleTerm(const Model& model, std::vector<Muscle> muscles, MuscleTe
     validateMuscle(model, m);
     if (m.mass_points.size() == 0) continue;
     massive_.push_back(m);
-    compact_id_.push_back(needsCompactId(m));
+    compact_id_.push_back(pathwiseInverseDynamicsRefusal(m) != nullptr);
     massive_states_.push_back(states.empty() ? MuscleStateIndex{} : states[k]);
     for (double mass : m.mass_points.mass) adds_mass_ = adds_mass_ || mass != 0.0;
     node_points_ = node_points_ || hasNodePoints(m.path);

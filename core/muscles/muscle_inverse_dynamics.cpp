@@ -47,6 +47,13 @@ void solveFactoredTransposed(int n, Sub sub, const VecX& c, const VecX& inv_piv,
 
 }  // namespace
 
+const char* pathwiseInverseDynamicsRefusal(const Muscle& m) {
+  if (pathType(m.path) == PathType::III) return "wraps (Type III)";
+  if (hasNodePoints(m.path)) return "runs through a deformable node";
+  if (m.fibre.enabled()) return "has fibre-following mass points";
+  return nullptr;
+}
+
 void calcBodyWorldMotion(const BodyMotion& motion, std::vector<BodyWorldMotion>& out) {
   const size_t nb = motion.E_wi.size();
   out.resize(nb);

@@ -81,6 +81,12 @@ void calcBodyWorldMotion(const BodyMotion& motion, std::vector<BodyWorldMotion>&
 void addWorldWrenches(const std::vector<BodyWorldMotion>& bodies, const std::vector<Vec6>& w_world,
                       std::vector<Vec6>& wrench);
 
+/// Why a muscle's mass points do not take the path-wise pass below (null when they do): it wraps
+/// (Type III), its points follow its fibre, or its path runs through a deformable node; those
+/// muscles form their compact J_ar instead (MuscleTerm), and have no written ID derivatives
+/// (core/muscles/muscle_id_tangent.hpp covers the path-wise ones).
+const char* pathwiseInverseDynamicsRefusal(const Muscle& muscle);
+
 /// Adds the mass points' share of inverse dynamics of one Type I or II muscle (no wrap objects):
 /// to w_world[b] the wrench body b must supply for them (world axes, torque about the body
 /// origin; addWorldWrenches turns it into body coordinates [D Eq. 3.14]) and to tau the direct
