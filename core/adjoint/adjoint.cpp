@@ -596,7 +596,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   if (pr.step_jacobians == "analytic" && !analytic)
     throw AdjointError("adjoint: analytic step Jacobians do not apply: " + why);
   res.analytic_jacobians = analytic;
-  if (!analytic) res.jacobian_note = why;
+  res.jacobian_note = analytic ? systemIdDerivativesLocalDifferences(sys) : why;
 
   // reverse sweep: lambda_k = (dPhi_k/dy)^T lambda_{k+1}, parameter terms from lambda_{k+1}
   res.gradient = VecX::Zero(pr.numParameters());
@@ -764,7 +764,9 @@ VecX finiteDifferenceGradient(const Problem& pr, const Objective& obj, const Vec
 }
 
 std::string stepJacobiansText(const Result& r) {
-  if (r.analytic_jacobians) return "analytic (derivatives of inverse dynamics, docs/gradients.md §2.1)";
+  if (r.analytic_jacobians)
+    return "analytic (derivatives of inverse dynamics, docs/gradients.md §2.1)" +
+           (r.jacobian_note.empty() ? std::string() : "; " + r.jacobian_note);
   return "central differences of the step" + (r.jacobian_note.empty() ? std::string() : "; not analytic: " + r.jacobian_note);
 }
 

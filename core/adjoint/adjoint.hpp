@@ -164,7 +164,7 @@ struct Result {
   long step_evaluations = 0; ///< calls of the integrator's step, forward and adjoint together
   double forward_seconds = 0.0;  ///< wall time of the forward pass (the simulation alone)
   bool analytic_jacobians = false;  ///< the step Jacobians came from the ID derivatives
-  std::string jacobian_note;     ///< why they did not (empty when they did or were not asked)
+  std::string jacobian_note;     ///< why they did not; when they did, the parts taken by local differences (or empty)
 };
 
 /// How a result's step Jacobians were formed, as the commands print it: "analytic (...)" or

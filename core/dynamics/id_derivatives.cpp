@@ -10,6 +10,8 @@
 #include "core/dynamics/coordinate_actuator_term.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/muscles/muscle_id_tangent.hpp"
+#include "core/muscles/muscle_kinematics.hpp"
+#include "core/muscles/path.hpp"
 #include "core/dynamics/passive_force_terms.hpp"
 #include "core/dynamics/skeleton_dynamics.hpp"
 #include "core/geometry/local_difference.hpp"
@@ -253,23 +255,79 @@ void idDerivatives(const Model& model, const State& s, const VecX& qddot, const 
   }
 }
 
-// the muscles a MuscleTerm adds mass points for, when every one of them takes the path-wise ID
-// pass (whose tangent is written) and the term keeps the quadratic velocity vector; false with the
-// reason otherwise
-bool muscleTermSupported(const MuscleTerm& mt, std::vector<const Muscle*>* out, std::string* why) {
+// The muscles of a MuscleTerm with mass points, by how their ID derivatives are formed: the
+// path-wise ones (Types I and II) by the dual pass inside the skeleton's tangent, the wrapping ones
+// (Type III) by a muscle-local difference (addWrappingMuscleIdDerivatives). False with the reason
+// when a muscle is neither (fibre-following points, a deformable node) or the term drops its
+// quadratic velocity vector.
+struct TermMuscles {
+  std::vector<const Muscle*> pathwise, wrapping;
+};
+bool muscleTermSupported(const MuscleTerm& mt, TermMuscles* out, std::string* why) {
   if (!mt.options().quadratic_velocity) {
     if (why) *why = "the term '" + mt.name() + "' without its quadratic velocity vector";
     return false;
   }
   for (const Muscle& mu : mt.muscles()) {
     if (mu.mass_points.size() == 0) continue;
-    if (const char* reason = pathwiseInverseDynamicsRefusal(mu)) {
+    const char* reason = pathwiseInverseDynamicsRefusal(mu);
+    const bool wraps = pathType(mu.path) == PathType::III && !hasNodePoints(mu.path) && !mu.fibre.enabled();
+    if (reason && !wraps) {
       if (why) *why = "the mass points of muscle '" + mu.name + "', which " + reason;
       return false;
     }
-    if (out) out->push_back(&mu);
+    if (out) (wraps ? out->wrapping : out->pathwise).push_back(&mu);
   }
   return true;
+}
+
+// The Type III muscles' share of inverse dynamics, sum_a J_ar^T m_a (J_ar qddot + Jdot_ar qdot - g)
+// as MuscleTerm forms it (addCompactMuscleIdShare), differentiated along each coordinate and speed
+// that moves one of them by the fourth-order local difference (localDerivative): the wrap
+// construction's J and Jdot have no written derivatives along q (its Jets carry value, velocity and
+// first partials), as the dissertation differences its network Jacobians in time [D Eq. 5.58].
+// A stencil point recomputes the skeleton's kinematics and the muscles that coordinate moves, not
+// the step: O(k) muscle evaluations per muscle of k columns. The step is 1e-4, not localDerivative's
+// 1e-3: the smooth model's fades bend the share within a few 1e-3 rad (on reach_arm.osim's elbow the
+// 1e-3 stencil's truncation was 5.6e-7 of the column, and 1e-4 of the gradient), while the share
+// is exact to round-off at each point, so a smaller step costs only eps |tau| / h ~ 2e-12.
+constexpr double kWrapStep = 1e-4;
+void addWrappingMuscleIdDerivatives(const Model& model, const State& s, const VecX& qddot,
+                                    const std::vector<const Muscle*>& muscles, MatX& dtau_dq, MatX& dtau_dqdot) {
+  if (muscles.empty()) return;
+  const int nr = model.nr();
+  std::vector<MuscleKinematics> mk(muscles.size());
+  for (size_t m = 0; m < muscles.size(); ++m) initMuscleKinematics(model, *muscles[m], mk[m]);
+  SkeletonWorkspace sk(model);
+  State sp = s;
+  VecX qdot_c, qddot_c, fc;
+  std::vector<size_t> moved;
+  for (int col = 0; col < 2 * nr; ++col) {
+    const bool speed = col >= nr;
+    const int c = speed ? col - nr : col;
+    moved.clear();
+    for (size_t m = 0; m < muscles.size(); ++m)
+      if (c < static_cast<int>(mk[m].col_of.size()) && mk[m].col_of[static_cast<size_t>(c)] >= 0) moved.push_back(m);
+    if (moved.empty()) continue;
+    VecX& x = speed ? sp.qdot : sp.q;
+    const double x0 = x[c];
+    auto share = [&](double xc) {
+      x[c] = xc;
+      calcKinematics(model, sp, sk);
+      VecX tau = VecX::Zero(nr);
+      for (size_t m : moved) {
+        calcMuscleKinematics(model, sp, sk, *muscles[m], mk[m], true);
+        gatherColumns(sp.qdot, mk[m], qdot_c);
+        gatherColumns(qddot, mk[m], qddot_c);
+        fc.setZero(qdot_c.size());
+        addCompactMuscleIdShare(muscles[m]->mass_points, mk[m], qdot_c, qddot_c, model.gravity(), true, false, fc);
+        scatterAddColumns(fc, mk[m], tau);
+      }
+      return tau;
+    };
+    (speed ? dtau_dqdot : dtau_dq).col(c) += localDerivative(share, x0, kWrapStep);
+    x[c] = x0;
+  }
 }
 
 }  // namespace
@@ -302,6 +360,16 @@ bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
   return true;
 }
 
+std::string systemIdDerivativesLocalDifferences(const System& sys) {
+  TermMuscles muscles;
+  for (const auto& t : sys.terms())
+    if (const auto* mt = dynamic_cast<const MuscleTerm*>(t.get())) muscleTermSupported(*mt, &muscles, nullptr);
+  if (muscles.wrapping.empty()) return "";
+  const size_t n = muscles.wrapping.size();
+  return "the mass points of " + std::to_string(n) + " wrapping (Type III) muscle" + (n > 1 ? "s" : "") + " ('" +
+         muscles.wrapping.front()->name + "'" + (n > 1 ? ", ..." : "") + ") by muscle-local fourth-order differences";
+}
+
 bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, const DynamicsWorkspace& ws,
                          MatX& dtau_dq, MatX& dtau_dqdot, std::string* why) {
   if (!ws.loads.empty()) {
@@ -309,10 +377,11 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
     return false;
   }
   if (!systemIdDerivativesAvailable(sys, why)) return false;
-  std::vector<const Muscle*> muscles;
+  TermMuscles muscles;
   for (const auto& t : sys.terms())
     if (const auto* mt = dynamic_cast<const MuscleTerm*>(t.get())) muscleTermSupported(*mt, &muscles, nullptr);
-  idDerivatives(sys.model(), s, qddot, muscles, dtau_dq, dtau_dqdot);
+  idDerivatives(sys.model(), s, qddot, muscles.pathwise, dtau_dq, dtau_dqdot);
+  addWrappingMuscleIdDerivatives(sys.model(), s, qddot, muscles.wrapping, dtau_dq, dtau_dqdot);
   // the terms' share of tau is -f_t: dtau += -df_t/dq, -df_t/dqdot
   for (const auto& t : sys.terms()) {
     if (const auto* cl = dynamic_cast<const CoordinateLimitForceTerm*>(t.get())) {

@@ -19,10 +19,13 @@
 // The derivative of J_mr follows from the same identity: dJ_mr/dq_c = Jdot_mr(q, e_c)
 // (jacobianDerivative). Terms: the joint springs and dampers, the massless terms whose
 // derivatives are written (CoordinateLimitForceTerm, SpringGeneralizedForceTerm,
-// CoordinateActuatorTerm at fixed controls), and a MuscleTerm's mass points on Type I and II paths
-// (core/muscles/muscle_id_tangent.hpp: the path-wise pass over dual numbers, seeded by the tangent
-// of the bodies' world motion, its wrenches added to the tangent's backward pass); any other term
-// (Type III or fibre-following mass points among them), external loads, extra coordinates, a
+// CoordinateActuatorTerm at fixed controls), and a MuscleTerm's mass points: on Type I and II paths
+// analytic (core/muscles/muscle_id_tangent.hpp: the path-wise pass over dual numbers, seeded by the
+// tangent of the bodies' world motion, its wrenches added to the tangent's backward pass), on
+// Type III (wrapping) paths by a muscle-local fourth-order difference of the muscle's own share
+// along the coordinates that move it (the wrap construction's J and Jdot have no written
+// derivatives along q; the dissertation differences its network Jacobians likewise [D Eq. 5.58]).
+// Any other term (fibre-following mass points among them), external loads, extra coordinates, a
 // coordinate map or Simbody-compatible joint velocity terms make systemIdDerivatives refuse
 // (false, with the reason), and the adjoint then differences its step (docs/gradients.md §2).
 #include <string>
@@ -47,6 +50,9 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
 /// Whether systemIdDerivatives can apply to this system (everything but the workspace's loads);
 /// false with the first part that has no written derivatives.
 bool systemIdDerivativesAvailable(const System& sys, std::string* why = nullptr);
+/// The parts whose derivatives systemIdDerivatives takes by muscle-local differences rather than
+/// in closed form, in words ("" when none): the mass points of wrapping (Type III) muscles.
+std::string systemIdDerivativesLocalDifferences(const System& sys);
 
 /// The derivatives of the constraint rows as System::calcConstraints forms them (G, the stabilized
 /// rhs, vel_err), written for coordinate couplers (OpenSim's CoordinateCouplerConstraint,

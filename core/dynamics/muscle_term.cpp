@@ -204,13 +204,8 @@ void MuscleTerm::addInverseDynamics(const Model& model, const State& s, const Ve
     gatherColumns(s.qdot, mk, sc.qdot_c);
     gatherColumns(qddot, mk, sc.qddot_c);
     sc.fc.setZero(sc.qdot_c.size());
-    const MassPoints& mp = mu.mass_points;
-    for (int a = 0; a < mp.size(); ++a) {
-      Vec3 acc = mk.J_ar.middleRows<3>(3 * a) * sc.qddot_c - model.gravity();
-      if (options_.quadratic_velocity) acc.noalias() += mk.Jdot_ar.middleRows<3>(3 * a) * sc.qdot_c;
-      if (fibre) acc.noalias() += mk.a_z.segment<3>(3 * a);  // as addForce: the fibre's own motion
-      sc.fc.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * (mp.mass[a] * acc);
-    }
+    addCompactMuscleIdShare(mu.mass_points, mk, sc.qdot_c, sc.qddot_c, model.gravity(), options_.quadratic_velocity,
+                            fibre, sc.fc);
     scatterAddColumns(sc.fc, mk, tau);
   }
   if (pathwise) addWorldWrenches(sc.bodies, sc.w_world, wrench);

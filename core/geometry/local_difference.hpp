@@ -9,10 +9,11 @@
 
 namespace redmax {
 
-/// d f / dx at x; f maps a double to a double or an Eigen object of fixed shape
+/// d f / dx at x; f maps a double to a double or an Eigen object of fixed shape; the step is
+/// `relative_step` max(1, |x|)
 template <class F>
-auto localDerivative(F&& f, double x) {
-  const double h = 1e-3 * std::max(1.0, std::abs(x));
+auto localDerivative(F&& f, double x, double relative_step = 1e-3) {
+  const double h = relative_step * std::max(1.0, std::abs(x));
   // evaluated in one full expression: an Eigen expression kept in `auto` would refer to the
   // temporaries f returns after they are gone
   return decltype(f(x))((f(x - 2.0 * h) - 8.0 * f(x - h) + 8.0 * f(x + h) - f(x + 2.0 * h)) / (12.0 * h));

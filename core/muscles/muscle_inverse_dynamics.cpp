@@ -54,6 +54,16 @@ const char* pathwiseInverseDynamicsRefusal(const Muscle& m) {
   return nullptr;
 }
 
+void addCompactMuscleIdShare(const MassPoints& mp, const MuscleKinematics& mk, const VecX& qdot_c, const VecX& qddot_c,
+                             const Vec3& gravity, bool quadratic_velocity, bool fibre_bias, VecX& fc) {
+  for (int a = 0; a < mp.size(); ++a) {
+    Vec3 acc = mk.J_ar.middleRows<3>(3 * a) * qddot_c - gravity;
+    if (quadratic_velocity) acc.noalias() += mk.Jdot_ar.middleRows<3>(3 * a) * qdot_c;
+    if (fibre_bias) acc.noalias() += mk.a_z.segment<3>(3 * a);  // as addForce: the fibre's own motion
+    fc.noalias() += mk.J_ar.middleRows<3>(3 * a).transpose() * (mp.mass[a] * acc);
+  }
+}
+
 void calcBodyWorldMotion(const BodyMotion& motion, std::vector<BodyWorldMotion>& out) {
   const size_t nb = motion.E_wi.size();
   out.resize(nb);

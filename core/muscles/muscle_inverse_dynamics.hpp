@@ -87,6 +87,15 @@ void addWorldWrenches(const std::vector<BodyWorldMotion>& bodies, const std::vec
 /// (core/muscles/muscle_id_tangent.hpp covers the path-wise ones).
 const char* pathwiseInverseDynamicsRefusal(const Muscle& muscle);
 
+/// The compact route of the muscles the path-wise pass refuses (MuscleTerm, and the Type III
+/// share's derivatives in core/dynamics/id_derivatives.cpp): after calcMuscleKinematics with
+/// velocity, adds to fc (the muscle's k compact columns)
+///   sum_a J_ar^T m_a (J_ar qddot_c (+ Jdot_ar qdot_c) (+ a_z) - g)
+/// with the quadratic velocity part when `quadratic_velocity` and the fibre's own motion a_z when
+/// `fibre_bias` (fibre-following points).
+void addCompactMuscleIdShare(const MassPoints& mp, const MuscleKinematics& mk, const VecX& qdot_c, const VecX& qddot_c,
+                             const Vec3& gravity, bool quadratic_velocity, bool fibre_bias, VecX& fc);
+
 /// Adds the mass points' share of inverse dynamics of one Type I or II muscle (no wrap objects):
 /// to w_world[b] the wrench body b must supply for them (world axes, torque about the body
 /// origin; addWorldWrenches turns it into body coordinates [D Eq. 3.14]) and to tau the direct

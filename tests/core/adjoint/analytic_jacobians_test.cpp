@@ -128,6 +128,49 @@ TEST_P(AnalyticJacobians, TypeOneAndTwoMusclesWithMassAgainstCentralDifferences)
   EXPECT_LE(e.route, 2e-9);
 }
 
+// inertial muscles of Type III (the smooth wrap model over a cylinder and a sphere on a 3-D chain)
+// beside a straight one: their share's derivatives by muscle-local differences inside the analytic
+// route (addWrappingMuscleIdDerivatives), which says so
+TEST_P(AnalyticJacobians, TypeThreeMusclesWithMassAgainstCentralDifferences) {
+  std::mt19937 rng(6);
+  const Model m = scenes::revoluteChain(3);
+  const std::vector<Muscle> muscles = {
+      test::chainWrapMuscle(WrapSurface::makeCylinder(0.08, 0.4), WrapModel::Smooth, "cylinder", 0.8),
+      test::chainWrapMuscle(WrapSurface::makeSphere(0.1), WrapModel::Smooth, "sphere", 0.5),
+      test::straightMuscle(m, rng, 0.4)};
+  auto sys = std::make_shared<System>(m);
+  sys->addTerm(std::make_shared<MuscleTerm>(m, muscles));
+  Problem pr = problemFor(sys, GetParam(), 0.05, 0.005);
+  // a start at which both paths wrap (the first of a fixed sequence of random poses)
+  std::mt19937 poses(11);
+  auto wraps = [&](const State& s, int k) { return test::offStraightLine(test::evalMuscle(m, muscles[k], s)) > 1e-3; };
+  for (int trial = 0; trial < 500; ++trial) {
+    const State s = test::randomState(m.nr(), poses, 1.2, 0.0);
+    try {
+      if (wraps(s, 0) && wraps(s, 1)) {
+        pr.initial.q = s.q;
+        break;
+      }
+    } catch (const MuscleError&) {  // an end point inside a surface
+    }
+  }
+  ASSERT_TRUE(wraps(pr.initial, 0) && wraps(pr.initial, 1));
+  pr.forces = {{0, 0, 2}, {1, 0, 2}, {2, 0, 1}};
+  pr.initial_q = {1};
+  pr.initial_qdot = {2};
+  const RouteErrors e = compareRoutes(pr, pointAndRest(m), kFiveParameters);
+  pr.step_jacobians = "auto";
+  const adjoint::Result r = adjoint::evaluate(pr, pointAndRest(m), kFiveParameters, true);
+  EXPECT_NE(adjoint::stepJacobiansText(r).find("the mass points of 2 wrapping (Type III) muscles ('cylinder', ...) "
+                                               "by muscle-local fourth-order differences"),
+            std::string::npos)
+      << adjoint::stepJacobiansText(r);
+  std::printf("[ measured ] %s, Type III muscles with mass: analytic vs whole-run differences %.2e, vs the "
+              "differenced route %.2e\n", GetParam().c_str(), e.fd, e.route);
+  EXPECT_LE(e.fd, 1e-9);
+  EXPECT_LE(e.route, 2e-9);
+}
+
 // coordinate couplers (OpenSim's CoordinateCouplerConstraint, e.g. a knee's translations or a
 // patella following the knee angle): two couplers through a cubic of one coordinate and a
 // function of two, on a random tree with springs, dampers and limit forces; with and without

@@ -1,12 +1,14 @@
 #pragma once
-// A random Type II muscle for the dynamics tests (muscle_term_test, thread_safety_test): the same
-// rng draws in the same order wherever it is used.
+// Muscles for the dynamics tests (muscle_term_test, thread_safety_test, the ID derivatives' and the
+// adjoint's): random Type I/II ones (the same rng draws in the same order wherever used) and a
+// Type III one on a 3-D chain.
 #include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "core/muscles/mass_points.hpp"
+#include "core/spatial/se3.hpp"
 #include "tests/core/muscles/muscle_test_util.hpp"
 
 namespace redmax::test {
@@ -52,6 +54,25 @@ inline Muscle conditionalMuscle(const Model& m, std::mt19937& rng, double mass) 
   MassPointOptions opt;
   opt.count = 13;
   mu.mass_points = makeMassPoints(mass, 0.3, 0.1, opt);
+  return mu;
+}
+
+// a Type III muscle on scenes::revoluteChain(3): origin on link 0, insertion on link 2, the
+// surface on link 1 (tilted and offset, so that the path wraps over part of the joints' range)
+inline Muscle chainWrapMuscle(const WrapSurface& surface, WrapModel model, const std::string& name = "chain",
+                              double mass = 0.3) {
+  Muscle mu;
+  mu.name = name;
+  mu.path.points = {makeFixedPoint(0, Vec3(0.35, -0.25, 0.05)), makeFixedPoint(2, Vec3(-0.3, -0.4, -0.05))};
+  PathWrap w;
+  w.name = name + "_surface";
+  w.surface = surface;
+  w.body = 1;
+  w.E_bs = makeE(expSO3(Vec3(0.3, -0.2, 0.1)), Vec3(0.02, -0.3, 0.01));
+  mu.path.wraps = {w};
+  mu.path.num_wraps = 1;
+  mu.mass_points = makeMassPoints(mass, 0.5, 0.2, {7});
+  mu.wrap.model = model;
   return mu;
 }
 

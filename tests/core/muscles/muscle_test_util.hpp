@@ -44,6 +44,15 @@ inline MuscleKinematics evalMuscle(const Model& model, const Muscle& muscle, con
   return mk;
 }
 
+/// the largest distance of a mass point from the straight origin-insertion line (m): above round-off
+/// when a Type III path wraps
+inline double offStraightLine(const MuscleKinematics& mk) {
+  const Vec3 a = mk.x_w.front(), b = mk.x_w.back();
+  double off = 0.0;
+  for (const Vec3& x : mk.x_a) off = std::max(off, ((x - a).cross(b - a)).norm() / (b - a).norm());
+  return off;
+}
+
 /// state moved by t along its own velocity (q + t qdot, same qdot): every joint uses qdot = dq/dt
 inline State along(const State& s, double t) {
   State r = s;

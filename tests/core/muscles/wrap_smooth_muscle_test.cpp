@@ -7,6 +7,7 @@
 
 #include "core/muscles/wrap_muscle.hpp"
 #include "core/spatial/se3.hpp"
+#include "tests/core/dynamics/random_muscle.hpp"
 #include "tests/core/muscles/muscle_test_util.hpp"
 #include "validation/scenes/scenes.hpp"
 
@@ -14,23 +15,6 @@ namespace redmax {
 namespace {
 
 bool nearRel(const MatX& A, const MatX& B, double tol) { return (A - B).norm() <= tol * (1.0 + B.norm()); }
-
-// a 3-D chain (links 0.5 m): origin on link 0, insertion on link 2, the surface on link 1
-Muscle chainMuscle(const WrapSurface& surface, WrapModel model) {
-  Muscle mu;
-  mu.name = "chain";
-  mu.path.points = {makeFixedPoint(0, Vec3(0.35, -0.25, 0.05)), makeFixedPoint(2, Vec3(-0.3, -0.4, -0.05))};
-  PathWrap w;
-  w.name = "surf";
-  w.surface = surface;
-  w.body = 1;
-  w.E_bs = makeE(expSO3(Vec3(0.3, -0.2, 0.1)), Vec3(0.02, -0.3, 0.01));
-  mu.path.wraps = {w};
-  mu.path.num_wraps = 1;
-  mu.mass_points = makeMassPoints(0.3, 0.5, 0.2, {7});
-  mu.wrap.model = model;
-  return mu;
-}
 
 // J_ar against central differences of x_a in q, and Jdot_ar against central differences of J_ar
 // along qdot; false (not a test) when the differences at h and 2h disagree by more than the
@@ -55,7 +39,7 @@ TEST(WrapSmoothMuscle, EllipsoidTorusAndQuadrantSphereOnAMovingBody) {
                                   WrapSurface::makeEllipsoid(Vec3(0.14, 0.1, 0.12), 0, 1),
                                   WrapSurface::makeSphere(0.1, 0, 1)};
   for (const WrapSurface& surface : surfaces) {
-    const Muscle mu = chainMuscle(surface, WrapModel::Smooth);
+    const Muscle mu = test::chainWrapMuscle(surface, WrapModel::Smooth);
     EXPECT_EQ(wrapMassPointsUnsupportedReason(mu), "");
     validateMuscle(m, mu);
     const char* what = surface.type == WrapType::Torus    ? "chain torus"
@@ -72,10 +56,7 @@ TEST(WrapSmoothMuscle, EllipsoidTorusAndQuadrantSphereOnAMovingBody) {
         continue;
       }
       // wrapped: some mass point off the straight origin-insertion line
-      const Vec3 a = mk.x_w.front(), b = mk.x_w.back();
-      double off = 0.0;
-      for (const Vec3& x : mk.x_a) off = std::max(off, ((x - a).cross(b - a)).norm() / (b - a).norm());
-      const bool wraps = off > 1e-9;
+      const bool wraps = test::offStraightLine(mk) > 1e-9;
       if ((wraps && n_wrapped >= 6) || (!wraps && n_straight >= 4)) continue;
       if (!checkAgainstFd(m, mu, s, what)) continue;
       ++tested;
