@@ -96,27 +96,37 @@ TEST_F(GradientCli, StepJacobianRoutes) {
   const CmdResult staged = run(kRun + " --integrator sdirk2 --check --check-tolerance 5e-9");
   EXPECT_EQ(staged.code, 0) << staged.out << staged.err;
   EXPECT_NE(staged.out.find("step Jacobians: analytic"), std::string::npos) << staged.out;
-  // Type II mass points take the analytic route; a wrapping (Type III) muscle's do not
+  // Type II mass points take the analytic route, a wrapping (Type III) muscle's too, its share by
+  // muscle-local differences (said so); q2 starts at 0.8
   const CmdResult via = run("--duration 0.1 --dt 0.005 --muscle-mass-kg via_muscle=0.5 --params 'torques:q1' --objective speed "
                             "--step-jacobians analytic --check");
   EXPECT_EQ(via.code, 0) << via.out << via.err;
-  const CmdResult refused = runRedmax(
-      dir_, "gradient --model " + scene("double_pendulum_wrap.osim") +
-                " --duration 0.1 --dt 0.005 --muscle-mass-kg wrap_muscle=0.5 --params 'torques:q1' --objective speed "
-                "--step-jacobians analytic");
-  EXPECT_EQ(refused.code, 2) << refused.out << refused.err;
-  EXPECT_NE(refused.err.find("analytic step Jacobians do not apply: the mass points of muscle 'wrap_muscle', which wraps"),
-            std::string::npos)
-      << refused.err;
-  // under auto the same run differences its steps and says why
-  const CmdResult wrapped = runRedmax(
-      dir_, "gradient --model " + scene("double_pendulum_wrap.osim") +
-                " --duration 0.1 --dt 0.005 --muscle-mass-kg wrap_muscle=0.5 --params 'torques:q1' --objective speed");
-  EXPECT_EQ(wrapped.code, 0) << wrapped.out << wrapped.err;
-  EXPECT_NE(wrapped.out.find("step Jacobians: central differences of the step; not analytic: the mass points of "
-                             "muscle 'wrap_muscle', which wraps (Type III)"),
+  const std::string wrap = "gradient --model " + scene("double_pendulum_wrap.osim") +
+                           " --duration 0.1 --dt 0.005 --muscle-mass-kg wrap_muscle=0.5 --params 'torques:q1;q0:q2=0.8' "
+                           "--objective 'point:link2@0,-1,0=0.5,-1.5,0;speed' ";
+  const CmdResult wrapped = runRedmax(dir_, wrap + "--step-jacobians analytic --check --check-tolerance 1e-9");
+  EXPECT_EQ(wrapped.code, 0) << wrapped.out << wrapped.err;  // measured 1.4e-12
+  EXPECT_NE(wrapped.out.find("step Jacobians: analytic (derivatives of inverse dynamics, docs/gradients.md §2.1); the "
+                             "mass points of 1 wrapping (Type III) muscle ('wrap_muscle') by muscle-local fourth-order "
+                             "differences"),
             std::string::npos)
       << wrapped.out;
+  // fibre-following mass points have no written derivatives: analytic exits 2 naming them, auto
+  // differences the steps and says why
+  const std::string fibre = "--duration 0.1 --dt 0.005 --muscle-mass-kg via_muscle=0.5 --mass-placement fibre "
+                            "--params 'torques:q1' --objective speed ";
+  const CmdResult refused = run(fibre + "--step-jacobians analytic");
+  EXPECT_EQ(refused.code, 2) << refused.out << refused.err;
+  EXPECT_NE(refused.err.find("analytic step Jacobians do not apply: the mass points of muscle 'via_muscle', which has "
+                             "fibre-following mass points"),
+            std::string::npos)
+      << refused.err;
+  const CmdResult fell_back = run(fibre);
+  EXPECT_EQ(fell_back.code, 0) << fell_back.out << fell_back.err;
+  EXPECT_NE(fell_back.out.find("step Jacobians: central differences of the step; not analytic: the mass points of "
+                               "muscle 'via_muscle', which has fibre-following mass points"),
+            std::string::npos)
+      << fell_back.out;
   const CmdResult bad = run("--duration 0.1 --params 'torques:q1' --objective speed --step-jacobians exact");
   EXPECT_EQ(bad.code, 2) << bad.err;
 }

@@ -20,7 +20,9 @@
 #include "../dynamics/constraint_scenes.hpp"
 #include "tests/core/dynamics/random_muscle.hpp"
 #include "tests/core/adjoint/adjoint_test_util.hpp"
+#include "core/muscles/wrap/network_model.hpp"
 #include "validation/scenes/scenes.hpp"
+#include "validation/scenes/wrap_pendulums.hpp"
 
 namespace redmax {
 namespace {
@@ -167,6 +169,36 @@ TEST_P(AnalyticJacobians, TypeThreeMusclesWithMassAgainstCentralDifferences) {
       << adjoint::stepJacobiansText(r);
   std::printf("[ measured ] %s, Type III muscles with mass: analytic vs whole-run differences %.2e, vs the "
               "differenced route %.2e\n", GetParam().c_str(), e.fd, e.route);
+  EXPECT_LE(e.fd, 1e-9);
+  EXPECT_LE(e.route, 2e-9);
+}
+
+// the network wrap model (the committed cylinder network) on the wrap pendulum, inside its
+// training box: the step Jacobians difference the network's share locally as they do the smooth one
+TEST_P(AnalyticJacobians, TypeThreeNetworkWrapModelAgainstCentralDifferences) {
+  const Model m = scenes::doublePendulum();
+  WrapMassOptions neural;
+  neural.model = WrapModel::Neural;
+  neural.network = loadWrapNetwork(std::string(REDMAX_SOURCE_DIR) + "/osim_models/networks/cylinder_3x64.txt");
+  const scenes::WrapPendulumSpec spec;
+  const Muscle mu = scenes::makeWrapPendulumMuscle(spec, neural);
+  auto sys = std::make_shared<System>(m);
+  sys->addTerm(std::make_shared<MuscleTerm>(m, std::vector<Muscle>{mu}));
+  Problem pr = problemFor(sys, GetParam(), 0.05, 0.005);
+  pr.initial.q = (VecX(2) << spec.q1, spec.q2).finished();
+  pr.forces = {{0, 0, 1}, {1, 0, 1}};
+  pr.initial_qdot = {0, 1};
+  // the path wraps at the start and the network (not its smooth fallback) places the points
+  const MuscleKinematics mk = test::evalMuscle(m, mu, pr.initial);
+  EXPECT_GT(test::offStraightLine(mk), 1e-3);
+  EXPECT_GT(mk.wrap_counts.evaluations, 0);
+  EXPECT_EQ(mk.wrap_counts.fallbacks, 0);
+  Objective obj;
+  obj.points.push_back({m.nb() - 1, Vec3(0.0, -1.0, 0.0), Vec3(0.5, -1.5, 0.0), 1.0});
+  obj.speed_weight = 0.1;
+  const RouteErrors e = compareRoutes(pr, obj, (VecX(4) << 0.4, -0.3, 0.2, 0.5).finished());
+  std::printf("[ measured ] %s, network wrap model: analytic vs whole-run differences %.2e, vs the differenced "
+              "route %.2e\n", GetParam().c_str(), e.fd, e.route);
   EXPECT_LE(e.fd, 1e-9);
   EXPECT_LE(e.route, 2e-9);
 }
