@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/dynamics/constraints/coordinate_coupler.hpp"
+#include "core/dynamics/constraints/prescribed_coordinate.hpp"
 #include "core/dynamics/coordinate_actuator_term.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/muscles/muscle_id_tangent.hpp"
@@ -281,40 +282,76 @@ bool muscleTermSupported(const MuscleTerm& mt, TermMuscles* out, std::string* wh
   return true;
 }
 
+// Whether a muscle's Jdot_ar is the exact time derivative of its J_ar, so that
+// Jdot_ar(q, v) = sum_j dJ_ar/dq_j v_j: the smooth model's and the network's (Jets, unless the
+// network takes Jdot by the forward difference of [D Eq. 5.58]); not the exact library's
+// finite-difference Jacobians.
+bool exactWrapJdot(const Muscle& mu) {
+  return mu.wrap.model == WrapModel::Smooth || (mu.wrap.model == WrapModel::Neural && !mu.wrap.network_fd_jdot);
+}
+
 // The Type III muscles' share of inverse dynamics, sum_a J_ar^T m_a (J_ar qddot + Jdot_ar qdot - g)
-// as MuscleTerm forms it (addCompactMuscleIdShare), differentiated along each coordinate and speed
-// that moves one of them by the fourth-order local difference (localDerivative): the wrap
+// as MuscleTerm forms it (addCompactMuscleIdShare), differentiated along each coordinate that
+// moves one of them by the fourth-order local difference (localDerivative): the wrap
 // construction's J and Jdot have no written derivatives along q (its Jets carry value, velocity and
 // first partials), as the dissertation differences its network Jacobians in time [D Eq. 5.58].
+// Along the speeds the share is J^T m (Jdot(q, e_c) qdot + Jdot(q, qdot) e_c), and where Jdot is
+// exact (exactWrapJdot) Jdot(q, e_c) = dJ/dq_c, which the same stencil differences beside the
+// share: no evaluation of its own (otherwise the speeds take a stencil too).
 // A stencil point recomputes the skeleton's kinematics and the muscles that coordinate moves, not
-// the step: O(k) muscle evaluations per muscle of k columns. The step is 1e-4, not localDerivative's
-// 1e-3: the smooth model's fades bend the share within a few 1e-3 rad (on reach_arm.osim's elbow the
-// 1e-3 stencil's truncation was 5.6e-7 of the column, and 1e-4 of the gradient), while the share
-// is exact to round-off at each point, so a smaller step costs only eps |tau| / h ~ 2e-12.
+// the step: 4k + 1 muscle evaluations per muscle of k columns. The step is 1e-4, not
+// localDerivative's 1e-3: the smooth model's fades bend the share within a few 1e-3 rad (on
+// reach_arm.osim's elbow the 1e-3 stencil's truncation was 5.6e-7 of the column, and 1e-4 of the
+// gradient), while the share is exact to round-off at each point, so a smaller step costs only
+// eps |tau| / h ~ 2e-12.
 constexpr double kWrapStep = 1e-4;
 void addWrappingMuscleIdDerivatives(const Model& model, const State& s, const VecX& qddot,
                                     const std::vector<const Muscle*>& muscles, MatX& dtau_dq, MatX& dtau_dqdot) {
   if (muscles.empty()) return;
   const int nr = model.nr();
-  std::vector<MuscleKinematics> mk(muscles.size());
-  for (size_t m = 0; m < muscles.size(); ++m) initMuscleKinematics(model, *muscles[m], mk[m]);
+  const size_t nm = muscles.size();
+  std::vector<MuscleKinematics> mk(nm);
+  std::vector<char> exact(nm);
+  for (size_t m = 0; m < nm; ++m) {
+    initMuscleKinematics(model, *muscles[m], mk[m]);
+    exact[m] = exactWrapJdot(*muscles[m]);
+  }
   SkeletonWorkspace sk(model);
   State sp = s;
   VecX qdot_c, qddot_c, fc;
+  // J_ar, Jdot_ar and the compact qdot of each muscle at s (the speeds' columns of exact ones)
+  std::vector<MatX> J0(nm), Jd0(nm);
+  std::vector<VecX> qdot0(nm);
+  calcKinematics(model, sp, sk);
+  for (size_t m = 0; m < nm; ++m) {
+    if (!exact[m]) continue;
+    calcMuscleKinematics(model, sp, sk, *muscles[m], mk[m], true);
+    J0[m] = mk[m].J_ar;
+    Jd0[m] = mk[m].Jdot_ar;
+    gatherColumns(s.qdot, mk[m], qdot0[m]);
+  }
   std::vector<size_t> moved;
   for (int col = 0; col < 2 * nr; ++col) {
     const bool speed = col >= nr;
     const int c = speed ? col - nr : col;
     moved.clear();
-    for (size_t m = 0; m < muscles.size(); ++m)
-      if (c < static_cast<int>(mk[m].col_of.size()) && mk[m].col_of[static_cast<size_t>(c)] >= 0) moved.push_back(m);
+    for (size_t m = 0; m < nm; ++m)
+      if (c < static_cast<int>(mk[m].col_of.size()) && mk[m].col_of[static_cast<size_t>(c)] >= 0 &&
+          !(speed && exact[m]))
+        moved.push_back(m);
     if (moved.empty()) continue;
+    // the moved muscles' share at a stencil point, then (along q) the exact ones' J_ar, stacked
+    Eigen::Index size = nr;
+    if (!speed)
+      for (size_t m : moved)
+        if (exact[m]) size += J0[m].size();
     VecX& x = speed ? sp.qdot : sp.q;
     const double x0 = x[c];
     auto share = [&](double xc) {
       x[c] = xc;
       calcKinematics(model, sp, sk);
-      VecX tau = VecX::Zero(nr);
+      VecX out(size), tau = VecX::Zero(nr);
+      Eigen::Index at = nr;
       for (size_t m : moved) {
         calcMuscleKinematics(model, sp, sk, *muscles[m], mk[m], true);
         gatherColumns(sp.qdot, mk[m], qdot_c);
@@ -322,11 +359,35 @@ void addWrappingMuscleIdDerivatives(const Model& model, const State& s, const Ve
         fc.setZero(qdot_c.size());
         addCompactMuscleIdShare(muscles[m]->mass_points, mk[m], qdot_c, qddot_c, model.gravity(), true, false, fc);
         scatterAddColumns(fc, mk[m], tau);
+        if (!speed && exact[m]) {
+          out.segment(at, mk[m].J_ar.size()) = Eigen::Map<const VecX>(mk[m].J_ar.data(), mk[m].J_ar.size());
+          at += mk[m].J_ar.size();
+        }
       }
-      return tau;
+      out.head(nr) = tau;
+      return out;
     };
-    (speed ? dtau_dqdot : dtau_dq).col(c) += localDerivative(share, x0, kWrapStep);
+    const VecX d = localDerivative(share, x0, kWrapStep);
     x[c] = x0;
+    (speed ? dtau_dqdot : dtau_dq).col(c) += d.head(nr);
+    if (speed) continue;
+    // the exact muscles' speed column c: J^T m (dJ/dq_c qdot + Jdot e_c)
+    Eigen::Index at = nr;
+    VecX tau = VecX::Zero(nr);
+    for (size_t m : moved) {
+      if (!exact[m]) continue;
+      const Eigen::Map<const MatX> dJ(d.data() + at, J0[m].rows(), J0[m].cols());
+      at += J0[m].size();
+      const int j = mk[m].col_of[static_cast<size_t>(c)];
+      const MassPoints& mp = muscles[m]->mass_points;
+      fc.setZero(J0[m].cols());
+      for (int a = 0; a < mp.size(); ++a) {
+        const Vec3 acc = dJ.middleRows<3>(3 * a) * qdot0[m] + Jd0[m].middleRows<3>(3 * a).col(j);
+        fc.noalias() += J0[m].middleRows<3>(3 * a).transpose() * (mp.mass[a] * acc);
+      }
+      scatterAddColumns(fc, mk[m], tau);
+    }
+    dtau_dqdot.col(c) += tau;
   }
 }
 
@@ -404,8 +465,10 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
 
 bool constraintRowDerivativesAvailable(const System& sys, std::string* why) {
   for (const auto& c : sys.constraints())
-    if (!dynamic_cast<const CoordinateCoupler*>(c.get())) {
-      if (why) *why = "the constraint '" + c->name() + "' (only coordinate couplers have written derivatives)";
+    if (!dynamic_cast<const CoordinateCoupler*>(c.get()) && !dynamic_cast<const PrescribedCoordinate*>(c.get())) {
+      if (why)
+        *why = "the constraint '" + c->name() +
+               "' (only coordinate couplers and locked or prescribed coordinates have written derivatives)";
       return false;
     }
   return true;
@@ -424,6 +487,14 @@ void constraintRowDerivatives(const System& sys, const State& s, const VecX& w, 
   int r = 0;
   FunctionValue fv, ft;
   for (const auto& c : sys.constraints()) {
+    if (const auto* pc = dynamic_cast<const PrescribedCoordinate*>(c.get())) {
+      // G = -e_k^T and rhs = -qddot_p(t) are constant in the state; pos_err = q_p(t) - q_k,
+      // vel_err = qdot_p(t) - qdot_k
+      out.dverr_dv(r, pc->coordinate()) = -1.0;
+      dperr_dq(r, pc->coordinate()) = -1.0;
+      r += pc->rows();
+      continue;
+    }
     const auto& cc = dynamic_cast<const CoordinateCoupler&>(*c);
     const std::vector<int>& I = cc.independent();
     const int m = static_cast<int>(I.size()), d = cc.dependent();

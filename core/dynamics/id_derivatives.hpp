@@ -67,7 +67,10 @@ struct ConstraintRowDerivatives {
   MatX drhs_dq, drhs_dv;    ///< the stabilized rhs              (nc x n)
   MatX dverr_dq, dverr_dv;  ///< the velocity error              (nc x n)
 };
-/// Whether every constraint of the system is a coordinate coupler; false with the first that is not.
+/// Locked and prescribed coordinates (PrescribedCoordinate: G = -e_k^T, rhs = -qddot_p(t)) have
+/// constant rows; only their errors move with the state.
+/// Whether every constraint of the system is a coordinate coupler or a locked or prescribed
+/// coordinate; false with the first that is not.
 bool constraintRowDerivativesAvailable(const System& sys, std::string* why = nullptr);
 void constraintRowDerivatives(const System& sys, const State& s, const VecX& w, const VecX& lambda,
                               ConstraintRowDerivatives& out);

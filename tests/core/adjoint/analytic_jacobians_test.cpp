@@ -15,6 +15,7 @@
 #include "core/adjoint/adjoint.hpp"
 #include "core/dynamics/constraints/coordinate_coupler.hpp"
 #include "core/dynamics/constraints/point_constraint.hpp"
+#include "core/dynamics/constraints/prescribed_coordinate.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/dynamics/passive_force_terms.hpp"
 #include "../dynamics/constraint_scenes.hpp"
@@ -244,6 +245,36 @@ TEST_P(AnalyticJacobians, CoordinateCouplersAgainstCentralDifferences) {
   }
 }
 
+// a locked coordinate (OpenSim's `locked`, e.g. Rajagopal2016's subtalar and MTP angles) and a
+// coordinate prescribed along a sine (a prescribed_function): constant rows, only their errors move
+// with the state (and with stabilization, the rhs)
+TEST_P(AnalyticJacobians, LockedAndPrescribedCoordinatesAgainstCentralDifferences) {
+  for (double alpha : {0.0, 5.0}) {
+    const auto sys = randomSystem(21);
+    const int n = sys->ndof();
+    const Model& m = sys->model();
+    ASSERT_GE(n, 5);
+    sys->addConstraint(PrescribedCoordinate::makeLocked(m, n - 1, 0.1));
+    auto sine = makeConstraintFunction1([](double t) { return 0.2 * std::sin(3.0 * t) - 0.1; },
+                                        [](double t) { return 0.6 * std::cos(3.0 * t); },
+                                        [](double t) { return -1.8 * std::sin(3.0 * t); });
+    sys->addConstraint(std::make_shared<PrescribedCoordinate>(m, n - 2, sine, "sine"));
+    sys->stabilization.alpha = alpha;
+    sys->stabilization.beta = alpha;
+    Problem pr = problemFor(sys, GetParam(), 0.05, 0.005);
+    pr.initial.q[n - 1] = 0.1;
+    pr.initial.q[n - 2] = -0.1;
+    pr.initial.qdot[n - 2] = 0.6;
+    pr.forces = {{0, 0, 2}, {0, 1, 2}, {1, 0, 1}, {n / 2 - 1, 0, 1}};
+    pr.initial_qdot = {0};
+    const RouteErrors e = compareRoutes(pr, pointAndRest(m), kFiveParameters);
+    std::printf("[ measured ] %s, locked and prescribed coordinates (stabilization %g): analytic vs whole-run "
+                "differences %.2e, vs the differenced route %.2e\n", GetParam().c_str(), alpha, e.fd, e.route);
+    EXPECT_LE(e.fd, 1e-9);
+    EXPECT_LE(e.route, 2e-9);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Integrators, AnalyticJacobians, ::testing::Values("euler", "bdf1", "sdirk2"));
 
 TEST(AnalyticJacobiansRoute, AutoFallsBackAndNamesWhyAnalyticRefuses) {
@@ -258,7 +289,7 @@ TEST(AnalyticJacobiansRoute, AutoFallsBackAndNamesWhyAnalyticRefuses) {
   obj.speed_weight = 1.0;
   const adjoint::Result r = adjoint::evaluate(pr, obj, VecX::Constant(1, 0.5), true);
   EXPECT_FALSE(r.analytic_jacobians);
-  EXPECT_NE(r.jacobian_note.find("only coordinate couplers have written derivatives"), std::string::npos)
+  EXPECT_NE(r.jacobian_note.find("only coordinate couplers and locked or prescribed coordinates have written derivatives"), std::string::npos)
       << r.jacobian_note;
   pr.step_jacobians = "analytic";
   try {

@@ -322,7 +322,8 @@ TEST(IdDerivatives, TypeThreeMusclesByLocalDifferences) {
   // fourth-order difference of the whole system's ID at 3e-5 (its truncation at 2.5e-4 was 4.6e-9
   // here). A column whose reference disagrees with the difference at 2e-4, a stencil wider than
   // the local one, is at a kink (the ellipsoid's and torus's blends, a mass point meeting a
-  // tangent point) and is left out and counted.
+  // tangent point) and is left out and counted, and so is the speed column of a coordinate at a
+  // kink (it is formed from the same stencil's dJ/dq: 2.2e-8 on this torus state).
   const Model m = scenes::revoluteChain(3);
   const int n = m.nr();
   std::mt19937 rng(37);
@@ -351,6 +352,7 @@ TEST(IdDerivatives, TypeThreeMusclesByLocalDifferences) {
       }
       wrapped += test::offStraightLine(test::evalMuscle(m, muscles[0], s)) > 1e-9;
       ++tested;
+      std::vector<char> kinked_q(n, 0);  // the speeds' columns take dJ/dq_c from the q stencil
       for (int c = 0; c < 2 * n; ++c) {
         const bool speed = c >= n;
         const int j = speed ? c - n : c;
@@ -364,8 +366,9 @@ TEST(IdDerivatives, TypeThreeMusclesByLocalDifferences) {
         }
         const double scale = std::max(1.0, d1.lpNorm<Eigen::Infinity>());
         ++columns;
-        if ((d1 - d2).lpNorm<Eigen::Infinity>() > 1e-7 * scale) {
+        if ((d1 - d2).lpNorm<Eigen::Infinity>() > 1e-7 * scale || (speed && kinked_q[j])) {
           ++kinked;
+          if (!speed) kinked_q[j] = 1;
           continue;
         }
         const VecX got = speed ? VecX(dqd.col(j)) : VecX(dq.col(j));
