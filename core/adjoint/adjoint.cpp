@@ -7,6 +7,7 @@
 
 #include "core/dynamics/coordinate_actuator_term.hpp"
 #include "core/dynamics/id_derivatives.hpp"
+#include "core/dynamics/muscle_force_term.hpp"
 #include "core/integrators/integrator.hpp"
 #include "core/integrators/sdirk2.hpp"
 #include "core/skeleton/kinematics.hpp"
@@ -196,6 +197,10 @@ class Stepper {
     integ_ = dynamic_cast<FixedStepIntegrator*>(owner_.get());
     n_ = sys.ndof();
     nz_ = sys.numStates();
+    term_step_ = pr.jacobian_step;
+    for (const auto& t : sys.terms())
+      if (const auto* mf = dynamic_cast<const MuscleForceTerm*>(t.get()); mf && !mf->actuated().empty())
+        state_terms_ = true;
   }
   int size() const { return 2 * n_ + nz_; }
   State unpack(const VecX& y, double t) const {
@@ -229,8 +234,8 @@ class Stepper {
   // Whether the step's Jacobians can be formed from the ID derivatives (docs/gradients.md §2.1):
   // no auxiliary states, no constraints but coordinate couplers, every part with written derivatives.
   bool analyticAvailable(std::string* why) const {
-    if (nz_ > 0) {
-      *why = "auxiliary states (Hill-type muscles)";
+    if (nz_ > 0 && !state_terms_) {
+      *why = "auxiliary states of a term other than Hill-type muscles";
       return false;
     }
     if (sys_.numConstraintRows() > 0 && !constraintRowDerivativesAvailable(sys_, why)) return false;
@@ -250,10 +255,15 @@ class Stepper {
   //           at the converged stages, chained through stage 2's start (zq, zv)
   // System parameters s (muscle masses) enter as the generalized force -dtau/ds at the step's (or
   // each stage's) state and acceleration: with `dtau_ds` (n x ns at a state and acceleration),
-  // Js = dy+/ds (2n x ns).
+  // Js = dy+/ds (2n + nz x ns).
+  // Hill-type muscles (auxiliary states z, controls u_m; docs/gradients.md §2.1) enter the same
+  // way: the step holds z and u during q's and qdot's update, so df/dz and df/du at each stage's
+  // state are generalized forces like -dtau/ds, and z+ = z + h zdot(q, v, z, u) at the step's
+  // start adds its rows [h dzdot/dq, h dzdot/dv, I + h dzdot/dz], h dzdot/du. Then Jy is
+  // (2n + nz) square, and Ju (2n + nz x nu, with `Ju`) holds the columns of the terms' controls.
   using ParamIdDerivative = std::function<MatX(const State&, const VecX&)>;
   void analyticJacobians(const VecX& y, double t, double h, const VecX& u, MatX& Jy, MatX& Jf,
-                         const ParamIdDerivative* dtau_ds = nullptr, MatX* Js = nullptr) {
+                         const ParamIdDerivative* dtau_ds = nullptr, MatX* Js = nullptr, MatX* Ju = nullptr) {
     const int n = n_;
     const MatX I = MatX::Identity(n, n);
     State s = unpack(y, t);
@@ -262,10 +272,25 @@ class Stepper {
     // the ID derivatives at a state and acceleration; M's factorization left in `lu`
     auto idDerivatives = [&](const State& st, const VecX& a) {
       std::string why;
-      if (!systemIdDerivatives(sys_, st, a, ws_, Dq, Dv, &why))
+      if (!systemIdDerivatives(sys_, st, a, ws_, Dq, Dv, &why, term_step_))
         throw AdjointError("adjoint: analytic step Jacobians: " + why);
     };
-    MatX dv_dy(n, 2 * n), dv_dF(n, n), Gs;  // Gs: -dtau/ds at the step's state and acceleration
+    // the generalized forces of the step's parameters at a state and acceleration: -dtau/ds of
+    // the system parameters, then df/dz and df/du of the Hill-type muscles (n x (ns + nz + nu))
+    int ns = 0;
+    auto forceColumns = [&](const State& st, const VecX& a) {
+      MatX gs = dtau_ds ? MatX(-(*dtau_ds)(st, a)) : MatX(n, 0);
+      ns = static_cast<int>(gs.cols());
+      if (!state_terms_) return gs;
+      MatX fz, fu;
+      stateTermForceDerivatives(sys_, st, ws_, term_step_, fz, fu);
+      MatX g(n, gs.cols() + fz.cols() + fu.cols());
+      g << gs, fz, fu;
+      return g;
+    };
+    const bool columns = dtau_ds || state_terms_;
+    MatX JG;  // d(q+, v+)/d(s, z, u) through forceColumns
+    MatX dv_dy(n, 2 * n), dv_dF(n, n), Gs;  // Gs: forceColumns at the step's state and acceleration
     const int nc = sys_.numConstraintRows();
     ConstraintRowDerivatives crd;
     if (integ_->name() == "euler" || integ_->name() == "bdf1") {
@@ -296,7 +321,7 @@ class Stepper {
       }
       const VecX a = (vplus - s.qdot) / h;
       idDerivatives(s, a);
-      if (dtau_ds) Gs = -(*dtau_ds)(s, a);
+      if (columns) Gs = forceColumns(s, a);
       if (nc == 0) {
         const Eigen::LDLT<MatX> ldlt(A);
         dv_dy.leftCols(n) = -h * ldlt.solve(Dq);
@@ -326,10 +351,11 @@ class Stepper {
         st.t = ts;
         st.q = zq + hg * V;
         st.qdot = V;
+        st.z = s.z;  // held during the step
         sys_.calcMassAndForce(st, ws_);
         const VecX a = (V - zv) / hg;
         idDerivatives(st, a);
-        if (dtau_ds) G_s = -(*dtau_ds)(st, a);
+        if (columns) G_s = forceColumns(st, a);
         MatX a_v;
         if (nc == 0) {
           const Eigen::LDLT<MatX> ldlt(ws_.M);
@@ -381,25 +407,51 @@ class Stepper {
       Jf.resize(2 * n, n);
       Jf.topRows(n) = h * (1.0 - g) * dV1_dF + hg * dv_dF;
       Jf.bottomRows(n) = dv_dF;
-      if (dtau_ds && Js) {
-        // each stage's own force -dtau/ds, through the same chain as F
+      if (columns) {
+        // each stage's own forces, through the same chain as F
         const MatX dV1_ds = dV1_dF * G1;
         const MatX dV2_ds = lu2.solve(hg * aq2 * (h * (1.0 - g) * dV1_ds) + c * dV1_ds + hg * aF2 * G2);
-        Js->resize(2 * n, G1.cols());
-        Js->topRows(n) = h * (1.0 - g) * dV1_ds + hg * dV2_ds;
-        Js->bottomRows(n) = dV2_ds;
+        JG.resize(2 * n, G1.cols());
+        JG.topRows(n) = h * (1.0 - g) * dV1_ds + hg * dV2_ds;
+        JG.bottomRows(n) = dV2_ds;
       }
-      return;
     }
-    // euler and bdf1: q+ = q + h v+
-    Jy.resize(2 * n, 2 * n);
-    Jy.topRows(n) = h * dv_dy;
-    Jy.topLeftCorner(n, n) += I;
-    Jy.bottomRows(n) = dv_dy;
-    Jf.resize(2 * n, n);
-    Jf.topRows(n) = h * dv_dF;
-    Jf.bottomRows(n) = dv_dF;
-    if (dtau_ds && Js) *Js = Jf * Gs;
+    if (integ_->name() != "sdirk2") {
+      // euler and bdf1: q+ = q + h v+
+      Jy.resize(2 * n, 2 * n);
+      Jy.topRows(n) = h * dv_dy;
+      Jy.topLeftCorner(n, n) += I;
+      Jy.bottomRows(n) = dv_dy;
+      Jf.resize(2 * n, n);
+      Jf.topRows(n) = h * dv_dF;
+      Jf.bottomRows(n) = dv_dF;
+      if (columns) JG = Jf * Gs;
+    }
+    if (dtau_ds && Js) *Js = JG.leftCols(ns);
+    if (nz_ == 0 && !state_terms_) return;
+    // the Hill-type muscles' states: z+ = z + h zdot(q, v, z, u) at the step's start
+    const int nz = nz_, nu = sys_.numControls();
+    StateTermDerivatives sd;
+    ws_.controls = u;
+    stateTermDerivatives(sys_, s, ws_, term_step_, sd);
+    MatX Jfull = MatX::Zero(2 * n + nz, 2 * n + nz);
+    Jfull.topLeftCorner(2 * n, 2 * n) = Jy;
+    Jfull.block(0, 2 * n, 2 * n, nz) = JG.middleCols(ns, nz);
+    Jfull.block(2 * n, 0, nz, n) = h * sd.dzdot_dq;
+    Jfull.block(2 * n, n, nz, n) = h * sd.dzdot_dv;
+    Jfull.bottomRightCorner(nz, nz) = MatX::Identity(nz, nz) + h * sd.dzdot_dz;
+    Jy = std::move(Jfull);
+    Jf.conservativeResize(2 * n + nz, n);
+    Jf.bottomRows(nz).setZero();
+    if (dtau_ds && Js) {
+      Js->conservativeResize(2 * n + nz, ns);
+      Js->bottomRows(nz).setZero();
+    }
+    if (Ju) {
+      Ju->resize(2 * n + nz, nu);
+      Ju->topRows(2 * n) = JG.middleCols(ns + nz, nu);
+      Ju->bottomRows(nz) = h * sd.dzdot_du;
+    }
   }
   /// the system's inverse dynamics at (st, a) with controls u (the system-parameter columns)
   VecX inverseDynamics(const State& st, const VecX& a, const VecX& u) {
@@ -414,6 +466,8 @@ class Stepper {
   std::unique_ptr<Integrator> owner_;
   FixedStepIntegrator* integ_ = nullptr;
   int n_ = 0, nz_ = 0;
+  double term_step_ = 6e-6;     // the Hill-type muscles' term-local differences (Problem::jacobian_step)
+  bool state_terms_ = false;    // the system has Hill-type muscles (MuscleForceTerm with a model)
 };
 
 double fdStep(double rel, double x) { return rel * std::max(1.0, std::abs(x)); }
@@ -589,10 +643,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
   // the step Jacobians' route (docs/gradients.md §2.1)
   std::string why;
   bool analytic = false;
-  if (pr.step_jacobians != "differences") {
-    if (!rs.excited.empty()) why = "excitation parameters (Hill-type muscle states)";
-    else analytic = stepper.analyticAvailable(&why);
-  }
+  if (pr.step_jacobians != "differences") analytic = stepper.analyticAvailable(&why);
   if (pr.step_jacobians == "analytic" && !analytic)
     throw AdjointError("adjoint: analytic step Jacobians do not apply: " + why);
   res.analytic_jacobians = analytic;
@@ -613,14 +664,28 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
     }
     return d;
   };
+  // an excitation-driven control's column d = lambda^T dy+/de at step k, at the clamped value the
+  // step used: through the clamp (zero outside [min, max]) and the hat weights to the step's two nodes
+  auto addExcitation = [&](const Excited& ex, int k, double d) {
+    const double raw = excitationAt(ex, p, nf, k, N);
+    if (raw < ex.min || raw > ex.max) return;
+    int i0 = 0;
+    double w0 = 0.0, w1 = 0.0;
+    hatWeights(ex.nodes, k, N, i0, w0, w1);
+    res.gradient[nf + ex.param[i0]] += w0 * d;
+    if (w1 != 0.0) res.gradient[nf + ex.param[i0 + 1]] += w1 * d;
+  };
+  MatX Jm;  // analytic: the Hill-type muscles' control columns
   for (int k = N - 1; k >= 0; --k) {
     const double t = timeAt(k);
     u = controlsAt(pr, rs, p, k, N);
     if (analytic) {
-      stepper.analyticJacobians(y[k], t, h, u, Jy, Jf, ns > 0 ? &dtau_ds : nullptr, ns > 0 ? &Js : nullptr);
+      stepper.analyticJacobians(y[k], t, h, u, Jy, Jf, ns > 0 ? &dtau_ds : nullptr, ns > 0 ? &Js : nullptr,
+                                rs.excited.empty() ? nullptr : &Jm);
       if (ns > 0) res.gradient.tail(ns) += Js.transpose() * lambda;
       const VecX lf = Jf.transpose() * lambda;
       for (int c = nub; c < nub + nd; ++c) Ju[c] = lf[rs.driven[c - nub]];
+      for (const Excited& ex : rs.excited) addExcitation(ex, k, lambda.dot(Jm.col(ex.control)));
     } else {
       // generalized-force columns: one central difference per driven coordinate (the step is
       // linear in them for euler and bdf1, so this is exact up to round-off there)
@@ -640,14 +705,7 @@ Result evaluate(const Problem& pr, const Objective& obj, const VecX& p, bool wit
         VecX up = u, um = u;
         up[c] += e;
         um[c] -= e;
-        const double d = lambda.dot(stepper.step(y[k], t, h, up) - stepper.step(y[k], t, h, um)) / (2.0 * e);
-        const double raw = excitationAt(ex, p, nf, k, N);
-        if (raw < ex.min || raw > ex.max) continue;
-        int i0 = 0;
-        double w0 = 0.0, w1 = 0.0;
-        hatWeights(ex.nodes, k, N, i0, w0, w1);
-        res.gradient[nf + ex.param[i0]] += w0 * d;
-        if (w1 != 0.0) res.gradient[nf + ex.param[i0 + 1]] += w1 * d;
+        addExcitation(ex, k, lambda.dot(stepper.step(y[k], t, h, up) - stepper.step(y[k], t, h, um)) / (2.0 * e));
       }
       for (int j = 0; j < ns; ++j) {
         auto phi = [&](int m) { return step_at[4 * j + m]->step(y[k], t, h, u); };

@@ -9,6 +9,7 @@
 #include "core/dynamics/constraints/coordinate_coupler.hpp"
 #include "core/dynamics/constraints/prescribed_coordinate.hpp"
 #include "core/dynamics/coordinate_actuator_term.hpp"
+#include "core/dynamics/muscle_force_term.hpp"
 #include "core/dynamics/muscle_term.hpp"
 #include "core/muscles/muscle_id_tangent.hpp"
 #include "core/muscles/muscle_kinematics.hpp"
@@ -391,6 +392,117 @@ void addWrappingMuscleIdDerivatives(const Model& model, const State& s, const Ve
   }
 }
 
+// Central differences of the Hill-type muscles (MuscleForceTerm) alone, muscle by muscle, at s with
+// the controls of ws: muscle k's share g_k = (-F_t dl/dq in its columns; its zdot), F_t and zdot
+// from its model at (its z, l, ldot, its u), differenced along each coordinate and speed that moves
+// its path (the skeleton's kinematics once per stencil point for all of them, then each moved
+// muscle's path and model), and along its own states and control (its model alone, at the
+// state's path). `out` selects the blocks of d(f; zdot)/d(q, qdot, z, u) wanted (null: not).
+struct StateTermColumns {
+  MatX* f_q = nullptr;  MatX* f_v = nullptr;  MatX* f_z = nullptr;  MatX* f_u = nullptr;
+  MatX* z_q = nullptr;  MatX* z_v = nullptr;  MatX* z_z = nullptr;  MatX* z_u = nullptr;
+};
+void differenceStateTerms(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
+                          const StateTermColumns& out) {
+  const Model& model = sys.model();
+  const int n = sys.ndof(), nz = sys.numStates(), nu = sys.numControls();
+  if (out.f_q) out.f_q->setZero(n, n);
+  if (out.f_v) out.f_v->setZero(n, n);
+  if (out.f_z) out.f_z->setZero(n, nz);
+  if (out.f_u) out.f_u->setZero(n, nu);
+  if (out.z_q) out.z_q->setZero(nz, n);
+  if (out.z_v) out.z_v->setZero(nz, n);
+  if (out.z_z) out.z_z->setZero(nz, nz);
+  if (out.z_u) out.z_u->setZero(nz, nu);
+  // every Hill-type muscle: its term, index, states and control
+  struct Hill {
+    const MuscleForceTerm* term;
+    int k, z0, nzk, u;
+    std::vector<char> moves;  // per coordinate: its path's columns
+  };
+  std::vector<Hill> hills;
+  SkeletonWorkspace sk(model);
+  calcKinematics(model, s, sk);
+  double l = 0.0, ld = 0.0;
+  VecX dl;
+  for (size_t i = 0; i < sys.terms().size(); ++i) {
+    const auto* mf = dynamic_cast<const MuscleForceTerm*>(sys.terms()[i].get());
+    if (!mf) continue;
+    for (int k = 0; k < static_cast<int>(mf->actuated().size()); ++k) {
+      const MuscleForceTerm::Actuated& a = mf->actuated()[static_cast<size_t>(k)];
+      Hill h{mf, k, sys.stateOffset(i) + a.z_offset, a.model->numStates(), sys.controlOffset(i) + k, {}};
+      MuscleKinematics mk;
+      initMuscleKinematics(model, a.muscle.path, mk);
+      h.moves.assign(static_cast<size_t>(n), 0);
+      for (int c : mk.cols)
+        if (c < n) h.moves[static_cast<size_t>(c)] = 1;
+      hills.push_back(std::move(h));
+    }
+  }
+  if (hills.empty()) return;
+  State sp = s;
+  VecX u = ws.controls.size() == nu ? ws.controls : VecX::Zero(nu);
+  hill::MuscleOutput mo;
+  // muscle h's (f in all n; zdot_h) at sp, u with the skeleton's kinematics in sk; path given or
+  // evaluated
+  auto evalMuscle = [&](const Hill& h, bool path, VecX& f, Eigen::Ref<VecX> zdot) {
+    if (path) h.term->calcPath(model, sp, sk, h.k, l, ld, dl);
+    hill::MusculotendonInput in;
+    in.length = l;
+    in.speed = ld;
+    in.excitation = u[h.u];
+    h.term->actuated()[static_cast<size_t>(h.k)].model->calc(h.nzk > 0 ? sp.z.data() + h.z0 : nullptr, in, mo,
+                                                              zdot.data());
+    f.noalias() -= mo.tendon_force * dl.head(n);
+  };
+  VecX fp(n), fm(n), zp(nz), zm(nz);
+  // along one variable x (a coordinate or speed: kinematics per point, every moved muscle; a state
+  // or control: the muscle alone at the state's path)
+  auto column = [&](double& x, const std::vector<size_t>& which, bool kinematics, MatX* f_block, MatX* z_block,
+                    int col) {
+    const double x0 = x, e = step * std::max(1.0, std::abs(x0));
+    fp.setZero();
+    fm.setZero();
+    zp.setZero();
+    zm.setZero();
+    for (int sign : {1, -1}) {
+      x = x0 + sign * e;
+      if (kinematics) calcKinematics(model, sp, sk);
+      VecX& f = sign > 0 ? fp : fm;
+      VecX& z = sign > 0 ? zp : zm;
+      for (size_t j : which) {
+        const Hill& h = hills[j];
+        evalMuscle(h, kinematics, f, z.segment(h.z0, h.nzk));
+      }
+    }
+    x = x0;
+    if (f_block) f_block->col(col) = (fp - fm) / (2.0 * e);
+    if (z_block) z_block->col(col) = (zp - zm) / (2.0 * e);
+  };
+  // states and controls first, each muscle at the state's path
+  if (out.f_z || out.z_z || out.f_u || out.z_u)
+    for (size_t j = 0; j < hills.size(); ++j) {
+      const Hill& h = hills[j];
+      h.term->calcPath(model, sp, sk, h.k, l, ld, dl);
+      const std::vector<size_t> one{j};
+      if (out.f_z || out.z_z)
+        for (int c = h.z0; c < h.z0 + h.nzk; ++c) column(sp.z[c], one, false, out.f_z, out.z_z, c);
+      if (out.f_u || out.z_u) column(u[h.u], one, false, out.f_u, out.z_u, h.u);
+    }
+  // then coordinates and speeds
+  std::vector<size_t> moved;
+  for (int col = 0; col < 2 * n; ++col) {
+    const bool speed = col >= n;
+    const int c = speed ? col - n : col;
+    if (speed ? !(out.f_v || out.z_v) : !(out.f_q || out.z_q)) continue;
+    moved.clear();
+    for (size_t j = 0; j < hills.size(); ++j)
+      if (hills[j].moves[static_cast<size_t>(c)]) moved.push_back(j);
+    if (moved.empty()) continue;
+    column(speed ? sp.qdot[c] : sp.q[c], moved, true, speed ? out.f_v : out.f_q, speed ? out.z_v : out.z_q, c);
+  }
+}
+
 }  // namespace
 
 void skeletonIdDerivatives(const Model& model, const State& s, const VecX& qddot, MatX& dtau_dq, MatX& dtau_dqdot) {
@@ -410,7 +522,7 @@ bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
   // the terms with written derivatives; none adds K or D (the adjoint's bdf1 route relies on it)
   for (const auto& t : sys.terms()) {
     if (dynamic_cast<const CoordinateActuatorTerm*>(t.get()) || dynamic_cast<const CoordinateLimitForceTerm*>(t.get()) ||
-        dynamic_cast<const SpringGeneralizedForceTerm*>(t.get()))
+        dynamic_cast<const SpringGeneralizedForceTerm*>(t.get()) || dynamic_cast<const MuscleForceTerm*>(t.get()))
       continue;
     if (const auto* mt = dynamic_cast<const MuscleTerm*>(t.get())) {
       if (!muscleTermSupported(*mt, nullptr, why)) return false;
@@ -423,16 +535,28 @@ bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
 
 std::string systemIdDerivativesLocalDifferences(const System& sys) {
   TermMuscles muscles;
-  for (const auto& t : sys.terms())
+  std::string hill;
+  for (const auto& t : sys.terms()) {
     if (const auto* mt = dynamic_cast<const MuscleTerm*>(t.get())) muscleTermSupported(*mt, &muscles, nullptr);
-  if (muscles.wrapping.empty()) return "";
-  const size_t n = muscles.wrapping.size();
-  return "the mass points of " + std::to_string(n) + " wrapping (Type III) muscle" + (n > 1 ? "s" : "") + " ('" +
-         muscles.wrapping.front()->name + "'" + (n > 1 ? ", ..." : "") + ") by muscle-local fourth-order differences";
+    if (const auto* mf = dynamic_cast<const MuscleForceTerm*>(t.get()); mf && !mf->actuated().empty()) {
+      const size_t n = mf->actuated().size();
+      hill = "the forces and states of " + std::to_string(n) + " Hill-type muscle" + (n > 1 ? "s" : "") + " ('" +
+             mf->actuated().front().muscle.name + "'" + (n > 1 ? ", ..." : "") +
+             ") by central differences of their term";
+    }
+  }
+  std::string text;
+  if (!muscles.wrapping.empty()) {
+    const size_t n = muscles.wrapping.size();
+    text = "the mass points of " + std::to_string(n) + " wrapping (Type III) muscle" + (n > 1 ? "s" : "") + " ('" +
+           muscles.wrapping.front()->name + "'" + (n > 1 ? ", ..." : "") + ") by muscle-local fourth-order differences";
+  }
+  if (!hill.empty()) text += (text.empty() ? "" : "; ") + hill;
+  return text;
 }
 
 bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, const DynamicsWorkspace& ws,
-                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why) {
+                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why, double term_step) {
   if (!ws.loads.empty()) {
     if (why) *why = "external loads";
     return false;
@@ -460,7 +584,38 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
     }
     // CoordinateActuatorTerm: optimal_force * u does not depend on q or qdot
   }
+  // Hill-type muscles: term-local differences (stateTermDerivatives)
+  if (std::any_of(sys.terms().begin(), sys.terms().end(),
+                  [](const auto& t) { return dynamic_cast<const MuscleForceTerm*>(t.get()) != nullptr; })) {
+    MatX df_dq, df_dv;
+    StateTermColumns cols;
+    cols.f_q = &df_dq;
+    cols.f_v = &df_dv;
+    differenceStateTerms(sys, s, ws, term_step, cols);
+    dtau_dq -= df_dq;
+    dtau_dqdot -= df_dv;
+  }
   return true;
+}
+
+void stateTermDerivatives(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
+                          StateTermDerivatives& out) {
+  StateTermColumns cols;
+  cols.f_z = &out.df_dz;
+  cols.f_u = &out.df_du;
+  cols.z_q = &out.dzdot_dq;
+  cols.z_v = &out.dzdot_dv;
+  cols.z_z = &out.dzdot_dz;
+  cols.z_u = &out.dzdot_du;
+  differenceStateTerms(sys, s, ws, step, cols);
+}
+
+void stateTermForceDerivatives(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
+                               MatX& df_dz, MatX& df_du) {
+  StateTermColumns cols;
+  cols.f_z = &df_dz;
+  cols.f_u = &df_du;
+  differenceStateTerms(sys, s, ws, step, cols);
 }
 
 bool constraintRowDerivativesAvailable(const System& sys, std::string* why) {

@@ -46,13 +46,36 @@ bool jointsHaveExactVelocityTerms(const Model& model, std::string* offending = n
 /// (ws.controls): the skeleton's plus each term's. False (and *why) when the system has a part
 /// whose derivatives are not written (see the file comment); the matrices are then unspecified.
 bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, const DynamicsWorkspace& ws,
-                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why = nullptr);
+                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why = nullptr, double term_step = 2e-7);
 /// Whether systemIdDerivatives can apply to this system (everything but the workspace's loads);
 /// false with the first part that has no written derivatives.
 bool systemIdDerivativesAvailable(const System& sys, std::string* why = nullptr);
-/// The parts whose derivatives systemIdDerivatives takes by muscle-local differences rather than
-/// in closed form, in words ("" when none): the mass points of wrapping (Type III) muscles.
+/// The parts whose derivatives systemIdDerivatives takes by local differences rather than in
+/// closed form, in words ("" when none): the mass points of wrapping (Type III) muscles, the
+/// Hill-type muscles' forces and states.
 std::string systemIdDerivativesLocalDifferences(const System& sys);
+
+/// Hill-type muscles (MuscleForceTerm: f -= F_t (dl/dq)^T, zdot from each model's calc) are the
+/// terms with auxiliary states z and controls u (excitations). Their Hill curves (Thelen's
+/// force-velocity inverse, the activation's switch, a tendon's toe region) and Type III path
+/// lengths (dl/dq is itself a difference at 1e-7) have no written derivatives, so theirs are
+/// central differences of the term alone, not of the step: at each column the skeleton's
+/// kinematics and the term (every muscle's path, model and rates) are evaluated twice, at the
+/// relative step `step` (the adjoint passes its Problem::jacobian_step: 2e-7 for muscles that do
+/// not wrap, 6e-6 with wrapping ones, docs/gradients.md §2). systemIdDerivatives adds their
+/// -df/dq and -df/dqdot at `term_step`; StateTermDerivatives holds the rest, at the controls
+/// ws.controls (n = ndof, nz = numStates, nu = numControls; zero outside the terms' own):
+struct StateTermDerivatives {
+  MatX df_dz, df_du;                    ///< their generalized force        (n x nz, n x nu)
+  MatX dzdot_dq, dzdot_dv;              ///< their states' rates            (nz x n)
+  MatX dzdot_dz, dzdot_du;              ///<                                (nz x nz, nz x nu)
+};
+void stateTermDerivatives(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
+                          StateTermDerivatives& out);
+/// df/dz and df/du alone (the forces' dependence on the states and controls at a state: the
+/// stages of sdirk2 take them at their own (q, qdot) with the step's z and u)
+void stateTermForceDerivatives(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
+                               MatX& df_dz, MatX& df_du);
 
 /// The derivatives of the constraint rows as System::calcConstraints forms them (G, the stabilized
 /// rhs, vel_err), written for coordinate couplers (OpenSim's CoordinateCouplerConstraint,

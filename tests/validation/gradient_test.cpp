@@ -161,16 +161,22 @@ TEST_P(HillGradient, TugOfWarNodesInitialStateAndMassAgainstDifferences) {
   VecX p = g.p0;
   for (int i = 0; i < 8; ++i) p[i] = u(rng);
   p[9] = 0.02;  // qdot0
-  const adjoint::Result r = adjoint::evaluate(g.problem, g.objective, p, true);
   const VecX fd = adjoint::finiteDifferenceGradient(g.problem, g.objective, p);
-  // measured 1.1e-9 (euler and bdf1 alike: no joint springs; sdirk2 2.5e-9) with the step Jacobians' relative
-  // difference step 2e-7 that makeGradientSetup picks for non-wrapping Hill muscles; 3.2e-6 at
-  // the default 6e-6, whose truncation error the tendon's curvature near slack makes (§2, §5)
+  // differenced route: measured 1.7e-9 (euler and bdf1 alike: no joint springs; sdirk2 2.5e-9)
+  // with the step Jacobians' relative difference step 2e-7 that makeGradientSetup picks for
+  // non-wrapping Hill muscles; 3.2e-6 at the default 6e-6, whose truncation error the tendon's
+  // curvature near slack makes (§2, §5). Analytic route (the muscles' term differenced alone at
+  // the same step, docs/gradients.md §2.1): measured 2.9e-9 (euler, bdf1), 2.6e-9 (sdirk2)
   EXPECT_DOUBLE_EQ(g.problem.jacobian_step, 2e-7);
-  EXPECT_LE(adjoint::worstRelativeError(r.gradient, fd), 6e-9)
-      << "adjoint " << r.gradient.transpose() << "\ndifferences " << fd.transpose();
-  for (int i = 0; i < 8; ++i) EXPECT_NE(r.gradient[i], 0.0) << i;  // every node moves the block
-  EXPECT_NE(r.gradient[10], 0.0);
+  for (const char* route : {"differences", "analytic"}) {
+    g.problem.step_jacobians = route;
+    const adjoint::Result r = adjoint::evaluate(g.problem, g.objective, p, true);
+    const double err = adjoint::worstRelativeError(r.gradient, fd);
+    std::printf("[ measured ] %s, %s step Jacobians: %.2e\n", GetParam(), route, err);
+    EXPECT_LE(err, 6e-9) << route << "\nadjoint " << r.gradient.transpose() << "\ndifferences " << fd.transpose();
+    for (int i = 0; i < 8; ++i) EXPECT_NE(r.gradient[i], 0.0) << i;  // every node moves the block
+    EXPECT_NE(r.gradient[10], 0.0);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, HillGradient, ::testing::Values("euler", "bdf1", "sdirk2"));
@@ -213,15 +219,21 @@ TEST(HillGradientTerms, ClampedNodesHaveZeroDerivative) {
 // step, N (1 + 2 n_excited + 2 (2 n + n_z)) step evaluations
 TEST(HillGradientTerms, StepEvaluationsDoNotGrowWithTheNodes) {
   SimulationModelOptions mo;
-  auto count = [&](const std::string& params) {
+  auto count = [&](const std::string& params, const char* route) {
     GradientSetup g = makeGradientSetup(osimModel("tug_of_war_step.osim"), mo, "euler", 0.05, 0.001, params,
                                         "point:block@0,0,0=0.05,0,0");
-    return adjoint::evaluate(g.problem, g.objective, g.p0, true).step_evaluations;
+    g.problem.step_jacobians = route;
+    const adjoint::Result r = adjoint::evaluate(g.problem, g.objective, g.p0, true);
+    EXPECT_EQ(r.analytic_jacobians, std::string(route) == "analytic");
+    return r.step_evaluations;
   };
-  const long two = count("excitations:left_muscle@2=0.6,right_muscle@2=0.5");
-  const long forty = count("excitations:left_muscle@40=0.6,right_muscle@40=0.5");
+  const long two = count("excitations:left_muscle@2=0.6,right_muscle@2=0.5", "differences");
+  const long forty = count("excitations:left_muscle@40=0.6,right_muscle@40=0.5", "differences");
   EXPECT_EQ(two, forty);
   EXPECT_EQ(two, 50 * (1 + 2 * 2 + 2 * (2 * 1 + 4)));
+  // the analytic route evaluates the forward run's steps only, whatever the nodes
+  EXPECT_EQ(count("excitations:left_muscle@2=0.6,right_muscle@2=0.5", "analytic"), 50);
+  EXPECT_EQ(count("excitations:left_muscle@40=0.6,right_muscle@40=0.5", "analytic"), 50);
 }
 
 // zero muscle mass is the massless (lumped) model: the same gradient, bit for bit
