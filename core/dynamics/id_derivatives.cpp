@@ -503,6 +503,59 @@ void differenceStateTerms(const System& sys, const State& s, const DynamicsWorks
   }
 }
 
+// Force terms with no written derivatives that add no mass and have no states (contact, bushings,
+// point-to-point springs, point and torque actuators, sampled or impulse loads): their
+// generalized force is differenced alone (term-local central differences at `step`, each stencil
+// point the skeleton's kinematics and those terms). A term that adds mass or has states of its
+// own is not one of them.
+bool differencedForceTerm(const ForceTerm& t) {
+  if (dynamic_cast<const CoordinateActuatorTerm*>(&t) || dynamic_cast<const CoordinateLimitForceTerm*>(&t) ||
+      dynamic_cast<const SpringGeneralizedForceTerm*>(&t) || dynamic_cast<const MuscleForceTerm*>(&t) ||
+      dynamic_cast<const MuscleTerm*>(&t))
+    return false;
+  return !t.addsMass() && t.numStates() == 0;
+}
+
+void addDifferencedForceTerms(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
+                              MatX& dtau_dq, MatX& dtau_dqdot) {
+  const Model& model = sys.model();
+  const int n = sys.ndof(), nu = sys.numControls();
+  std::vector<size_t> terms;
+  for (size_t i = 0; i < sys.terms().size(); ++i)
+    if (differencedForceTerm(*sys.terms()[i])) terms.push_back(i);
+  if (terms.empty()) return;
+  SkeletonWorkspace sk(model);
+  std::vector<std::unique_ptr<TermScratch>> scratch;
+  for (size_t i : terms) scratch.push_back(sys.terms()[i]->makeScratch(model));
+  std::uint64_t evaluation = 0;
+  State sp = s;
+  const VecX u = ws.controls.size() == nu ? ws.controls : VecX::Zero(nu);
+  auto force = [&]() {
+    calcKinematics(model, sp, sk);
+    ++evaluation;
+    VecX f = VecX::Zero(n);
+    for (size_t j = 0; j < terms.size(); ++j) {
+      TermContext ctx(sk, scratch[j].get(), evaluation);
+      ctx.z_offset = sys.stateOffset(terms[j]);
+      ctx.u_offset = sys.controlOffset(terms[j]);
+      if (nu > 0) ctx.controls = &u;
+      sys.terms()[terms[j]]->addForce(model, sp, ctx, f);
+    }
+    return f;
+  };
+  for (int col = 0; col < 2 * n; ++col) {
+    const bool speed = col >= n;
+    double& x = speed ? sp.qdot[col - n] : sp.q[col];
+    const double x0 = x, e = step * std::max(1.0, std::abs(x0));
+    x = x0 + e;
+    const VecX fp = force();
+    x = x0 - e;
+    const VecX fm = force();
+    x = x0;
+    (speed ? dtau_dqdot : dtau_dq).col(speed ? col - n : col) -= (fp - fm) / (2.0 * e);
+  }
+}
+
 }  // namespace
 
 void skeletonIdDerivatives(const Model& model, const State& s, const VecX& qddot, MatX& dtau_dq, MatX& dtau_dqdot) {
@@ -522,7 +575,8 @@ bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
   // the terms with written derivatives; none adds K or D (the adjoint's bdf1 route relies on it)
   for (const auto& t : sys.terms()) {
     if (dynamic_cast<const CoordinateActuatorTerm*>(t.get()) || dynamic_cast<const CoordinateLimitForceTerm*>(t.get()) ||
-        dynamic_cast<const SpringGeneralizedForceTerm*>(t.get()) || dynamic_cast<const MuscleForceTerm*>(t.get()))
+        dynamic_cast<const SpringGeneralizedForceTerm*>(t.get()) || dynamic_cast<const MuscleForceTerm*>(t.get()) ||
+        differencedForceTerm(*t))
       continue;
     if (const auto* mt = dynamic_cast<const MuscleTerm*>(t.get())) {
       if (!muscleTermSupported(*mt, nullptr, why)) return false;
@@ -552,6 +606,10 @@ std::string systemIdDerivativesLocalDifferences(const System& sys) {
            muscles.wrapping.front()->name + "'" + (n > 1 ? ", ..." : "") + ") by muscle-local fourth-order differences";
   }
   if (!hill.empty()) text += (text.empty() ? "" : "; ") + hill;
+  std::string others;
+  for (const auto& t : sys.terms())
+    if (differencedForceTerm(*t)) others += (others.empty() ? "'" : ", '") + t->name() + "'";
+  if (!others.empty()) text += (text.empty() ? "" : "; ") + std::string("the forces of ") + others + " by central differences of their terms";
   return text;
 }
 
@@ -595,6 +653,8 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
     dtau_dq -= df_dq;
     dtau_dqdot -= df_dv;
   }
+  // the other force terms without written derivatives: term-local differences
+  addDifferencedForceTerms(sys, s, ws, term_step, dtau_dq, dtau_dqdot);
   return true;
 }
 

@@ -25,9 +25,13 @@
 // Type III (wrapping) paths by a muscle-local fourth-order difference of the muscle's own share
 // along the coordinates that move it (the wrap construction's J and Jdot have no written
 // derivatives along q; the dissertation differences its network Jacobians likewise [D Eq. 5.58]).
-// Any other term (fibre-following mass points among them), external loads, extra coordinates, a
-// coordinate map or Simbody-compatible joint velocity terms make systemIdDerivatives refuse
-// (false, with the reason), and the adjoint then differences its step (docs/gradients.md §2).
+// Hill-type muscles (MuscleForceTerm) and the force terms without written derivatives that add
+// no mass and have no states (contact, bushings, point-to-point springs, point and torque
+// actuators) join by central differences of the term alone at `term_step`, not of the step
+// (systemIdDerivativesLocalDifferences names them). Fibre-following mass points, any other term,
+// external loads, extra coordinates, a coordinate map or Simbody-compatible joint velocity terms
+// make systemIdDerivatives refuse (false, with the reason), and the adjoint then differences its
+// step (docs/gradients.md §2).
 #include <string>
 
 #include "core/dynamics/system.hpp"
@@ -52,7 +56,7 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
 bool systemIdDerivativesAvailable(const System& sys, std::string* why = nullptr);
 /// The parts whose derivatives systemIdDerivatives takes by local differences rather than in
 /// closed form, in words ("" when none): the mass points of wrapping (Type III) muscles, the
-/// Hill-type muscles' forces and states.
+/// Hill-type muscles' forces and states, the force terms differenced alone.
 std::string systemIdDerivativesLocalDifferences(const System& sys);
 
 /// Hill-type muscles (MuscleForceTerm: f -= F_t (dl/dq)^T, zdot from each model's calc) are the

@@ -94,8 +94,10 @@ TEST_F(OptimizeCli, ExcitationDriveWritesTheBestRun) {
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.err.find("6 excitation nodes"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("lbfgs excitations: excitation left_muscle node 1/3="), std::string::npos) << r.out;
-  // Hill-type states keep the differenced route, and the output says why
-  EXPECT_NE(r.out.find("lbfgs step Jacobians: central differences of the step; not analytic: excitation parameters"),
+  // Hill-type muscles take the analytic route, their term differenced alone, and the output says so
+  EXPECT_NE(r.out.find("lbfgs step Jacobians: analytic (derivatives of inverse dynamics, docs/gradients.md §2.1); the "
+                       "forces and states of 2 Hill-type muscles ('left_muscle', ...) by central differences of their "
+                       "term"),
             std::string::npos)
       << r.out;
   const std::string csv = slurp(report / "best_run.csv");
