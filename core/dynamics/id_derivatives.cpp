@@ -680,10 +680,8 @@ void stateTermForceDerivatives(const System& sys, const State& s, const Dynamics
 
 bool constraintRowDerivativesAvailable(const System& sys, std::string* why) {
   for (const auto& c : sys.constraints())
-    if (!dynamic_cast<const CoordinateCoupler*>(c.get()) && !dynamic_cast<const PrescribedCoordinate*>(c.get())) {
-      if (why)
-        *why = "the constraint '" + c->name() +
-               "' (only coordinate couplers and locked or prescribed coordinates have written derivatives)";
+    if (c->actsOnExtraCoordinates()) {
+      if (why) *why = "the constraint '" + c->name() + "' on extra coordinates (deformables)";
       return false;
     }
   return true;
@@ -701,7 +699,53 @@ void constraintRowDerivatives(const System& sys, const State& s, const VecX& w, 
   MatX dperr_dq = MatX::Zero(nc, n);
   int r = 0;
   FunctionValue fv, ft;
+  SkeletonWorkspace sk(sys.model());
   for (const auto& c : sys.constraints()) {
+    if (!dynamic_cast<const PrescribedCoordinate*>(c.get()) && !dynamic_cast<const CoordinateCoupler*>(c.get())) {
+      // points, welds, prescribed points: the rows differenced alone (fourth order, local), G w,
+      // G^T lambda and the errors along q, the rhs and the errors along qdot
+      const int m = c->rows();
+      const Model& model = sys.model();
+      const VecX lr = lambda.segment(r, m);
+      State sp = s;
+      MatX G(m, n);
+      VecX rhs(m), perr(m), verr(m);
+      auto rows = [&]() {
+        calcKinematics(model, sp, sk);
+        G.setZero();
+        rhs.setZero();
+        c->calcAcceleration(model, sp, sk, G, rhs);
+        c->calcErrors(model, sp, sk, perr, verr);
+        VecX out(4 * m + n);
+        out << G * w, rhs, verr, perr, G.transpose() * lr;
+        return out;
+      };
+      for (int j = 0; j < 2 * n; ++j) {
+        const bool speed = j >= n;
+        const int col = speed ? j - n : j;
+        double& x = speed ? sp.qdot[col] : sp.q[col];
+        const double x0 = x;
+        const VecX d = localDerivative(
+            [&](double v) {
+              x = v;
+              return rows();
+            },
+            x0);
+        x = x0;
+        if (!speed) {
+          out.dGw_dq.block(r, col, m, 1) = d.head(m);
+          out.drhs_dq.block(r, col, m, 1) = d.segment(m, m);
+          out.dverr_dq.block(r, col, m, 1) = d.segment(2 * m, m);
+          dperr_dq.block(r, col, m, 1) = d.segment(3 * m, m);
+          out.dGTl_dq.col(col) += d.tail(n);
+        } else {
+          out.drhs_dv.block(r, col, m, 1) = d.segment(m, m);
+          out.dverr_dv.block(r, col, m, 1) = d.segment(2 * m, m);
+        }
+      }
+      r += m;
+      continue;
+    }
     if (const auto* pc = dynamic_cast<const PrescribedCoordinate*>(c.get())) {
       // G = -e_k^T and rhs = -qddot_p(t) are constant in the state; pos_err = q_p(t) - q_k,
       // vel_err = qdot_p(t) - qdot_k

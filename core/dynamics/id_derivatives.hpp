@@ -82,7 +82,10 @@ void stateTermForceDerivatives(const System& sys, const State& s, const Dynamics
                                MatX& df_dz, MatX& df_du);
 
 /// The derivatives of the constraint rows as System::calcConstraints forms them (G, the stabilized
-/// rhs, vel_err), written for coordinate couplers (OpenSim's CoordinateCouplerConstraint,
+/// rhs, vel_err). Other constraints (points, welds, prescribed points) are differenced alone: a
+/// fourth-order local difference of their own G w, G^T lambda, rhs and errors along each
+/// coordinate and speed (localDerivative; the skeleton's kinematics at each stencil point).
+/// Written for coordinate couplers (OpenSim's CoordinateCouplerConstraint,
 /// C = scale f(q_I) - q_dep): G = (scale grad f, -1) and rhs = -scale qdot_I^T Hess f qdot_I, so the
 /// derivatives need f's Hessian (exact, the function's own) and, for rhs along q, its third
 /// derivative (a fourth-order difference of the Hessian, function-local as the joints' second
@@ -96,8 +99,8 @@ struct ConstraintRowDerivatives {
 };
 /// Locked and prescribed coordinates (PrescribedCoordinate: G = -e_k^T, rhs = -qddot_p(t)) have
 /// constant rows; only their errors move with the state.
-/// Whether every constraint of the system is a coordinate coupler or a locked or prescribed
-/// coordinate; false with the first that is not.
+/// Whether the rows of every constraint of the system have derivatives here (all but those on
+/// extra coordinates); false with the first that has not.
 bool constraintRowDerivativesAvailable(const System& sys, std::string* why = nullptr);
 void constraintRowDerivatives(const System& sys, const State& s, const VecX& w, const VecX& lambda,
                               ConstraintRowDerivatives& out);

@@ -298,6 +298,9 @@ TEST(AdjointExcitations, NodesAgainstTheClosedFormOfTheDiscreteRunWithTheClamp) 
       g_effort += 2.0 * h * u * w;
     }
     const adjoint::Result r = adjoint::evaluate(pr, obj, p, true);
+    // a term with states of its own other than Hill-type muscles has no derivatives: differenced
+    EXPECT_FALSE(r.analytic_jacobians);
+    EXPECT_EQ(r.jacobian_note, "auxiliary states of a term other than Hill-type muscles");
     EXPECT_NEAR(r.final.q[0], y[0], 1e-13);
     EXPECT_NEAR(r.final.z[0], y[2], 1e-13);
     const double J = 0.5 * (y[0] - 0.4) * (y[0] - 0.4) + 0.15 * y[1] * y[1] + 0.02 * effort;
