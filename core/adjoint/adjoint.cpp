@@ -232,7 +232,8 @@ class Stepper {
   }
 
   // Whether the step's Jacobians can be formed from the ID derivatives (docs/gradients.md §2.1):
-  // no auxiliary states, no constraints but coordinate couplers, every part with written derivatives.
+  // no auxiliary states but the Hill-type muscles', constraints on the skeleton's coordinates, and
+  // every term with derivatives (written, or differenced alone).
   bool analyticAvailable(std::string* why) const {
     if (nz_ > 0 && !state_terms_) {
       *why = "auxiliary states of a term other than Hill-type muscles";
@@ -269,21 +270,31 @@ class Stepper {
     State s = unpack(y, t);
     ws_.controls = u;
     MatX Dq, Dv;
-    // the ID derivatives at a state and acceleration; M's factorization left in `lu`
-    auto idDerivatives = [&](const State& st, const VecX& a) {
+    // the Hill-type muscles' derivatives at the step's start (euler and bdf1: from the same
+    // evaluations as the ID derivatives there; sdirk2: of their own, its stages being elsewhere)
+    StateTermDerivatives sd;
+    bool have_sd = false;
+    // the ID derivatives at a state and acceleration (at the step's start: with sd)
+    auto idDerivatives = [&](const State& st, const VecX& a, bool start) {
       std::string why;
-      if (!systemIdDerivatives(sys_, st, a, ws_, Dq, Dv, &why, term_step_))
+      if (!systemIdDerivatives(sys_, st, a, ws_, Dq, Dv, &why, term_step_, start && state_terms_ ? &sd : nullptr))
         throw AdjointError("adjoint: analytic step Jacobians: " + why);
+      have_sd = have_sd || (start && state_terms_);
     };
     // the generalized forces of the step's parameters at a state and acceleration: -dtau/ds of
     // the system parameters, then df/dz and df/du of the Hill-type muscles (n x (ns + nz + nu))
     int ns = 0;
-    auto forceColumns = [&](const State& st, const VecX& a) {
+    auto forceColumns = [&](const State& st, const VecX& a, bool start) {
       MatX gs = dtau_ds ? MatX(-(*dtau_ds)(st, a)) : MatX(n, 0);
       ns = static_cast<int>(gs.cols());
       if (!state_terms_) return gs;
       MatX fz, fu;
-      stateTermForceDerivatives(sys_, st, ws_, term_step_, fz, fu);
+      if (start) {
+        fz = sd.df_dz;
+        fu = sd.df_du;
+      } else {
+        stateTermForceDerivatives(sys_, st, ws_, term_step_, fz, fu);
+      }
       MatX g(n, gs.cols() + fz.cols() + fu.cols());
       g << gs, fz, fu;
       return g;
@@ -320,8 +331,8 @@ class Stepper {
         vplus = A.ldlt().solve(top);
       }
       const VecX a = (vplus - s.qdot) / h;
-      idDerivatives(s, a);
-      if (columns) Gs = forceColumns(s, a);
+      idDerivatives(s, a, true);
+      if (columns) Gs = forceColumns(s, a, true);
       if (nc == 0) {
         const Eigen::LDLT<MatX> ldlt(A);
         dv_dy.leftCols(n) = -h * ldlt.solve(Dq);
@@ -354,8 +365,8 @@ class Stepper {
         st.z = s.z;  // held during the step
         sys_.calcMassAndForce(st, ws_);
         const VecX a = (V - zv) / hg;
-        idDerivatives(st, a);
-        if (columns) G_s = forceColumns(st, a);
+        idDerivatives(st, a, false);
+        if (columns) G_s = forceColumns(st, a, false);
         MatX a_v;
         if (nc == 0) {
           const Eigen::LDLT<MatX> ldlt(ws_.M);
@@ -431,9 +442,8 @@ class Stepper {
     if (nz_ == 0 && !state_terms_) return;
     // the Hill-type muscles' states: z+ = z + h zdot(q, v, z, u) at the step's start
     const int nz = nz_, nu = sys_.numControls();
-    StateTermDerivatives sd;
     ws_.controls = u;
-    stateTermDerivatives(sys_, s, ws_, term_step_, sd);
+    if (!have_sd) stateTermDerivatives(sys_, s, ws_, term_step_, sd);
     MatX Jfull = MatX::Zero(2 * n + nz, 2 * n + nz);
     Jfull.topLeftCorner(2 * n, 2 * n) = Jy;
     Jfull.block(0, 2 * n, 2 * n, nz) = JG.middleCols(ns, nz);

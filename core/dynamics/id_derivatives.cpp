@@ -614,7 +614,8 @@ std::string systemIdDerivativesLocalDifferences(const System& sys) {
 }
 
 bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, const DynamicsWorkspace& ws,
-                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why, double term_step) {
+                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why, double term_step,
+                         StateTermDerivatives* state_terms) {
   if (!ws.loads.empty()) {
     if (why) *why = "external loads";
     return false;
@@ -649,6 +650,14 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
     StateTermColumns cols;
     cols.f_q = &df_dq;
     cols.f_v = &df_dv;
+    if (state_terms) {
+      cols.f_z = &state_terms->df_dz;
+      cols.f_u = &state_terms->df_du;
+      cols.z_q = &state_terms->dzdot_dq;
+      cols.z_v = &state_terms->dzdot_dv;
+      cols.z_z = &state_terms->dzdot_dz;
+      cols.z_u = &state_terms->dzdot_du;
+    }
     differenceStateTerms(sys, s, ws, term_step, cols);
     dtau_dq -= df_dq;
     dtau_dqdot -= df_dv;

@@ -49,8 +49,10 @@ bool jointsHaveExactVelocityTerms(const Model& model, std::string* offending = n
 /// The system's dtau/dq and dtau/dqdot (ndof x ndof) at (s, qddot) with the workspace's controls
 /// (ws.controls): the skeleton's plus each term's. False (and *why) when the system has a part
 /// whose derivatives are not written (see the file comment); the matrices are then unspecified.
+struct StateTermDerivatives;
 bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, const DynamicsWorkspace& ws,
-                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why = nullptr, double term_step = 2e-7);
+                         MatX& dtau_dq, MatX& dtau_dqdot, std::string* why = nullptr, double term_step = 2e-7,
+                         StateTermDerivatives* state_terms = nullptr);
 /// Whether systemIdDerivatives can apply to this system (everything but the workspace's loads);
 /// false with the first part that has no written derivatives.
 bool systemIdDerivativesAvailable(const System& sys, std::string* why = nullptr);
@@ -67,8 +69,9 @@ std::string systemIdDerivativesLocalDifferences(const System& sys);
 /// kinematics and the term (every muscle's path, model and rates) are evaluated twice, at the
 /// relative step `step` (the adjoint passes its Problem::jacobian_step: 2e-7 for muscles that do
 /// not wrap, 6e-6 with wrapping ones, docs/gradients.md §2). systemIdDerivatives adds their
-/// -df/dq and -df/dqdot at `term_step`; StateTermDerivatives holds the rest, at the controls
-/// ws.controls (n = ndof, nz = numStates, nu = numControls; zero outside the terms' own):
+/// -df/dq and -df/dqdot at `term_step`, and with `state_terms` fills it from the same
+/// evaluations; StateTermDerivatives holds the rest, at the controls ws.controls (n = ndof,
+/// nz = numStates, nu = numControls; zero outside the terms' own):
 struct StateTermDerivatives {
   MatX df_dz, df_du;                    ///< their generalized force        (n x nz, n x nu)
   MatX dzdot_dq, dzdot_dv;              ///< their states' rates            (nz x n)
