@@ -244,10 +244,46 @@ TEST(IdDerivatives, SystemWithPassiveTermsAndActuators) {
 // conditional point): the mass points' share, against differences of the mass-matrix route
 // (System::inverseDynamics, sum_a J_ar^T m_a (J_ar qddot + Jdot_ar qdot - g)); and the dual pass's
 // value equals the optimized path-wise pass (addMuscleInverseDynamics)
+// (dq, dqd) column by column against fourth-order differences of tau at the step h1; a column whose
+// difference at h2 disagrees with it by more than 1e-7 of the column (a stencil across a kink:
+// J_ar jumps where a mass point passes a via point or a tangent point, core/muscles/path.hpp) is
+// left out and counted, and with `speeds_follow` the speed column of such a coordinate too (formed
+// from the same stencil). A column whose stencil meets a degenerate path (MuscleError) is skipped.
+struct ColumnCheck {
+  double worst = 0.0;
+  int columns = 0, kinked = 0;
+};
+template <class Tau>
+void checkColumns(Tau tau, const State& s, const MatX& dq, const MatX& dqd, double h1, double h2, bool speeds_follow,
+                  ColumnCheck& out) {
+  const int n = static_cast<int>(s.q.size());
+  std::vector<char> kinked_q(static_cast<size_t>(n), 0);
+  for (int k = 0; k < 2 * n; ++k) {
+    const bool speed = k >= n;
+    const int c = speed ? k - n : k;
+    VecX d1, d2;
+    try {
+      d1 = diffState(tau, s, c, speed, h1);
+      d2 = diffState(tau, s, c, speed, h2);
+    } catch (const MuscleError&) {
+      continue;
+    }
+    const double scale = std::max(1.0, d1.lpNorm<Eigen::Infinity>());
+    ++out.columns;
+    if ((d1 - d2).lpNorm<Eigen::Infinity>() > 1e-7 * scale || (speed && speeds_follow && kinked_q[c])) {
+      ++out.kinked;
+      if (!speed) kinked_q[c] = 1;
+      continue;
+    }
+    const VecX got = speed ? VecX(dqd.col(c)) : VecX(dq.col(c));
+    out.worst = std::max(out.worst, (got - d1).lpNorm<Eigen::Infinity>() / scale);
+  }
+}
+
 TEST(IdDerivatives, TypeOneAndTwoMusclesWithMass) {
   std::mt19937 rng(29);
-  double worst = 0.0, worst_value = 0.0, effect = 0.0;
-  int columns = 0, kinked = 0;
+  double worst_value = 0.0, effect = 0.0;
+  ColumnCheck check;
   for (int seed = 0; seed < 4; ++seed) {
     const Model m = scenes::randomTree(7, 640 + seed, scenes::TreeJoints::All);
     const int n = m.nr();
@@ -263,23 +299,11 @@ TEST(IdDerivatives, TypeOneAndTwoMusclesWithMass) {
       std::string why;
       ASSERT_TRUE(systemIdDerivatives(sys, s, qddot, ws, dq, dqd, &why)) << why;
       // a mass point crossing a via point (or a conditional point switching) within a stencil puts
-      // a kink in tau there (J_ar jumps, core/muscles/path.hpp): such columns, found as two steps'
-      // differences that disagree, are left out and counted. The reference differences at 2.5e-4:
-      // the paths' curvature gave 1.8e-9 of truncation at 1e-3 (falling 16-fold per halving)
-      for (int k = 0; k < 2 * n; ++k) {
-        const bool speed = k >= n;
-        const int c = speed ? k - n : k;
-        auto tau = [&](const State& t) { return sys.inverseDynamics(t, qddot, ws); };
-        const VecX d1 = diffState(tau, s, c, speed, 2.5e-4), d2 = diffState(tau, s, c, speed, 5e-4);
-        const double scale = std::max(1.0, d1.lpNorm<Eigen::Infinity>());
-        ++columns;
-        if ((d1 - d2).lpNorm<Eigen::Infinity>() > 1e-7 * scale) {
-          ++kinked;
-          continue;
-        }
-        const VecX got = speed ? VecX(dqd.col(c)) : VecX(dq.col(c));
-        worst = std::max(worst, (got - d1).lpNorm<Eigen::Infinity>() / scale);
-      }
+      // a kink in tau there: such columns are left out and counted (checkColumns). The reference
+      // differences at 2.5e-4: the paths' curvature gave 1.8e-9 of truncation at 1e-3 (falling
+      // 16-fold per halving)
+      checkColumns([&](const State& t) { return sys.inverseDynamics(t, qddot, ws); }, s, dq, dqd, 2.5e-4, 5e-4, false,
+                   check);
       MatX bq, bqd;
       skeletonIdDerivatives(m, s, qddot, bq, bqd);
       effect = std::max(effect, (dq - bq).lpNorm<Eigen::Infinity>() / dq.lpNorm<Eigen::Infinity>());
@@ -309,9 +333,9 @@ TEST(IdDerivatives, TypeOneAndTwoMusclesWithMass) {
   }
   std::printf("[ measured ] Type I/II muscles with mass: derivatives %.2e (%d of %d columns left out at a "
               "kink); dual pass value %.2e; the muscles' share of dtau/dq: %.0f%% of its largest entry\n",
-              worst, kinked, columns, worst_value, 100 * effect);
-  EXPECT_LT(worst, 5e-10);  // measured 1.2e-10: the references' round-off at their smaller step
-  EXPECT_LE(kinked, columns / 10);
+              check.worst, check.kinked, check.columns, worst_value, 100 * effect);
+  EXPECT_LT(check.worst, 5e-10);  // measured 1.2e-10: the references' round-off at their smaller step
+  EXPECT_LE(check.kinked, check.columns / 10);
   EXPECT_LT(worst_value, 1e-13);
   EXPECT_GT(effect, 1e-2);  // the muscles' share is not negligible in these derivatives
 }
@@ -330,8 +354,9 @@ TEST(IdDerivatives, TypeThreeMusclesByLocalDifferences) {
   const WrapSurface surfaces[] = {WrapSurface::makeCylinder(0.08, 0.4), WrapSurface::makeSphere(0.1),
                                   WrapSurface::makeEllipsoid(Vec3(0.14, 0.1, 0.12)),
                                   WrapSurface::makeTorus(0.05, 0.15)};
-  double worst = 0.0, effect = 0.0;
-  int columns = 0, kinked = 0, wrapped = 0;
+  double effect = 0.0;
+  int wrapped = 0;
+  ColumnCheck check;
   for (int k = 0; k < 4; ++k) {
     const std::vector<Muscle> muscles = {test::chainWrapMuscle(surfaces[k], WrapModel::Smooth, "wrap" + std::to_string(k), 1.5),
                                          test::straightMuscle(m, rng, 0.7)};
@@ -352,28 +377,8 @@ TEST(IdDerivatives, TypeThreeMusclesByLocalDifferences) {
       }
       wrapped += test::offStraightLine(test::evalMuscle(m, muscles[0], s)) > 1e-9;
       ++tested;
-      std::vector<char> kinked_q(n, 0);  // the speeds' columns take dJ/dq_c from the q stencil
-      for (int c = 0; c < 2 * n; ++c) {
-        const bool speed = c >= n;
-        const int j = speed ? c - n : c;
-        auto tau = [&](const State& t) { return sys.inverseDynamics(t, qddot, ws); };
-        VecX d1, d2;
-        try {
-          d1 = diffState(tau, s, j, speed, 3e-5);
-          d2 = diffState(tau, s, j, speed, 2e-4);
-        } catch (const MuscleError&) {
-          continue;
-        }
-        const double scale = std::max(1.0, d1.lpNorm<Eigen::Infinity>());
-        ++columns;
-        if ((d1 - d2).lpNorm<Eigen::Infinity>() > 1e-7 * scale || (speed && kinked_q[j])) {
-          ++kinked;
-          if (!speed) kinked_q[j] = 1;
-          continue;
-        }
-        const VecX got = speed ? VecX(dqd.col(j)) : VecX(dq.col(j));
-        worst = std::max(worst, (got - d1).lpNorm<Eigen::Infinity>() / scale);
-      }
+      checkColumns([&](const State& t) { return sys.inverseDynamics(t, qddot, ws); }, s, dq, dqd, 3e-5, 2e-4, true,
+                   check);
       MatX bq, bqd;
       skeletonIdDerivatives(m, s, qddot, bq, bqd);
       effect = std::max(effect, (dq - bq).lpNorm<Eigen::Infinity>() / dq.lpNorm<Eigen::Infinity>());
@@ -382,11 +387,11 @@ TEST(IdDerivatives, TypeThreeMusclesByLocalDifferences) {
   std::printf("[ measured ] Type III muscles with mass (4 surfaces, smooth model): derivatives %.2e (%d of %d "
               "columns left out at a kink; %d of the states wrapped); the muscles' share of dtau/dq: %.0f%% of its "
               "largest entry\n",
-              worst, kinked, columns, wrapped, 100 * effect);
+              check.worst, check.kinked, check.columns, wrapped, 100 * effect);
   // measured 5.4e-9: a torus state whose own references at 3e-5 and 2e-4 differ by 3.0e-9 (the
   // other columns below 1e-9)
-  EXPECT_LT(worst, 2e-8);
-  EXPECT_LE(kinked, columns / 10);
+  EXPECT_LT(check.worst, 2e-8);
+  EXPECT_LE(check.kinked, check.columns / 10);
   EXPECT_GE(wrapped, 6);
   EXPECT_GT(effect, 1e-2);
 }
