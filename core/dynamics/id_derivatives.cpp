@@ -419,8 +419,10 @@ void differenceStateTerms(const System& sys, const State& s, const DynamicsWorks
     const MuscleForceTerm* term;
     int k, z0, nzk, u;
     std::vector<char> moves;  // per coordinate: its path's columns
+    MuscleForceScratch* sc;   // its term's path scratch
   };
   std::vector<Hill> hills;
+  std::vector<std::unique_ptr<MuscleForceScratch>> scratch;  // one per term
   SkeletonWorkspace sk(model);
   calcKinematics(model, s, sk);
   double l = 0.0, ld = 0.0;
@@ -428,9 +430,11 @@ void differenceStateTerms(const System& sys, const State& s, const DynamicsWorks
   for (size_t i = 0; i < sys.terms().size(); ++i) {
     const auto* mf = dynamic_cast<const MuscleForceTerm*>(sys.terms()[i].get());
     if (!mf) continue;
+    scratch.push_back(std::make_unique<MuscleForceScratch>());
     for (int k = 0; k < static_cast<int>(mf->actuated().size()); ++k) {
       const MuscleForceTerm::Actuated& a = mf->actuated()[static_cast<size_t>(k)];
-      Hill h{mf, k, sys.stateOffset(i) + a.z_offset, a.model->numStates(), sys.controlOffset(i) + k, {}};
+      Hill h{mf, k, sys.stateOffset(i) + a.z_offset, a.model->numStates(), sys.controlOffset(i) + k, {},
+             scratch.back().get()};
       MuscleKinematics mk;
       initMuscleKinematics(model, a.muscle.path, mk);
       h.moves.assign(static_cast<size_t>(n), 0);
@@ -446,7 +450,7 @@ void differenceStateTerms(const System& sys, const State& s, const DynamicsWorks
   // muscle h's (f in all n; zdot_h) at sp, u with the skeleton's kinematics in sk; path given or
   // evaluated
   auto evalMuscle = [&](const Hill& h, bool path, VecX& f, Eigen::Ref<VecX> zdot) {
-    if (path) h.term->calcPath(model, sp, sk, h.k, l, ld, dl);
+    if (path) h.term->calcPath(model, sp, sk, h.k, *h.sc, l, ld, dl);
     hill::MusculotendonInput in;
     in.length = l;
     in.speed = ld;
@@ -483,7 +487,7 @@ void differenceStateTerms(const System& sys, const State& s, const DynamicsWorks
   if (out.f_z || out.z_z || out.f_u || out.z_u)
     for (size_t j = 0; j < hills.size(); ++j) {
       const Hill& h = hills[j];
-      h.term->calcPath(model, sp, sk, h.k, l, ld, dl);
+      h.term->calcPath(model, sp, sk, h.k, *h.sc, l, ld, dl);
       const std::vector<size_t> one{j};
       if (out.f_z || out.z_z)
         for (int c = h.z0; c < h.z0 + h.nzk; ++c) column(sp.z[c], one, false, out.f_z, out.z_z, c);

@@ -249,11 +249,20 @@ void MuscleForceTerm::calcPath(const Model& model, const State& s, const Skeleto
   MuscleForceScratch sc;
   sc.muscles.resize(actuated_.size());
   initMuscleKinematics(model, actuated_.at(k).muscle.path, sc.muscles[k].mk);
+  calcPath(model, s, sk, k, sc, length, speed, dl_dq);
+}
+
+void MuscleForceTerm::calcPath(const Model& model, const State& s, const SkeletonWorkspace& sk, int k,
+                               MuscleForceScratch& sc, double& length, double& speed, VecX& dl_dq) const {
+  if (sc.muscles.size() != actuated_.size()) {
+    sc.muscles.resize(actuated_.size());
+    for (size_t m = 0; m < actuated_.size(); ++m) initMuscleKinematics(model, actuated_[m].muscle.path, sc.muscles[m].mk);
+  }
   evalPath(model, s, sk, k, sc);
   const MuscleForceScratch::Entry& e = sc.muscles[k];
   length = e.length;
   speed = e.speed;
-  dl_dq = VecX::Zero(std::max<int>(model.nr(), static_cast<int>(s.q.size())));  // with extra coordinates: all of q
+  dl_dq.setZero(std::max<int>(model.nr(), static_cast<int>(s.q.size())));  // with extra coordinates: all of q
   for (int j = 0; j < e.dl_dq.size(); ++j) dl_dq[e.mk.cols[j]] = e.dl_dq[j];
 }
 

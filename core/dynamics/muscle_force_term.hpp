@@ -80,6 +80,10 @@ class MuscleForceTerm final : public ForceTerm {
   /// at s (Stage::Velocity)
   void calcPath(const Model& model, const State& s, const SkeletonWorkspace& sk, int k, double& length,
                 double& speed, VecX& dl_dq) const;
+  /// the same with the caller's scratch, kept between calls (sized for every muscle on first use;
+  /// no allocation afterwards): for callers that evaluate single muscles many times
+  void calcPath(const Model& model, const State& s, const SkeletonWorkspace& sk, int k, MuscleForceScratch& sc,
+                double& length, double& speed, VecX& dl_dq) const;
 
  private:
   MuscleForceScratch& evaluate(const Model& model, const State& s, const TermContext& ctx,
