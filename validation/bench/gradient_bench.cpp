@@ -4,9 +4,11 @@
 // q2 in 2, 20 or 200 time pieces each. Counters: the time of one forward run (forward_s), of the
 // forward run and the adjoint sweep (adjoint_s), of the 2P runs of central differences
 // (differences_s), and their ratios (adjoint_per_forward, differences_per_adjoint); then the step
-// Jacobians' two routes without muscle mass (stepJacobianRoutes). Not run by ctest.
+// Jacobians' two routes without muscle mass (stepJacobianRoutes) and with muscles whose parts the
+// analytic route differences locally (stepJacobianRoutesWithMuscles). Not run by ctest.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <string>
 
@@ -91,6 +93,63 @@ void stepJacobianRoutes(benchmark::State& st) {
 }
 
 BENCHMARK(stepJacobianRoutes)->Arg(2)->Arg(20)->Arg(200)->Iterations(1)->Unit(benchmark::kSecond);
+
+// The two routes where the analytic one differences parts locally (docs/gradients.md §2.1), the
+// same counters: 0, tug_of_war_step.osim with its two Millard muscles excited (8 nodes) and 0.5 kg
+// in one, 0.1 s at 1 ms; 1, reach_arm.osim with its six wrapping heads' physiological mass, four
+// torques, 0.3 s at 10 ms; 2, the same arm with DELT1 and TRIlong excited (3 nodes each), 0.05 s
+// at 0.25 ms.
+void stepJacobianRoutesWithMuscles(benchmark::State& st) {
+  const int c = static_cast<int>(st.range(0));
+  redmax::validation::SimulationModelOptions mo;
+  const std::string dir = std::string(REDMAX_SOURCE_DIR) + "/osim_models/";
+  GradientSetup g = [&] {
+    if (c == 0) {
+      mo.explicit_masses = {{"left_muscle", 0.5}};
+      mo.muscle_mass.mass_points = 8;
+      st.SetLabel("tug of war, Hill-type");
+      return redmax::validation::makeGradientSetup(dir + "tug_of_war_step.osim", mo, "euler", 0.1, 1e-3,
+                                                   "excitations:left_muscle@5=0.8,right_muscle@3=0.7",
+                                                   "point:block@0,0,0=0.05,0,0;0.1*speed");
+    }
+    mo.muscle_mass.source = redmax::osim::MuscleMassOptions::Source::Physiological;
+    mo.muscle_mass.wrap_mass = true;
+    if (c == 1) {
+      st.SetLabel("reach arm, wrapping mass points");
+      return redmax::validation::makeGradientSetup(
+          dir + "reach_arm.osim", mo, "euler", 0.3, 1e-2,
+          "torques:shoulder_flexion,shoulder_adduction,shoulder_rotation,elbow_flexion",
+          "point:hand@0,-0.08,0=0.25,-0.55,0.05;0.1*speed");
+    }
+    st.SetLabel("reach arm, wrapping mass points and Hill-type");
+    return redmax::validation::makeGradientSetup(dir + "reach_arm.osim", mo, "euler", 0.05, 2.5e-4,
+                                                 "excitations:DELT1@3=0.3,TRIlong@3=0.3",
+                                                 "point:hand@0,-0.08,0=0.25,-0.55,0.05");
+  }();
+  const redmax::VecX p = g.p0;
+  double forward = 1e300, analytic = 1e300, differenced = 1e300;
+  for (auto _ : st) {
+    for (int rep = 0; rep < 3; ++rep) {
+      auto t0 = std::chrono::steady_clock::now();
+      benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, false).objective);
+      forward = std::min(forward, seconds(t0));
+      g.problem.step_jacobians = "analytic";
+      t0 = std::chrono::steady_clock::now();
+      benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, true).gradient);
+      analytic = std::min(analytic, seconds(t0));
+      g.problem.step_jacobians = "differences";
+      t0 = std::chrono::steady_clock::now();
+      benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, true).gradient);
+      differenced = std::min(differenced, seconds(t0));
+    }
+  }
+  st.counters["parameters"] = static_cast<double>(g.p0.size());
+  st.counters["forward_s"] = forward;
+  st.counters["analytic_per_forward"] = analytic / forward;
+  st.counters["differenced_per_forward"] = differenced / forward;
+}
+
+BENCHMARK(stepJacobianRoutesWithMuscles)->Arg(0)->Arg(1)->Arg(2)->Iterations(1)->Unit(benchmark::kSecond);
 
 }  // namespace
 
