@@ -576,7 +576,8 @@ bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
   std::string joint;
   if (!jointsHaveExactVelocityTerms(sys.model(), &joint))
     return refuse("the Simbody-compatible velocity terms of the joint of body '" + joint + "'");
-  // the terms with written derivatives; none adds K or D (the adjoint's bdf1 route relies on it)
+  // the terms with written or local derivatives; none adds K or D (the adjoint's bdf1 route
+  // relies on it)
   for (const auto& t : sys.terms()) {
     if (dynamic_cast<const CoordinateActuatorTerm*>(t.get()) || dynamic_cast<const CoordinateLimitForceTerm*>(t.get()) ||
         dynamic_cast<const SpringGeneralizedForceTerm*>(t.get()) || dynamic_cast<const MuscleForceTerm*>(t.get()) ||
@@ -586,7 +587,7 @@ bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
       if (!muscleTermSupported(*mt, nullptr, why)) return false;
       continue;
     }
-    return refuse("the term '" + t->name() + "'");
+    return refuse("the term '" + t->name() + "' (it adds mass or has states of its own, without written derivatives)");
   }
   return true;
 }

@@ -84,7 +84,8 @@ void addWorldWrenches(const std::vector<BodyWorldMotion>& bodies, const std::vec
 /// Why a muscle's mass points do not take the path-wise pass below (null when they do): it wraps
 /// (Type III), its points follow its fibre, or its path runs through a deformable node; those
 /// muscles form their compact J_ar instead (MuscleTerm), and have no written ID derivatives
-/// (core/muscles/muscle_id_tangent.hpp covers the path-wise ones).
+/// (core/muscles/muscle_id_tangent.hpp covers the path-wise ones; the wrapping ones' are local
+/// differences, core/dynamics/id_derivatives.cpp).
 const char* pathwiseInverseDynamicsRefusal(const Muscle& muscle);
 
 /// The compact route of the muscles the path-wise pass refuses (MuscleTerm, and the Type III
