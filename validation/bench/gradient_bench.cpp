@@ -22,6 +22,24 @@ double seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// the fastest of three: a forward run, forward + adjoint by the analytic route, and by the
+// differenced route (docs/gradients.md §2.1), each kept at its minimum over calls
+void timeRoutes(GradientSetup& g, const redmax::VecX& p, double& forward, double& analytic, double& differenced) {
+  for (int rep = 0; rep < 3; ++rep) {
+    auto t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, false).objective);
+    forward = std::min(forward, seconds(t0));
+    g.problem.step_jacobians = "analytic";
+    t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, true).gradient);
+    analytic = std::min(analytic, seconds(t0));
+    g.problem.step_jacobians = "differences";
+    t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, true).gradient);
+    differenced = std::min(differenced, seconds(t0));
+  }
+}
+
 void adjointAgainstDifferences(benchmark::State& st) {
   const int pieces = static_cast<int>(st.range(0));
   redmax::validation::SimulationModelOptions mo;
@@ -67,21 +85,7 @@ void stepJacobianRoutes(benchmark::State& st) {
       "point:link2@0,-1,0=0.5,-1.5,0;0.1*speed");
   redmax::VecX p = redmax::VecX::Constant(g.p0.size(), 0.3);
   double forward = 1e300, analytic = 1e300, differenced = 1e300;
-  for (auto _ : st) {
-    for (int rep = 0; rep < 3; ++rep) {
-      auto t0 = std::chrono::steady_clock::now();
-      benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, false).objective);
-      forward = std::min(forward, seconds(t0));
-      g.problem.step_jacobians = "analytic";
-      t0 = std::chrono::steady_clock::now();
-      benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, true).gradient);
-      analytic = std::min(analytic, seconds(t0));
-      g.problem.step_jacobians = "differences";
-      t0 = std::chrono::steady_clock::now();
-      benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, true).gradient);
-      differenced = std::min(differenced, seconds(t0));
-    }
-  }
+  for (auto _ : st) timeRoutes(g, p, forward, analytic, differenced);
   const double P = static_cast<double>(g.p0.size());
   st.counters["parameters"] = P;
   st.counters["forward_s"] = forward;
@@ -128,21 +132,7 @@ void stepJacobianRoutesWithMuscles(benchmark::State& st) {
   }();
   const redmax::VecX p = g.p0;
   double forward = 1e300, analytic = 1e300, differenced = 1e300;
-  for (auto _ : st) {
-    for (int rep = 0; rep < 3; ++rep) {
-      auto t0 = std::chrono::steady_clock::now();
-      benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, false).objective);
-      forward = std::min(forward, seconds(t0));
-      g.problem.step_jacobians = "analytic";
-      t0 = std::chrono::steady_clock::now();
-      benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, true).gradient);
-      analytic = std::min(analytic, seconds(t0));
-      g.problem.step_jacobians = "differences";
-      t0 = std::chrono::steady_clock::now();
-      benchmark::DoNotOptimize(redmax::adjoint::evaluate(g.problem, g.objective, p, true).gradient);
-      differenced = std::min(differenced, seconds(t0));
-    }
-  }
+  for (auto _ : st) timeRoutes(g, p, forward, analytic, differenced);
   st.counters["parameters"] = static_cast<double>(g.p0.size());
   st.counters["forward_s"] = forward;
   st.counters["analytic_per_forward"] = analytic / forward;
