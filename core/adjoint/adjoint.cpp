@@ -270,33 +270,28 @@ class Stepper {
     State s = unpack(y, t);
     ws_.controls = u;
     MatX Dq, Dv;
-    // the Hill-type muscles' derivatives at the step's start (euler and bdf1: from the same
-    // evaluations as the ID derivatives there; sdirk2: of their own, its stages being elsewhere)
+    // the Hill-type muscles' derivatives at the state of the last idDerivatives call: the same
+    // evaluations as the ID derivatives there (euler and bdf1: the step's start, whose rates the
+    // z update needs; sdirk2: each stage, for its forces, and the start again below)
     StateTermDerivatives sd;
-    bool have_sd = false;
-    // the ID derivatives at a state and acceleration (at the step's start: with sd)
+    bool sd_at_start = false;
+    // the ID derivatives at a state and acceleration
     auto idDerivatives = [&](const State& st, const VecX& a, bool start) {
       std::string why;
-      if (!systemIdDerivatives(sys_, st, a, ws_, Dq, Dv, &why, term_step_, start && state_terms_ ? &sd : nullptr))
+      if (!systemIdDerivatives(sys_, st, a, ws_, Dq, Dv, &why, term_step_, state_terms_ ? &sd : nullptr))
         throw AdjointError("adjoint: analytic step Jacobians: " + why);
-      have_sd = have_sd || (start && state_terms_);
+      sd_at_start = start && state_terms_;
     };
-    // the generalized forces of the step's parameters at a state and acceleration: -dtau/ds of
-    // the system parameters, then df/dz and df/du of the Hill-type muscles (n x (ns + nz + nu))
+    // the generalized forces of the step's parameters at the state and acceleration of the last
+    // idDerivatives call: -dtau/ds of the system parameters, then df/dz and df/du of the Hill-type
+    // muscles (n x (ns + nz + nu))
     int ns = 0;
-    auto forceColumns = [&](const State& st, const VecX& a, bool start) {
+    auto forceColumns = [&](const State& st, const VecX& a) {
       MatX gs = dtau_ds ? MatX(-(*dtau_ds)(st, a)) : MatX(n, 0);
       ns = static_cast<int>(gs.cols());
       if (!state_terms_) return gs;
-      MatX fz, fu;
-      if (start) {
-        fz = sd.df_dz;
-        fu = sd.df_du;
-      } else {
-        stateTermForceDerivatives(sys_, st, ws_, term_step_, fz, fu);
-      }
-      MatX g(n, gs.cols() + fz.cols() + fu.cols());
-      g << gs, fz, fu;
+      MatX g(n, gs.cols() + sd.df_dz.cols() + sd.df_du.cols());
+      g << gs, sd.df_dz, sd.df_du;
       return g;
     };
     const bool columns = dtau_ds || state_terms_;
@@ -332,7 +327,7 @@ class Stepper {
       }
       const VecX a = (vplus - s.qdot) / h;
       idDerivatives(s, a, true);
-      if (columns) Gs = forceColumns(s, a, true);
+      if (columns) Gs = forceColumns(s, a);
       if (nc == 0) {
         const Eigen::LDLT<MatX> ldlt(A);
         dv_dy.leftCols(n) = -h * ldlt.solve(Dq);
@@ -366,7 +361,7 @@ class Stepper {
         sys_.calcMassAndForce(st, ws_);
         const VecX a = (V - zv) / hg;
         idDerivatives(st, a, false);
-        if (columns) G_s = forceColumns(st, a, false);
+        if (columns) G_s = forceColumns(st, a);
         MatX a_v;
         if (nc == 0) {
           const Eigen::LDLT<MatX> ldlt(ws_.M);
@@ -443,7 +438,7 @@ class Stepper {
     // the Hill-type muscles' states: z+ = z + h zdot(q, v, z, u) at the step's start
     const int nz = nz_, nu = sys_.numControls();
     ws_.controls = u;
-    if (!have_sd) stateTermDerivatives(sys_, s, ws_, term_step_, sd);
+    if (!sd_at_start) stateTermDerivatives(sys_, s, ws_, term_step_, sd);
     MatX Jfull = MatX::Zero(2 * n + nz, 2 * n + nz);
     Jfull.topLeftCorner(2 * n, 2 * n) = Jy;
     Jfull.block(0, 2 * n, 2 * n, nz) = JG.middleCols(ns, nz);

@@ -402,6 +402,18 @@ struct StateTermColumns {
   MatX* f_q = nullptr;  MatX* f_v = nullptr;  MatX* f_z = nullptr;  MatX* f_u = nullptr;
   MatX* z_q = nullptr;  MatX* z_v = nullptr;  MatX* z_z = nullptr;  MatX* z_u = nullptr;
 };
+// every block of a StateTermDerivatives (the force's along q and qdot are systemIdDerivatives')
+StateTermColumns columnsOf(StateTermDerivatives& d) {
+  StateTermColumns c;
+  c.f_z = &d.df_dz;
+  c.f_u = &d.df_du;
+  c.z_q = &d.dzdot_dq;
+  c.z_v = &d.dzdot_dv;
+  c.z_z = &d.dzdot_dz;
+  c.z_u = &d.dzdot_du;
+  return c;
+}
+
 void differenceStateTerms(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
                           const StateTermColumns& out) {
   const Model& model = sys.model();
@@ -459,29 +471,27 @@ void differenceStateTerms(const System& sys, const State& s, const DynamicsWorks
                                                               zdot.data());
     f.noalias() -= mo.tendon_force * dl.head(n);
   };
-  VecX fp(n), fm(n), zp(nz), zm(nz);
+  VecX f(n), zdot(nz);
   // along one variable x (a coordinate or speed: kinematics per point, every moved muscle; a state
-  // or control: the muscle alone at the state's path)
+  // or control: the muscle alone at the state's path), (f; zdot) stacked
   auto column = [&](double& x, const std::vector<size_t>& which, bool kinematics, MatX* f_block, MatX* z_block,
                     int col) {
-    const double x0 = x, e = step * std::max(1.0, std::abs(x0));
-    fp.setZero();
-    fm.setZero();
-    zp.setZero();
-    zm.setZero();
-    for (int sign : {1, -1}) {
-      x = x0 + sign * e;
-      if (kinematics) calcKinematics(model, sp, sk);
-      VecX& f = sign > 0 ? fp : fm;
-      VecX& z = sign > 0 ? zp : zm;
-      for (size_t j : which) {
-        const Hill& h = hills[j];
-        evalMuscle(h, kinematics, f, z.segment(h.z0, h.nzk));
-      }
-    }
+    const double x0 = x;
+    const VecX d = centralDerivative(
+        [&](double v) {
+          x = v;
+          if (kinematics) calcKinematics(model, sp, sk);
+          f.setZero();
+          zdot.setZero();
+          for (size_t j : which) evalMuscle(hills[j], kinematics, f, zdot.segment(hills[j].z0, hills[j].nzk));
+          VecX out(n + nz);
+          out << f, zdot;
+          return out;
+        },
+        x0, step);
     x = x0;
-    if (f_block) f_block->col(col) = (fp - fm) / (2.0 * e);
-    if (z_block) z_block->col(col) = (zp - zm) / (2.0 * e);
+    if (f_block) f_block->col(col) = d.head(n);
+    if (z_block) z_block->col(col) = d.tail(nz);
   };
   // states and controls first, each muscle at the state's path
   if (out.f_z || out.z_z || out.f_u || out.z_u)
@@ -507,15 +517,20 @@ void differenceStateTerms(const System& sys, const State& s, const DynamicsWorks
   }
 }
 
+// The terms whose derivatives are written (systemIdDerivatives adds them; none adds K or D, which
+// the adjoint's bdf1 route relies on)
+bool writtenDerivativesTerm(const ForceTerm& t) {
+  return dynamic_cast<const CoordinateActuatorTerm*>(&t) || dynamic_cast<const CoordinateLimitForceTerm*>(&t) ||
+         dynamic_cast<const SpringGeneralizedForceTerm*>(&t);
+}
+
 // Force terms with no written derivatives that add no mass and have no states (contact, bushings,
 // point-to-point springs, point and torque actuators, sampled or impulse loads): their
 // generalized force is differenced alone (term-local central differences at `step`, each stencil
 // point the skeleton's kinematics and those terms). A term that adds mass or has states of its
 // own is not one of them.
 bool differencedForceTerm(const ForceTerm& t) {
-  if (dynamic_cast<const CoordinateActuatorTerm*>(&t) || dynamic_cast<const CoordinateLimitForceTerm*>(&t) ||
-      dynamic_cast<const SpringGeneralizedForceTerm*>(&t) || dynamic_cast<const MuscleForceTerm*>(&t) ||
-      dynamic_cast<const MuscleTerm*>(&t))
+  if (writtenDerivativesTerm(t) || dynamic_cast<const MuscleForceTerm*>(&t) || dynamic_cast<const MuscleTerm*>(&t))
     return false;
   return !t.addsMass() && t.numStates() == 0;
 }
@@ -550,13 +565,14 @@ void addDifferencedForceTerms(const System& sys, const State& s, const DynamicsW
   for (int col = 0; col < 2 * n; ++col) {
     const bool speed = col >= n;
     double& x = speed ? sp.qdot[col - n] : sp.q[col];
-    const double x0 = x, e = step * std::max(1.0, std::abs(x0));
-    x = x0 + e;
-    const VecX fp = force();
-    x = x0 - e;
-    const VecX fm = force();
+    const double x0 = x;
+    (speed ? dtau_dqdot : dtau_dq).col(speed ? col - n : col) -= centralDerivative(
+        [&](double v) {
+          x = v;
+          return force();
+        },
+        x0, step);
     x = x0;
-    (speed ? dtau_dqdot : dtau_dq).col(speed ? col - n : col) -= (fp - fm) / (2.0 * e);
   }
 }
 
@@ -579,9 +595,7 @@ bool systemIdDerivativesAvailable(const System& sys, std::string* why) {
   // the terms with written or local derivatives; none adds K or D (the adjoint's bdf1 route
   // relies on it)
   for (const auto& t : sys.terms()) {
-    if (dynamic_cast<const CoordinateActuatorTerm*>(t.get()) || dynamic_cast<const CoordinateLimitForceTerm*>(t.get()) ||
-        dynamic_cast<const SpringGeneralizedForceTerm*>(t.get()) || dynamic_cast<const MuscleForceTerm*>(t.get()) ||
-        differencedForceTerm(*t))
+    if (writtenDerivativesTerm(*t) || dynamic_cast<const MuscleForceTerm*>(t.get()) || differencedForceTerm(*t))
       continue;
     if (const auto* mt = dynamic_cast<const MuscleTerm*>(t.get())) {
       if (!muscleTermSupported(*mt, nullptr, why)) return false;
@@ -652,17 +666,9 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
   if (std::any_of(sys.terms().begin(), sys.terms().end(),
                   [](const auto& t) { return dynamic_cast<const MuscleForceTerm*>(t.get()) != nullptr; })) {
     MatX df_dq, df_dv;
-    StateTermColumns cols;
+    StateTermColumns cols = state_terms ? columnsOf(*state_terms) : StateTermColumns{};
     cols.f_q = &df_dq;
     cols.f_v = &df_dv;
-    if (state_terms) {
-      cols.f_z = &state_terms->df_dz;
-      cols.f_u = &state_terms->df_du;
-      cols.z_q = &state_terms->dzdot_dq;
-      cols.z_v = &state_terms->dzdot_dv;
-      cols.z_z = &state_terms->dzdot_dz;
-      cols.z_u = &state_terms->dzdot_du;
-    }
     differenceStateTerms(sys, s, ws, term_step, cols);
     dtau_dq -= df_dq;
     dtau_dqdot -= df_dv;
@@ -674,22 +680,7 @@ bool systemIdDerivatives(const System& sys, const State& s, const VecX& qddot, c
 
 void stateTermDerivatives(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
                           StateTermDerivatives& out) {
-  StateTermColumns cols;
-  cols.f_z = &out.df_dz;
-  cols.f_u = &out.df_du;
-  cols.z_q = &out.dzdot_dq;
-  cols.z_v = &out.dzdot_dv;
-  cols.z_z = &out.dzdot_dz;
-  cols.z_u = &out.dzdot_du;
-  differenceStateTerms(sys, s, ws, step, cols);
-}
-
-void stateTermForceDerivatives(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
-                               MatX& df_dz, MatX& df_du) {
-  StateTermColumns cols;
-  cols.f_z = &df_dz;
-  cols.f_u = &df_du;
-  differenceStateTerms(sys, s, ws, step, cols);
+  differenceStateTerms(sys, s, ws, step, columnsOf(out));
 }
 
 bool constraintRowDerivativesAvailable(const System& sys, std::string* why) {

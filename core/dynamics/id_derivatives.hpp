@@ -70,8 +70,9 @@ std::string systemIdDerivativesLocalDifferences(const System& sys);
 /// relative step `step` (the adjoint passes its Problem::jacobian_step: 2e-7 for muscles that do
 /// not wrap, 6e-6 with wrapping ones, docs/gradients.md §2). systemIdDerivatives adds their
 /// -df/dq and -df/dqdot at `term_step`, and with `state_terms` fills it from the same
-/// evaluations; StateTermDerivatives holds the rest, at the controls ws.controls (n = ndof,
-/// nz = numStates, nu = numControls; zero outside the terms' own):
+/// evaluations (the adjoint's sdirk2 stages take their df/dz, df/du so); StateTermDerivatives
+/// holds the rest, at the controls ws.controls (n = ndof, nz = numStates, nu = numControls; zero
+/// outside the terms' own):
 struct StateTermDerivatives {
   MatX df_dz, df_du;                    ///< their generalized force        (n x nz, n x nu)
   MatX dzdot_dq, dzdot_dv;              ///< their states' rates            (nz x n)
@@ -79,10 +80,6 @@ struct StateTermDerivatives {
 };
 void stateTermDerivatives(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
                           StateTermDerivatives& out);
-/// df/dz and df/du alone (the forces' dependence on the states and controls at a state: the
-/// stages of sdirk2 take them at their own (q, qdot) with the step's z and u)
-void stateTermForceDerivatives(const System& sys, const State& s, const DynamicsWorkspace& ws, double step,
-                               MatX& df_dz, MatX& df_du);
 
 /// The derivatives of the constraint rows as System::calcConstraints forms them (G, the stabilized
 /// rhs, vel_err). Other constraints (points, welds, prescribed points) are differenced alone: a

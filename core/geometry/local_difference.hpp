@@ -19,4 +19,13 @@ auto localDerivative(F&& f, double x, double relative_step = 1e-3) {
   return decltype(f(x))((f(x - 2.0 * h) - 8.0 * f(x - h) + 8.0 * f(x + h) - f(x + 2.0 * h)) / (12.0 * h));
 }
 
+/// The second-order sibling for parts whose derivatives the adjoint takes at its own relative
+/// step (Problem::jacobian_step: Hill-type muscles, force terms differenced alone): the central
+/// difference at h = relative_step max(1, |x|).
+template <class F>
+auto centralDerivative(F&& f, double x, double relative_step) {
+  const double h = relative_step * std::max(1.0, std::abs(x));
+  return decltype(f(x))((f(x + h) - f(x - h)) / (2.0 * h));
+}
+
 }  // namespace redmax
