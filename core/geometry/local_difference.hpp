@@ -1,9 +1,10 @@
 #pragma once
-// The one derivative the analytic Jacobians take by differences (docs/gradients.md §2.1): a
-// derivative that no code computes in closed form - a joint's dSdot/dq, a moving point's or a
-// coupling function's third derivative - of a function of one scalar that is cheap to evaluate
-// (joint-local, function-local). Fourth-order central difference at h = 1e-3 max(1, |x|):
-// truncation about h^4 |f^(5)| / 30 ~ 1e-12, round-off about eps |f| / h ~ 1e-13 of the value.
+// The differences the analytic Jacobians take (docs/gradients.md §2.1): of a part alone, never of
+// the whole step, where no code computes the derivative in closed form - a joint's dSdot/dq, a
+// moving point's or a coupling function's third derivative, a wrapping muscle's share, a
+// constraint's rows - as a function of one scalar that is cheap to evaluate. localDerivative:
+// fourth-order central difference at h = 1e-3 max(1, |x|) by default, truncation about
+// h^4 |f^(5)| / 30 ~ 1e-12, round-off about eps |f| / h ~ 1e-13 of the value.
 #include <algorithm>
 #include <cmath>
 
